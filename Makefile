@@ -1,0 +1,40 @@
+# Quick start: `make demo` (set up everything and run the bundled example), `make test`.
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.deps-stamp
+OUT    ?= out
+
+.PHONY: all setup build test test-rust test-python demo bench clean
+
+all: build
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install -q --upgrade pip
+	$(BIN)/pip install -q "maturin>=1.5,<2" "numpy>=1.24" "scipy>=1.10" "matplotlib>=3.7" "pytest>=7" "hypothesis>=6.80"
+	touch $@
+
+setup: $(STAMP)
+
+# Build the Rust extension into the virtual environment (editable install of python/regrasp).
+build: $(STAMP)
+	VIRTUAL_ENV=$(abspath $(VENV)) PATH="$(abspath $(BIN)):$$PATH" $(BIN)/maturin develop --release -q
+
+test: test-rust test-python
+
+test-rust:
+	cargo test --release -p regrasp-core
+
+test-python: build
+	$(BIN)/pytest -q
+
+demo: build
+	$(BIN)/regrasp demo --out $(OUT)/demo
+
+bench: build
+	cargo bench -p regrasp-core --bench cones
+	$(BIN)/regrasp bench --json
+
+clean:
+	rm -rf target $(VENV) $(OUT) python/regrasp/*.so

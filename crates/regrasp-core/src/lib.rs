@@ -1,0 +1,15 @@
+//! regrasp: mechanics, motion cones and planning for in-hand regrasps by prehensile pushing
+//! (Chavan-Dafle, *Dexterous Manipulation with Simple Grippers*, MIT 2020).
+
+pub mod batch;
+pub mod error;
+pub mod friction_cone;
+pub mod geometry;
+pub mod gravity;
+pub mod limit_surface;
+pub mod motion_cone;
+pub mod scene;
+
+pub use error::{Error, Result};
+pub use motion_cone::{Classification, GripForceRange, PlanarPush, PushSpec};
+pub use scene::Scene;

@@ -1,0 +1,521 @@
+//! Motion cones of a planar push (Chavan-Dafle, Holladay & Rodriguez, RSS 2018; thesis §3.3).
+//!
+//! Quasi-static balance in the object frame: `J_sᵀ w_s = w_p + w_g` with `w_s` on the support's
+//! limit surface (the support slides), `w_p ∈ W_p` (the pusher sticks) and `w_g` gravity. The
+//! motion cone is the set of object twists `v = J_s⁻¹ A w_s` this allows.
+//!
+//! * **Exact test**: for a twist `v`, `v_s = J_s v`, `ŵ = A⁻¹v_s/√(v_sᵀA⁻¹v_s)` (eq 3.10); the
+//!   required pusher wrench is `w_p = J_sᵀŵ − w_g`; `v` is feasible iff `w_p ∈ W_p`.
+//! * **Rays**: for a pusher wrench direction `p`, `u = J_s⁻ᵀp`, `u_g = J_s⁻ᵀw_g`; the positive
+//!   root `λ` of `(λu + u_g)ᵀA(λu + u_g) = 1` gives the twist `J_s⁻¹A(λu + u_g)`. The
+//!   polyhedral approximation takes one ray per edge of `W_p` (its generators).
+//! * **Gravity-free cone**: `V_gf = J_s⁻¹ A J_s⁻ᵀ W_p`, exactly polyhedral.
+//!
+//! The same construction covers a grasp (support = finger pads) and an object on a surface
+//! (support = the surface under it, Mason 1986; Lynch & Mason 1996).
+//!
+//! Twists are compared in the metric `diag(1, 1, L²)` and wrenches in `diag(1, 1, 1/L²)` (L: a
+//! characteristic length of the object), which are dual to each other.
+
+use crate::error::{Error, Result};
+use crate::friction_cone::{ConeShape, ContactLimit, EdgeWrench, PolyhedralCone, PusherContact};
+use crate::geometry::{perp, Mat3, Vec2, Vec3};
+use crate::limit_surface::LimitSurface;
+
+/// Tolerance of the exact membership test on the (dimensionless) margin.
+pub const MEMBERSHIP_TOL: f64 = 1e-9;
+
+/// Everything that defines one push at one pose.
+#[derive(Clone, Debug)]
+pub struct PushSpec {
+    /// Unit limit surface of the support, in the support frame.
+    pub limit_surface: LimitSurface,
+    /// `μ_s N` of the support [N]: the limit surface is `wᵀ (B / s²) w = 1`.
+    pub friction_scale: f64,
+    /// `J_s`: object twist (object frame) → support twist (support frame).
+    pub support_jacobian: Mat3,
+    pub pusher: PusherContact,
+    /// Gravity wrench in the object frame.
+    pub gravity: Vec3,
+    /// Characteristic length L [m] of the metrics.
+    pub length: f64,
+    /// The pose, for error messages.
+    pub pose: [f64; 3],
+    /// Grip force of each finger per unit `friction_scale` (`1/(2μ_s)` for a two-pad grasp);
+    /// `None` when the normal force is not a free parameter (object on a surface).
+    pub grip_per_scale: Option<f64>,
+}
+
+/// Result of the exact membership test.
+#[derive(Clone, Copy, Debug)]
+pub struct Classification {
+    pub feasible: bool,
+    /// Signed margin (≥ 0 inside): the sine of the angle from the required pusher wrench to the
+    /// nearest boundary of `W_p`, in the scaled wrench metric.
+    pub margin: f64,
+    /// The contact limit nearest to being violated (active when `margin ≈ 0`).
+    pub limit: ContactLimit,
+    /// Wrench the pusher must apply [N, N, N·m], object frame.
+    pub pusher_wrench: Vec3,
+    /// Load wrench of the object on the support, mapped to the object frame (`J_sᵀŵ`).
+    pub support_wrench: Vec3,
+}
+
+/// Range of per-finger grip force for which a given pusher motion sticks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GripForceRange {
+    pub min: f64,
+    /// `f64::INFINITY` when unbounded.
+    pub max: f64,
+}
+
+/// One push at one pose: the motion cone and everything computed from it.
+#[derive(Clone, Debug)]
+pub struct PlanarPush {
+    spec: PushSpec,
+    a: Mat3,
+    a_inv: Mat3,
+    js_inv: Mat3,
+    js_inv_t: Mat3,
+    edges: Vec<EdgeWrench>,
+    /// `W_p` in the scaled wrench space.
+    wp: PolyhedralCone,
+    /// `J_s⁻ᵀ w_g`.
+    ug: Vec3,
+    /// `√(u_gᵀ A u_g)`: < 1 when the support holds the object against gravity.
+    hold_ratio: f64,
+}
+
+impl PlanarPush {
+    /// Builds the push; fails when the support cannot hold the object against gravity.
+    pub fn new(spec: PushSpec) -> Result<Self> {
+        let p = Self::new_unchecked(spec)?;
+        if p.hold_ratio >= 1.0 {
+            return Err(Error::GraspCannotHold { pose: p.spec.pose, ratio: p.hold_ratio });
+        }
+        Ok(p)
+    }
+
+    /// Builds the push even when gravity alone would make the support slip: the gravity-free
+    /// cone and grip-force queries remain meaningful; rays and the exact test do not.
+    pub fn new_unchecked(spec: PushSpec) -> Result<Self> {
+        if !(spec.friction_scale > 0.0) || !spec.friction_scale.is_finite() {
+            return Err(Error::arg("friction_scale", "must be positive and finite"));
+        }
+        if !(spec.length > 0.0) {
+            return Err(Error::arg("length", "must be positive"));
+        }
+        let a = spec.limit_surface.matrix(spec.friction_scale);
+        let a_inv = a.try_inverse().ok_or_else(|| Error::arg("limit_surface", "matrix is singular"))?;
+        let js_inv = spec
+            .support_jacobian
+            .try_inverse()
+            .ok_or_else(|| Error::arg("support_jacobian", "is singular"))?;
+        let js_inv_t = js_inv.transpose();
+        let edges = spec.pusher.edge_wrenches();
+        let l = spec.length;
+        let scaled: Vec<Vec3> = edges.iter().map(|e| wrench_scaled(&e.wrench, l)).collect();
+        let wp = PolyhedralCone::from_edges(&scaled)
+            .map_err(|e| Error::arg("pusher", format!("its friction cone is degenerate ({e:?})")))?;
+        let ug = js_inv_t * spec.gravity;
+        let hold_ratio = ug.dot(&(a * ug)).sqrt();
+        Ok(Self { spec, a, a_inv, js_inv, js_inv_t, edges, wp, ug, hold_ratio })
+    }
+
+    pub fn spec(&self) -> &PushSpec {
+        &self.spec
+    }
+
+    /// `√(u_gᵀ A u_g)`: how much of the support's friction gravity alone uses (< 1 to hold).
+    pub fn hold_ratio(&self) -> f64 {
+        self.hold_ratio
+    }
+
+    /// The pusher's generalized friction cone edges (eq 3.6), physical units.
+    pub fn pusher_edges(&self) -> &[EdgeWrench] {
+        &self.edges
+    }
+
+    /// The pusher's generalized friction cone in the scaled wrench space `[fx, fz, τ/L]`.
+    pub fn pusher_cone(&self) -> &PolyhedralCone {
+        &self.wp
+    }
+
+    pub fn length(&self) -> f64 {
+        self.spec.length
+    }
+
+    /// Norm of a twist in the metric `diag(1, 1, L²)`.
+    pub fn twist_norm(&self, v: &Vec3) -> f64 {
+        twist_scaled(v, self.spec.length).norm()
+    }
+
+    fn unit_twist(&self, v: Vec3) -> Vec3 {
+        v / self.twist_norm(&v)
+    }
+
+    /// The motion-cone ray produced by pusher wrench direction `p` (physical units), as a unit
+    /// twist; `None` if the support cannot hold the object (no positive root).
+    pub fn ray(&self, p: &Vec3) -> Option<Vec3> {
+        let u = self.js_inv_t * p;
+        let au = self.a * u;
+        let qa = u.dot(&au);
+        let qb = 2.0 * self.ug.dot(&au);
+        let qc = self.hold_ratio * self.hold_ratio - 1.0;
+        if !(qc < 0.0) || !(qa > 0.0) {
+            return None;
+        }
+        let disc = (qb * qb - 4.0 * qa * qc).sqrt();
+        // positive root, in the cancellation-free form
+        let lambda = if qb >= 0.0 { 2.0 * qc / (-qb - disc) } else { (-qb + disc) / (2.0 * qa) };
+        let w = u * lambda + self.ug;
+        Some(self.unit_twist(self.js_inv * (self.a * w)))
+    }
+
+    /// Generators of the polyhedral approximation: one ray per edge of `W_p`, unit twists.
+    pub fn generators(&self) -> Result<Vec<Vec3>> {
+        self.edges
+            .iter()
+            .map(|e| self.ray(&e.wrench).ok_or(Error::GraspCannotHold { pose: self.spec.pose, ratio: self.hold_ratio }))
+            .collect()
+    }
+
+    /// Generators of the gravity-free cone `J_s⁻¹ A J_s⁻ᵀ e_i`, unit twists.
+    pub fn gravity_free_generators(&self) -> Vec<Vec3> {
+        self.edges.iter().map(|e| self.unit_twist(self.js_inv * (self.a * (self.js_inv_t * e.wrench)))).collect()
+    }
+
+    fn check_twist(&self, v: &Vec3) -> Result<()> {
+        if !v.iter().all(|x| x.is_finite()) {
+            return Err(Error::arg("twist", "has a non-finite component"));
+        }
+        if self.twist_norm(v) == 0.0 {
+            return Err(Error::arg("twist", "is zero: a push must move the object"));
+        }
+        Ok(())
+    }
+
+    /// Support load wrench (support frame) for twist `v` on the surface `A` (eq 3.10).
+    fn support_load(&self, v: &Vec3) -> Vec3 {
+        LimitSurface::wrench_for_twist(&self.a_inv, &(self.spec.support_jacobian * v))
+    }
+
+    /// The exact membership test: can the pusher produce twist `v` while sticking?
+    pub fn classify(&self, v: &Vec3) -> Result<Classification> {
+        self.check_twist(v)?;
+        if self.hold_ratio >= 1.0 {
+            return Err(Error::GraspCannotHold { pose: self.spec.pose, ratio: self.hold_ratio });
+        }
+        let support = self.spec.support_jacobian.transpose() * self.support_load(v);
+        let wp = support - self.spec.gravity;
+        let m = self.wp.membership(&wrench_scaled(&wp, self.spec.length));
+        Ok(Classification {
+            feasible: m.margin >= -MEMBERSHIP_TOL,
+            margin: m.margin,
+            limit: self.spec.pusher.limit_of(&self.edges, m.active),
+            pusher_wrench: wp,
+            support_wrench: support,
+        })
+    }
+
+    pub fn contains(&self, v: &Vec3) -> Result<bool> {
+        Ok(self.classify(v)?.feasible)
+    }
+
+    /// The polyhedral approximation as a cone in the scaled twist space `[vx, vz, Lω]`.
+    pub fn polyhedral_cone(&self) -> Result<PolyhedralCone> {
+        let g: Vec<Vec3> = self.generators()?.iter().map(|v| twist_scaled(v, self.spec.length)).collect();
+        PolyhedralCone::from_edges(&g).map_err(|e| Error::arg("pusher", format!("degenerate motion cone ({e:?})")))
+    }
+
+    /// Membership in the gravity-free cone, in the wrench space (exact, polyhedral).
+    pub fn gravity_free_margin(&self, v: &Vec3) -> Result<f64> {
+        self.check_twist(v)?;
+        let a0 = self.spec.support_jacobian.transpose() * self.support_load(v);
+        Ok(self.wp.membership(&wrench_scaled(&a0, self.spec.length)).margin)
+    }
+
+    /// Closest feasible twist to `d` in the metric `diag(1, 1, L²)` (exact cone): `d` itself
+    /// when feasible, else `⟨d, û⟩ û` for the boundary ray `û` nearest in angle (zero when no
+    /// ray makes an acute angle with `d`).
+    pub fn project(&self, d: &Vec3) -> Result<Vec3> {
+        if !d.iter().all(|x| x.is_finite()) {
+            return Err(Error::arg("twist", "has a non-finite component"));
+        }
+        if self.twist_norm(d) == 0.0 {
+            return Ok(Vec3::zeros());
+        }
+        if self.classify(d)?.feasible {
+            return Ok(*d);
+        }
+        let (cos, u) = self.nearest_boundary_ray(d);
+        Ok(if cos > 0.0 { u * (cos * self.twist_norm(d)) } else { Vec3::zeros() })
+    }
+
+    /// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images
+    /// of the boundary fans of `W_p`); returns the cosine and the unit ray.
+    fn nearest_boundary_ray(&self, d: &Vec3) -> (f64, Vec3) {
+        let l = self.spec.length;
+        let ds = twist_scaled(d, l) / twist_scaled(d, l).norm();
+        let score = |p: &Vec3| -> (f64, Vec3) {
+            match self.ray(&wrench_unscaled(p, l)) {
+                Some(v) => (twist_scaled(&v, l).dot(&ds), v),
+                None => (f64::NEG_INFINITY, Vec3::zeros()),
+            }
+        };
+        let mut best = (f64::NEG_INFINITY, Vec3::zeros());
+        for (i, j) in self.wp.boundary_segments() {
+            let (ea, eb) = (self.wp.edges[i], self.wp.edges[j]);
+            let at = |t: f64| ea * (1.0 - t) + eb * t;
+            if i == j {
+                let s = score(&ea);
+                if s.0 > best.0 {
+                    best = s;
+                }
+                continue;
+            }
+            const GRID: usize = 16;
+            let mut k_best = 0;
+            let mut s_best = score(&at(0.0));
+            for k in 1..=GRID {
+                let s = score(&at(k as f64 / GRID as f64));
+                if s.0 > s_best.0 {
+                    s_best = s;
+                    k_best = k;
+                }
+            }
+            // golden-section refinement around the best grid point
+            let (mut lo, mut hi) =
+                ((k_best.saturating_sub(1)) as f64 / GRID as f64, ((k_best + 1).min(GRID)) as f64 / GRID as f64);
+            let g = 0.5 * (5f64.sqrt() - 1.0);
+            let mut x1 = hi - g * (hi - lo);
+            let mut x2 = lo + g * (hi - lo);
+            let (mut f1, mut f2) = (score(&at(x1)), score(&at(x2)));
+            while hi - lo > 1e-11 {
+                if f1.0 >= f2.0 {
+                    hi = x2;
+                    x2 = x1;
+                    f2 = f1;
+                    x1 = hi - g * (hi - lo);
+                    f1 = score(&at(x1));
+                } else {
+                    lo = x1;
+                    x1 = x2;
+                    f1 = f2;
+                    x2 = lo + g * (hi - lo);
+                    f2 = score(&at(x2));
+                }
+            }
+            for s in [s_best, f1, f2] {
+                if s.0 > best.0 {
+                    best = s;
+                }
+            }
+        }
+        best
+    }
+
+    /// For a point pusher: the object twist that results when the contact point moves with
+    /// velocity `u` (object frame) and the pusher sticks, i.e. the rotation rate that makes
+    /// the required pusher wrench pass through the contact point, at friction scale `s`.
+    /// `None` when no rotation rate balances the moments.
+    pub fn point_pusher_twist(&self, u: &Vec2, s: f64) -> Option<Vec3> {
+        let r = *self.spec.pusher.points.first()?;
+        let l = self.spec.length;
+        let un = u.norm();
+        let uhat = if un > 0.0 { u / un } else { Vec2::zeros() };
+        let pr = perp(&r);
+        let twist = |phi: f64| -> Vec3 {
+            let (sp, cp) = phi.sin_cos();
+            let w = sp / l;
+            let lin = uhat * cp - pr * w;
+            Vec3::new(lin.x, lin.y, w)
+        };
+        let bt = self.spec.support_jacobian.transpose();
+        let binv = self.spec.limit_surface.b.try_inverse()?;
+        // moment about r of the required pusher wrench
+        let h = |phi: f64| -> f64 {
+            let v = twist(phi);
+            let w = bt * LimitSurface::wrench_for_twist(&binv, &(self.spec.support_jacobian * v)) * s - self.spec.gravity;
+            w.z - crate::geometry::cross2(&r, &Vec2::new(w.x, w.y))
+        };
+        let half = std::f64::consts::FRAC_PI_2;
+        let (mut lo, mut hi) = (if un > 0.0 { -half } else { half }, half);
+        if un == 0.0 {
+            // no translation of the contact point: pure rotation about it, one sign each way
+            for phi in [half, -half] {
+                if h(phi).abs() < 1e-12 * (1.0 + s) {
+                    return Some(twist(phi));
+                }
+            }
+            return None;
+        }
+        let (hlo, hhi) = (h(lo), h(hi));
+        if hlo > 0.0 || hhi < 0.0 {
+            return None;
+        }
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if h(mid) < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+            if hi - lo < 1e-15 {
+                break;
+            }
+        }
+        let phi = 0.5 * (lo + hi);
+        if phi.abs() >= half - 1e-12 {
+            return None;
+        }
+        Some(twist(phi))
+    }
+
+    /// The same push with another friction scale (another grip force).
+    pub fn with_friction_scale(&self, s: f64) -> Result<Self> {
+        Self::new_unchecked(PushSpec { friction_scale: s, ..self.spec.clone() })
+    }
+
+    /// Range of per-finger grip force for which the pusher motion of twist `v` sticks (RSS 2018
+    /// Theorem 1: every twist inside the gravity-free cone is stable above some grip force).
+    ///
+    /// A line pusher imposes the whole twist: with `a₀ = J_sᵀŵ₀(v)` (unit surface) and inward
+    /// facet normals `nⱼ` of `W_p`, stability is `nⱼ·(s a₀ − w_g) ≥ 0`, linear in `s = μ_s N`
+    /// (*derived*). A point pusher imposes only its contact point's velocity; the rotation rate
+    /// adapts (see [`Self::point_pusher_twist`]) and the range is found numerically. `None` when
+    /// no grip force makes the motion stick.
+    pub fn grip_force_range(&self, v: &Vec3) -> Result<Option<GripForceRange>> {
+        self.check_twist(v)?;
+        let per = self
+            .spec
+            .grip_per_scale
+            .ok_or_else(|| Error::arg("scene", "grip force is defined only for a grasp (not an object on a surface)"))?;
+        let b = self.spec.limit_surface.b;
+        // u_gᵀ A u_g = u_gᵀ B u_g / s² < 1  ⇔  s > √(u_gᵀ B u_g)
+        let s_hold = self.ug.dot(&(b * self.ug)).sqrt();
+        let range = if self.wp.is_solid() {
+            self.solid_scale_range(v, s_hold)
+        } else {
+            self.point_scale_range(v, s_hold)
+        };
+        Ok(range.map(|(lo, hi)| GripForceRange { min: lo * per, max: hi * per }))
+    }
+
+    fn solid_scale_range(&self, v: &Vec3, s_hold: f64) -> Option<(f64, f64)> {
+        let ConeShape::Solid { facets } = &self.wp.shape else { return None };
+        let l = self.spec.length;
+        let binv = self.spec.limit_surface.b.try_inverse()?;
+        let a0 = self.spec.support_jacobian.transpose()
+            * LimitSurface::wrench_for_twist(&binv, &(self.spec.support_jacobian * v));
+        let (a0s, wgs) = (wrench_scaled(&a0, l), wrench_scaled(&self.spec.gravity, l));
+        let (mut lo, mut hi) = (s_hold * (1.0 + 1e-12), f64::INFINITY);
+        for f in facets {
+            let (al, be) = (f.normal.dot(&a0s), f.normal.dot(&wgs));
+            let tol = 1e-12 * (a0s.norm() + wgs.norm());
+            if al > tol {
+                lo = lo.max(be / al);
+            } else if al < -tol {
+                hi = hi.min(be / al);
+            } else if be > tol {
+                return None;
+            }
+        }
+        (lo <= hi).then_some((lo.max(0.0), hi))
+    }
+
+    fn point_scale_range(&self, v: &Vec3, s_hold: f64) -> Option<(f64, f64)> {
+        let ConeShape::Fan { inward, .. } = &self.wp.shape else { return None };
+        let r = self.spec.pusher.points[0];
+        let u = Vec2::new(v.x, v.y) + perp(&r) * v.z;
+        let l = self.spec.length;
+        let bt = self.spec.support_jacobian.transpose();
+        let binv = self.spec.limit_surface.b.try_inverse()?;
+        let sticks = |s: f64| -> bool {
+            match self.point_pusher_twist(&u, s) {
+                None => false,
+                Some(t) => {
+                    let w = bt * LimitSurface::wrench_for_twist(&binv, &(self.spec.support_jacobian * t)) * s
+                        - self.spec.gravity;
+                    let ws = wrench_scaled(&w, l);
+                    let n = ws.norm().max(1e-300);
+                    inward.iter().all(|m| m.dot(&ws) / n >= -MEMBERSHIP_TOL)
+                }
+            }
+        };
+        let base = if s_hold > 0.0 { s_hold } else { self.spec.friction_scale * 1e-6 };
+        let grid: Vec<f64> = (0..=240).map(|k| base * (1.0 + 1e-9) * 10f64.powf(k as f64 * 8.0 / 240.0)).collect();
+        let first = grid.iter().position(|&s| sticks(s))?;
+        let refine = |mut a: f64, mut b: f64, want_a: bool| {
+            // sticks(a) == want_a, sticks(b) != want_a
+            for _ in 0..80 {
+                let m = (a * b).sqrt();
+                if sticks(m) == want_a {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            if want_a { a } else { b }
+        };
+        let lo = if first == 0 { grid[0] } else { refine(grid[first - 1], grid[first], false) };
+        let last = grid[first..].iter().position(|&s| !sticks(s)).map(|k| k + first);
+        let hi = match last {
+            None => f64::INFINITY,
+            Some(k) => refine(grid[k - 1], grid[k], true),
+        };
+        Some((lo, hi))
+    }
+}
+
+/// `[vx, vz, L ω]`.
+#[inline]
+pub fn twist_scaled(v: &Vec3, l: f64) -> Vec3 {
+    Vec3::new(v.x, v.y, v.z * l)
+}
+
+/// `[fx, fz, τ / L]`.
+#[inline]
+pub fn wrench_scaled(w: &Vec3, l: f64) -> Vec3 {
+    Vec3::new(w.x, w.y, w.z / l)
+}
+
+#[inline]
+fn wrench_unscaled(w: &Vec3, l: f64) -> Vec3 {
+    Vec3::new(w.x, w.y, w.z * l)
+}
+
+/// Euclidean projection of `d` onto the cone generated by `gens` (non-negative least squares,
+/// exact by enumerating the faces: a projection lies in the relative interior of a face spanned
+/// by at most 3 independent generators). Returns the projection and the weights.
+pub fn project_onto_generators(gens: &[Vec3], d: &Vec3) -> (Vec3, Vec<f64>) {
+    let k = gens.len();
+    let mut best = (d.norm_squared(), Vec3::zeros(), vec![0.0; k]);
+    for mask in 1u32..(1u32 << k) {
+        let idx: Vec<usize> = (0..k).filter(|i| mask & (1 << i) != 0).collect();
+        if idx.len() > 3 {
+            continue;
+        }
+        let g = nalgebra::Matrix3xX::from_columns(&idx.iter().map(|&i| gens[i]).collect::<Vec<_>>());
+        let gtg = g.transpose() * &g;
+        let Some(inv) = gtg.clone().try_inverse() else { continue };
+        if gtg.determinant().abs() < 1e-14 * gtg.norm().powi(idx.len() as i32) {
+            continue;
+        }
+        let alpha = inv * (g.transpose() * d);
+        if alpha.iter().any(|&a| a < 0.0) {
+            continue;
+        }
+        let p = &g * &alpha;
+        let res = (d - p).norm_squared();
+        if res < best.0 - 1e-300 {
+            let mut w = vec![0.0; k];
+            for (j, &i) in idx.iter().enumerate() {
+                w[i] = alpha[j];
+            }
+            best = (res, Vec3::new(p[0], p[1], p[2]), w);
+        }
+    }
+    (best.1, best.2)
+}
+

@@ -1,0 +1,358 @@
+//! Property tests of the motion cone against independent checks (force balance solved as an
+//! LP over the contact forces with clarabel, limits, invariances).
+
+mod common;
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use common::*;
+use proptest::prelude::*;
+use regrasp::geometry::{perp, rot, Vec2, Vec3};
+use regrasp::scene::{RawGravity, RawScene};
+use regrasp::Scene;
+
+fn twist_from_angles(a: f64, b: f64, l: f64) -> Vec3 {
+    // uniform-ish direction in the scaled twist space, returned unscaled
+    let d = Vec3::new(a.cos() * b.cos(), a.sin() * b.cos(), b.sin());
+    Vec3::new(d.x, d.y, d.z / l)
+}
+
+/// Independent force balance: the load wrench of the finger pads is recomputed from the pose
+/// and the pad's limit surface (eq 3.10), then an LP asks for contact forces at the pusher
+/// points, inside their Coulomb cones, that balance it with gravity. Returns feasibility.
+fn brute_force_sticks(raw: &RawScene, q: &[f64; 3], v: &Vec3) -> bool {
+    let obj = raw.object.as_ref().unwrap();
+    let grasp = raw.grasp.as_ref().unwrap();
+    let grav = raw.gravity.clone().unwrap_or(RawGravity { direction: None, g: None });
+    let p = &raw.pushers.as_ref().unwrap()[0];
+    let (mass, com) = (obj.mass.unwrap(), obj.com.unwrap());
+    let s = 2.0 * grasp.force.unwrap() * grasp.friction.unwrap();
+    let k = 0.6 * grasp.pad_radius.unwrap();
+    // pad centre in the object frame, and the object's velocity there, in gripper axes
+    let r = rot(q[2]);
+    let c = r.transpose() * -Vec2::new(q[0], q[1]);
+    let vel_obj = Vec2::new(v.x, v.y) + perp(&c) * v.z;
+    let vel = r * vel_obj;
+    // eq 3.10 with A = diag(1, 1, 1/k²)/s²: w = s [vx, vz, k² ω]/√(vx² + vz² + k² ω²)
+    let den = (vel.x * vel.x + vel.y * vel.y + k * k * v.z * v.z).sqrt();
+    let f_pad = r.transpose() * Vec2::new(vel.x, vel.y) * (s / den);
+    let tau_pad = s * k * k * v.z / den;
+    // required pusher wrench about the object origin = support load − gravity
+    let d = grav.direction.unwrap_or([0.0, -1.0]);
+    let g = grav.g.unwrap_or(9.81);
+    let fg = r.transpose() * Vec2::new(d[0], d[1]) * (mass * g);
+    let comv = Vec2::new(com[0], com[1]);
+    let req = Vec3::new(
+        f_pad.x - fg.x,
+        f_pad.y - fg.y,
+        tau_pad + (c.x * f_pad.y - c.y * f_pad.x) - (comv.x * fg.y - comv.y * fg.x),
+    );
+    // LP: variables (f_n, f_t) per point; J_pᵀ f = req; f_n ≥ 0, μ f_n ± f_t ≥ 0
+    let pts = p.points.as_ref().unwrap();
+    let n = Vec2::new(p.normal.unwrap()[0], p.normal.unwrap()[1]).normalize();
+    let t = perp(&n);
+    let mu = p.friction.unwrap();
+    let m = 2 * pts.len();
+    let mut cols: Vec<Vec<f64>> = Vec::new();
+    for pt in pts {
+        let pv = Vec2::new(pt[0], pt[1]);
+        for dir in [n, t] {
+            cols.push(vec![dir.x, dir.y, pv.x * dir.y - pv.y * dir.x]);
+        }
+    }
+    // rows: 3 equalities, then 3 inequalities per point written as -G f + s = 0, s ≥ 0
+    let mut dense = vec![vec![0.0; m]; 3 + 3 * pts.len()];
+    for j in 0..m {
+        for i in 0..3 {
+            dense[i][j] = cols[j][i];
+        }
+    }
+    for i in 0..pts.len() {
+        let (jn, jt) = (2 * i, 2 * i + 1);
+        dense[3 + 3 * i][jn] = -1.0;
+        dense[4 + 3 * i][jn] = -mu;
+        dense[4 + 3 * i][jt] = -1.0;
+        dense[5 + 3 * i][jn] = -mu;
+        dense[5 + 3 * i][jt] = 1.0;
+    }
+    let a = CscMatrix::from(&dense);
+    let mut b = vec![0.0; 3 + 3 * pts.len()];
+    b[..3].copy_from_slice(&[req.x, req.y, req.z]);
+    let pmat = CscMatrix::zeros((m, m));
+    let qv = vec![0.0; m];
+    let cones = [SupportedConeT::ZeroConeT(3), SupportedConeT::NonnegativeConeT(3 * pts.len())];
+    let settings = DefaultSettings { verbose: false, ..DefaultSettings::default() };
+    let mut solver = DefaultSolver::new(&pmat, &qv, &a, &b, &cones, settings).unwrap();
+    solver.solve();
+    matches!(solver.solution.status, SolverStatus::Solved | SolverStatus::AlmostSolved)
+}
+
+fn angle(a: &Vec3, b: &Vec3) -> f64 {
+    let (a, b) = (a.normalize(), b.normalize());
+    a.cross(&b).norm().atan2(a.dot(&b))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, .. ProptestConfig::default() })]
+
+    /// Every generator's pusher wrench lies on an edge of the pusher's friction cone, and the
+    /// support wrench is on the limit surface, balancing pusher and gravity.
+    #[test]
+    fn generators_balance_forces(b in block_case()) {
+        let Some(scene) = scene(&b) else { return Ok(()) };
+        let push = scene.push(&b.pose, 0).unwrap();
+        let gens = push.generators().unwrap();
+        let spec = push.spec().clone();
+        let a = spec.limit_surface.matrix(spec.friction_scale);
+        let js_inv_t = spec.support_jacobian.try_inverse().unwrap().transpose();
+        for (g, e) in gens.iter().zip(push.pusher_edges()) {
+            let c = push.classify(g).unwrap();
+            // on the cone's boundary, pusher wrench along this edge
+            prop_assert!(c.margin.abs() < 1e-7, "margin {}", c.margin);
+            let ang = angle(&c.pusher_wrench, &e.wrench);
+            prop_assert!(ang < 1e-6 || c.pusher_wrench.norm() < 1e-9 * spec.friction_scale, "edge angle {ang}");
+            // support wrench on the limit surface and normal to it along the twist
+            let ws = js_inv_t * c.support_wrench;
+            prop_assert!((ws.dot(&(a * ws)) - 1.0).abs() < 1e-9);
+            prop_assert!(angle(&(a * ws), &(spec.support_jacobian * g)) < 1e-7);
+            // balance
+            prop_assert!((c.support_wrench - c.pusher_wrench - spec.gravity).norm() < 1e-9 * spec.friction_scale);
+        }
+    }
+
+    /// Rays from random wrenches inside W_p are feasible, with the pusher wrench along them.
+    #[test]
+    fn interior_rays_are_feasible(b in block_case(), w in proptest::collection::vec(0.01f64..1.0, 4)) {
+        let Some(scene) = scene(&b) else { return Ok(()) };
+        let push = scene.push(&b.pose, 0).unwrap();
+        let p: Vec3 = push.pusher_edges().iter().zip(&w).map(|(e, x)| e.wrench * *x).sum();
+        let v = push.ray(&p).unwrap();
+        let c = push.classify(&v).unwrap();
+        prop_assert!(c.feasible, "margin {}", c.margin);
+        prop_assert!(angle(&c.pusher_wrench, &p) < 1e-6);
+    }
+
+    /// Projection returns a feasible twist no farther than any sampled feasible twist.
+    #[test]
+    fn projection_is_feasible_and_closest(b in block_case(), a1 in -3.2f64..3.2, a2 in -1.5f64..1.5) {
+        let Some(scene) = scene(&b) else { return Ok(()) };
+        let push = scene.push(&b.pose, 0).unwrap();
+        let d = twist_from_angles(a1, a2, scene.length);
+        let p = push.project(&d).unwrap();
+        let dist = |x: &Vec3| push.twist_norm(&(d - x));
+        if push.twist_norm(&p) > 0.0 {
+            let c = push.classify(&p).unwrap();
+            prop_assert!(c.margin > -1e-7, "projection infeasible: margin {}", c.margin);
+        }
+        let edges = push.pusher_edges();
+        let mut rng = 0x9E3779B97F4A7C15u64;
+        let mut next = || { rng ^= rng << 13; rng ^= rng >> 7; rng ^= rng << 17; (rng >> 11) as f64 / (1u64 << 53) as f64 };
+        for _ in 0..300 {
+            let wp: Vec3 = edges.iter().map(|e| e.wrench * next().powi(3)).sum();
+            let Some(u) = push.ray(&wp) else { continue };
+            let s = push.twist_norm(&d) * 0.0 + {
+                let l = push.length();
+                let (us, ds) = (Vec3::new(u.x, u.y, u.z * l), Vec3::new(d.x, d.y, d.z * l));
+                us.dot(&ds).max(0.0)
+            };
+            prop_assert!(dist(&p) <= dist(&(u * s)) + 1e-9, "sampled ray closer: {} < {}", dist(&(u * s)), dist(&p));
+        }
+    }
+
+    /// Without gravity the exact cone is the polyhedral cone.
+    #[test]
+    fn zero_gravity_cone_is_polyhedral(mut b in block_case(), a1 in -3.2f64..3.2, a2 in -1.5f64..1.5) {
+        b.g = 0.0;
+        let Some(scene) = scene(&b) else { return Ok(()) };
+        let push = scene.push(&b.pose, 0).unwrap();
+        for (g, gf) in push.generators().unwrap().iter().zip(push.gravity_free_generators()) {
+            prop_assert!(angle(g, &gf) < 1e-9);
+        }
+        if b.line {
+            let v = twist_from_angles(a1, a2, scene.length);
+            let c = push.classify(&v).unwrap();
+            let poly = push.polyhedral_cone().unwrap();
+            let l = scene.length;
+            let m = poly.membership(&Vec3::new(v.x, v.y, v.z * l)).margin;
+            if c.margin.abs() > 1e-7 && m.abs() > 1e-7 {
+                prop_assert_eq!(c.feasible, m >= 0.0);
+            }
+        }
+    }
+
+    /// As the grip force grows the cone tends to the gravity-free cone.
+    #[test]
+    fn large_grip_force_tends_to_gravity_free(b in block_case()) {
+        let Some(scene) = scene(&b) else { return Ok(()) };
+        let mut last = f64::INFINITY;
+        let mut seq = Vec::new();
+        for f in [1.0, 10.0, 100.0, 1000.0] {
+            let s = scene.with_grip_force(b.force * f);
+            let push = s.push(&b.pose, 0).unwrap();
+            let worst = push.generators().unwrap().iter().zip(push.gravity_free_generators())
+                .map(|(g, gf)| angle(g, &gf)).fold(0.0, f64::max);
+            prop_assert!(worst <= last * 1.0000001 + 1e-12, "not shrinking: {worst} after {last}");
+            seq.push(worst);
+            last = worst;
+        }
+        // the distance decays like 1/N (the cone depends on N through ρ = μN/mg)
+        prop_assert!(seq[3] <= seq[1] * 0.02 + 1e-12, "not converging like 1/N: {seq:?}");
+    }
+
+    /// Results do not depend on where the object frame is put.
+    #[test]
+    fn invariant_under_change_of_object_frame(b in block_case(), tx in -0.05f64..0.05, tz in -0.05f64..0.05,
+                                              phi in -3.0f64..3.0, a1 in -3.2f64..3.2, a2 in -1.5f64..1.5) {
+        let raw = raw_scene(&b);
+        let Ok(scene) = Scene::from_raw(raw.clone()) else { return Ok(()) };
+        // new frame: p' = R_h p + t_h for every object-frame quantity
+        let rh = rot(phi);
+        let th = Vec2::new(tx, tz);
+        let mv = |p: [f64; 2]| { let q = rh * Vec2::new(p[0], p[1]) + th; [q.x, q.y] };
+        let mut raw2 = raw.clone();
+        let obj = raw2.object.as_mut().unwrap();
+        obj.outline = Some(obj.outline.as_ref().unwrap().iter().map(|p| mv(*p)).collect());
+        obj.com = obj.com.map(mv);
+        let pu = &mut raw2.pushers.as_mut().unwrap()[0];
+        pu.points = Some(pu.points.as_ref().unwrap().iter().map(|p| mv(*p)).collect());
+        let n = rh * Vec2::new(pu.normal.unwrap()[0], pu.normal.unwrap()[1]);
+        pu.normal = Some([n.x, n.y]);
+        // pose of the new frame: P' = P ∘ H⁻¹
+        let q = b.pose;
+        let r = rot(q[2]);
+        let t2 = Vec2::new(q[0], q[1]) - r * rh.transpose() * th;
+        let q2 = [t2.x, t2.y, q[2] - phi];
+        let task = raw2.task.as_mut().unwrap();
+        task.start = Some(q2);
+        task.goal = Some(q2);
+        let scene2 = Scene::from_raw(raw2).unwrap();
+        let to2 = |v: &Vec3| { let l = rh * Vec2::new(v.x, v.y) - perp(&th) * v.z; Vec3::new(l.x, l.y, v.z) };
+        let (p1, p2) = (scene.push(&q, 0).unwrap(), scene2.push(&q2, 0).unwrap());
+        for (g1, g2) in p1.generators().unwrap().iter().zip(p2.generators().unwrap()) {
+            prop_assert!(angle(&to2(g1), &g2) < 1e-7);
+        }
+        let v = twist_from_angles(a1, a2, scene.length);
+        let (c1, c2) = (p1.classify(&v).unwrap(), p2.classify(&to2(&v)).unwrap());
+        if c1.margin.abs() > 1e-6 {
+            prop_assert_eq!(c1.feasible, c2.feasible);
+        }
+    }
+
+    /// Inside the grip-force range the twist sticks; outside it does not (line pushers).
+    #[test]
+    fn grip_force_range_is_tight(mut b in block_case(), a1 in -3.2f64..3.2, a2 in -1.5f64..1.5) {
+        b.line = true;
+        let Some(scene) = scene(&b) else { return Ok(()) };
+        let push = scene.push_unchecked(&b.pose, 0).unwrap();
+        let v = twist_from_angles(a1, a2, scene.length);
+        let range = push.grip_force_range(&v).unwrap();
+        let sticks = |f: f64| scene.with_grip_force(f).push(&b.pose, 0).map(|p| p.classify(&v).unwrap().feasible).unwrap_or(false);
+        match range {
+            Some(r) => {
+                prop_assert!(sticks(r.min * 1.001));
+                prop_assert!(!sticks(r.min * 0.999));
+                if r.max.is_finite() {
+                    prop_assert!(sticks(r.max * 0.999) && !sticks(r.max * 1.001));
+                } else {
+                    prop_assert!(sticks(r.min * 1e4));
+                }
+            }
+            None => {
+                for f in [1.0, 3.0, 10.0, 30.0, 100.0, 1000.0] {
+                    prop_assert!(!sticks(f));
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn zero_pusher_friction_collapses_the_cone() {
+    let b = BlockCase {
+        w: 0.05, h: 0.08, mass: 0.13, force: 20.0, mu_s: 0.6, pad: 0.007, mu_p: 0.0, face: 3, line: true,
+        at: 0.0, gdir: 0.0, g: 9.81, pose: [0.0, 0.0, 0.0], com: [0.0, 0.0],
+    };
+    let scene = scene(&b).unwrap();
+    let push = scene.push(&b.pose, 0).unwrap();
+    let g = push.generators().unwrap();
+    // the two edges of each contact point coincide: two distinct generators
+    assert!(angle(&g[0], &g[1]) < 1e-12 && angle(&g[2], &g[3]) < 1e-12);
+    assert!(!push.pusher_cone().is_solid());
+    // a push straight along the normal needs friction to carry the weight: infeasible
+    let c = push.classify(&Vec3::new(1.0, 0.0, 0.0)).unwrap();
+    assert!(!c.feasible);
+    // the cone has no interior: random twists are never inside it
+    let mut inside = 0;
+    for i in 0..2000 {
+        let a = i as f64 * 0.618;
+        let v = twist_from_angles(a * 7.0, (a * 3.0).sin() * 1.5, scene.length);
+        if push.classify(&v).unwrap().feasible {
+            inside += 1;
+        }
+    }
+    assert_eq!(inside, 0);
+    // with some friction, the same cone has an interior
+    let b2 = BlockCase { mu_p: 0.3, ..b };
+    let push2 = common::scene(&b2).unwrap().push(&b2.pose, 0).unwrap();
+    assert!(push2.pusher_cone().is_solid());
+}
+
+#[test]
+fn cannot_hold_is_an_error_not_a_nan() {
+    let b = BlockCase {
+        w: 0.05, h: 0.08, mass: 3.0, force: 20.0, mu_s: 0.6, pad: 0.007, mu_p: 0.3, face: 0, line: true,
+        at: 0.0, gdir: 0.0, g: 9.81, pose: [0.0, 0.0, 0.0], com: [0.0, 0.0],
+    };
+    // 3 kg: the scene itself is rejected, naming grasp.force
+    let err = Scene::from_raw(raw_scene(&b)).unwrap_err();
+    assert!(err.to_string().contains("grasp.force"), "{err}");
+    // a scene that holds at its start but not with a weaker grip
+    let ok = BlockCase { mass: 0.13, ..b };
+    let s = scene(&ok).unwrap().with_grip_force(0.5);
+    let e = s.push(&ok.pose, 0).unwrap_err();
+    assert!(matches!(e, regrasp::Error::GraspCannotHold { .. }), "{e}");
+    // unchecked: gravity-free cone and grip-force range still work, and are finite
+    let p = s.push_unchecked(&ok.pose, 0).unwrap();
+    assert!(p.gravity_free_generators().iter().all(|g| g.iter().all(|x| x.is_finite())));
+    assert!(p.classify(&Vec3::new(0.0, 1.0, 0.0)).is_err());
+    let r = p.grip_force_range(&Vec3::new(0.0, 1.0, 0.0)).unwrap().unwrap();
+    assert!(r.min > 0.5 && r.min.is_finite());
+}
+
+/// The exact test agrees with an LP over contact forces built from the raw scene values, on
+/// 3000 random scenes, poses and twists (twists drawn near the cone half of the time), with
+/// both outcomes well represented.
+#[test]
+fn exact_test_matches_brute_force_lp() {
+    use proptest::strategy::ValueTree;
+    use proptest::test_runner::TestRunner;
+    let mut runner = TestRunner::deterministic();
+    let strat = (block_case(), -3.2f64..3.2, -1.5f64..1.5, proptest::collection::vec(0.0f64..1.0, 4), any::<bool>());
+    let (mut checked, mut inside, mut disagree) = (0, 0, Vec::new());
+    for _ in 0..3000 {
+        let (b, a1, a2, w, near) = strat.new_tree(&mut runner).unwrap().current();
+        let raw = raw_scene(&b);
+        let Ok(scene) = Scene::from_raw(raw.clone()) else { continue };
+        let push = scene.push(&b.pose, 0).unwrap();
+        let mut v = twist_from_angles(a1, a2, scene.length);
+        if near {
+            // a ray of the cone plus a perturbation of ~20% of its size
+            let p: Vec3 = push.pusher_edges().iter().zip(&w).map(|(e, x)| e.wrench * *x).sum();
+            if let Some(r) = push.ray(&p) {
+                v = r + v * 0.2;
+            }
+        }
+        let c = push.classify(&v).unwrap();
+        if c.margin.abs() < 1e-6 {
+            continue;
+        }
+        checked += 1;
+        inside += c.feasible as usize;
+        if c.feasible != brute_force_sticks(&raw, &b.pose, &v) {
+            disagree.push((b, v, c.margin));
+        }
+    }
+    assert!(disagree.is_empty(), "{} disagreements, first: {:?}", disagree.len(), disagree.first());
+    assert!(checked > 2000, "only {checked} cases checked");
+    assert!(inside > 300 && checked - inside > 300, "inside {inside} of {checked}");
+}

@@ -1,0 +1,507 @@
+//! Python bindings of the regrasp core: conversion only, no mechanics here.
+
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use regrasp::friction_cone::ConeShape;
+use regrasp::geometry::{Vec2, Vec3};
+use regrasp::motion_cone::{project_onto_generators, twist_scaled, Classification, PlanarPush};
+use regrasp::{batch, Error};
+
+/// Raise the Python exception (defined in `regrasp.errors`) matching a core error.
+fn to_py(err: Error) -> PyErr {
+    Python::with_gil(|py| {
+        let module = match py.import("regrasp.errors") {
+            Ok(m) => m,
+            Err(e) => return e,
+        };
+        let (cls, args): (&str, (String, Option<String>)) = match &err {
+            Error::Scene { field, .. } => ("SceneError", (err.to_string(), Some(field.clone()))),
+            Error::InvalidArgument { name, .. } => ("ArgumentError", (err.to_string(), Some(name.clone()))),
+            Error::GraspCannotHold { .. } => ("GraspError", (err.to_string(), Some("grasp.force".into()))),
+        };
+        match module.getattr(cls).and_then(|c| c.call1(args)) {
+            Ok(exc) => PyErr::from_value(exc),
+            Err(e) => e,
+        }
+    })
+}
+
+fn arg_err(name: &str, msg: impl Into<String>) -> PyErr {
+    to_py(Error::arg(name, msg))
+}
+
+fn vec3(name: &str, v: &[f64]) -> PyResult<Vec3> {
+    if v.len() != 3 {
+        return Err(arg_err(name, format!("must have 3 components, got {}", v.len())));
+    }
+    if !v.iter().all(|x| x.is_finite()) {
+        return Err(arg_err(name, "has a non-finite component"));
+    }
+    Ok(Vec3::new(v[0], v[1], v[2]))
+}
+
+fn pose3(v: &[f64]) -> PyResult<[f64; 3]> {
+    let p = vec3("pose", v)?;
+    Ok([p.x, p.y, p.z])
+}
+
+fn rows3(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<Vec<[f64; 3]>> {
+    let a = a.as_array();
+    if a.ncols() != 3 {
+        return Err(arg_err(name, format!("must have shape (n, 3), got (n, {})", a.ncols())));
+    }
+    Ok(a.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect())
+}
+
+fn mat_from_rows(rows: &[Vec3]) -> Array2<f64> {
+    let mut m = Array2::zeros((rows.len(), 3));
+    for (i, r) in rows.iter().enumerate() {
+        for j in 0..3 {
+            m[(i, j)] = r[j];
+        }
+    }
+    m
+}
+
+fn classification_dict<'py>(py: Python<'py>, c: &Classification) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("feasible", c.feasible)?;
+    d.set_item("margin", c.margin)?;
+    d.set_item("active_limit", c.limit.label())?;
+    d.set_item("pusher_wrench", c.pusher_wrench.as_slice().to_vec())?;
+    d.set_item("support_wrench", c.support_wrench.as_slice().to_vec())?;
+    Ok(d)
+}
+
+/// A validated planar scene (immutable).
+#[pyclass(module = "regrasp._core", frozen)]
+struct Scene {
+    inner: regrasp::Scene,
+}
+
+#[pymethods]
+impl Scene {
+    /// Parse and validate a scene from TOML text.
+    #[staticmethod]
+    fn from_toml(text: &str) -> PyResult<Self> {
+        regrasp::Scene::from_toml_str(text).map(|inner| Self { inner }).map_err(to_py)
+    }
+
+    /// Parse and validate a scene from JSON text (same layout as the TOML file).
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        regrasp::Scene::from_json_str(text).map(|inner| Self { inner }).map_err(to_py)
+    }
+
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name.clone()
+    }
+    #[getter]
+    fn kind(&self) -> &'static str {
+        match self.inner.support {
+            regrasp::scene::Support::Grasp(_) => "grasp",
+            regrasp::scene::Support::Surface(_) => "surface",
+        }
+    }
+    #[getter]
+    fn pusher_names(&self) -> Vec<String> {
+        self.inner.pushers.iter().map(|p| p.name.clone()).collect()
+    }
+    #[getter]
+    fn length(&self) -> f64 {
+        self.inner.length
+    }
+    #[getter]
+    fn mass(&self) -> f64 {
+        self.inner.mass
+    }
+    #[getter]
+    fn com(&self) -> (f64, f64) {
+        (self.inner.com.x, self.inner.com.y)
+    }
+    #[getter]
+    fn gravity(&self) -> (f64, f64, f64) {
+        (self.inner.gravity_dir.x, self.inner.gravity_dir.y, self.inner.g)
+    }
+    #[getter]
+    fn grip_force(&self) -> Option<f64> {
+        self.inner.grip_force()
+    }
+    #[getter]
+    fn friction_scale(&self) -> f64 {
+        self.inner.friction_scale()
+    }
+    #[getter]
+    fn outline<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let v = self.inner.outline.vertices();
+        let mut m = Array2::zeros((v.len(), 2));
+        for (i, p) in v.iter().enumerate() {
+            m[(i, 0)] = p.x;
+            m[(i, 1)] = p.y;
+        }
+        m.into_pyarray(py)
+    }
+    /// Pad description: ("circle", radius) or ("rectangle", width, height); None on a surface.
+    #[getter]
+    fn pad(&self) -> Option<(String, f64, f64)> {
+        match &self.inner.support {
+            regrasp::scene::Support::Grasp(g) => Some(match g.pad {
+                regrasp::scene::PadShape::Circle { radius } => ("circle".into(), radius, radius),
+                regrasp::scene::PadShape::Rectangle { width, height } => ("rectangle".into(), width, height),
+            }),
+            _ => None,
+        }
+    }
+    /// Pusher `name`: (points (k, 2), normal (2,), friction).
+    fn pusher<'py>(&self, py: Python<'py>, name: &str) -> PyResult<(Bound<'py, PyArray2<f64>>, (f64, f64), f64)> {
+        let i = self.inner.pusher_index(name).map_err(to_py)?;
+        let c = &self.inner.pushers[i].contact;
+        let mut m = Array2::zeros((c.points.len(), 2));
+        for (k, p) in c.points.iter().enumerate() {
+            m[(k, 0)] = p.x;
+            m[(k, 1)] = p.y;
+        }
+        Ok((m.into_pyarray(py), (c.normal.x, c.normal.y), c.friction))
+    }
+    /// (start, goal, tolerance) or None.
+    #[getter]
+    fn task(&self) -> Option<([f64; 3], [f64; 3], [f64; 3])> {
+        self.inner.task.map(|t| (t.start, t.goal, t.tolerance))
+    }
+
+    fn admissible(&self, pose: Vec<f64>) -> PyResult<bool> {
+        Ok(self.inner.admissible(&pose3(&pose)?))
+    }
+
+    fn admissible_many<'py>(&self, py: Python<'py>, poses: PyReadonlyArray2<f64>) -> PyResult<Bound<'py, PyArray1<bool>>> {
+        let q = rows3("poses", &poses)?;
+        let out: Vec<bool> = py.allow_threads(|| q.iter().map(|p| self.inner.admissible(p)).collect());
+        Ok(Array1::from(out).into_pyarray(py))
+    }
+
+    fn hold_ratio(&self, pose: Vec<f64>) -> PyResult<f64> {
+        Ok(self.inner.hold_ratio(&pose3(&pose)?))
+    }
+
+    fn with_grip_force(&self, force: f64) -> PyResult<Self> {
+        if !(force > 0.0) || !force.is_finite() {
+            return Err(arg_err("force", "must be a positive number"));
+        }
+        if self.inner.grip_force().is_none() {
+            return Err(arg_err("force", "only a grasp scene has a grip force"));
+        }
+        Ok(Self { inner: self.inner.with_grip_force(force) })
+    }
+
+    /// The motion cone of pusher `pusher` at `pose` (raises GraspError if the grasp cannot hold).
+    #[pyo3(signature = (pose, pusher, check_hold=true))]
+    fn motion_cone(&self, pose: Vec<f64>, pusher: &str, check_hold: bool) -> PyResult<MotionCone> {
+        let q = pose3(&pose)?;
+        let i = self.inner.pusher_index(pusher).map_err(to_py)?;
+        let push = if check_hold { self.inner.push(&q, i) } else { self.inner.push_unchecked(&q, i) };
+        Ok(MotionCone { push: push.map_err(to_py)?, pusher: pusher.to_string() })
+    }
+
+    /// Polyhedral generators at many poses: (generators (n, k, 3), valid (n,), errors).
+    fn generators_many<'py>(
+        &self,
+        py: Python<'py>,
+        poses: PyReadonlyArray2<f64>,
+        pusher: &str,
+        gravity_free: bool,
+    ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<bool>>, Vec<Option<String>>)> {
+        let q = rows3("poses", &poses)?;
+        let i = self.inner.pusher_index(pusher).map_err(to_py)?;
+        let k = self.inner.pushers[i].contact.points.len() * 2;
+        let res = py.allow_threads(|| {
+            if gravity_free {
+                batch::gravity_free_generators(&self.inner, &q, i)
+            } else {
+                batch::generators(&self.inner, &q, i)
+            }
+        });
+        let mut g = Array3::zeros((q.len(), k, 3));
+        let mut valid = Array1::from_elem(q.len(), false);
+        let mut errors = Vec::with_capacity(q.len());
+        for (n, r) in res.into_iter().enumerate() {
+            match r {
+                Ok(gens) => {
+                    for (j, v) in gens.iter().enumerate() {
+                        for c in 0..3 {
+                            g[(n, j, c)] = v[c];
+                        }
+                    }
+                    valid[n] = true;
+                    errors.push(None);
+                }
+                Err(e) => errors.push(Some(e.to_string())),
+            }
+        }
+        Ok((g.into_pyarray(py), valid.into_pyarray(py), errors))
+    }
+
+    /// Exact test of twist i at pose i: (feasible, margin, active limit label, valid, errors).
+    #[allow(clippy::type_complexity)]
+    fn classify_many<'py>(
+        &self,
+        py: Python<'py>,
+        poses: PyReadonlyArray2<f64>,
+        twists: PyReadonlyArray2<f64>,
+        pusher: &str,
+    ) -> PyResult<(
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyArray1<f64>>,
+        Vec<String>,
+        Bound<'py, PyArray1<bool>>,
+        Vec<Option<String>>,
+    )> {
+        let q = rows3("poses", &poses)?;
+        let t: Vec<Vec3> = rows3("twists", &twists)?.iter().map(|v| Vec3::new(v[0], v[1], v[2])).collect();
+        if q.len() != t.len() {
+            return Err(arg_err("twists", format!("has {} rows but poses has {}", t.len(), q.len())));
+        }
+        let i = self.inner.pusher_index(pusher).map_err(to_py)?;
+        let res = py.allow_threads(|| batch::classify(&self.inner, &q, &t, i));
+        let n = q.len();
+        let (mut feas, mut margin, mut valid) = (Array1::from_elem(n, false), Array1::zeros(n), Array1::from_elem(n, false));
+        let mut labels = Vec::with_capacity(n);
+        let mut errors = Vec::with_capacity(n);
+        for (k, r) in res.into_iter().enumerate() {
+            match r {
+                Ok(c) => {
+                    feas[k] = c.feasible;
+                    margin[k] = c.margin;
+                    valid[k] = true;
+                    labels.push(c.limit.label());
+                    errors.push(None);
+                }
+                Err(e) => {
+                    labels.push(String::new());
+                    errors.push(Some(e.to_string()));
+                }
+            }
+        }
+        Ok((feas.into_pyarray(py), margin.into_pyarray(py), labels, valid.into_pyarray(py), errors))
+    }
+
+    /// Closest feasible twist to twist i at pose i: (projections (n, 3), valid, errors).
+    fn project_many<'py>(
+        &self,
+        py: Python<'py>,
+        poses: PyReadonlyArray2<f64>,
+        twists: PyReadonlyArray2<f64>,
+        pusher: &str,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>, Vec<Option<String>>)> {
+        let q = rows3("poses", &poses)?;
+        let t: Vec<Vec3> = rows3("twists", &twists)?.iter().map(|v| Vec3::new(v[0], v[1], v[2])).collect();
+        if q.len() != t.len() {
+            return Err(arg_err("twists", format!("has {} rows but poses has {}", t.len(), q.len())));
+        }
+        let i = self.inner.pusher_index(pusher).map_err(to_py)?;
+        let res = py.allow_threads(|| batch::project(&self.inner, &q, &t, i));
+        let n = q.len();
+        let mut out = Array2::zeros((n, 3));
+        let mut valid = Array1::from_elem(n, false);
+        let mut errors = Vec::with_capacity(n);
+        for (k, r) in res.into_iter().enumerate() {
+            match r {
+                Ok(v) => {
+                    for c in 0..3 {
+                        out[(k, c)] = v[c];
+                    }
+                    valid[k] = true;
+                    errors.push(None);
+                }
+                Err(e) => errors.push(Some(e.to_string())),
+            }
+        }
+        Ok((out.into_pyarray(py), valid.into_pyarray(py), errors))
+    }
+}
+
+/// The motion cone of one pusher at one pose.
+#[pyclass(module = "regrasp._core", frozen)]
+struct MotionCone {
+    push: PlanarPush,
+    pusher: String,
+}
+
+impl MotionCone {
+    fn twists(&self, t: &Bound<'_, PyAny>) -> PyResult<(Vec<Vec3>, bool)> {
+        if let Ok(a) = t.extract::<PyReadonlyArray2<f64>>() {
+            let rows = rows3("twist", &a)?;
+            return Ok((rows.iter().map(|v| Vec3::new(v[0], v[1], v[2])).collect(), true));
+        }
+        let v: Vec<f64> = t.extract().map_err(|_| arg_err("twist", "must be 3 numbers or an (n, 3) array"))?;
+        Ok((vec![vec3("twist", &v)?], false))
+    }
+}
+
+#[pymethods]
+impl MotionCone {
+    #[getter]
+    fn pusher(&self) -> String {
+        self.pusher.clone()
+    }
+    #[getter]
+    fn pose(&self) -> [f64; 3] {
+        self.push.spec().pose
+    }
+    #[getter]
+    fn length(&self) -> f64 {
+        self.push.length()
+    }
+    #[getter]
+    fn hold_ratio(&self) -> f64 {
+        self.push.hold_ratio()
+    }
+    /// Whether the pusher's generalized friction cone has an interior (line pusher).
+    #[getter]
+    fn solid(&self) -> bool {
+        self.push.pusher_cone().is_solid()
+    }
+    /// Generators of the polyhedral approximation, one unit twist a row.
+    #[getter]
+    fn generators<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(mat_from_rows(&self.push.generators().map_err(to_py)?).into_pyarray(py))
+    }
+    #[getter]
+    fn gravity_free_generators<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        mat_from_rows(&self.push.gravity_free_generators()).into_pyarray(py)
+    }
+    /// Edge wrenches of the pusher's generalized friction cone (unit normal force), one a row.
+    #[getter]
+    fn pusher_edges<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let e: Vec<Vec3> = self.push.pusher_edges().iter().map(|e| e.wrench).collect();
+        mat_from_rows(&e).into_pyarray(py)
+    }
+    /// Pairs of edge indices spanning the boundary fans of the pusher's friction cone.
+    #[getter]
+    fn boundary_segments(&self) -> Vec<(usize, usize)> {
+        self.push.pusher_cone().boundary_segments()
+    }
+    /// The limit-surface matrix A (support frame) and J_s.
+    #[getter]
+    fn support_matrices<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>) {
+        let s = self.push.spec();
+        let a = s.limit_surface.matrix(s.friction_scale);
+        let to = |m: &regrasp::geometry::Mat3| {
+            let mut o = Array2::zeros((3, 3));
+            for i in 0..3 {
+                for j in 0..3 {
+                    o[(i, j)] = m[(i, j)];
+                }
+            }
+            o
+        };
+        (to(&a).into_pyarray(py), to(&s.support_jacobian).into_pyarray(py), Array1::from(s.gravity.as_slice().to_vec()).into_pyarray(py))
+    }
+
+    /// Motion-cone ray (unit twist) produced by pusher wrench `wrench`, or None.
+    fn ray<'py>(&self, py: Python<'py>, wrench: Vec<f64>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
+        let w = vec3("wrench", &wrench)?;
+        Ok(self.push.ray(&w).map(|v| Array1::from(v.as_slice().to_vec()).into_pyarray(py)))
+    }
+
+    /// Exact test of one twist: dict(feasible, margin, active_limit, pusher_wrench, support_wrench).
+    fn classify<'py>(&self, py: Python<'py>, twist: Vec<f64>) -> PyResult<Bound<'py, PyDict>> {
+        let c = self.push.classify(&vec3("twist", &twist)?).map_err(to_py)?;
+        classification_dict(py, &c)
+    }
+
+    /// Signed margins of one twist or of an (n, 3) array of twists.
+    fn margin(&self, py: Python<'_>, twist: &Bound<'_, PyAny>) -> PyResult<PyObject> {
+        let (ts, many) = self.twists(twist)?;
+        let m: Vec<f64> = ts.iter().map(|t| self.push.classify(t).map(|c| c.margin)).collect::<Result<_, _>>().map_err(to_py)?;
+        Ok(if many { Array1::from(m).into_pyarray(py).into_any().unbind() } else { m[0].into_pyobject(py)?.into_any().unbind() })
+    }
+
+    /// Exact membership of one twist or of an (n, 3) array of twists.
+    fn contains(&self, py: Python<'_>, twist: &Bound<'_, PyAny>) -> PyResult<PyObject> {
+        let (ts, many) = self.twists(twist)?;
+        let m: Vec<bool> = ts.iter().map(|t| self.push.contains(t)).collect::<Result<_, _>>().map_err(to_py)?;
+        Ok(if many {
+            Array1::from(m).into_pyarray(py).into_any().unbind()
+        } else {
+            pyo3::types::PyBool::new(py, m[0]).to_owned().into_any().unbind()
+        })
+    }
+
+    /// Membership in the polyhedral approximation.
+    fn contains_polyhedral(&self, twist: Vec<f64>) -> PyResult<bool> {
+        let v = vec3("twist", &twist)?;
+        let cone = self.push.polyhedral_cone().map_err(to_py)?;
+        Ok(cone.contains(&twist_scaled(&v, self.push.length()), regrasp::motion_cone::MEMBERSHIP_TOL))
+    }
+
+    /// Margin of a twist in the gravity-free cone (exact, polyhedral).
+    fn gravity_free_margin(&self, twist: Vec<f64>) -> PyResult<f64> {
+        self.push.gravity_free_margin(&vec3("twist", &twist)?).map_err(to_py)
+    }
+
+    /// Closest feasible twist (metric diag(1, 1, L²)), exact cone.
+    fn project<'py>(&self, py: Python<'py>, twist: &Bound<'_, PyAny>) -> PyResult<PyObject> {
+        let (ts, many) = self.twists(twist)?;
+        let p: Vec<Vec3> = ts.iter().map(|t| self.push.project(t)).collect::<Result<_, _>>().map_err(to_py)?;
+        Ok(if many {
+            mat_from_rows(&p).into_pyarray(py).into_any().unbind()
+        } else {
+            Array1::from(p[0].as_slice().to_vec()).into_pyarray(py).into_any().unbind()
+        })
+    }
+
+    /// Closest twist in a polyhedral cone given by `generators` ("approx" or "gravity_free").
+    #[pyo3(signature = (twist, which="approx"))]
+    fn project_polyhedral<'py>(&self, py: Python<'py>, twist: Vec<f64>, which: &str) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let v = vec3("twist", &twist)?;
+        let gens = match which {
+            "approx" => self.push.generators().map_err(to_py)?,
+            "gravity_free" => self.push.gravity_free_generators(),
+            _ => return Err(PyValueError::new_err("which must be \"approx\" or \"gravity_free\"")),
+        };
+        let l = self.push.length();
+        let gs: Vec<Vec3> = gens.iter().map(|g| twist_scaled(g, l)).collect();
+        let (p, _) = project_onto_generators(&gs, &twist_scaled(&v, l));
+        Ok(Array1::from(vec![p.x, p.y, p.z / l]).into_pyarray(py))
+    }
+
+    /// Per-finger grip-force range [min, max] for which the pusher motion of `twist` sticks.
+    fn grip_force_range(&self, twist: Vec<f64>) -> PyResult<Option<(f64, f64)>> {
+        let r = self.push.grip_force_range(&vec3("twist", &twist)?).map_err(to_py)?;
+        Ok(r.map(|r| (r.min, r.max)))
+    }
+
+    /// Point pushers: object twist when the contact point moves with velocity `u` (object frame).
+    fn point_pusher_twist<'py>(&self, py: Python<'py>, u: Vec<f64>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
+        if u.len() != 2 || !u.iter().all(|x| x.is_finite()) {
+            return Err(arg_err("u", "must be 2 finite numbers"));
+        }
+        if self.push.pusher_cone().is_solid() {
+            return Err(arg_err("pusher", "point_pusher_twist needs a point pusher"));
+        }
+        let s = self.push.spec().friction_scale;
+        Ok(self.push.point_pusher_twist(&Vec2::new(u[0], u[1]), s).map(|v| Array1::from(v.as_slice().to_vec()).into_pyarray(py)))
+    }
+
+    /// Shape of the pusher's friction cone: "solid", "fan" or "ray".
+    #[getter]
+    fn pusher_cone_shape(&self) -> &'static str {
+        match self.push.pusher_cone().shape {
+            ConeShape::Solid { .. } => "solid",
+            ConeShape::Fan { .. } => "fan",
+            ConeShape::Ray => "ray",
+        }
+    }
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Scene>()?;
+    m.add_class::<MotionCone>()?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
