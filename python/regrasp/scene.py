@@ -157,8 +157,10 @@ class MotionCone:
         """Closest twist in the polyhedral approximation (non-negative least squares)."""
         return self._core.project_polyhedral(list(_vec(twist, 3, "twist")), "approx")
 
-    def contains_polyhedral(self, twist: ArrayLike) -> bool:
-        return self._core.contains_polyhedral(list(_vec(twist, 3, "twist")))
+    def contains_polyhedral(self, twist):
+        """Membership in the polyhedral approximation (one twist, or an (n, 3) array)."""
+        t = np.asarray(twist, dtype=float)
+        return self._core.contains_polyhedral(np.ascontiguousarray(t) if t.ndim == 2 else list(_vec(t, 3, "twist")))
 
     def grip_force_range(self, twist: ArrayLike) -> Optional[tuple[float, float]]:
         """Per-finger grip forces [min, max] (max may be inf) for which the pusher motion of
@@ -185,6 +187,14 @@ class MotionCone:
         return self._core.point_pusher_twist(list(_vec(u, 2, "u")))
 
 
+_STATUS = dict(_core.Scene.status_messages())
+_LIMITS = np.array(_core.Scene.limit_labels())
+
+
+def _errors(status: np.ndarray) -> list:
+    return [None if c == 0 else _STATUS[int(c)] for c in status]
+
+
 @dataclass
 class MotionConeBatch:
     """Motion cones of one pusher at many poses (vectorized in Rust, no Python loop)."""
@@ -193,28 +203,39 @@ class MotionConeBatch:
     pusher: str
     poses: np.ndarray  # (n, 3)
     generators: np.ndarray  # (n, k, 3), zeros where not valid
-    valid: np.ndarray  # (n,) bool
-    errors: list  # reason per pose (None where valid)
+    status: np.ndarray  # (n,) uint8, 0 where valid
+
+    @property
+    def valid(self) -> np.ndarray:
+        return self.status == 0
+
+    @property
+    def errors(self) -> list:
+        """Reason per pose (None where valid)."""
+        return _errors(self.status)
 
     def gravity_free_generators(self) -> np.ndarray:
-        g, _, _ = self.scene._core.generators_many(self.poses, self.pusher, True)
+        g, _ = self.scene._core.generators_many(self.poses, self.pusher, True)
         return g
 
     def classify(self, twists) -> dict:
         """Exact test of twist i at pose i: dict of arrays feasible, margin, active_limit, valid."""
         t = _rows(twists, "twists")
-        feas, margin, labels, valid, errors = self.scene._core.classify_many(self.poses, t, self.pusher)
-        return {"feasible": feas, "margin": margin, "active_limit": labels, "valid": valid, "errors": errors}
+        feas, margin, codes, status = self.scene._core.classify_many(self.poses, t, self.pusher)
+        return {"feasible": feas, "margin": margin, "active_limit": _LIMITS[codes], "valid": status == 0,
+                "errors": _errors(status)}
 
     def contains(self, twists) -> np.ndarray:
-        return self.classify(twists)["feasible"]
+        t = _rows(twists, "twists")
+        return self.scene._core.classify_many(self.poses, t, self.pusher)[0]
 
     def margin(self, twists) -> np.ndarray:
-        return self.classify(twists)["margin"]
+        t = _rows(twists, "twists")
+        return self.scene._core.classify_many(self.poses, t, self.pusher)[1]
 
     def project(self, twists) -> np.ndarray:
         t = _rows(twists, "twists")
-        out, _, _ = self.scene._core.project_many(self.poses, t, self.pusher)
+        out, _ = self.scene._core.project_many(self.poses, t, self.pusher)
         return out
 
 
@@ -339,8 +360,8 @@ class Scene:
     def motion_cones(self, poses, pusher: str, strict: bool = False) -> MotionConeBatch:
         """Motion cones at many poses. With ``strict`` the first invalid pose raises."""
         q = _rows(poses, "poses")
-        g, valid, errors = self._core.generators_many(q, pusher, False)
-        if strict and not valid.all():
-            i = int(np.flatnonzero(~valid)[0])
-            raise ArgumentError(f"invalid `poses[{i}]`: {errors[i]}", f"poses[{i}]")
-        return MotionConeBatch(self, pusher, q, g, valid, errors)
+        g, status = self._core.generators_many(q, pusher, False)
+        if strict and status.any():
+            i = int(np.flatnonzero(status)[0])
+            raise ArgumentError(f"invalid `poses[{i}]`: {_STATUS[int(status[i])]}", f"poses[{i}]")
+        return MotionConeBatch(self, pusher, q, g, status)

@@ -35,6 +35,26 @@ pub enum ContactLimit {
 }
 
 impl ContactLimit {
+    /// Every limit, in the order of [`Self::code`].
+    pub const ALL: [ContactLimit; 6] = [
+        ContactLimit::Slide { side: 1 },
+        ContactLimit::Slide { side: -1 },
+        ContactLimit::Roll { point: 0 },
+        ContactLimit::Roll { point: 1 },
+        ContactLimit::Torque,
+        ContactLimit::OffRay,
+    ];
+
+    /// A small integer per limit (index into [`Self::ALL`]).
+    pub fn code(&self) -> u8 {
+        match self {
+            ContactLimit::Slide { side } => (*side < 0) as u8,
+            ContactLimit::Roll { point } => 2 + (*point).min(1),
+            ContactLimit::Torque => 4,
+            ContactLimit::OffRay => 5,
+        }
+    }
+
     pub fn label(&self) -> String {
         match self {
             ContactLimit::Slide { side } => {

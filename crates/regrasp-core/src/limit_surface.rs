@@ -23,13 +23,28 @@ pub fn circular_pad_k(radius: f64) -> f64 {
 pub struct LimitSurface {
     /// `B`, symmetric positive definite.
     pub b: Mat3,
+    /// `B⁻¹`.
+    pub b_inv: Mat3,
 }
 
 impl LimitSurface {
     /// Circular pad of radius `r`, uniform pressure: `B = diag(1, 1, 1/(0.6 r)²)` (eq 3.7).
     pub fn circular(radius: f64) -> Self {
         let k = circular_pad_k(radius);
-        Self { b: Mat3::from_diagonal(&Vec3::new(1.0, 1.0, 1.0 / (k * k))) }
+        Self::from_matrix(Mat3::from_diagonal(&Vec3::new(1.0, 1.0, 1.0 / (k * k))))
+            .expect("a positive radius gives a positive definite surface")
+    }
+
+    /// From a symmetric positive definite `B`; `None` otherwise.
+    pub fn from_matrix(b: Mat3) -> Option<Self> {
+        let sym = (b + b.transpose()) * 0.5;
+        nalgebra::Cholesky::new(sym)?;
+        Some(Self { b: sym, b_inv: sym.try_inverse()? })
+    }
+
+    /// `A⁻¹ = B⁻¹ (μN)²`.
+    pub fn matrix_inv(&self, mu_n: f64) -> Mat3 {
+        self.b_inv * (mu_n * mu_n)
     }
 
     /// `A = B / (μN)²` for friction coefficient × normal force `mu_n` (eq 3.7).
@@ -46,6 +61,11 @@ impl LimitSurface {
     /// Fits an ellipsoid to the limit surface of a pressure distribution. Returns the surface
     /// and the fit's largest relative radial error over the sampled twists.
     pub fn fit(pad: &PressureDistribution) -> (Self, f64) {
+        let (b, err) = Self::fit_matrix(pad);
+        (Self::from_matrix(b).expect("the fitted limit surface is an ellipsoid"), err)
+    }
+
+    fn fit_matrix(pad: &PressureDistribution) -> (Mat3, f64) {
         let ell = pad.length_scale();
         let dirs = fibonacci_sphere(600);
         // samples in scaled wrench space [fx, fz, τ/ℓ]
@@ -72,14 +92,13 @@ impl LimitSurface {
             .iter()
             .map(|w| (w.dot(&(qs * w)).sqrt() - 1.0).abs())
             .fold(0.0, f64::max);
-        (Self { b }, err)
+        (b, err)
     }
 
     /// Maximum moment (for `μN = 1`) on the fitted surface, `1/√B₃₃` for a diagonal `B`: the
     /// `k` of eq 3.7.
     pub fn k(&self) -> f64 {
-        let binv = self.b.try_inverse().expect("limit surface matrix is positive definite");
-        binv[(2, 2)].sqrt()
+        self.b_inv[(2, 2)].sqrt()
     }
 }
 

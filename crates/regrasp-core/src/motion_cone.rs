@@ -16,14 +16,132 @@
 //!
 //! Twists are compared in the metric `diag(1, 1, L²)` and wrenches in `diag(1, 1, 1/L²)` (L: a
 //! characteristic length of the object), which are dual to each other.
+//!
+//! Split as in MuJoCo's model/data: a [`PusherModel`] (pose-independent: the pusher's cone in
+//! the object frame) and a [`SupportFrame`] (everything that depends on the pose).
 
 use crate::error::{Error, Result};
 use crate::friction_cone::{ConeShape, ContactLimit, EdgeWrench, PolyhedralCone, PusherContact};
-use crate::geometry::{perp, Mat3, Vec2, Vec3};
+use crate::geometry::{cross2, perp, Mat3, Vec2, Vec3};
 use crate::limit_surface::LimitSurface;
 
 /// Tolerance of the exact membership test on the (dimensionless) margin.
 pub const MEMBERSHIP_TOL: f64 = 1e-9;
+
+/// `[vx, vz, L ω]`.
+#[inline]
+pub fn twist_scaled(v: &Vec3, l: f64) -> Vec3 {
+    Vec3::new(v.x, v.y, v.z * l)
+}
+
+/// `[fx, fz, τ / L]`.
+#[inline]
+pub fn wrench_scaled(w: &Vec3, l: f64) -> Vec3 {
+    Vec3::new(w.x, w.y, w.z / l)
+}
+
+#[inline]
+fn wrench_unscaled(w: &Vec3, l: f64) -> Vec3 {
+    Vec3::new(w.x, w.y, w.z * l)
+}
+
+/// A pusher's generalized friction cone in the object frame (pose-independent).
+#[derive(Clone, Debug)]
+pub struct PusherModel {
+    pub contact: PusherContact,
+    /// Edge wrenches, physical units, unit normal force (eq 3.6).
+    pub edges: Vec<EdgeWrench>,
+    /// `W_p` in the scaled wrench space `[fx, fz, τ/L]`.
+    pub cone: PolyhedralCone,
+    pub length: f64,
+}
+
+impl PusherModel {
+    pub fn new(contact: PusherContact, length: f64) -> Result<Self> {
+        if !(length > 0.0) {
+            return Err(Error::arg("length", "must be positive"));
+        }
+        let edges = contact.edge_wrenches();
+        let scaled: Vec<Vec3> = edges.iter().map(|e| wrench_scaled(&e.wrench, length)).collect();
+        let cone = PolyhedralCone::from_edges(&scaled)
+            .map_err(|e| Error::arg("pusher", format!("its friction cone is degenerate ({e:?})")))?;
+        Ok(Self { contact, edges, cone, length })
+    }
+
+    /// Signed margin of pusher wrench `w` and the contact limit nearest to it.
+    pub fn membership(&self, w: &Vec3) -> (f64, ContactLimit) {
+        let m = self.cone.membership(&wrench_scaled(w, self.length));
+        (m.margin, self.contact.limit_of(&self.edges, m.active))
+    }
+}
+
+/// Pose-dependent quantities of a push: limit surface, support Jacobian, gravity.
+#[derive(Clone, Copy, Debug)]
+pub struct SupportFrame {
+    /// `A` (eq 3.7), support frame.
+    pub a: Mat3,
+    pub a_inv: Mat3,
+    /// `J_s`: object twist → support twist.
+    pub js: Mat3,
+    pub js_inv: Mat3,
+    /// Gravity wrench, object frame.
+    pub gravity: Vec3,
+    /// `J_s⁻ᵀ w_g`.
+    pub ug: Vec3,
+    /// `√(u_gᵀ A u_g)`: < 1 when the support holds the object against gravity.
+    pub hold_ratio: f64,
+}
+
+impl SupportFrame {
+    pub fn new(a: Mat3, a_inv: Mat3, js: Mat3, js_inv: Mat3, gravity: Vec3) -> Self {
+        let ug = js_inv.tr_mul(&gravity);
+        let hold_ratio = ug.dot(&(a * ug)).sqrt();
+        Self { a, a_inv, js, js_inv, gravity, ug, hold_ratio }
+    }
+
+    /// The motion-cone ray (unit twist in `diag(1,1,L²)`) of pusher wrench direction `p`;
+    /// `None` if the support cannot hold the object (no positive root).
+    #[inline]
+    pub fn ray(&self, p: &Vec3, l: f64) -> Option<Vec3> {
+        let u = self.js_inv.tr_mul(p);
+        let au = self.a * u;
+        let qa = u.dot(&au);
+        let qb = 2.0 * self.ug.dot(&au);
+        let qc = self.hold_ratio * self.hold_ratio - 1.0;
+        if !(qc < 0.0) || !(qa > 0.0) {
+            return None;
+        }
+        let disc = (qb * qb - 4.0 * qa * qc).sqrt();
+        // positive root, in the cancellation-free form
+        let lambda = if qb >= 0.0 { 2.0 * qc / (-qb - disc) } else { (-qb + disc) / (2.0 * qa) };
+        let v = self.js_inv * (au * lambda + self.a * self.ug);
+        Some(v / twist_scaled(&v, l).norm())
+    }
+
+    /// Ray of the gravity-free cone for pusher wrench `p`: `J_s⁻¹ A J_s⁻ᵀ p`, unit.
+    #[inline]
+    pub fn gravity_free_ray(&self, p: &Vec3, l: f64) -> Vec3 {
+        let v = self.js_inv * (self.a * self.js_inv.tr_mul(p));
+        v / twist_scaled(&v, l).norm()
+    }
+
+    /// Load wrench on the support for twist `v`, mapped to the object frame: `J_sᵀ ŵ` (eq 3.10).
+    #[inline]
+    pub fn support_load(&self, v: &Vec3) -> Vec3 {
+        let vs = self.js * v;
+        let w = self.a_inv * vs;
+        self.js.tr_mul(&(w / vs.dot(&w).sqrt()))
+    }
+
+    /// The exact test (twist assumed finite and non-zero, support assumed to hold).
+    #[inline]
+    pub fn classify(&self, model: &PusherModel, v: &Vec3) -> Classification {
+        let support = self.support_load(v);
+        let wp = support - self.gravity;
+        let (margin, limit) = model.membership(&wp);
+        Classification { feasible: margin >= -MEMBERSHIP_TOL, margin, limit, pusher_wrench: wp, support_wrench: support }
+    }
+}
 
 /// Everything that defines one push at one pose.
 #[derive(Clone, Debug)]
@@ -73,26 +191,15 @@ pub struct GripForceRange {
 #[derive(Clone, Debug)]
 pub struct PlanarPush {
     spec: PushSpec,
-    a: Mat3,
-    a_inv: Mat3,
-    js_inv: Mat3,
-    js_inv_t: Mat3,
-    edges: Vec<EdgeWrench>,
-    /// `W_p` in the scaled wrench space.
-    wp: PolyhedralCone,
-    /// `J_s⁻ᵀ w_g`.
-    ug: Vec3,
-    /// `√(u_gᵀ A u_g)`: < 1 when the support holds the object against gravity.
-    hold_ratio: f64,
+    frame: SupportFrame,
+    model: PusherModel,
 }
 
 impl PlanarPush {
     /// Builds the push; fails when the support cannot hold the object against gravity.
     pub fn new(spec: PushSpec) -> Result<Self> {
         let p = Self::new_unchecked(spec)?;
-        if p.hold_ratio >= 1.0 {
-            return Err(Error::GraspCannotHold { pose: p.spec.pose, ratio: p.hold_ratio });
-        }
+        p.check_hold()?;
         Ok(p)
     }
 
@@ -102,43 +209,49 @@ impl PlanarPush {
         if !(spec.friction_scale > 0.0) || !spec.friction_scale.is_finite() {
             return Err(Error::arg("friction_scale", "must be positive and finite"));
         }
-        if !(spec.length > 0.0) {
-            return Err(Error::arg("length", "must be positive"));
-        }
-        let a = spec.limit_surface.matrix(spec.friction_scale);
-        let a_inv = a.try_inverse().ok_or_else(|| Error::arg("limit_surface", "matrix is singular"))?;
+        let model = PusherModel::new(spec.pusher.clone(), spec.length)?;
         let js_inv = spec
             .support_jacobian
             .try_inverse()
             .ok_or_else(|| Error::arg("support_jacobian", "is singular"))?;
-        let js_inv_t = js_inv.transpose();
-        let edges = spec.pusher.edge_wrenches();
-        let l = spec.length;
-        let scaled: Vec<Vec3> = edges.iter().map(|e| wrench_scaled(&e.wrench, l)).collect();
-        let wp = PolyhedralCone::from_edges(&scaled)
-            .map_err(|e| Error::arg("pusher", format!("its friction cone is degenerate ({e:?})")))?;
-        let ug = js_inv_t * spec.gravity;
-        let hold_ratio = ug.dot(&(a * ug)).sqrt();
-        Ok(Self { spec, a, a_inv, js_inv, js_inv_t, edges, wp, ug, hold_ratio })
+        let frame = SupportFrame::new(
+            spec.limit_surface.matrix(spec.friction_scale),
+            spec.limit_surface.matrix_inv(spec.friction_scale),
+            spec.support_jacobian,
+            js_inv,
+            spec.gravity,
+        );
+        Ok(Self { spec, frame, model })
+    }
+
+    fn check_hold(&self) -> Result<()> {
+        if self.frame.hold_ratio >= 1.0 {
+            return Err(Error::GraspCannotHold { pose: self.spec.pose, ratio: self.frame.hold_ratio });
+        }
+        Ok(())
     }
 
     pub fn spec(&self) -> &PushSpec {
         &self.spec
     }
 
-    /// `√(u_gᵀ A u_g)`: how much of the support's friction gravity alone uses (< 1 to hold).
+    pub fn frame(&self) -> &SupportFrame {
+        &self.frame
+    }
+
+    /// How much of the support's friction gravity alone uses (< 1 to hold).
     pub fn hold_ratio(&self) -> f64 {
-        self.hold_ratio
+        self.frame.hold_ratio
     }
 
     /// The pusher's generalized friction cone edges (eq 3.6), physical units.
     pub fn pusher_edges(&self) -> &[EdgeWrench] {
-        &self.edges
+        &self.model.edges
     }
 
     /// The pusher's generalized friction cone in the scaled wrench space `[fx, fz, τ/L]`.
     pub fn pusher_cone(&self) -> &PolyhedralCone {
-        &self.wp
+        &self.model.cone
     }
 
     pub fn length(&self) -> f64 {
@@ -150,39 +263,21 @@ impl PlanarPush {
         twist_scaled(v, self.spec.length).norm()
     }
 
-    fn unit_twist(&self, v: Vec3) -> Vec3 {
-        v / self.twist_norm(&v)
-    }
-
     /// The motion-cone ray produced by pusher wrench direction `p` (physical units), as a unit
-    /// twist; `None` if the support cannot hold the object (no positive root).
+    /// twist; `None` if the support cannot hold the object.
     pub fn ray(&self, p: &Vec3) -> Option<Vec3> {
-        let u = self.js_inv_t * p;
-        let au = self.a * u;
-        let qa = u.dot(&au);
-        let qb = 2.0 * self.ug.dot(&au);
-        let qc = self.hold_ratio * self.hold_ratio - 1.0;
-        if !(qc < 0.0) || !(qa > 0.0) {
-            return None;
-        }
-        let disc = (qb * qb - 4.0 * qa * qc).sqrt();
-        // positive root, in the cancellation-free form
-        let lambda = if qb >= 0.0 { 2.0 * qc / (-qb - disc) } else { (-qb + disc) / (2.0 * qa) };
-        let w = u * lambda + self.ug;
-        Some(self.unit_twist(self.js_inv * (self.a * w)))
+        self.frame.ray(p, self.spec.length)
     }
 
     /// Generators of the polyhedral approximation: one ray per edge of `W_p`, unit twists.
     pub fn generators(&self) -> Result<Vec<Vec3>> {
-        self.edges
-            .iter()
-            .map(|e| self.ray(&e.wrench).ok_or(Error::GraspCannotHold { pose: self.spec.pose, ratio: self.hold_ratio }))
-            .collect()
+        self.check_hold()?;
+        Ok(self.model.edges.iter().filter_map(|e| self.ray(&e.wrench)).collect())
     }
 
     /// Generators of the gravity-free cone `J_s⁻¹ A J_s⁻ᵀ e_i`, unit twists.
     pub fn gravity_free_generators(&self) -> Vec<Vec3> {
-        self.edges.iter().map(|e| self.unit_twist(self.js_inv * (self.a * (self.js_inv_t * e.wrench)))).collect()
+        self.model.edges.iter().map(|e| self.frame.gravity_free_ray(&e.wrench, self.spec.length)).collect()
     }
 
     fn check_twist(&self, v: &Vec3) -> Result<()> {
@@ -195,27 +290,11 @@ impl PlanarPush {
         Ok(())
     }
 
-    /// Support load wrench (support frame) for twist `v` on the surface `A` (eq 3.10).
-    fn support_load(&self, v: &Vec3) -> Vec3 {
-        LimitSurface::wrench_for_twist(&self.a_inv, &(self.spec.support_jacobian * v))
-    }
-
     /// The exact membership test: can the pusher produce twist `v` while sticking?
     pub fn classify(&self, v: &Vec3) -> Result<Classification> {
         self.check_twist(v)?;
-        if self.hold_ratio >= 1.0 {
-            return Err(Error::GraspCannotHold { pose: self.spec.pose, ratio: self.hold_ratio });
-        }
-        let support = self.spec.support_jacobian.transpose() * self.support_load(v);
-        let wp = support - self.spec.gravity;
-        let m = self.wp.membership(&wrench_scaled(&wp, self.spec.length));
-        Ok(Classification {
-            feasible: m.margin >= -MEMBERSHIP_TOL,
-            margin: m.margin,
-            limit: self.spec.pusher.limit_of(&self.edges, m.active),
-            pusher_wrench: wp,
-            support_wrench: support,
-        })
+        self.check_hold()?;
+        Ok(self.frame.classify(&self.model, v))
     }
 
     pub fn contains(&self, v: &Vec3) -> Result<bool> {
@@ -228,11 +307,10 @@ impl PlanarPush {
         PolyhedralCone::from_edges(&g).map_err(|e| Error::arg("pusher", format!("degenerate motion cone ({e:?})")))
     }
 
-    /// Membership in the gravity-free cone, in the wrench space (exact, polyhedral).
+    /// Margin of `v` in the gravity-free cone, measured in the wrench space (exact, polyhedral).
     pub fn gravity_free_margin(&self, v: &Vec3) -> Result<f64> {
         self.check_twist(v)?;
-        let a0 = self.spec.support_jacobian.transpose() * self.support_load(v);
-        Ok(self.wp.membership(&wrench_scaled(&a0, self.spec.length)).margin)
+        Ok(self.model.membership(&self.frame.support_load(v)).0)
     }
 
     /// Closest feasible twist to `d` in the metric `diag(1, 1, L²)` (exact cone): `d` itself
@@ -242,77 +320,8 @@ impl PlanarPush {
         if !d.iter().all(|x| x.is_finite()) {
             return Err(Error::arg("twist", "has a non-finite component"));
         }
-        if self.twist_norm(d) == 0.0 {
-            return Ok(Vec3::zeros());
-        }
-        if self.classify(d)?.feasible {
-            return Ok(*d);
-        }
-        let (cos, u) = self.nearest_boundary_ray(d);
-        Ok(if cos > 0.0 { u * (cos * self.twist_norm(d)) } else { Vec3::zeros() })
-    }
-
-    /// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images
-    /// of the boundary fans of `W_p`); returns the cosine and the unit ray.
-    fn nearest_boundary_ray(&self, d: &Vec3) -> (f64, Vec3) {
-        let l = self.spec.length;
-        let ds = twist_scaled(d, l) / twist_scaled(d, l).norm();
-        let score = |p: &Vec3| -> (f64, Vec3) {
-            match self.ray(&wrench_unscaled(p, l)) {
-                Some(v) => (twist_scaled(&v, l).dot(&ds), v),
-                None => (f64::NEG_INFINITY, Vec3::zeros()),
-            }
-        };
-        let mut best = (f64::NEG_INFINITY, Vec3::zeros());
-        for (i, j) in self.wp.boundary_segments() {
-            let (ea, eb) = (self.wp.edges[i], self.wp.edges[j]);
-            let at = |t: f64| ea * (1.0 - t) + eb * t;
-            if i == j {
-                let s = score(&ea);
-                if s.0 > best.0 {
-                    best = s;
-                }
-                continue;
-            }
-            const GRID: usize = 16;
-            let mut k_best = 0;
-            let mut s_best = score(&at(0.0));
-            for k in 1..=GRID {
-                let s = score(&at(k as f64 / GRID as f64));
-                if s.0 > s_best.0 {
-                    s_best = s;
-                    k_best = k;
-                }
-            }
-            // golden-section refinement around the best grid point
-            let (mut lo, mut hi) =
-                ((k_best.saturating_sub(1)) as f64 / GRID as f64, ((k_best + 1).min(GRID)) as f64 / GRID as f64);
-            let g = 0.5 * (5f64.sqrt() - 1.0);
-            let mut x1 = hi - g * (hi - lo);
-            let mut x2 = lo + g * (hi - lo);
-            let (mut f1, mut f2) = (score(&at(x1)), score(&at(x2)));
-            while hi - lo > 1e-11 {
-                if f1.0 >= f2.0 {
-                    hi = x2;
-                    x2 = x1;
-                    f2 = f1;
-                    x1 = hi - g * (hi - lo);
-                    f1 = score(&at(x1));
-                } else {
-                    lo = x1;
-                    x1 = x2;
-                    f1 = f2;
-                    x2 = lo + g * (hi - lo);
-                    f2 = score(&at(x2));
-                }
-            }
-            for s in [s_best, f1, f2] {
-                if s.0 > best.0 {
-                    best = s;
-                }
-            }
-        }
-        best
+        self.check_hold()?;
+        Ok(project_exact(&self.frame, &self.model, d))
     }
 
     /// For a point pusher: the object twist that results when the contact point moves with
@@ -331,27 +340,22 @@ impl PlanarPush {
             let lin = uhat * cp - pr * w;
             Vec3::new(lin.x, lin.y, w)
         };
-        let bt = self.spec.support_jacobian.transpose();
-        let binv = self.spec.limit_surface.b.try_inverse()?;
-        // moment about r of the required pusher wrench
+        let binv = self.spec.limit_surface.b_inv;
+        let js = self.spec.support_jacobian;
+        // moment about r of the required pusher wrench; non-decreasing in phi because the
+        // load wrench is the gradient of a convex dissipation function (a monotone map)
         let h = |phi: f64| -> f64 {
             let v = twist(phi);
-            let w = bt * LimitSurface::wrench_for_twist(&binv, &(self.spec.support_jacobian * v)) * s - self.spec.gravity;
-            w.z - crate::geometry::cross2(&r, &Vec2::new(w.x, w.y))
+            let w = js.tr_mul(&LimitSurface::wrench_for_twist(&binv, &(js * v))) * s - self.spec.gravity;
+            w.z - cross2(&r, &Vec2::new(w.x, w.y))
         };
         let half = std::f64::consts::FRAC_PI_2;
-        let (mut lo, mut hi) = (if un > 0.0 { -half } else { half }, half);
         if un == 0.0 {
-            // no translation of the contact point: pure rotation about it, one sign each way
-            for phi in [half, -half] {
-                if h(phi).abs() < 1e-12 * (1.0 + s) {
-                    return Some(twist(phi));
-                }
-            }
-            return None;
+            // the contact point does not move: a pure rotation about it, either way
+            return [half, -half].into_iter().find(|&phi| h(phi).abs() < 1e-12 * (1.0 + s)).map(twist);
         }
-        let (hlo, hhi) = (h(lo), h(hi));
-        if hlo > 0.0 || hhi < 0.0 {
+        let (mut lo, mut hi) = (-half, half);
+        if h(lo) > 0.0 || h(hi) < 0.0 {
             return None;
         }
         for _ in 0..100 {
@@ -366,10 +370,7 @@ impl PlanarPush {
             }
         }
         let phi = 0.5 * (lo + hi);
-        if phi.abs() >= half - 1e-12 {
-            return None;
-        }
-        Some(twist(phi))
+        (phi.abs() < half - 1e-12).then(|| twist(phi))
     }
 
     /// The same push with another friction scale (another grip force).
@@ -382,19 +383,19 @@ impl PlanarPush {
     ///
     /// A line pusher imposes the whole twist: with `a₀ = J_sᵀŵ₀(v)` (unit surface) and inward
     /// facet normals `nⱼ` of `W_p`, stability is `nⱼ·(s a₀ − w_g) ≥ 0`, linear in `s = μ_s N`
-    /// (*derived*). A point pusher imposes only its contact point's velocity; the rotation rate
-    /// adapts (see [`Self::point_pusher_twist`]) and the range is found numerically. `None` when
-    /// no grip force makes the motion stick.
+    /// (*derived*), and the support must hold: `s > √(u_gᵀ B u_g)`. A point pusher imposes only
+    /// its contact point's velocity; the rotation rate adapts (see
+    /// [`Self::point_pusher_twist`]) and the range is found numerically. `None` when no grip
+    /// force makes the motion stick.
     pub fn grip_force_range(&self, v: &Vec3) -> Result<Option<GripForceRange>> {
         self.check_twist(v)?;
         let per = self
             .spec
             .grip_per_scale
             .ok_or_else(|| Error::arg("scene", "grip force is defined only for a grasp (not an object on a surface)"))?;
-        let b = self.spec.limit_surface.b;
         // u_gᵀ A u_g = u_gᵀ B u_g / s² < 1  ⇔  s > √(u_gᵀ B u_g)
-        let s_hold = self.ug.dot(&(b * self.ug)).sqrt();
-        let range = if self.wp.is_solid() {
+        let s_hold = self.frame.ug.dot(&(self.spec.limit_surface.b * self.frame.ug)).sqrt();
+        let range = if self.model.cone.is_solid() {
             self.solid_scale_range(v, s_hold)
         } else {
             self.point_scale_range(v, s_hold)
@@ -402,17 +403,19 @@ impl PlanarPush {
         Ok(range.map(|(lo, hi)| GripForceRange { min: lo * per, max: hi * per }))
     }
 
+    fn unit_load(&self, v: &Vec3) -> Vec3 {
+        let js = self.spec.support_jacobian;
+        js.tr_mul(&LimitSurface::wrench_for_twist(&self.spec.limit_surface.b_inv, &(js * v)))
+    }
+
     fn solid_scale_range(&self, v: &Vec3, s_hold: f64) -> Option<(f64, f64)> {
-        let ConeShape::Solid { facets } = &self.wp.shape else { return None };
+        let ConeShape::Solid { facets } = &self.model.cone.shape else { return None };
         let l = self.spec.length;
-        let binv = self.spec.limit_surface.b.try_inverse()?;
-        let a0 = self.spec.support_jacobian.transpose()
-            * LimitSurface::wrench_for_twist(&binv, &(self.spec.support_jacobian * v));
-        let (a0s, wgs) = (wrench_scaled(&a0, l), wrench_scaled(&self.spec.gravity, l));
+        let (a0s, wgs) = (wrench_scaled(&self.unit_load(v), l), wrench_scaled(&self.spec.gravity, l));
         let (mut lo, mut hi) = (s_hold * (1.0 + 1e-12), f64::INFINITY);
+        let tol = 1e-12 * (a0s.norm() + wgs.norm());
         for f in facets {
             let (al, be) = (f.normal.dot(&a0s), f.normal.dot(&wgs));
-            let tol = 1e-12 * (a0s.norm() + wgs.norm());
             if al > tol {
                 lo = lo.max(be / al);
             } else if al < -tol {
@@ -425,29 +428,22 @@ impl PlanarPush {
     }
 
     fn point_scale_range(&self, v: &Vec3, s_hold: f64) -> Option<(f64, f64)> {
-        let ConeShape::Fan { inward, .. } = &self.wp.shape else { return None };
+        let ConeShape::Fan { inward, .. } = &self.model.cone.shape else { return None };
         let r = self.spec.pusher.points[0];
         let u = Vec2::new(v.x, v.y) + perp(&r) * v.z;
         let l = self.spec.length;
-        let bt = self.spec.support_jacobian.transpose();
-        let binv = self.spec.limit_surface.b.try_inverse()?;
         let sticks = |s: f64| -> bool {
-            match self.point_pusher_twist(&u, s) {
-                None => false,
-                Some(t) => {
-                    let w = bt * LimitSurface::wrench_for_twist(&binv, &(self.spec.support_jacobian * t)) * s
-                        - self.spec.gravity;
-                    let ws = wrench_scaled(&w, l);
-                    let n = ws.norm().max(1e-300);
-                    inward.iter().all(|m| m.dot(&ws) / n >= -MEMBERSHIP_TOL)
-                }
-            }
+            self.point_pusher_twist(&u, s).is_some_and(|t| {
+                let ws = wrench_scaled(&(self.unit_load(&t) * s - self.spec.gravity), l);
+                let n = ws.norm().max(1e-300);
+                inward.iter().all(|m| m.dot(&ws) / n >= -MEMBERSHIP_TOL)
+            })
         };
         let base = if s_hold > 0.0 { s_hold } else { self.spec.friction_scale * 1e-6 };
+        // geometric scan over 8 decades, then bisection at the transitions
         let grid: Vec<f64> = (0..=240).map(|k| base * (1.0 + 1e-9) * 10f64.powf(k as f64 * 8.0 / 240.0)).collect();
         let first = grid.iter().position(|&s| sticks(s))?;
         let refine = |mut a: f64, mut b: f64, want_a: bool| {
-            // sticks(a) == want_a, sticks(b) != want_a
             for _ in 0..80 {
                 let m = (a * b).sqrt();
                 if sticks(m) == want_a {
@@ -456,33 +452,98 @@ impl PlanarPush {
                     b = m;
                 }
             }
-            if want_a { a } else { b }
+            if want_a {
+                a
+            } else {
+                b
+            }
         };
         let lo = if first == 0 { grid[0] } else { refine(grid[first - 1], grid[first], false) };
-        let last = grid[first..].iter().position(|&s| !sticks(s)).map(|k| k + first);
-        let hi = match last {
+        let hi = match grid[first..].iter().position(|&s| !sticks(s)) {
             None => f64::INFINITY,
-            Some(k) => refine(grid[k - 1], grid[k], true),
+            Some(k) => refine(grid[first + k - 1], grid[first + k], true),
         };
         Some((lo, hi))
     }
 }
 
-/// `[vx, vz, L ω]`.
-#[inline]
-pub fn twist_scaled(v: &Vec3, l: f64) -> Vec3 {
-    Vec3::new(v.x, v.y, v.z * l)
+/// Closest feasible twist (see [`PlanarPush::project`]); the support must hold.
+pub fn project_exact(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> Vec3 {
+    let l = model.length;
+    let dn = twist_scaled(d, l).norm();
+    if dn == 0.0 {
+        return Vec3::zeros();
+    }
+    if frame.classify(model, d).feasible {
+        return *d;
+    }
+    let (cos, u) = nearest_boundary_ray(frame, model, d);
+    if cos > 0.0 {
+        u * (cos * dn)
+    } else {
+        Vec3::zeros()
+    }
 }
 
-/// `[fx, fz, τ / L]`.
-#[inline]
-pub fn wrench_scaled(w: &Vec3, l: f64) -> Vec3 {
-    Vec3::new(w.x, w.y, w.z / l)
-}
-
-#[inline]
-fn wrench_unscaled(w: &Vec3, l: f64) -> Vec3 {
-    Vec3::new(w.x, w.y, w.z * l)
+/// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images of
+/// the boundary fans of `W_p`): a grid over each fan, then golden-section refinement. Returns
+/// the cosine and the unit ray.
+fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> (f64, Vec3) {
+    let l = model.length;
+    let ds = twist_scaled(d, l).normalize();
+    let score = |p: &Vec3| -> (f64, Vec3) {
+        match frame.ray(&wrench_unscaled(p, l), l) {
+            Some(v) => (twist_scaled(&v, l).dot(&ds), v),
+            None => (f64::NEG_INFINITY, Vec3::zeros()),
+        }
+    };
+    let mut best = (f64::NEG_INFINITY, Vec3::zeros());
+    let mut keep = |s: (f64, Vec3)| {
+        if s.0 > best.0 {
+            best = s;
+        }
+    };
+    for (i, j) in model.cone.boundary_segments() {
+        let (ea, eb) = (model.cone.edges[i], model.cone.edges[j]);
+        if i == j {
+            keep(score(&ea));
+            continue;
+        }
+        let at = |t: f64| ea * (1.0 - t) + eb * t;
+        const GRID: usize = 16;
+        let mut k_best = 0;
+        let mut s_best = score(&at(0.0));
+        for k in 1..=GRID {
+            let s = score(&at(k as f64 / GRID as f64));
+            if s.0 > s_best.0 {
+                s_best = s;
+                k_best = k;
+            }
+        }
+        let (mut lo, mut hi) = (k_best.saturating_sub(1) as f64 / GRID as f64, (k_best + 1).min(GRID) as f64 / GRID as f64);
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        let (mut f1, mut f2) = (score(&at(x1)), score(&at(x2)));
+        while hi - lo > 1e-11 {
+            if f1.0 >= f2.0 {
+                hi = x2;
+                x2 = x1;
+                f2 = f1;
+                x1 = hi - g * (hi - lo);
+                f1 = score(&at(x1));
+            } else {
+                lo = x1;
+                x1 = x2;
+                f1 = f2;
+                x2 = lo + g * (hi - lo);
+                f2 = score(&at(x2));
+            }
+        }
+        keep(s_best);
+        keep(f1);
+        keep(f2);
+    }
+    best
 }
 
 /// Euclidean projection of `d` onto the cone generated by `gens` (non-negative least squares,
@@ -498,17 +559,17 @@ pub fn project_onto_generators(gens: &[Vec3], d: &Vec3) -> (Vec3, Vec<f64>) {
         }
         let g = nalgebra::Matrix3xX::from_columns(&idx.iter().map(|&i| gens[i]).collect::<Vec<_>>());
         let gtg = g.transpose() * &g;
-        let Some(inv) = gtg.clone().try_inverse() else { continue };
         if gtg.determinant().abs() < 1e-14 * gtg.norm().powi(idx.len() as i32) {
             continue;
         }
+        let Some(inv) = gtg.try_inverse() else { continue };
         let alpha = inv * (g.transpose() * d);
         if alpha.iter().any(|&a| a < 0.0) {
             continue;
         }
         let p = &g * &alpha;
         let res = (d - p).norm_squared();
-        if res < best.0 - 1e-300 {
+        if res < best.0 {
             let mut w = vec![0.0; k];
             for (j, &i) in idx.iter().enumerate() {
                 w[i] = alpha[j];
@@ -518,4 +579,3 @@ pub fn project_onto_generators(gens: &[Vec3], d: &Vec3) -> (Vec3, Vec<f64>) {
     }
     (best.1, best.2)
 }
-

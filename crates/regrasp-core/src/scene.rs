@@ -9,7 +9,7 @@ use crate::friction_cone::PusherContact;
 use crate::geometry::{rot, shift_jacobian, Mat3, Polygon, Vec2, Vec3};
 use crate::gravity::gravity_wrench;
 use crate::limit_surface::{LimitSurface, Pressure, PressureDistribution};
-use crate::motion_cone::{PlanarPush, PushSpec};
+use crate::motion_cone::{PlanarPush, PushSpec, PusherModel, SupportFrame};
 use serde::{Deserialize, Serialize};
 
 // ---------------------------------------------------------------------------------------------
@@ -125,6 +125,8 @@ pub enum Support {
 pub struct Pusher {
     pub name: String,
     pub contact: PusherContact,
+    /// Its generalized friction cone in the object frame (pose-independent).
+    pub model: PusherModel,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -304,6 +306,10 @@ impl Scene {
         }
 
         let length = outline.gyration_radius_sq(&com).sqrt();
+        for (i, p) in pushers.iter_mut().enumerate() {
+            p.model = PusherModel::new(p.contact.clone(), length)
+                .map_err(|e| Error::scene(format!("pushers[{i}]"), e.to_string()))?;
+        }
         let mut scene = Scene {
             name,
             description: raw.description.clone(),
@@ -445,7 +451,10 @@ impl Scene {
                 ));
             }
         }
-        Ok(Pusher { name, contact: PusherContact { points, normal, friction } })
+        let contact = PusherContact { points, normal, friction };
+        let model = PusherModel::new(contact.clone(), size)
+            .map_err(|e| Error::scene(field.to_string(), e.to_string()))?;
+        Ok(Pusher { name, contact, model })
     }
 
     pub fn pusher_index(&self, name: &str) -> Result<usize> {
@@ -517,16 +526,7 @@ impl Scene {
 
     /// `J_s` at pose `q`: object twist → support twist (support frame).
     pub fn support_jacobian(&self, q: &[f64; 3]) -> Mat3 {
-        match &self.support {
-            Support::Grasp(_) => {
-                let r = rot(q[2]);
-                let c = -(rot(-q[2]) * Vec2::new(q[0], q[1]));
-                let mut axes = Mat3::identity();
-                axes.fixed_view_mut::<2, 2>(0, 0).copy_from(&r);
-                axes * shift_jacobian(&c)
-            }
-            Support::Surface(s) => shift_jacobian(&s.cop),
-        }
+        self.frame(q).js
     }
 
     fn limit_surface(&self) -> LimitSurface {
@@ -538,16 +538,10 @@ impl Scene {
 
     /// How much of the support's friction gravity alone uses at `q` (< 1 to hold).
     pub fn hold_ratio(&self, q: &[f64; 3]) -> f64 {
-        let js_inv_t = match self.support_jacobian(q).try_inverse() {
-            Some(m) => m.transpose(),
-            None => return f64::INFINITY,
-        };
-        let ug = js_inv_t * self.gravity_wrench(q);
-        let a = self.limit_surface().matrix(self.friction_scale());
-        ug.dot(&(a * ug)).sqrt()
+        self.frame(q).hold_ratio
     }
 
-    fn check_pose(&self, q: &[f64; 3]) -> Result<()> {
+    pub fn check_pose(&self, q: &[f64; 3]) -> Result<()> {
         if !q.iter().all(|x| x.is_finite()) {
             return Err(Error::arg("pose", "has a non-finite component"));
         }
@@ -555,6 +549,36 @@ impl Scene {
             return Err(Error::arg("pose", format!("{q:?} is not admissible: the finger pad is not entirely on the object")));
         }
         Ok(())
+    }
+
+    /// Pose-dependent quantities of every push at `q` (no admissibility check).
+    pub fn frame(&self, q: &[f64; 3]) -> SupportFrame {
+        let s = self.friction_scale();
+        let ls = self.limit_surface();
+        let (js, js_inv) = match &self.support {
+            Support::Grasp(_) => {
+                // J_s = diag(R, 1) · shift(c), c = −Rᵀ t the pad centre in the object frame
+                let r = rot(q[2]);
+                let c = -(r.transpose() * Vec2::new(q[0], q[1]));
+                let mut axes = Mat3::identity();
+                axes.fixed_view_mut::<2, 2>(0, 0).copy_from(&r);
+                let mut axes_t = Mat3::identity();
+                axes_t.fixed_view_mut::<2, 2>(0, 0).copy_from(&r.transpose());
+                (axes * shift_jacobian(&c), shift_jacobian(&-c) * axes_t)
+            }
+            Support::Surface(sf) => (shift_jacobian(&sf.cop), shift_jacobian(&-sf.cop)),
+        };
+        SupportFrame::new(ls.matrix(s), ls.matrix_inv(s), js, js_inv, self.gravity_wrench(q))
+    }
+
+    /// Checks a pose and returns its frame; the error says what is wrong.
+    pub fn checked_frame(&self, q: &[f64; 3]) -> Result<SupportFrame> {
+        self.check_pose(q)?;
+        let f = self.frame(q);
+        if f.hold_ratio >= 1.0 {
+            return Err(Error::GraspCannotHold { pose: *q, ratio: f.hold_ratio });
+        }
+        Ok(f)
     }
 
     /// The definition of pusher `pusher` acting at pose `q`.

@@ -5,7 +5,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use regrasp::friction_cone::ConeShape;
+use regrasp::friction_cone::{ConeShape, ContactLimit};
 use regrasp::geometry::{Vec2, Vec3};
 use regrasp::motion_cone::{project_onto_generators, twist_scaled, Classification, PlanarPush};
 use regrasp::{batch, Error};
@@ -206,45 +206,27 @@ impl Scene {
         Ok(MotionCone { push: push.map_err(to_py)?, pusher: pusher.to_string() })
     }
 
-    /// Polyhedral generators at many poses: (generators (n, k, 3), valid (n,), errors).
+    /// Polyhedral (or gravity-free) generators at many poses: (generators (n, k, 3),
+    /// status (n,) uint8; 0 = ok, see `status_messages`).
     fn generators_many<'py>(
         &self,
         py: Python<'py>,
         poses: PyReadonlyArray2<f64>,
         pusher: &str,
         gravity_free: bool,
-    ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<bool>>, Vec<Option<String>>)> {
+    ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<u8>>)> {
         let q = rows3("poses", &poses)?;
         let i = self.inner.pusher_index(pusher).map_err(to_py)?;
-        let k = self.inner.pushers[i].contact.points.len() * 2;
-        let res = py.allow_threads(|| {
-            if gravity_free {
-                batch::gravity_free_generators(&self.inner, &q, i)
-            } else {
-                batch::generators(&self.inner, &q, i)
-            }
-        });
-        let mut g = Array3::zeros((q.len(), k, 3));
-        let mut valid = Array1::from_elem(q.len(), false);
-        let mut errors = Vec::with_capacity(q.len());
-        for (n, r) in res.into_iter().enumerate() {
-            match r {
-                Ok(gens) => {
-                    for (j, v) in gens.iter().enumerate() {
-                        for c in 0..3 {
-                            g[(n, j, c)] = v[c];
-                        }
-                    }
-                    valid[n] = true;
-                    errors.push(None);
-                }
-                Err(e) => errors.push(Some(e.to_string())),
-            }
-        }
-        Ok((g.into_pyarray(py), valid.into_pyarray(py), errors))
+        let k = self.inner.pushers[i].model.edges.len();
+        let mut out = vec![0.0; q.len() * k * 3];
+        let mut st = vec![batch::Status::Ok; q.len()];
+        py.allow_threads(|| batch::generators_into(&self.inner, &q, i, gravity_free, &mut out, &mut st));
+        let g = Array3::from_shape_vec((q.len(), k, 3), out).expect("shape");
+        Ok((g.into_pyarray(py), status_array(py, &st)))
     }
 
-    /// Exact test of twist i at pose i: (feasible, margin, active limit label, valid, errors).
+    /// Exact test of twist i at pose i: (feasible, margin, active-limit labels, status).
+    /// Exact test of twist i at pose i: (feasible, margin, active-limit codes, status).
     #[allow(clippy::type_complexity)]
     fn classify_many<'py>(
         &self,
@@ -252,75 +234,64 @@ impl Scene {
         poses: PyReadonlyArray2<f64>,
         twists: PyReadonlyArray2<f64>,
         pusher: &str,
-    ) -> PyResult<(
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyArray1<f64>>,
-        Vec<String>,
-        Bound<'py, PyArray1<bool>>,
-        Vec<Option<String>>,
-    )> {
+    ) -> PyResult<(Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u8>>, Bound<'py, PyArray1<u8>>)> {
         let q = rows3("poses", &poses)?;
-        let t: Vec<Vec3> = rows3("twists", &twists)?.iter().map(|v| Vec3::new(v[0], v[1], v[2])).collect();
+        let t = rows3("twists", &twists)?;
         if q.len() != t.len() {
             return Err(arg_err("twists", format!("has {} rows but poses has {}", t.len(), q.len())));
         }
         let i = self.inner.pusher_index(pusher).map_err(to_py)?;
-        let res = py.allow_threads(|| batch::classify(&self.inner, &q, &t, i));
         let n = q.len();
-        let (mut feas, mut margin, mut valid) = (Array1::from_elem(n, false), Array1::zeros(n), Array1::from_elem(n, false));
-        let mut labels = Vec::with_capacity(n);
-        let mut errors = Vec::with_capacity(n);
-        for (k, r) in res.into_iter().enumerate() {
-            match r {
-                Ok(c) => {
-                    feas[k] = c.feasible;
-                    margin[k] = c.margin;
-                    valid[k] = true;
-                    labels.push(c.limit.label());
-                    errors.push(None);
-                }
-                Err(e) => {
-                    labels.push(String::new());
-                    errors.push(Some(e.to_string()));
-                }
-            }
-        }
-        Ok((feas.into_pyarray(py), margin.into_pyarray(py), labels, valid.into_pyarray(py), errors))
+        let (mut fe, mut ma) = (vec![false; n], vec![0.0; n]);
+        let mut li = vec![ContactLimit::Torque; n];
+        let mut st = vec![batch::Status::Ok; n];
+        py.allow_threads(|| batch::classify_into(&self.inner, &q, &t, i, &mut fe, &mut ma, &mut li, &mut st));
+        let codes: Vec<u8> = li.iter().map(|l| l.code()).collect();
+        Ok((
+            Array1::from(fe).into_pyarray(py),
+            Array1::from(ma).into_pyarray(py),
+            Array1::from(codes).into_pyarray(py),
+            status_array(py, &st),
+        ))
     }
 
-    /// Closest feasible twist to twist i at pose i: (projections (n, 3), valid, errors).
+    /// Closest feasible twist to twist i at pose i: (projections (n, 3), status).
     fn project_many<'py>(
         &self,
         py: Python<'py>,
         poses: PyReadonlyArray2<f64>,
         twists: PyReadonlyArray2<f64>,
         pusher: &str,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<bool>>, Vec<Option<String>>)> {
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>)> {
         let q = rows3("poses", &poses)?;
-        let t: Vec<Vec3> = rows3("twists", &twists)?.iter().map(|v| Vec3::new(v[0], v[1], v[2])).collect();
+        let t = rows3("twists", &twists)?;
         if q.len() != t.len() {
             return Err(arg_err("twists", format!("has {} rows but poses has {}", t.len(), q.len())));
         }
         let i = self.inner.pusher_index(pusher).map_err(to_py)?;
-        let res = py.allow_threads(|| batch::project(&self.inner, &q, &t, i));
-        let n = q.len();
-        let mut out = Array2::zeros((n, 3));
-        let mut valid = Array1::from_elem(n, false);
-        let mut errors = Vec::with_capacity(n);
-        for (k, r) in res.into_iter().enumerate() {
-            match r {
-                Ok(v) => {
-                    for c in 0..3 {
-                        out[(k, c)] = v[c];
-                    }
-                    valid[k] = true;
-                    errors.push(None);
-                }
-                Err(e) => errors.push(Some(e.to_string())),
-            }
-        }
-        Ok((out.into_pyarray(py), valid.into_pyarray(py), errors))
+        let mut out = vec![0.0; 3 * q.len()];
+        let mut st = vec![batch::Status::Ok; q.len()];
+        py.allow_threads(|| batch::project_into(&self.inner, &q, &t, i, &mut out, &mut st));
+        let o = Array2::from_shape_vec((q.len(), 3), out).expect("shape");
+        Ok((o.into_pyarray(py), status_array(py, &st)))
     }
+
+    /// Labels of the contact-limit codes returned by `classify_many`.
+    #[staticmethod]
+    fn limit_labels() -> Vec<String> {
+        ContactLimit::ALL.iter().map(|l| l.label()).collect()
+    }
+
+    /// Messages of the batch status codes.
+    #[staticmethod]
+    fn status_messages() -> Vec<(u8, &'static str)> {
+        use batch::Status::*;
+        [Ok, NonFinite, Inadmissible, CannotHold, ZeroTwist].iter().map(|s| (*s as u8, s.message())).collect()
+    }
+}
+
+fn status_array<'py>(py: Python<'py>, st: &[batch::Status]) -> Bound<'py, PyArray1<u8>> {
+    Array1::from(st.iter().map(|s| *s as u8).collect::<Vec<u8>>()).into_pyarray(py)
 }
 
 /// The motion cone of one pusher at one pose.
@@ -431,11 +402,18 @@ impl MotionCone {
         })
     }
 
-    /// Membership in the polyhedral approximation.
-    fn contains_polyhedral(&self, twist: Vec<f64>) -> PyResult<bool> {
-        let v = vec3("twist", &twist)?;
+    /// Membership in the polyhedral approximation, of one twist or an (n, 3) array.
+    fn contains_polyhedral(&self, py: Python<'_>, twist: &Bound<'_, PyAny>) -> PyResult<PyObject> {
+        let (ts, many) = self.twists(twist)?;
         let cone = self.push.polyhedral_cone().map_err(to_py)?;
-        Ok(cone.contains(&twist_scaled(&v, self.push.length()), regrasp::motion_cone::MEMBERSHIP_TOL))
+        let l = self.push.length();
+        let m: Vec<bool> =
+            ts.iter().map(|v| cone.contains(&twist_scaled(v, l), regrasp::motion_cone::MEMBERSHIP_TOL)).collect();
+        Ok(if many {
+            Array1::from(m).into_pyarray(py).into_any().unbind()
+        } else {
+            pyo3::types::PyBool::new(py, m[0]).to_owned().into_any().unbind()
+        })
     }
 
     /// Margin of a twist in the gravity-free cone (exact, polyhedral).
