@@ -59,8 +59,14 @@ class RefParams:
         return np.array(out)
 
 
+def _metric_norm(p: RefParams, v: np.ndarray) -> np.ndarray:
+    """Norm of twists in the metric [velocity of the COM, L omega]."""
+    w = v[..., 2]
+    return np.sqrt((v[..., 0] - w * p.com[1]) ** 2 + (v[..., 1] + w * p.com[0]) ** 2 + (p.L * w) ** 2)
+
+
 def generators_numpy(p: RefParams, pose) -> np.ndarray:
-    """Polyhedral motion-cone generators at one pose (unit twists in diag(1, 1, L²))."""
+    """Polyhedral motion-cone generators at one pose (unit twists in the COM metric)."""
     x, z, th = pose
     c, s = np.cos(th), np.sin(th)
     R = np.array([[c, -s], [s, c]])
@@ -83,7 +89,7 @@ def generators_numpy(p: RefParams, pose) -> np.ndarray:
         b = 2 * u @ A @ ug
         lam = (-b + np.sqrt(b * b - 4 * a * cq)) / (2 * a)
         v = Jinv @ A @ (lam * u + ug)
-        out.append(v / np.sqrt(v[0] ** 2 + v[1] ** 2 + (p.L * v[2]) ** 2))
+        out.append(v / _metric_norm(p, v))
     return np.array(out)
 
 
@@ -120,8 +126,7 @@ def generators_numpy_batch(p: RefParams, poses: np.ndarray) -> np.ndarray:
     lam = (-b + np.sqrt(b * b - 4 * a * cq[:, None])) / (2 * a)
     w = lam[..., None] * u + ug[:, None, :]
     v = np.einsum("nij,nej->nei", Jinv, w * Ad)
-    norm = np.sqrt(v[..., 0] ** 2 + v[..., 1] ** 2 + (p.L * v[..., 2]) ** 2)
-    return v / norm[..., None]
+    return v / _metric_norm(p, v)[..., None]
 
 
 def classify_numpy_batch(p: RefParams, poses: np.ndarray, twists: np.ndarray) -> np.ndarray:
@@ -133,8 +138,12 @@ def classify_numpy_batch(p: RefParams, poses: np.ndarray, twists: np.ndarray) ->
     w = vs / Ad
     w /= np.sqrt(np.einsum("ni,ni->n", vs, w))[:, None]
     wp = np.einsum("nji,nj->ni", Js, w) - wg
-    # facets of the line pusher's cone: inward normals from pairs of scaled edges
-    E = p.edges() * np.array([1.0, 1.0, 1.0 / p.L])
+    # facets of the line pusher's cone: inward normals from pairs of edges in the wrench metric
+    # [f, moment about the COM / L] (the same facets in any metric; this one sets the margins)
+    def scaled(w):
+        return np.stack([w[..., 0], w[..., 1], (w[..., 2] - (p.com[0] * w[..., 1] - p.com[1] * w[..., 0])) / p.L], -1)
+
+    E = scaled(p.edges())
     normals = []
     for i in range(len(E)):
         for j in range(i + 1, len(E)):
@@ -147,6 +156,6 @@ def classify_numpy_batch(p: RefParams, poses: np.ndarray, twists: np.ndarray) ->
             elif all(o <= 1e-12 for o in others):
                 normals.append(-nrm / np.linalg.norm(nrm))
     N = np.array(normals)
-    ws = wp * np.array([1.0, 1.0, 1.0 / p.L])
+    ws = scaled(wp)
     ws /= np.linalg.norm(ws, axis=1)[:, None]
     return np.all(ws @ N.T >= -1e-9, axis=1)

@@ -88,9 +88,10 @@ class MotionCone:
     """Motion cone of one pusher at one pose (RSS 2018; thesis §3.3).
 
     ``generators``: polyhedral approximation, one unit twist a row (one per edge of the
-    pusher's friction cone). ``contains``/``margin``/``classify``: the exact test (is the
-    twist producible with a sticking pusher?). ``project``: closest feasible twist in the
-    metric diag(1, 1, L^2). ``gravity_free``: the gravity-free cone.
+    pusher's friction cone; unit in the metric of :meth:`Scene.metric_twist`).
+    ``contains``/``margin``/``classify``: the exact test (is the twist producible with a
+    sticking pusher?). ``project``: closest feasible twist in that metric. ``gravity_free``:
+    the gravity-free cone.
     """
 
     def __init__(self, core: "_core.MotionCone", scene: "Scene"):
@@ -149,7 +150,8 @@ class MotionCone:
         )
 
     def project(self, twist):
-        """Closest feasible twist (exact cone) to one twist or to each row of an (n, 3) array."""
+        """Closest feasible twist (exact cone) to one twist or to each row of an (n, 3) array,
+        in the metric of :meth:`Scene.metric_twist`."""
         t = np.asarray(twist, dtype=float)
         return self._core.project(np.ascontiguousarray(t) if t.ndim == 2 else list(_vec(t, 3, "twist")))
 
@@ -173,10 +175,8 @@ class MotionCone:
 
     def central_twist(self) -> np.ndarray:
         """A twist well inside the gravity-free cone: the normalized sum of its generators."""
-        g = self.gravity_free_generators
-        L = self.scene.length
-        s = g.sum(axis=0)
-        return s / np.sqrt(s[0] ** 2 + s[1] ** 2 + (L * s[2]) ** 2)
+        s = self.scene.metric_twist(self.gravity_free_generators).sum(axis=0)
+        return self.scene.metric_twist_inv(s / np.linalg.norm(s))
 
     def ray(self, wrench: ArrayLike) -> Optional[np.ndarray]:
         """Unit twist of the exact cone produced by pusher wrench ``wrench`` (or None)."""
@@ -239,6 +239,31 @@ class MotionConeBatch:
         return out
 
 
+def _non_finite(x, path: str):
+    """Dotted path of the first non-finite number in a nested dict/list, or None."""
+    if isinstance(x, dict):
+        for k, v in x.items():
+            r = _non_finite(v, f"{path}.{k}" if path else str(k))
+            if r is not None:
+                return r
+    elif isinstance(x, (list, tuple, np.ndarray)):
+        for i, v in enumerate(x):
+            r = _non_finite(v, f"{path}[{i}]")
+            if r is not None:
+                return r
+    elif isinstance(x, (float, np.floating)) and not np.isfinite(x):
+        return path
+    return None
+
+
+def _jsonable(x):
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    raise TypeError(f"{type(x).__name__} is not a scene value")
+
+
 class Scene:
     """A validated planar scene. Load with :meth:`Scene.load` (TOML) or :meth:`Scene.from_dict`."""
 
@@ -261,8 +286,12 @@ class Scene:
 
     @classmethod
     def from_dict(cls, d: dict) -> "Scene":
+        """A scene from a dict with the layout of the TOML file (numbers may be numpy scalars)."""
+        bad = _non_finite(d, "")
+        if bad is not None:
+            raise SceneError(f"scene field `{bad}`: must be a finite number", bad)
         try:
-            text = json.dumps(d, allow_nan=True)
+            text = json.dumps(d, allow_nan=False, default=_jsonable)
         except (TypeError, ValueError) as e:
             raise SceneError(f"scene is not serializable: {e}", None) from e
         return cls(_core.Scene.from_json(text))
@@ -299,6 +328,21 @@ class Scene:
     def length(self) -> float:
         """Characteristic length L [m] weighing rotation against translation."""
         return self._core.length
+
+    def metric_twist(self, twist) -> np.ndarray:
+        """Twists (rows) in the frame-invariant metric: [velocity of the COM, L omega]. Norms,
+        distances and projections of regrasp are Euclidean in these coordinates."""
+        v = np.asarray(twist, dtype=float)
+        c, L = self.com, self.length
+        w = v[..., 2]
+        return np.stack([v[..., 0] - w * c[1], v[..., 1] + w * c[0], L * w], axis=-1)
+
+    def metric_twist_inv(self, scaled) -> np.ndarray:
+        """Inverse of :meth:`metric_twist`."""
+        s = np.asarray(scaled, dtype=float)
+        c, L = self.com, self.length
+        w = s[..., 2] / L
+        return np.stack([s[..., 0] + w * c[1], s[..., 1] - w * c[0], w], axis=-1)
 
     @property
     def mass(self) -> float:

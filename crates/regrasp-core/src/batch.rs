@@ -3,7 +3,7 @@
 //! others.
 
 use crate::geometry::Vec3;
-use crate::motion_cone::{project_exact, twist_scaled, SupportFrame};
+use crate::motion_cone::{project_exact, SupportFrame};
 use crate::scene::Scene;
 use rayon::prelude::*;
 
@@ -64,7 +64,7 @@ pub fn generators_into(
 ) {
     let model = &scene.pushers[pusher].model;
     let k = model.edges.len();
-    let l = scene.length;
+    let m = scene.metric();
     assert_eq!(out.len(), poses.len() * k * 3);
     assert_eq!(status.len(), poses.len());
     let work = |(q, (o, st)): (&[f64; 3], (&mut [f64], &mut Status))| {
@@ -87,7 +87,7 @@ pub fn generators_into(
             Ok(f) => {
                 *st = Status::Ok;
                 for (j, e) in model.edges.iter().enumerate() {
-                    let v = if gravity_free { Some(f.gravity_free_ray(&e.wrench, l)) } else { f.ray(&e.wrench, l) };
+                    let v = if gravity_free { Some(f.gravity_free_ray(&e.wrench, &m)) } else { f.ray(&e.wrench, &m) };
                     let v = v.unwrap_or_else(Vec3::zeros);
                     o[3 * j..3 * j + 3].copy_from_slice(v.as_slice());
                 }
@@ -115,7 +115,7 @@ pub fn classify_into(
     status: &mut [Status],
 ) {
     let model = &scene.pushers[pusher].model;
-    let l = scene.length;
+    let m = scene.metric();
     let n = poses.len();
     assert!(twists.len() == n && feasible.len() == n && margin.len() == n && limit.len() == n && status.len() == n);
     (0..n)
@@ -138,7 +138,7 @@ pub fn classify_into(
                     return;
                 }
             };
-            if twist_scaled(&v, l).norm() == 0.0 {
+            if m.twist_norm(&v) == 0.0 {
                 *st = Status::ZeroTwist;
                 return;
             }

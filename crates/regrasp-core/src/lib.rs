@@ -7,9 +7,11 @@ pub mod friction_cone;
 pub mod geometry;
 pub mod gravity;
 pub mod limit_surface;
+pub mod metric;
 pub mod motion_cone;
 pub mod scene;
 
 pub use error::{Error, Result};
+pub use metric::Metric;
 pub use motion_cone::{Classification, GripForceRange, PlanarPush, PushSpec};
 pub use scene::Scene;

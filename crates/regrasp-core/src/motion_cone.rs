@@ -14,8 +14,8 @@
 //! The same construction covers a grasp (support = finger pads) and an object on a surface
 //! (support = the surface under it, Mason 1986; Lynch & Mason 1996).
 //!
-//! Twists are compared in the metric `diag(1, 1, L²)` and wrenches in `diag(1, 1, 1/L²)` (L: a
-//! characteristic length of the object), which are dual to each other.
+//! Twists and wrenches are compared in the frame-invariant, dual metrics of [`Metric`]
+//! (centre-of-mass velocity and `Lω`; force and moment about the centre of mass over `L`).
 //!
 //! Split as in MuJoCo's model/data: a [`PusherModel`] (pose-independent: the pusher's cone in
 //! the object frame) and a [`SupportFrame`] (everything that depends on the pose).
@@ -24,26 +24,10 @@ use crate::error::{Error, Result};
 use crate::friction_cone::{ConeShape, ContactLimit, EdgeWrench, PolyhedralCone, PusherContact};
 use crate::geometry::{cross2, perp, Mat3, Vec2, Vec3};
 use crate::limit_surface::LimitSurface;
+use crate::metric::Metric;
 
 /// Tolerance of the exact membership test on the (dimensionless) margin.
 pub const MEMBERSHIP_TOL: f64 = 1e-9;
-
-/// `[vx, vz, L ω]`.
-#[inline]
-pub fn twist_scaled(v: &Vec3, l: f64) -> Vec3 {
-    Vec3::new(v.x, v.y, v.z * l)
-}
-
-/// `[fx, fz, τ / L]`.
-#[inline]
-pub fn wrench_scaled(w: &Vec3, l: f64) -> Vec3 {
-    Vec3::new(w.x, w.y, w.z / l)
-}
-
-#[inline]
-fn wrench_unscaled(w: &Vec3, l: f64) -> Vec3 {
-    Vec3::new(w.x, w.y, w.z * l)
-}
 
 /// A pusher's generalized friction cone in the object frame (pose-independent).
 #[derive(Clone, Debug)]
@@ -51,26 +35,26 @@ pub struct PusherModel {
     pub contact: PusherContact,
     /// Edge wrenches, physical units, unit normal force (eq 3.6).
     pub edges: Vec<EdgeWrench>,
-    /// `W_p` in the scaled wrench space `[fx, fz, τ/L]`.
+    /// `W_p` in the scaled wrench space of `metric`.
     pub cone: PolyhedralCone,
-    pub length: f64,
+    pub metric: Metric,
 }
 
 impl PusherModel {
-    pub fn new(contact: PusherContact, length: f64) -> Result<Self> {
-        if !(length > 0.0) {
+    pub fn new(contact: PusherContact, metric: Metric) -> Result<Self> {
+        if !(metric.length > 0.0) {
             return Err(Error::arg("length", "must be positive"));
         }
         let edges = contact.edge_wrenches();
-        let scaled: Vec<Vec3> = edges.iter().map(|e| wrench_scaled(&e.wrench, length)).collect();
+        let scaled: Vec<Vec3> = edges.iter().map(|e| metric.wrench(&e.wrench)).collect();
         let cone = PolyhedralCone::from_edges(&scaled)
             .map_err(|e| Error::arg("pusher", format!("its friction cone is degenerate ({e:?})")))?;
-        Ok(Self { contact, edges, cone, length })
+        Ok(Self { contact, edges, cone, metric })
     }
 
     /// Signed margin of pusher wrench `w` and the contact limit nearest to it.
     pub fn membership(&self, w: &Vec3) -> (f64, ContactLimit) {
-        let m = self.cone.membership(&wrench_scaled(w, self.length));
+        let m = self.cone.membership(&self.metric.wrench(w));
         (m.margin, self.contact.limit_of(&self.edges, m.active))
     }
 }
@@ -99,10 +83,10 @@ impl SupportFrame {
         Self { a, a_inv, js, js_inv, gravity, ug, hold_ratio }
     }
 
-    /// The motion-cone ray (unit twist in `diag(1,1,L²)`) of pusher wrench direction `p`;
+    /// The motion-cone ray (unit twist in `metric`) of pusher wrench direction `p`;
     /// `None` if the support cannot hold the object (no positive root).
     #[inline]
-    pub fn ray(&self, p: &Vec3, l: f64) -> Option<Vec3> {
+    pub fn ray(&self, p: &Vec3, metric: &Metric) -> Option<Vec3> {
         let u = self.js_inv.tr_mul(p);
         let au = self.a * u;
         let qa = u.dot(&au);
@@ -115,14 +99,14 @@ impl SupportFrame {
         // positive root, in the cancellation-free form
         let lambda = if qb >= 0.0 { 2.0 * qc / (-qb - disc) } else { (-qb + disc) / (2.0 * qa) };
         let v = self.js_inv * (au * lambda + self.a * self.ug);
-        Some(v / twist_scaled(&v, l).norm())
+        Some(v / metric.twist_norm(&v))
     }
 
     /// Ray of the gravity-free cone for pusher wrench `p`: `J_s⁻¹ A J_s⁻ᵀ p`, unit.
     #[inline]
-    pub fn gravity_free_ray(&self, p: &Vec3, l: f64) -> Vec3 {
+    pub fn gravity_free_ray(&self, p: &Vec3, metric: &Metric) -> Vec3 {
         let v = self.js_inv * (self.a * self.js_inv.tr_mul(p));
-        v / twist_scaled(&v, l).norm()
+        v / metric.twist_norm(&v)
     }
 
     /// Load wrench on the support for twist `v`, mapped to the object frame: `J_sᵀ ŵ` (eq 3.10).
@@ -155,8 +139,8 @@ pub struct PushSpec {
     pub pusher: PusherContact,
     /// Gravity wrench in the object frame.
     pub gravity: Vec3,
-    /// Characteristic length L [m] of the metrics.
-    pub length: f64,
+    /// Metrics on twists and wrenches.
+    pub metric: Metric,
     /// The pose, for error messages.
     pub pose: [f64; 3],
     /// Grip force of each finger per unit `friction_scale` (`1/(2μ_s)` for a two-pad grasp);
@@ -209,7 +193,7 @@ impl PlanarPush {
         if !(spec.friction_scale > 0.0) || !spec.friction_scale.is_finite() {
             return Err(Error::arg("friction_scale", "must be positive and finite"));
         }
-        let model = PusherModel::new(spec.pusher.clone(), spec.length)?;
+        let model = PusherModel::new(spec.pusher.clone(), spec.metric)?;
         let js_inv = spec
             .support_jacobian
             .try_inverse()
@@ -249,24 +233,24 @@ impl PlanarPush {
         &self.model.edges
     }
 
-    /// The pusher's generalized friction cone in the scaled wrench space `[fx, fz, τ/L]`.
+    /// The pusher's generalized friction cone in the scaled wrench space of the metric.
     pub fn pusher_cone(&self) -> &PolyhedralCone {
         &self.model.cone
     }
 
-    pub fn length(&self) -> f64 {
-        self.spec.length
+    pub fn metric(&self) -> &Metric {
+        &self.spec.metric
     }
 
-    /// Norm of a twist in the metric `diag(1, 1, L²)`.
+    /// Norm of a twist in the metric.
     pub fn twist_norm(&self, v: &Vec3) -> f64 {
-        twist_scaled(v, self.spec.length).norm()
+        self.spec.metric.twist_norm(v)
     }
 
     /// The motion-cone ray produced by pusher wrench direction `p` (physical units), as a unit
     /// twist; `None` if the support cannot hold the object.
     pub fn ray(&self, p: &Vec3) -> Option<Vec3> {
-        self.frame.ray(p, self.spec.length)
+        self.frame.ray(p, &self.spec.metric)
     }
 
     /// Generators of the polyhedral approximation: one ray per edge of `W_p`, unit twists.
@@ -277,7 +261,7 @@ impl PlanarPush {
 
     /// Generators of the gravity-free cone `J_s⁻¹ A J_s⁻ᵀ e_i`, unit twists.
     pub fn gravity_free_generators(&self) -> Vec<Vec3> {
-        self.model.edges.iter().map(|e| self.frame.gravity_free_ray(&e.wrench, self.spec.length)).collect()
+        self.model.edges.iter().map(|e| self.frame.gravity_free_ray(&e.wrench, &self.spec.metric)).collect()
     }
 
     fn check_twist(&self, v: &Vec3) -> Result<()> {
@@ -301,9 +285,9 @@ impl PlanarPush {
         Ok(self.classify(v)?.feasible)
     }
 
-    /// The polyhedral approximation as a cone in the scaled twist space `[vx, vz, Lω]`.
+    /// The polyhedral approximation as a cone in the scaled twist space of the metric.
     pub fn polyhedral_cone(&self) -> Result<PolyhedralCone> {
-        let g: Vec<Vec3> = self.generators()?.iter().map(|v| twist_scaled(v, self.spec.length)).collect();
+        let g: Vec<Vec3> = self.generators()?.iter().map(|v| self.spec.metric.twist(v)).collect();
         PolyhedralCone::from_edges(&g).map_err(|e| Error::arg("pusher", format!("degenerate motion cone ({e:?})")))
     }
 
@@ -313,7 +297,7 @@ impl PlanarPush {
         Ok(self.model.membership(&self.frame.support_load(v)).0)
     }
 
-    /// Closest feasible twist to `d` in the metric `diag(1, 1, L²)` (exact cone): `d` itself
+    /// Closest feasible twist to `d` in the twist metric (exact cone): `d` itself
     /// when feasible, else `⟨d, û⟩ û` for the boundary ray `û` nearest in angle (zero when no
     /// ray makes an acute angle with `d`).
     pub fn project(&self, d: &Vec3) -> Result<Vec3> {
@@ -330,7 +314,7 @@ impl PlanarPush {
     /// `None` when no rotation rate balances the moments.
     pub fn point_pusher_twist(&self, u: &Vec2, s: f64) -> Option<Vec3> {
         let r = *self.spec.pusher.points.first()?;
-        let l = self.spec.length;
+        let l = self.spec.metric.length;
         let un = u.norm();
         let uhat = if un > 0.0 { u / un } else { Vec2::zeros() };
         let pr = perp(&r);
@@ -410,8 +394,8 @@ impl PlanarPush {
 
     fn solid_scale_range(&self, v: &Vec3, s_hold: f64) -> Option<(f64, f64)> {
         let ConeShape::Solid { facets } = &self.model.cone.shape else { return None };
-        let l = self.spec.length;
-        let (a0s, wgs) = (wrench_scaled(&self.unit_load(v), l), wrench_scaled(&self.spec.gravity, l));
+        let m = &self.spec.metric;
+        let (a0s, wgs) = (m.wrench(&self.unit_load(v)), m.wrench(&self.spec.gravity));
         let (mut lo, mut hi) = (s_hold * (1.0 + 1e-12), f64::INFINITY);
         let tol = 1e-12 * (a0s.norm() + wgs.norm());
         for f in facets {
@@ -431,10 +415,10 @@ impl PlanarPush {
         let ConeShape::Fan { inward, .. } = &self.model.cone.shape else { return None };
         let r = self.spec.pusher.points[0];
         let u = Vec2::new(v.x, v.y) + perp(&r) * v.z;
-        let l = self.spec.length;
+        let m = &self.spec.metric;
         let sticks = |s: f64| -> bool {
             self.point_pusher_twist(&u, s).is_some_and(|t| {
-                let ws = wrench_scaled(&(self.unit_load(&t) * s - self.spec.gravity), l);
+                let ws = m.wrench(&(self.unit_load(&t) * s - self.spec.gravity));
                 let n = ws.norm().max(1e-300);
                 inward.iter().all(|m| m.dot(&ws) / n >= -MEMBERSHIP_TOL)
             })
@@ -469,8 +453,7 @@ impl PlanarPush {
 
 /// Closest feasible twist (see [`PlanarPush::project`]); the support must hold.
 pub fn project_exact(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> Vec3 {
-    let l = model.length;
-    let dn = twist_scaled(d, l).norm();
+    let dn = model.metric.twist_norm(d);
     if dn == 0.0 {
         return Vec3::zeros();
     }
@@ -489,11 +472,11 @@ pub fn project_exact(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> Vec
 /// the boundary fans of `W_p`): a grid over each fan, then golden-section refinement. Returns
 /// the cosine and the unit ray.
 fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> (f64, Vec3) {
-    let l = model.length;
-    let ds = twist_scaled(d, l).normalize();
+    let m = &model.metric;
+    let ds = m.twist(d).normalize();
     let score = |p: &Vec3| -> (f64, Vec3) {
-        match frame.ray(&wrench_unscaled(p, l), l) {
-            Some(v) => (twist_scaled(&v, l).dot(&ds), v),
+        match frame.ray(&m.wrench_inv(p), m) {
+            Some(v) => (m.twist(&v).dot(&ds), v),
             None => (f64::NEG_INFINITY, Vec3::zeros()),
         }
     };

@@ -9,6 +9,7 @@ use crate::friction_cone::PusherContact;
 use crate::geometry::{rot, shift_jacobian, Mat3, Polygon, Vec2, Vec3};
 use crate::gravity::gravity_wrench;
 use crate::limit_surface::{LimitSurface, Pressure, PressureDistribution};
+use crate::metric::Metric;
 use crate::motion_cone::{PlanarPush, PushSpec, PusherModel, SupportFrame};
 use serde::{Deserialize, Serialize};
 
@@ -202,7 +203,7 @@ impl Scene {
             let msg = e.message().to_string();
             let field = e
                 .span()
-                .map(|s| format!("(line {})", text[..s.start.min(text.len())].lines().count().max(1)))
+                .map(|s| format!("(line {})", text[..s.start.min(text.len())].matches('\n').count() + 1))
                 .unwrap_or_default();
             Error::scene(field, msg)
         })?;
@@ -307,7 +308,7 @@ impl Scene {
 
         let length = outline.gyration_radius_sq(&com).sqrt();
         for (i, p) in pushers.iter_mut().enumerate() {
-            p.model = PusherModel::new(p.contact.clone(), length)
+            p.model = PusherModel::new(p.contact.clone(), Metric::new(com, length))
                 .map_err(|e| Error::scene(format!("pushers[{i}]"), e.to_string()))?;
         }
         let mut scene = Scene {
@@ -343,20 +344,43 @@ impl Scene {
                             format!("pose {q:?} is not admissible: the finger pad is not entirely on the object"),
                         ));
                     }
-                    let ratio = scene.hold_ratio(&q);
-                    if ratio >= 1.0 {
-                        return Err(Error::scene(
-                            "grasp.force",
-                            format!(
-                                "the grasp cannot hold the object against gravity at {field} = {q:?}: gravity needs {ratio:.3}x the friction the pads can give"
-                            ),
-                        ));
-                    }
+                    scene.check_holds(&q, field)?;
                 }
                 scene.task = Some(Task { start, goal, tolerance: tol });
             }
         }
+        if let Support::Surface(_) = scene.support {
+            // the support frame sits under the centre of mass: holding depends on the heading only
+            for k in 0..16 {
+                let th = k as f64 * std::f64::consts::PI / 8.0;
+                scene.check_holds(&[0.0, 0.0, th], "surface")?;
+            }
+        }
         Ok(scene)
+    }
+
+    /// Error naming the field to change when gravity alone would make the support slip at `q`.
+    fn check_holds(&self, q: &[f64; 3], at: &str) -> Result<()> {
+        let ratio = self.hold_ratio(q);
+        if ratio < 1.0 {
+            return Ok(());
+        }
+        Err(match &self.support {
+            Support::Grasp(_) => Error::scene(
+                "grasp.force",
+                format!(
+                    "the grasp cannot hold the object against gravity at {at} = {q:?}: gravity needs {ratio:.3}x the friction the pads can give"
+                ),
+            ),
+            Support::Surface(s) => Error::scene(
+                "surface.friction",
+                format!(
+                    "the object slides down the incline by itself (heading {:.3} rad): gravity needs {ratio:.3}x the friction the surface can give (tan(incline) = {:.3})",
+                    q[2],
+                    s.incline.tan()
+                ),
+            ),
+        })
     }
 
     fn grasp(gr: &RawGrasp) -> Result<Grasp> {
@@ -372,6 +396,12 @@ impl Scene {
         let pad = match gr.pad_shape.as_deref() {
             None | Some("circle") => PadShape::Circle { radius: positive("grasp.pad_radius", gr.pad_radius)? },
             Some("rectangle") => {
+                if gr.pad_radius.is_some() {
+                    return Err(Error::scene(
+                        "grasp.pad_radius",
+                        "a rectangular pad is sized by grasp.pad_size; remove pad_radius",
+                    ));
+                }
                 let s = gr.pad_size.ok_or_else(|| Error::scene("grasp.pad_size", "is required for a rectangular pad"))?;
                 PadShape::Rectangle {
                     width: positive("grasp.pad_size[0]", Some(s[0]))?,
@@ -452,7 +482,7 @@ impl Scene {
             }
         }
         let contact = PusherContact { points, normal, friction };
-        let model = PusherModel::new(contact.clone(), size)
+        let model = PusherModel::new(contact.clone(), Metric::new(Vec2::zeros(), size))
             .map_err(|e| Error::scene(field.to_string(), e.to_string()))?;
         Ok(Pusher { name, contact, model })
     }
@@ -551,6 +581,11 @@ impl Scene {
         Ok(())
     }
 
+    /// The frame-invariant metrics on twists and wrenches of this object.
+    pub fn metric(&self) -> Metric {
+        Metric::new(self.com, self.length)
+    }
+
     /// Pose-dependent quantities of every push at `q` (no admissibility check).
     pub fn frame(&self, q: &[f64; 3]) -> SupportFrame {
         let s = self.friction_scale();
@@ -591,7 +626,7 @@ impl Scene {
             support_jacobian: self.support_jacobian(q),
             pusher: p.contact.clone(),
             gravity: self.gravity_wrench(q),
-            length: self.length,
+            metric: self.metric(),
             pose: *q,
             grip_per_scale: match &self.support {
                 Support::Grasp(g) => Some(1.0 / (2.0 * g.friction)),

@@ -150,11 +150,8 @@ proptest! {
         for _ in 0..300 {
             let wp: Vec3 = edges.iter().map(|e| e.wrench * next().powi(3)).sum();
             let Some(u) = push.ray(&wp) else { continue };
-            let s = push.twist_norm(&d) * 0.0 + {
-                let l = push.length();
-                let (us, ds) = (Vec3::new(u.x, u.y, u.z * l), Vec3::new(d.x, d.y, d.z * l));
-                us.dot(&ds).max(0.0)
-            };
+            let m = push.metric();
+            let s = m.twist(&u).dot(&m.twist(&d)).max(0.0);
             prop_assert!(dist(&p) <= dist(&(u * s)) + 1e-9, "sampled ray closer: {} < {}", dist(&(u * s)), dist(&p));
         }
     }
@@ -172,8 +169,7 @@ proptest! {
             let v = twist_from_angles(a1, a2, scene.length);
             let c = push.classify(&v).unwrap();
             let poly = push.polyhedral_cone().unwrap();
-            let l = scene.length;
-            let m = poly.membership(&Vec3::new(v.x, v.y, v.z * l)).margin;
+            let m = poly.membership(&scene.metric().twist(&v)).margin;
             if c.margin.abs() > 1e-7 && m.abs() > 1e-7 {
                 prop_assert_eq!(c.feasible, m >= 0.0);
             }
@@ -185,8 +181,8 @@ proptest! {
     #[test]
     fn large_grip_force_tends_to_gravity_free(b in block_case()) {
         let Some(scene) = scene(&b) else { return Ok(()) };
-        let l = scene.length;
-        let sc = |v: &Vec3| Vec3::new(v.x, v.y, v.z * l);
+        let metric = scene.metric();
+        let sc = |v: &Vec3| metric.twist(v);
         let mut seq = Vec::new();
         for f in [1.0, 10.0, 100.0, 1000.0] {
             let s = scene.with_grip_force(b.force * f);
@@ -236,6 +232,10 @@ proptest! {
         if c1.margin.abs() > 1e-6 {
             prop_assert_eq!(c1.feasible, c2.feasible);
         }
+        // margins and projections are frame-invariant too (metrics about the centre of mass)
+        prop_assert!((c1.margin - c2.margin).abs() < 1e-8, "margins {} vs {}", c1.margin, c2.margin);
+        let (j1, j2) = (p1.project(&v).unwrap(), p2.project(&to2(&v)).unwrap());
+        prop_assert!(p2.twist_norm(&(to2(&j1) - j2)) < 1e-7 * (1.0 + p2.twist_norm(&j2)), "projections differ");
     }
 
     /// Inside the grip-force range the twist sticks; outside it does not (line pushers).

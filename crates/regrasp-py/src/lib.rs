@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use regrasp::friction_cone::{ConeShape, ContactLimit};
 use regrasp::geometry::{Vec2, Vec3};
-use regrasp::motion_cone::{project_onto_generators, twist_scaled, Classification, PlanarPush};
+use regrasp::motion_cone::{project_onto_generators, Classification, PlanarPush};
 use regrasp::{batch, Error};
 
 /// Raise the Python exception (defined in `regrasp.errors`) matching a core error.
@@ -324,7 +324,7 @@ impl MotionCone {
     }
     #[getter]
     fn length(&self) -> f64 {
-        self.push.length()
+        self.push.metric().length
     }
     #[getter]
     fn hold_ratio(&self) -> f64 {
@@ -406,9 +406,9 @@ impl MotionCone {
     fn contains_polyhedral(&self, py: Python<'_>, twist: &Bound<'_, PyAny>) -> PyResult<PyObject> {
         let (ts, many) = self.twists(twist)?;
         let cone = self.push.polyhedral_cone().map_err(to_py)?;
-        let l = self.push.length();
+        let mt = self.push.metric();
         let m: Vec<bool> =
-            ts.iter().map(|v| cone.contains(&twist_scaled(v, l), regrasp::motion_cone::MEMBERSHIP_TOL)).collect();
+            ts.iter().map(|v| cone.contains(&mt.twist(v), regrasp::motion_cone::MEMBERSHIP_TOL)).collect();
         Ok(if many {
             Array1::from(m).into_pyarray(py).into_any().unbind()
         } else {
@@ -441,10 +441,10 @@ impl MotionCone {
             "gravity_free" => self.push.gravity_free_generators(),
             _ => return Err(PyValueError::new_err("which must be \"approx\" or \"gravity_free\"")),
         };
-        let l = self.push.length();
-        let gs: Vec<Vec3> = gens.iter().map(|g| twist_scaled(g, l)).collect();
-        let (p, _) = project_onto_generators(&gs, &twist_scaled(&v, l));
-        Ok(Array1::from(vec![p.x, p.y, p.z / l]).into_pyarray(py))
+        let m = self.push.metric();
+        let gs: Vec<Vec3> = gens.iter().map(|g| m.twist(g)).collect();
+        let (p, _) = project_onto_generators(&gs, &m.twist(&v));
+        Ok(Array1::from(m.twist_inv(&p).as_slice().to_vec()).into_pyarray(py))
     }
 
     /// Per-finger grip-force range [min, max] for which the pusher motion of `twist` sticks.
@@ -472,6 +472,7 @@ impl MotionCone {
             ConeShape::Solid { .. } => "solid",
             ConeShape::Fan { .. } => "fan",
             ConeShape::Ray => "ray",
+            ConeShape::Full => "full",
         }
     }
 }

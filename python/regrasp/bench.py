@@ -1,0 +1,124 @@
+"""End-to-end speed probe (``regrasp bench``): the Rust core through the Python API against
+plain numpy implementations of the same equations, measured in the same run.
+
+Each entry reports the median wall time of the regrasp call, the median of the baseline and
+their ratio (baseline / regrasp), plus the largest difference between the two answers.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import reference
+from .scene import Scene
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def _median_time(fn, reps: int) -> float:
+    ts = []
+    for _ in range(reps):
+        t0 = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t0)
+    return float(np.median(ts))
+
+
+def _random_poses(scene: Scene, n: int, rng) -> np.ndarray:
+    out = np.empty((0, 3))
+    while len(out) < n:
+        q = np.column_stack(
+            [rng.uniform(-0.02, 0.02, 2 * n), rng.uniform(-0.035, 0.035, 2 * n), rng.uniform(-0.6, 0.6, 2 * n)]
+        )
+        out = np.vstack([out, q[scene.admissible(q)]])
+    return out[:n]
+
+
+def run(n: int = 100_000, reps: int = 5, baseline_reps: int = 3, scene_path=None, pusher: str = "left") -> dict:
+    scene = Scene.load(scene_path or EXAMPLES / "block-low-friction.toml")
+    rng = np.random.default_rng(0)
+    poses = _random_poses(scene, n, rng)
+    params = reference.RefParams.from_scene(scene, pusher)
+    L = scene.length
+    twists = rng.normal(size=(n, 3)) * np.array([1.0, 1.0, 1.0 / L])
+    results = {}
+
+    # one batch of n cones: Rust (threads) vs a per-cone numpy loop and vectorized numpy
+    rust = scene.motion_cones(poses, pusher)
+    loop = np.array([reference.generators_numpy(params, q) for q in poses[: min(n, 2000)]])
+    vec = reference.generators_numpy_batch(params, poses)
+    diff = max(np.abs(rust.generators[: len(loop)] - loop).max(), np.abs(rust.generators - vec).max())
+    t_rust = _median_time(lambda: scene.motion_cones(poses, pusher), reps)
+    t_loop = _median_time(lambda: [reference.generators_numpy(params, q) for q in poses], baseline_reps)
+    t_vec = _median_time(lambda: reference.generators_numpy_batch(params, poses), reps)
+    results[f"cone_batch_{n}"] = {
+        "median_s": t_rust,
+        "baseline_median_s": t_loop,
+        "ratio": t_loop / t_rust,
+        "baseline": "numpy, one cone per call (thesis equations)",
+        "n": n,
+        "max_abs_diff": float(diff),
+    }
+    results[f"cone_batch_{n}_vs_vectorized_numpy"] = {
+        "median_s": t_rust,
+        "baseline_median_s": t_vec,
+        "ratio": t_vec / t_rust,
+        "baseline": "numpy, vectorized over poses (einsum)",
+        "n": n,
+        "max_abs_diff": float(np.abs(rust.generators - vec).max()),
+    }
+
+    # exact membership of n twists (one per pose)
+    got = rust.contains(twists)
+    ref = reference.classify_numpy_batch(params, poses, twists)
+    t_rust = _median_time(lambda: rust.contains(twists), reps)
+    t_vec = _median_time(lambda: reference.classify_numpy_batch(params, poses, twists), reps)
+    results[f"membership_batch_{n}"] = {
+        "median_s": t_rust,
+        "baseline_median_s": t_vec,
+        "ratio": t_vec / t_rust,
+        "baseline": "numpy, vectorized over poses",
+        "n": n,
+        "disagreements": int((got != ref).sum()),
+    }
+
+    # one cone from Python, call by call
+    q0 = poses[0]
+    m = 2000
+    t_one = _median_time(lambda: [scene.motion_cone(q0, pusher).generators for _ in range(m)], reps) / m
+    t_np = _median_time(lambda: [reference.generators_numpy(params, q0) for _ in range(m)], reps) / m
+    results["cone_single_call"] = {
+        "median_s": t_one,
+        "baseline_median_s": t_np,
+        "ratio": t_np / t_one,
+        "baseline": "numpy, one cone per call",
+        "n": 1,
+    }
+
+    # projection onto the exact cone (no numpy baseline: reported as throughput)
+    k = min(n, 20_000)
+    sub = scene.motion_cones(poses[:k], pusher)
+    t_proj = _median_time(lambda: sub.project(twists[:k]), reps)
+    t_poly = _median_time(
+        lambda: [scene.motion_cone(q, pusher).project_polyhedral(t) for q, t in zip(poses[:500], twists[:500])], 1
+    ) * (k / 500)
+    results[f"project_exact_batch_{k}"] = {
+        "median_s": t_proj,
+        "baseline_median_s": t_poly,
+        "ratio": t_poly / t_proj,
+        "baseline": "polyhedral projection (NNLS) called one by one from Python",
+        "n": k,
+    }
+    return results
+
+
+def format_results(res: dict) -> str:
+    lines = [f"{'benchmark':42s} {'regrasp':>12s} {'baseline':>12s} {'ratio':>9s}  baseline"]
+    for name, r in res.items():
+        lines.append(
+            f"{name:42s} {r['median_s'] * 1e3:10.3f}ms {r['baseline_median_s'] * 1e3:10.3f}ms {r['ratio']:8.1f}x  {r['baseline']}"
+        )
+    return "\n".join(lines)

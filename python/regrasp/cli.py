@@ -1,0 +1,188 @@
+"""Command line: ``regrasp cone | approx-error | bench | demo``.
+
+Exit status: 0 success, 1 the task cannot be done (reason printed), 2 invalid input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ArgumentError, GraspError, RegraspError, SceneError
+from .scene import Scene
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def _floats(text: str, n: int, name: str) -> np.ndarray:
+    try:
+        v = np.array([float(x) for x in text.split(",")])
+    except ValueError:
+        raise ArgumentError(f"invalid `{name}`: expected {n} comma-separated numbers, got {text!r}", name)
+    if v.shape != (n,) or not np.all(np.isfinite(v)):
+        raise ArgumentError(f"invalid `{name}`: expected {n} finite comma-separated numbers, got {text!r}", name)
+    return v
+
+
+def _json_float(x):
+    return None if x is None or not np.isfinite(x) else float(x)
+
+
+def cone_report(scene: Scene, pose, pusher: str, twist=None) -> dict:
+    """Everything `regrasp cone --json` prints."""
+    hold = scene.hold_grip_force(pose)
+    probe = scene.motion_cone(pose, pusher, check_hold=False)
+    twist = probe.central_twist() if twist is None else np.asarray(twist, float)
+    rng = probe.grip_force_range(twist) if scene.grip_force is not None else None
+    cone = scene.motion_cone(pose, pusher)  # raises GraspError when it cannot hold
+    return {
+        "scene": scene.name,
+        "pusher": pusher,
+        "pose": [float(x) for x in pose],
+        "generators": cone.generators.tolist(),
+        "gravity_free_generators": cone.gravity_free_generators.tolist(),
+        "min_grip_force": None if rng is None else _json_float(rng[0]),
+        "max_grip_force": None if rng is None else _json_float(rng[1]),
+        "min_grip_force_twist": twist.tolist(),
+        "grip_force": scene.grip_force,
+        "hold_grip_force": hold,
+        "hold_ratio": cone.hold_ratio,
+        "pusher_kind": "line" if cone.is_line_pusher else "point",
+        "twist_metric_length": scene.length,
+    }
+
+
+def cmd_cone(a) -> int:
+    scene = Scene.load(a.scene)
+    pose = _floats(a.pose, 3, "--pose")
+    twist = None if a.twist is None else _floats(a.twist, 3, "--twist")
+    try:
+        rep = cone_report(scene, pose, a.pusher, twist)
+    except GraspError as e:
+        hold = scene.hold_grip_force(pose)
+        print(f"regrasp: {e} (holding needs at least {hold:.3f} N per finger)", file=sys.stderr)
+        return 1
+    if a.plot:
+        from .plotting import plot_motion_cone
+
+        plot_motion_cone(scene.motion_cone(pose, a.pusher), a.plot)
+    if a.json:
+        print(json.dumps(rep))
+    else:
+        print(f"motion cone of pusher '{a.pusher}' in scene '{scene.name}' at pose {rep['pose']}")
+        print(f"  ({rep['pusher_kind']} pusher; twists [vx, vz, omega] in the object frame, unit in diag(1,1,L^2), L = {scene.length:.4f} m)")
+        print("  generators (polyhedral approximation):")
+        for g in rep["generators"]:
+            print("    [{:+.5f}, {:+.5f}, {:+.4f}]".format(*g))
+        print("  gravity-free cone generators:")
+        for g in rep["gravity_free_generators"]:
+            print("    [{:+.5f}, {:+.5f}, {:+.4f}]".format(*g))
+        mn, mx = rep["min_grip_force"], rep["max_grip_force"]
+        rng = "none" if mn is None else f"[{mn:.3f}, {'inf' if mx is None else f'{mx:.3f}'}] N"
+        print(f"  grip force {scene.grip_force} N per finger; holding needs {rep['hold_grip_force']:.3f} N")
+        print(f"  grip forces at which the central gravity-free twist sticks: {rng}")
+        if a.plot:
+            print(f"  figure: {a.plot}")
+    return 0
+
+
+def cmd_approx_error(a) -> int:
+    from .report import approximation_report, format_report
+
+    paths = a.scenes or sorted(EXAMPLES.glob("*.toml"))
+    scenes = [Scene.load(p) for p in paths]
+    forces = _floats(a.forces, len(a.forces.split(",")), "--forces")
+    rows = approximation_report(scenes, tuple(forces), a.samples, a.seed)
+    print(json.dumps(rows) if a.json else format_report(rows))
+    return 0
+
+
+def cmd_bench(a) -> int:
+    from .bench import format_results, run
+
+    n = 10_000 if a.quick else a.n
+    res = run(n=n, reps=3 if a.quick else 5, baseline_reps=1 if a.quick else 3)
+    print(json.dumps(res) if a.json else format_results(res))
+    return 0
+
+
+def cmd_demo(a) -> int:
+    from .plotting import plot_motion_cone
+    from .report import approximation_report, format_report
+
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    path = EXAMPLES / "block-low-friction.toml"
+    scene = Scene.load(path)
+    start = scene.task.start
+    print(f"demo: motion cones of every pusher of {path.name} at the start pose {start.tolist()}")
+    reports = []
+    for p in scene.pusher_names:
+        rep = cone_report(scene, start, p)
+        fig = plot_motion_cone(scene.motion_cone(start, p), out / f"cone-{p}.png")
+        reports.append(rep)
+        mn = rep["min_grip_force"]
+        print(f"  {p:8s} {rep['pusher_kind']:5s} pusher: {len(rep['generators'])} generators, "
+              f"central push sticks above {mn:.2f} N per finger -> {fig}")
+    (out / "cones.json").write_text(json.dumps(reports, indent=1))
+    rows = approximation_report([scene], (5.0, 20.0, 80.0), samples=5000)
+    print("\npolyhedral approximation vs exact cone (share of random pushes misclassified):")
+    print(format_report(rows))
+    print(f"\nwrote {out / 'cones.json'} and {len(reports)} figures in {out}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="regrasp", description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+
+    c = sub.add_parser("cone", help="motion cone of a pusher at a pose")
+    c.add_argument("scene")
+    c.add_argument("--pose", required=True, help="x,z,theta (m, m, rad)")
+    c.add_argument("--pusher", required=True)
+    c.add_argument("--twist", help="vx,vz,omega for min_grip_force (default: the central gravity-free twist)")
+    c.add_argument("--json", action="store_true")
+    c.add_argument("--plot", metavar="PNG")
+    c.set_defaults(fn=cmd_cone)
+
+    e = sub.add_parser("approx-error", help="polyhedral approximation vs exact cone, per scene and grip force")
+    e.add_argument("scenes", nargs="*", help="scene files (default: every bundled example)")
+    e.add_argument("--forces", default="5,20,80", help="grip forces per finger, N")
+    e.add_argument("--samples", type=int, default=20000)
+    e.add_argument("--seed", type=int, default=0)
+    e.add_argument("--json", action="store_true")
+    e.set_defaults(fn=cmd_approx_error)
+
+    b = sub.add_parser("bench", help="speed probe against numpy baselines")
+    b.add_argument("--json", action="store_true")
+    b.add_argument("--quick", action="store_true", help="10,000 cones instead of 100,000")
+    b.add_argument("-n", type=int, default=100_000)
+    b.set_defaults(fn=cmd_bench)
+
+    d = sub.add_parser("demo", help="the bundled example end to end, writing its figures")
+    d.add_argument("--out", default="out/demo")
+    d.set_defaults(fn=cmd_demo)
+    return ap
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.fn(args)
+    except (SceneError, ArgumentError) as e:
+        print(f"regrasp: {e}", file=sys.stderr)
+        return 2
+    except GraspError as e:
+        print(f"regrasp: {e}", file=sys.stderr)
+        return 1
+    except RegraspError as e:
+        print(f"regrasp: {e}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

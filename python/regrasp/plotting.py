@@ -1,0 +1,164 @@
+"""Figures: the motion cone in wrench and twist space (thesis Fig 3-10)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .scene import MotionCone
+
+
+def _lambda(A, Js, wg, p):
+    """Positive root of (l u + ug)^T A (l u + ug) = 1, u = Js^-T p (see motion_cone.rs)."""
+    JinvT = np.linalg.inv(Js).T
+    u, ug = JinvT @ p, JinvT @ wg
+    a, b, c = u @ A @ u, 2 * u @ A @ ug, ug @ A @ ug - 1
+    return (-b + np.sqrt(b * b - 4 * a * c)) / (2 * a)
+
+
+def boundary_samples(cone: MotionCone, n: int = 40):
+    """Points on the boundary of the exact cone: for each boundary fan of the pusher's friction
+    cone, pusher wrench directions p(t), the balancing wrench w_g + lambda p (object frame) and
+    the twist ray. Returns a list of (wrenches (n, 3), twists (n, 3)) per fan."""
+    A, Js, wg = cone._core.support_matrices
+    E = cone._core.pusher_edges
+    L = cone.scene.length
+    S = np.array([1.0, 1.0, 1.0 / L])
+    out = []
+    for i, j in cone._core.boundary_segments:
+        ei, ej = E[i] * S / np.linalg.norm(E[i] * S), E[j] * S / np.linalg.norm(E[j] * S)
+        ws, ts = [], []
+        for t in np.linspace(0, 1, n if i != j else 1):
+            p = ((1 - t) * ei + t * ej) / S
+            lam = _lambda(A, Js, wg, p)
+            ws.append(wg + lam * p)
+            ts.append(cone.ray(p))
+        out.append((np.array(ws), np.array(ts)))
+    return out
+
+
+def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
+    """Two 3-D panels: (left) wrench space: the limit surface, the pusher's friction cone shifted
+    by gravity and their intersection (the wrench set); (right) twist space: the exact, curved
+    motion cone, its polyhedral approximation and the gravity-free cone."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    sc = cone.scene
+    L, com = sc.length, sc.com
+
+    def Wm(w):  # wrench metric: [f, moment about the COM / L]
+        w = np.asarray(w, float)
+        return np.stack([w[..., 0], w[..., 1], (w[..., 2] - (com[0] * w[..., 1] - com[1] * w[..., 0])) / L], axis=-1)
+
+    Tm = sc.metric_twist  # twist metric: [COM velocity, L omega]
+    A, Js, wg = cone._core.support_matrices
+    fig = plt.figure(figsize=(18, 6))
+
+    # --- wrench space -------------------------------------------------------------------------
+    ax = fig.add_subplot(1, 3, 1, projection="3d")
+    # limit surface {Js^T w : w^T A w = 1}: w = A^{-1/2} s for s on the unit sphere
+    evals, evecs = np.linalg.eigh(A)
+    Ainvh = evecs @ np.diag(evals**-0.5) @ evecs.T
+    uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
+    sph = np.stack([np.cos(uu) * np.sin(vv), np.sin(uu) * np.sin(vv), np.cos(vv)], axis=-1)
+    ell = Wm(np.einsum("ij,jk,...k->...i", Js.T, Ainvh, sph))
+    ax.plot_wireframe(ell[..., 0], ell[..., 1], ell[..., 2], color="0.6", linewidth=0.3, alpha=0.5)
+    # pusher cone shifted by gravity: apex at w_g
+    E = cone._core.pusher_edges
+    reach = 1.3 * np.max(np.linalg.norm(ell.reshape(-1, 3), axis=1))
+    apex = Wm(wg)
+    segs = cone._core.boundary_segments
+    for i, j in segs:
+        ei, ej = Wm(E[i]), Wm(E[j])
+        ei, ej = ei / np.linalg.norm(ei) * reach, ej / np.linalg.norm(ej) * reach
+        ax.add_collection3d(Poly3DCollection([[apex, apex + ei, apex + ej]], alpha=0.15, color="tab:blue"))
+    for e in E:
+        es = Wm(e)
+        ax.plot(*np.stack([apex, apex + es / np.linalg.norm(es) * reach]).T, color="tab:blue", lw=1)
+    ax.scatter(*apex, color="k", s=20)
+    ax.text(*apex, "  w_g", fontsize=8)
+    samples = boundary_samples(cone)
+    for k, (ws, _) in enumerate(samples):
+        ax.plot(*Wm(ws).T, color="tab:red", lw=2.5, label="wrench set boundary" if k == 0 else None)
+    ax.set_xlabel("f_x [N]")
+    ax.set_ylabel("f_z [N]")
+    ax.set_zlabel("tau_com / L [N]")
+    ax.set_title("wrench space: limit surface, pusher cone + gravity")
+    ax.legend(loc="upper left", fontsize=8)
+
+    # --- twist space --------------------------------------------------------------------------
+    ax = fig.add_subplot(1, 3, 2, projection="3d")
+    o = np.zeros(3)
+    for k, (_, ts) in enumerate(samples):
+        ts = Tm(ts)
+        tris = [[o, ts[m], ts[m + 1]] for m in range(len(ts) - 1)]
+        ax.add_collection3d(Poly3DCollection(tris, alpha=0.12, color="tab:red"))
+        ax.plot(*ts.T, color="tab:red", lw=2, label="exact cone (curved)" if k == 0 else None)
+    G = Tm(cone.generators)
+    GF = Tm(cone.gravity_free_generators)
+    for k, g in enumerate(G):
+        ax.plot(*np.stack([o, g]).T, color="tab:green", lw=2, label="polyhedral approximation" if k == 0 else None)
+    for i, j in segs:
+        if i != j:
+            ax.add_collection3d(Poly3DCollection([[o, G[i], G[j]]], alpha=0.12, color="tab:green"))
+    for k, g in enumerate(GF):
+        ax.plot(*np.stack([o, g]).T, color="k", ls="--", lw=1, label="gravity-free cone" if k == 0 else None)
+    ax.set_xlim(-1, 1)
+    ax.set_ylim(-1, 1)
+    ax.set_zlim(-1, 1)
+    ax.set_xlabel("v_com,x [m/s]")
+    ax.set_ylabel("v_com,z [m/s]")
+    ax.set_zlabel("L omega [m/s]")
+    ax.set_title("twist space: motion cone (unit twists)")
+    ax.legend(loc="upper left", fontsize=8)
+
+    # --- chart of ray directions: angles about the cone's axis --------------------------------
+    ax = fig.add_subplot(1, 3, 3)
+    axis = GF.sum(axis=0)
+    axis /= np.linalg.norm(axis)
+    # e2: the direction along which the cone spreads most; e1 = axis × e2 (its thin direction)
+    off = GF - np.outer(GF @ axis, axis)
+    evals, evecs = np.linalg.eigh(off.T @ off)
+    e2 = evecs[:, -1]
+    e1 = np.cross(axis, e2)
+
+    def proj(r):
+        # longitude along the cone (about e1, from the axis) and latitude across it
+        r = np.atleast_2d(r)
+        r = r / np.linalg.norm(r, axis=1)[:, None]
+        return np.degrees(np.column_stack([np.arctan2(r @ e2, r @ axis), np.arcsin(np.clip(r @ e1, -1, 1))]))
+
+    for k, (_, ts) in enumerate(samples):
+        p = proj(Tm(ts))
+        ax.plot(p[:, 0], p[:, 1], color="tab:red", lw=2.5, label="exact cone" if k == 0 else None)
+    for name, Gs, style in (("polyhedral approximation", G, dict(color="tab:green", lw=1.5)),
+                            ("gravity-free cone", GF, dict(color="k", ls="--", lw=1))):
+        for k, (i, j) in enumerate(segs):
+            if i == j:
+                continue
+            p = proj(np.stack([Gs[i], Gs[j]]))
+            ax.plot(p[:, 0], p[:, 1], label=name if k == 0 else None, **style)
+        p = proj(Gs)
+        ax.scatter(p[:, 0], p[:, 1], s=12, color=style["color"])
+    ax.set_title("chart of ray directions (twist space)")
+    ax.set_xlabel("longitude along the cone's widest spread [deg]")
+    ax.set_ylabel("latitude across it [deg]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    q = cone.pose
+    fig.suptitle(
+        title
+        or f"{cone.scene.name}: pusher '{cone.pusher}' at pose [{q[0]:.4f}, {q[1]:.4f}, {q[2]:.3f}]"
+        f" — grip {cone.scene.grip_force} N, gravity uses {100 * cone.hold_ratio:.1f}% of the pad friction"
+    )
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,71 @@
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import strategies as st
+
+import regrasp
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+
+@pytest.fixture
+def block():
+    return regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+
+
+def block_dict(w=0.05, h=0.08, mass=0.13, force=20.0, mu_s=0.6, pad=0.007, mu_p=0.3, face=3, line=True,
+               at=0.0, gdir=0.0, g=9.81, pose=(0.0, 0.0, 0.0), com=(0.0, 0.0)):
+    """A block scene with one pusher on face 0..3 (bottom, right, top, left)."""
+    hw, hh = w / 2, h / 2
+    faces = [
+        ([[-0.8 * hw, -hh], [0.8 * hw, -hh]], [0.0, 1.0]),
+        ([[hw, -0.8 * hh], [hw, 0.8 * hh]], [-1.0, 0.0]),
+        ([[0.8 * hw, hh], [-0.8 * hw, hh]], [0.0, -1.0]),
+        ([[-hw, 0.8 * hh], [-hw, -0.8 * hh]], [1.0, 0.0]),
+    ]
+    pts, n = faces[face]
+    if not line:
+        t = 0.5 + at
+        pts = [[pts[0][0] * (1 - t) + pts[1][0] * t, pts[0][1] * (1 - t) + pts[1][1] * t]]
+    return {
+        "name": "prop",
+        "object": {"outline": [[-hw, -hh], [hw, -hh], [hw, hh], [-hw, hh]], "mass": mass,
+                   "com": [com[0] * hw, com[1] * hh]},
+        "grasp": {"force": force, "friction": mu_s, "pad_radius": pad},
+        "gravity": {"direction": [float(np.sin(gdir)), float(-np.cos(gdir))], "g": g},
+        "pushers": [{"name": "p", "friction": mu_p, "points": pts, "normal": n}],
+        "task": {"start": list(pose), "goal": list(pose), "tolerance": [1e-3, 1e-3, 1e-2]},
+    }
+
+
+def pad_pose(cx, cz, th):
+    """Pose putting the pad centre (gripper origin) at object point (cx, cz): t = -R c."""
+    c, s = np.cos(th), np.sin(th)
+    return (-(c * cx - s * cz), -(s * cx + c * cz), th)
+
+
+@st.composite
+def block_scenes(draw, line=None, g=None):
+    w = draw(st.floats(0.03, 0.1))
+    h = draw(st.floats(0.03, 0.1))
+    pad = draw(st.floats(0.003, 0.008))
+    px, pz = draw(st.floats(-0.3, 0.3)), draw(st.floats(-0.3, 0.3))
+    th = draw(st.floats(-0.6, 0.6))
+    d = block_dict(
+        w=w, h=h, mass=draw(st.floats(0.05, 0.5)), force=draw(st.floats(5.0, 60.0)),
+        mu_s=draw(st.floats(0.3, 1.0)), pad=pad, mu_p=draw(st.floats(0.05, 1.2)),
+        face=draw(st.integers(0, 3)), line=draw(st.booleans()) if line is None else line,
+        at=draw(st.floats(-0.45, 0.45)), gdir=draw(st.floats(-0.6, 0.6)),
+        g=draw(st.floats(0.0, 12.0)) if g is None else g,
+        pose=pad_pose(px * (w / 2 - pad), pz * (h / 2 - pad), th),
+        com=(draw(st.floats(-0.3, 0.3)), draw(st.floats(-0.3, 0.3))),
+    )
+    return d
+
+
+def twist_dirs(n, L, rng):
+    d = rng.normal(size=(n, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    return d * np.array([1.0, 1.0, 1.0 / L])
