@@ -190,10 +190,16 @@ impl PlanarPush {
     /// Builds the push even when gravity alone would make the support slip: the gravity-free
     /// cone and grip-force queries remain meaningful; rays and the exact test do not.
     pub fn new_unchecked(spec: PushSpec) -> Result<Self> {
+        let model = PusherModel::new(spec.pusher.clone(), spec.metric)?;
+        Self::with_model(spec, model)
+    }
+
+    /// Like [`Self::new_unchecked`] with the pusher's cone already built (`model` must be the
+    /// cone of `spec.pusher` in `spec.metric`).
+    pub fn with_model(spec: PushSpec, model: PusherModel) -> Result<Self> {
         if !(spec.friction_scale > 0.0) || !spec.friction_scale.is_finite() {
             return Err(Error::arg("friction_scale", "must be positive and finite"));
         }
-        let model = PusherModel::new(spec.pusher.clone(), spec.metric)?;
         let js_inv = spec
             .support_jacobian
             .try_inverse()

@@ -545,13 +545,17 @@ impl Scene {
         }
     }
 
-    /// In-plane gravity wrench in the object frame at pose `q`.
-    pub fn gravity_wrench(&self, q: &[f64; 3]) -> Vec3 {
-        let g_plane = match &self.support {
+    /// In-plane gravity acceleration [m/s²]: g, or g sin(incline) on a surface.
+    pub fn g_plane(&self) -> f64 {
+        match &self.support {
             Support::Grasp(_) => self.g,
             Support::Surface(s) => self.g * s.incline.sin(),
-        };
-        gravity_wrench(self.mass, g_plane, &self.gravity_dir, q[2], &self.com)
+        }
+    }
+
+    /// In-plane gravity wrench in the object frame at pose `q`.
+    pub fn gravity_wrench(&self, q: &[f64; 3]) -> Vec3 {
+        gravity_wrench(self.mass, self.g_plane(), &self.gravity_dir, q[2], &self.com)
     }
 
     /// `J_s` at pose `q`: object twist → support twist (support frame).
@@ -590,20 +594,25 @@ impl Scene {
     pub fn frame(&self, q: &[f64; 3]) -> SupportFrame {
         let s = self.friction_scale();
         let ls = self.limit_surface();
+        let (sn, cs) = q[2].sin_cos();
         let (js, js_inv) = match &self.support {
             Support::Grasp(_) => {
-                // J_s = diag(R, 1) · shift(c), c = −Rᵀ t the pad centre in the object frame
-                let r = rot(q[2]);
-                let c = -(r.transpose() * Vec2::new(q[0], q[1]));
-                let mut axes = Mat3::identity();
-                axes.fixed_view_mut::<2, 2>(0, 0).copy_from(&r);
-                let mut axes_t = Mat3::identity();
-                axes_t.fixed_view_mut::<2, 2>(0, 0).copy_from(&r.transpose());
-                (axes * shift_jacobian(&c), shift_jacobian(&-c) * axes_t)
+                // J_s = diag(R, 1) · shift(c) with c = −Rᵀ t the pad centre in the object frame;
+                // J_s⁻¹ = shift(−c) · diag(Rᵀ, 1)
+                let cx = -(cs * q[0] + sn * q[1]);
+                let cz = -(-sn * q[0] + cs * q[1]);
+                let js = Mat3::new(cs, -sn, -cs * cz - sn * cx, sn, cs, -sn * cz + cs * cx, 0.0, 0.0, 1.0);
+                let js_inv = Mat3::new(cs, sn, cz, -sn, cs, -cx, 0.0, 0.0, 1.0);
+                (js, js_inv)
             }
             Support::Surface(sf) => (shift_jacobian(&sf.cop), shift_jacobian(&-sf.cop)),
         };
-        SupportFrame::new(ls.matrix(s), ls.matrix_inv(s), js, js_inv, self.gravity_wrench(q))
+        // gravity: Rᵀ d m g at the centre of mass
+        let d = self.gravity_dir * (self.mass * self.g_plane());
+        let f = Vec2::new(cs * d.x + sn * d.y, -sn * d.x + cs * d.y);
+        let wg = Vec3::new(f.x, f.y, self.com.x * f.y - self.com.y * f.x);
+        let k = 1.0 / (s * s);
+        SupportFrame::new(ls.b * k, ls.b_inv * (s * s), js, js_inv, wg)
     }
 
     /// Checks a pose and returns its frame; the error says what is wrong.
@@ -637,13 +646,18 @@ impl Scene {
 
     /// The push of `pusher` at pose `q`; fails if the support cannot hold the object there.
     pub fn push(&self, q: &[f64; 3], pusher: usize) -> Result<PlanarPush> {
-        PlanarPush::new(self.push_spec(q, pusher)?)
+        let p = self.push_unchecked(q, pusher)?;
+        if p.hold_ratio() >= 1.0 {
+            return Err(Error::GraspCannotHold { pose: *q, ratio: p.hold_ratio() });
+        }
+        Ok(p)
     }
 
     /// Like [`Self::push`] but also when gravity alone would make the support slip (for the
     /// gravity-free cone and grip-force queries).
     pub fn push_unchecked(&self, q: &[f64; 3], pusher: usize) -> Result<PlanarPush> {
-        PlanarPush::new_unchecked(self.push_spec(q, pusher)?)
+        let spec = self.push_spec(q, pusher)?;
+        PlanarPush::with_model(spec, self.pushers[pusher].model.clone())
     }
 
     /// Grip force of each finger (grasp scenes).

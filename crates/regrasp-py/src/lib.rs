@@ -48,12 +48,16 @@ fn pose3(v: &[f64]) -> PyResult<[f64; 3]> {
     Ok([p.x, p.y, p.z])
 }
 
-fn rows3(name: &str, a: &PyReadonlyArray2<f64>) -> PyResult<Vec<[f64; 3]>> {
-    let a = a.as_array();
-    if a.ncols() != 3 {
-        return Err(arg_err(name, format!("must have shape (n, 3), got (n, {})", a.ncols())));
+/// Rows of an (n, 3) float64 array, without a copy when it is C-contiguous.
+fn rows3<'a>(name: &str, a: &'a PyReadonlyArray2<'_, f64>) -> PyResult<std::borrow::Cow<'a, [[f64; 3]]>> {
+    let v = a.as_array();
+    if v.ncols() != 3 {
+        return Err(arg_err(name, format!("must have shape (n, 3), got (n, {})", v.ncols())));
     }
-    Ok(a.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect())
+    Ok(match a.as_slice() {
+        Ok(flat) => std::borrow::Cow::Borrowed(flat.as_chunks::<3>().0),
+        Err(_) => std::borrow::Cow::Owned(v.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect()),
+    })
 }
 
 fn mat_from_rows(rows: &[Vec3]) -> Array2<f64> {
