@@ -37,7 +37,7 @@ def _random_poses(scene: Scene, n: int, rng) -> np.ndarray:
     return out[:n]
 
 
-def run(n: int = 100_000, reps: int = 5, baseline_reps: int = 3, scene_path=None, pusher: str = "left") -> dict:
+def run(n: int = 100_000, reps: int = 11, baseline_reps: int = 3, scene_path=None, pusher: str = "left") -> dict:
     scene = Scene.load(scene_path or EXAMPLES / "block-low-friction.toml")
     rng = np.random.default_rng(0)
     poses = _random_poses(scene, n, rng)

@@ -105,7 +105,7 @@ def cmd_bench(a) -> int:
     from .bench import format_results, run
 
     n = 10_000 if a.quick else a.n
-    res = run(n=n, reps=3 if a.quick else 5, baseline_reps=1 if a.quick else 3)
+    res = run(n=n, reps=5 if a.quick else 11, baseline_reps=1 if a.quick else 3)
     print(json.dumps(res) if a.json else format_results(res))
     return 0
 

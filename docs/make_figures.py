@@ -1,0 +1,17 @@
+"""Regenerate the figures of the README: `python docs/make_figures.py` (after `make build`)."""
+
+from pathlib import Path
+
+import regrasp
+from regrasp.plotting import plot_motion_cone
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "docs"
+
+if __name__ == "__main__":
+    block = regrasp.Scene.load(ROOT / "examples" / "block-low-friction.toml")
+    plot_motion_cone(block.with_grip_force(5.0).motion_cone([0, 0, 0], "left"), OUT / "cone-left-5N.png")
+    plot_motion_cone(block.motion_cone([0, 0, 0], "left"), OUT / "cone-left-20N.png")
+    xzt = regrasp.Scene.load(ROOT / "examples" / "block-xztheta.toml")
+    plot_motion_cone(xzt.with_grip_force(5.0).motion_cone([0, 0, 0], "corner"), OUT / "cone-corner-5N.png")
+    print("wrote", *sorted(p.name for p in OUT.glob("*.png")))
