@@ -8,7 +8,9 @@ pub mod geometry;
 pub mod gravity;
 pub mod limit_surface;
 pub mod metric;
+pub mod mncp;
 pub mod motion_cone;
+pub mod quasistatic;
 pub mod scene;
 
 pub use error::{Error, Result};
