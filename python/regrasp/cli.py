@@ -36,9 +36,17 @@ def cone_report(scene: Scene, pose, pusher: str, twist=None) -> dict:
     """Everything `regrasp cone --json` prints."""
     hold = scene.hold_grip_force(pose)
     probe = scene.motion_cone(pose, pusher, check_hold=False)
-    twist = probe.central_twist() if twist is None else np.asarray(twist, float)
-    rng = probe.grip_force_range(twist) if scene.grip_force is not None else None
     cone = scene.motion_cone(pose, pusher)  # raises GraspError when it cannot hold
+    if twist is None:
+        twist = probe.central_twist()
+        if not cone.is_line_pusher:
+            # a point pusher imposes its contact point's velocity: report the twist it produces
+            r = scene.pusher(pusher).points[0]
+            u = twist[:2] + twist[2] * np.array([-r[1], r[0]])
+            t = cone.point_pusher_twist(u)
+            twist = twist if t is None else t
+    twist = np.asarray(twist, float)
+    rng = probe.grip_force_range(twist) if scene.grip_force is not None else None
     return {
         "scene": scene.name,
         "pusher": pusher,
@@ -96,6 +104,13 @@ def cmd_approx_error(a) -> int:
     paths = a.scenes or sorted(EXAMPLES.glob("*.toml"))
     scenes = [Scene.load(p) for p in paths]
     forces = _floats(a.forces, len(a.forces.split(",")), "--forces")
+    if a.samples < 1:
+        raise ArgumentError(f"invalid `--samples`: must be at least 1 (got {a.samples})", "--samples")
+    if (forces <= 0).any():
+        raise ArgumentError("invalid `--forces`: grip forces must be positive", "--forces")
+    skipped = [s.name for s in scenes if s.kind != "grasp"]
+    if skipped and not a.json:
+        print(f"(skipped {', '.join(skipped)}: no grasp, so no grip force to vary)", file=sys.stderr)
     rows = approximation_report(scenes, tuple(forces), a.samples, a.seed)
     print(json.dumps(rows) if a.json else format_report(rows))
     return 0

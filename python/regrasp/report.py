@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import GraspError
+from .errors import ArgumentError, GraspError
 from .scene import Scene
 
 
@@ -47,6 +47,8 @@ def approximation_error(scene: Scene, pusher: str, pose=None, samples: int = 200
         cone = scene.motion_cone(pose, pusher)
     except GraspError as e:
         return {"pusher": pusher, "error": str(e)}
+    if samples < 1:
+        raise ArgumentError(f"invalid `samples`: must be at least 1 (got {samples})", "samples")
     if cone.is_line_pusher:
         G = scene.metric_twist(cone.generators)
         axis = G.sum(axis=0)

@@ -128,7 +128,8 @@ class MotionCone:
 
     @property
     def is_line_pusher(self) -> bool:
-        return self._core.solid
+        """A line pusher (two rigidly connected points) rather than a point pusher."""
+        return self._core.line
 
     def contains(self, twist):
         """Exact test for one twist (bool) or an (n, 3) array (bool array)."""
@@ -166,7 +167,9 @@ class MotionCone:
 
     def grip_force_range(self, twist: ArrayLike) -> Optional[tuple[float, float]]:
         """Per-finger grip forces [min, max] (max may be inf) for which the pusher motion of
-        ``twist`` sticks (RSS 2018 Theorem 1), or None if no grip force does."""
+        ``twist`` sticks (RSS 2018 Theorem 1), or None if no grip force does. A line pusher's
+        motion is the whole twist; a point pusher's is only its contact point's velocity (the
+        object's rotation rate then depends on the grip force, see ``point_pusher_twist``)."""
         return self._core.grip_force_range(list(_vec(twist, 3, "twist")))
 
     def min_grip_force(self, twist: ArrayLike) -> Optional[float]:
@@ -385,7 +388,11 @@ class Scene:
         return self._core.admissible(list(_vec(a, 3, "pose")))
 
     def hold_ratio(self, pose) -> float:
-        return self._core.hold_ratio(list(_vec(pose, 3, "pose")))
+        """Share of the support's friction that gravity alone uses at ``pose`` (< 1 holds)."""
+        q = _vec(pose, 3, "pose")
+        if not self.admissible(q):
+            raise ArgumentError(f"invalid `pose`: {q.tolist()} is not admissible: the finger pad is not entirely on the object", "pose")
+        return self._core.hold_ratio(list(q))
 
     def hold_grip_force(self, pose) -> Optional[float]:
         """Smallest per-finger grip force that holds the object against gravity at ``pose``."""

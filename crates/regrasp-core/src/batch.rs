@@ -45,7 +45,7 @@ fn frame_or_status(scene: &Scene, q: &[f64; 3]) -> Result<SupportFrame, Status> 
         return Err(Status::Inadmissible);
     }
     let f = scene.frame(q);
-    if f.hold_ratio >= 1.0 {
+    if !(f.hold_ratio < 1.0) {
         return Err(Status::CannotHold);
     }
     Ok(f)
@@ -115,7 +115,6 @@ pub fn classify_into(
     status: &mut [Status],
 ) {
     let model = &scene.pushers[pusher].model;
-    let m = scene.metric();
     let n = poses.len();
     assert!(twists.len() == n && feasible.len() == n && margin.len() == n && limit.len() == n && status.len() == n);
     (0..n)
@@ -138,7 +137,7 @@ pub fn classify_into(
                     return;
                 }
             };
-            if m.twist_norm(&v) == 0.0 {
+            if v.amax() == 0.0 {
                 *st = Status::ZeroTwist;
                 return;
             }

@@ -328,11 +328,20 @@ impl PusherContact {
     }
 
     /// The contact limit a boundary of the generalized friction cone stands for.
-    pub fn limit_of(&self, edges: &[EdgeWrench], active: Active) -> ContactLimit {
+    /// Whether this is a line pusher (two rigidly connected points).
+    pub fn is_line(&self) -> bool {
+        self.points.len() == 2
+    }
+
+    /// The contact limit a boundary of the generalized friction cone stands for; `w` is the
+    /// required pusher wrench (physical units), used to tell the side of a friction limit
+    /// that a frictionless line pusher would need.
+    pub fn limit_of(&self, edges: &[EdgeWrench], active: Active, w: &Vec3) -> ContactLimit {
+        let line = self.is_line();
         match active {
             Active::Facet(i, j) => {
                 let (a, b) = (edges[i], edges[j]);
-                if a.point == b.point && self.points.len() == 2 {
+                if a.point == b.point && line {
                     ContactLimit::Roll { point: a.point }
                 } else if a.side == b.side {
                     ContactLimit::Slide { side: a.side }
@@ -344,12 +353,33 @@ impl PusherContact {
             }
             Active::Edge(i) => {
                 if self.friction == 0.0 {
-                    ContactLimit::OffRay
+                    if line {
+                        // a frictionless line pusher's fan is bounded by each point alone
+                        ContactLimit::Roll { point: edges[i].point }
+                    } else {
+                        ContactLimit::OffRay
+                    }
                 } else {
                     ContactLimit::Slide { side: edges[i].side }
                 }
             }
-            Active::Plane => ContactLimit::Torque,
+            Active::Plane => {
+                if line {
+                    // frictionless line pusher: the wrench needs a tangential force; its sign
+                    // is the component along a tangential force in the basis (e₀, e₁, t)
+                    let n = self.normal.normalize();
+                    let t = perp(&n);
+                    let m = nalgebra::Matrix3::from_columns(&[
+                        point_wrench(&self.points[0], &n),
+                        point_wrench(&self.points[1], &n),
+                        point_wrench(&self.points[0], &t),
+                    ]);
+                    let side = m.try_inverse().map(|mi| (mi * w).z).unwrap_or(1.0);
+                    ContactLimit::Slide { side: if side >= 0.0 { 1 } else { -1 } }
+                } else {
+                    ContactLimit::Torque
+                }
+            }
             Active::Apex => ContactLimit::Slide { side: 1 },
         }
     }
@@ -384,7 +414,7 @@ mod tests {
         assert_eq!(facets.len(), 4);
         let mut labels: Vec<String> = facets
             .iter()
-            .map(|f| p.limit_of(&edges, Active::Facet(f.edges.0, f.edges.1)).label())
+            .map(|f| p.limit_of(&edges, Active::Facet(f.edges.0, f.edges.1), &Vec3::zeros()).label())
             .collect();
         labels.sort();
         assert_eq!(labels, vec!["roll_about_point_0", "roll_about_point_1", "slide+t", "slide-t"]);

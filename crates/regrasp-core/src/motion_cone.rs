@@ -55,7 +55,7 @@ impl PusherModel {
     /// Signed margin of pusher wrench `w` and the contact limit nearest to it.
     pub fn membership(&self, w: &Vec3) -> (f64, ContactLimit) {
         let m = self.cone.membership(&self.metric.wrench(w));
-        (m.margin, self.contact.limit_of(&self.edges, m.active))
+        (m.margin, self.contact.limit_of(&self.edges, m.active, w))
     }
 }
 
@@ -87,7 +87,11 @@ impl SupportFrame {
     /// `None` if the support cannot hold the object (no positive root).
     #[inline]
     pub fn ray(&self, p: &Vec3, metric: &Metric) -> Option<Vec3> {
-        let u = self.js_inv.tr_mul(p);
+        let scale = p.amax();
+        if !(scale > 0.0) || !scale.is_finite() {
+            return None;
+        }
+        let u = self.js_inv.tr_mul(&(p / scale));
         let au = self.a * u;
         let qa = u.dot(&au);
         let qb = 2.0 * self.ug.dot(&au);
@@ -105,14 +109,15 @@ impl SupportFrame {
     /// Ray of the gravity-free cone for pusher wrench `p`: `J_s⁻¹ A J_s⁻ᵀ p`, unit.
     #[inline]
     pub fn gravity_free_ray(&self, p: &Vec3, metric: &Metric) -> Vec3 {
-        let v = self.js_inv * (self.a * self.js_inv.tr_mul(p));
+        let v = self.js_inv * (self.a * self.js_inv.tr_mul(&(p / p.amax())));
         v / metric.twist_norm(&v)
     }
 
     /// Load wrench on the support for twist `v`, mapped to the object frame: `J_sᵀ ŵ` (eq 3.10).
     #[inline]
     pub fn support_load(&self, v: &Vec3) -> Vec3 {
-        let vs = self.js * v;
+        // only the direction matters: normalize first so that huge or tiny twists are safe
+        let vs = self.js * (v / v.amax());
         let w = self.a_inv * vs;
         self.js.tr_mul(&(w / vs.dot(&w).sqrt()))
     }
@@ -215,7 +220,7 @@ impl PlanarPush {
     }
 
     fn check_hold(&self) -> Result<()> {
-        if self.frame.hold_ratio >= 1.0 {
+        if !(self.frame.hold_ratio < 1.0) {
             return Err(Error::GraspCannotHold { pose: self.spec.pose, ratio: self.frame.hold_ratio });
         }
         Ok(())
@@ -274,7 +279,7 @@ impl PlanarPush {
         if !v.iter().all(|x| x.is_finite()) {
             return Err(Error::arg("twist", "has a non-finite component"));
         }
-        if self.twist_norm(v) == 0.0 {
+        if v.amax() == 0.0 {
             return Err(Error::arg("twist", "is zero: a push must move the object"));
         }
         Ok(())
@@ -369,7 +374,9 @@ impl PlanarPush {
     }
 
     /// Range of per-finger grip force for which the pusher motion of twist `v` sticks (RSS 2018
-    /// Theorem 1: every twist inside the gravity-free cone is stable above some grip force).
+    /// Theorem 1: every twist inside the gravity-free cone is stable above some grip force). For
+    /// a point pusher the pusher motion is the contact point's velocity; the object's rotation
+    /// then depends on the grip force (see [`Self::point_pusher_twist`]).
     ///
     /// A line pusher imposes the whole twist: with `a₀ = J_sᵀŵ₀(v)` (unit surface) and inward
     /// facet normals `nⱼ` of `W_p`, stability is `nⱼ·(s a₀ − w_g) ≥ 0`, linear in `s = μ_s N`
@@ -385,11 +392,8 @@ impl PlanarPush {
             .ok_or_else(|| Error::arg("scene", "grip force is defined only for a grasp (not an object on a surface)"))?;
         // u_gᵀ A u_g = u_gᵀ B u_g / s² < 1  ⇔  s > √(u_gᵀ B u_g)
         let s_hold = self.frame.ug.dot(&(self.spec.limit_surface.b * self.frame.ug)).sqrt();
-        let range = if self.model.cone.is_solid() {
-            self.solid_scale_range(v, s_hold)
-        } else {
-            self.point_scale_range(v, s_hold)
-        };
+        let v = v / v.amax();
+        let range = if self.spec.pusher.is_line() { self.line_scale_range(&v, s_hold) } else { self.point_scale_range(&v, s_hold) };
         Ok(range.map(|(lo, hi)| GripForceRange { min: lo * per, max: hi * per }))
     }
 
@@ -398,21 +402,51 @@ impl PlanarPush {
         js.tr_mul(&LimitSurface::wrench_for_twist(&self.spec.limit_surface.b_inv, &(js * v)))
     }
 
-    fn solid_scale_range(&self, v: &Vec3, s_hold: f64) -> Option<(f64, f64)> {
-        let ConeShape::Solid { facets } = &self.model.cone.shape else { return None };
+    /// Line pusher: `w(s) = s a₀ − w_g` must lie in `W_p`, linear in `s` (facet inequalities; for
+    /// a frictionless pusher, whose cone is a fan, the fan's plane equation and its edges).
+    fn line_scale_range(&self, v: &Vec3, s_hold: f64) -> Option<(f64, f64)> {
         let m = &self.spec.metric;
         let (a0s, wgs) = (m.wrench(&self.unit_load(v)), m.wrench(&self.spec.gravity));
         let (mut lo, mut hi) = (s_hold * (1.0 + 1e-12), f64::INFINITY);
         let tol = 1e-12 * (a0s.norm() + wgs.norm());
-        for f in facets {
-            let (al, be) = (f.normal.dot(&a0s), f.normal.dot(&wgs));
+        // each constraint n·(s a₀ − w_g) ≥ 0
+        let mut inequality = |n: &Vec3| -> bool {
+            let (al, be) = (n.dot(&a0s), n.dot(&wgs));
             if al > tol {
                 lo = lo.max(be / al);
             } else if al < -tol {
                 hi = hi.min(be / al);
             } else if be > tol {
-                return None;
+                return false;
             }
+            true
+        };
+        match &self.model.cone.shape {
+            ConeShape::Solid { facets } => {
+                for f in facets {
+                    if !inequality(&f.normal) {
+                        return None;
+                    }
+                }
+            }
+            ConeShape::Fan { normal, inward, .. } => {
+                for n in inward {
+                    if !inequality(n) {
+                        return None;
+                    }
+                }
+                let (al, be) = (normal.dot(&a0s), normal.dot(&wgs));
+                if al.abs() > tol {
+                    let s = be / al;
+                    if s < lo || s > hi {
+                        return None;
+                    }
+                    return Some((s, s));
+                } else if be.abs() > tol {
+                    return None;
+                }
+            }
+            ConeShape::Ray | ConeShape::Full => return None,
         }
         (lo <= hi).then_some((lo.max(0.0), hi))
     }
@@ -459,78 +493,107 @@ impl PlanarPush {
 
 /// Closest feasible twist (see [`PlanarPush::project`]); the support must hold.
 pub fn project_exact(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> Vec3 {
-    let dn = model.metric.twist_norm(d);
-    if dn == 0.0 {
+    let scale = d.amax();
+    if scale == 0.0 {
         return Vec3::zeros();
     }
-    if frame.classify(model, d).feasible {
+    let dd = d / scale;
+    if frame.classify(model, &dd).feasible {
         return *d;
     }
-    let (cos, u) = nearest_boundary_ray(frame, model, d);
+    let dn = model.metric.twist_norm(&dd);
+    let (cos, u) = nearest_boundary_ray(frame, model, &dd);
     if cos > 0.0 {
-        u * (cos * dn)
+        u * (cos * dn * scale)
     } else {
         Vec3::zeros()
     }
 }
 
 /// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images of
-/// the boundary fans of `W_p`): a grid over each fan, then golden-section refinement. Returns
-/// the cosine and the unit ray.
+/// the boundary fans of `W_p`). Each fan is sampled until consecutive rays are less than 2°
+/// apart (the boundary can turn quickly where gravity matters most), then the best two local
+/// maxima are refined by golden-section search. Returns the cosine and the unit ray.
 fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> (f64, Vec3) {
+    const MAX_STEP: f64 = 0.035; // rad between consecutive samples
+    const MAX_SAMPLES: usize = 4096;
     let m = &model.metric;
     let ds = m.twist(d).normalize();
-    let score = |p: &Vec3| -> (f64, Vec3) {
+    // (t, cosine, unit ray in the metric, ray)
+    type Sample = (f64, f64, Vec3, Vec3);
+    let sample = |p: &Vec3, t: f64| -> Sample {
         match frame.ray(&m.wrench_inv(p), m) {
-            Some(v) => (m.twist(&v).dot(&ds), v),
-            None => (f64::NEG_INFINITY, Vec3::zeros()),
+            Some(v) => {
+                let s = m.twist(&v);
+                (t, s.dot(&ds), s, v)
+            }
+            None => (t, f64::NEG_INFINITY, Vec3::zeros(), Vec3::zeros()),
         }
     };
     let mut best = (f64::NEG_INFINITY, Vec3::zeros());
-    let mut keep = |s: (f64, Vec3)| {
-        if s.0 > best.0 {
-            best = s;
-        }
-    };
     for (i, j) in model.cone.boundary_segments() {
         let (ea, eb) = (model.cone.edges[i], model.cone.edges[j]);
+        let at = |t: f64| ea * (1.0 - t) + eb * t;
         if i == j {
-            keep(score(&ea));
+            let s = sample(&ea, 0.0);
+            if s.1 > best.0 {
+                best = (s.1, s.3);
+            }
             continue;
         }
-        let at = |t: f64| ea * (1.0 - t) + eb * t;
-        const GRID: usize = 16;
-        let mut k_best = 0;
-        let mut s_best = score(&at(0.0));
-        for k in 1..=GRID {
-            let s = score(&at(k as f64 / GRID as f64));
-            if s.0 > s_best.0 {
-                s_best = s;
-                k_best = k;
+        let mut pts: Vec<Sample> = (0..=8).map(|k| sample(&at(k as f64 / 8.0), k as f64 / 8.0)).collect();
+        loop {
+            let mut next = Vec::with_capacity(pts.len() * 2);
+            let mut split = false;
+            for w in pts.windows(2) {
+                next.push(w[0]);
+                let gap = w[0].2.cross(&w[1].2).norm().atan2(w[0].2.dot(&w[1].2));
+                if gap > MAX_STEP && w[1].0 - w[0].0 > 1e-9 && pts.len() < MAX_SAMPLES {
+                    let t = 0.5 * (w[0].0 + w[1].0);
+                    next.push(sample(&at(t), t));
+                    split = true;
+                }
+            }
+            next.push(*pts.last().expect("samples"));
+            pts = next;
+            if !split {
+                break;
             }
         }
-        let (mut lo, mut hi) = (k_best.saturating_sub(1) as f64 / GRID as f64, (k_best + 1).min(GRID) as f64 / GRID as f64);
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-        let (mut f1, mut f2) = (score(&at(x1)), score(&at(x2)));
-        while hi - lo > 1e-11 {
-            if f1.0 >= f2.0 {
-                hi = x2;
-                x2 = x1;
-                f2 = f1;
-                x1 = hi - g * (hi - lo);
-                f1 = score(&at(x1));
-            } else {
-                lo = x1;
-                x1 = x2;
-                f1 = f2;
-                x2 = lo + g * (hi - lo);
-                f2 = score(&at(x2));
+        // the two best local maxima
+        let mut peaks: Vec<usize> = (0..pts.len())
+            .filter(|&k| (k == 0 || pts[k].1 >= pts[k - 1].1) && (k + 1 == pts.len() || pts[k].1 >= pts[k + 1].1))
+            .collect();
+        peaks.sort_by(|a, b| pts[*b].1.total_cmp(&pts[*a].1));
+        for &k in peaks.iter().take(2) {
+            if pts[k].1 > best.0 {
+                best = (pts[k].1, pts[k].3);
+            }
+            let (mut lo, mut hi) = (pts[k.saturating_sub(1)].0, pts[(k + 1).min(pts.len() - 1)].0);
+            let g = 0.5 * (5f64.sqrt() - 1.0);
+            let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+            let (mut f1, mut f2) = (sample(&at(x1), x1), sample(&at(x2), x2));
+            while hi - lo > 1e-10 {
+                if f1.1 >= f2.1 {
+                    hi = x2;
+                    x2 = x1;
+                    f2 = f1;
+                    x1 = hi - g * (hi - lo);
+                    f1 = sample(&at(x1), x1);
+                } else {
+                    lo = x1;
+                    x1 = x2;
+                    f1 = f2;
+                    x2 = lo + g * (hi - lo);
+                    f2 = sample(&at(x2), x2);
+                }
+            }
+            for f in [f1, f2] {
+                if f.1 > best.0 {
+                    best = (f.1, f.3);
+                }
             }
         }
-        keep(s_best);
-        keep(f1);
-        keep(f2);
     }
     best
 }

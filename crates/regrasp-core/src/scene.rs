@@ -6,7 +6,7 @@
 
 use crate::error::{Error, Result};
 use crate::friction_cone::PusherContact;
-use crate::geometry::{rot, shift_jacobian, Mat3, Polygon, Vec2, Vec3};
+use crate::geometry::{cross2, perp, point_segment_distance, rot, shift_jacobian, Mat3, Polygon, Vec2, Vec3};
 use crate::gravity::gravity_wrench;
 use crate::limit_surface::{LimitSurface, Pressure, PressureDistribution};
 use crate::metric::Metric;
@@ -154,6 +154,46 @@ pub struct Scene {
     pub length: f64,
 }
 
+/// Whether `n` is an admissible pushing direction at boundary point `q`: the inward normal of
+/// the edge `q` lies on, or at a corner any direction between its two edges' inward normals.
+fn normal_fits(outline: &Polygon, q: &Vec2, n: &Vec2, tol: f64) -> bool {
+    let pts = outline.vertices();
+    let m = pts.len();
+    let inward = |i: usize| perp(&(pts[(i + 1) % m] - pts[i])).normalize();
+    for i in 0..m {
+        if (pts[i] - q).norm() <= tol {
+            // corner between edge i-1 and edge i
+            let (a, b) = (inward((i + m - 1) % m), inward(i));
+            let (ca, cb) = (cross2(&a, n), cross2(n, &b));
+            let turn = cross2(&a, &b);
+            return if turn >= 0.0 {
+                ca >= -1e-9 && cb >= -1e-9
+            } else {
+                // reflex corner: the shorter arc between the normals
+                ca <= 1e-9 && cb <= 1e-9
+            } && n.dot(&(a + b)) > 0.0;
+        }
+    }
+    outline
+        .edges()
+        .enumerate()
+        .filter(|(_, (a, b))| point_segment_distance(q, a, b) <= tol)
+        .any(|(i, _)| inward(i).dot(n) > 1.0 - 1e-6)
+}
+
+/// Largest values accepted for forces [N], masses [kg], friction coefficients and lengths [m]
+/// (beyond them the numbers stop meaning a gripper and a hand-held object).
+const MAX_FORCE: f64 = 1e6;
+const MAX_MASS: f64 = 1e4;
+const MAX_FRICTION: f64 = 100.0;
+
+fn bounded(field: &str, v: f64, lo: f64, hi: f64) -> Result<f64> {
+    if v < lo || v > hi {
+        return Err(Error::scene(field, format!("must be between {lo:e} and {hi:e} (got {v})")));
+    }
+    Ok(v)
+}
+
 fn positive(field: &str, v: Option<f64>) -> Result<f64> {
     let v = v.ok_or_else(|| Error::scene(field, "is required"))?;
     if !v.is_finite() || v <= 0.0 {
@@ -199,20 +239,27 @@ fn unit2(field: &str, v: [f64; 2]) -> Result<Vec2> {
 impl Scene {
     /// Parses and validates a scene from TOML text.
     pub fn from_toml_str(text: &str) -> Result<Scene> {
-        let raw: RawScene = toml::from_str(text).map_err(|e| {
-            let msg = e.message().to_string();
-            let field = e
+        let de = toml::Deserializer::new(text);
+        let raw: RawScene = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            let line = inner
                 .span()
-                .map(|s| format!("(line {})", text[..s.start.min(text.len())].matches('\n').count() + 1))
+                .map(|s| format!(" (line {})", text[..s.start.min(text.len())].matches('\n').count() + 1))
                 .unwrap_or_default();
-            Error::scene(field, msg)
+            let field = if path.is_empty() || path == "." { format!("(line{line})").replace("( ", "(") } else { path };
+            Error::scene(field, format!("{}{line}", inner.message()))
         })?;
         Self::from_raw(raw)
     }
 
     /// Parses and validates a scene from JSON text with the same layout as the TOML file.
     pub fn from_json_str(text: &str) -> Result<Scene> {
-        let raw: RawScene = serde_json::from_str(text).map_err(|e| Error::scene("(json)", e.to_string()))?;
+        let mut de = serde_json::Deserializer::from_str(text);
+        let raw: RawScene = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+            let path = e.path().to_string();
+            Error::scene(if path.is_empty() || path == "." { "(json)".to_string() } else { path }, e.into_inner().to_string())
+        })?;
         Self::from_raw(raw)
     }
 
@@ -235,7 +282,7 @@ impl Scene {
             .map(|(i, p)| finite2(&format!("object.outline[{i}]"), *p))
             .collect::<Result<Vec<_>>>()?;
         let outline = Polygon::new(pts).map_err(|d| Error::scene("object.outline", d.to_string()))?;
-        let mass = positive("object.mass", obj.mass)?;
+        let mass = bounded("object.mass", positive("object.mass", obj.mass)?, 1e-9, MAX_MASS)?;
         let centroid = outline.centroid();
         let com = match obj.com {
             Some(c) => finite2("object.com", c)?,
@@ -261,7 +308,7 @@ impl Scene {
                 };
                 let g = match gr.g {
                     None => 9.81,
-                    Some(g) => non_negative("gravity.g", Some(g))?,
+                    Some(g) => bounded("gravity.g", non_negative("gravity.g", Some(g))?, 0.0, 1e3)?,
                 };
                 (d, g)
             }
@@ -274,7 +321,7 @@ impl Scene {
             (None, None) => return Err(Error::scene("grasp", "table is required")),
             (Some(gr), None) => Support::Grasp(Self::grasp(gr)?),
             (None, Some(sf)) => {
-                let friction = positive("surface.friction", sf.friction)?;
+                let friction = bounded("surface.friction", positive("surface.friction", sf.friction)?, 1e-6, MAX_FRICTION)?;
                 let incline = match sf.incline {
                     None => 0.0,
                     Some(a) => non_negative("surface.incline", Some(a))?,
@@ -384,8 +431,8 @@ impl Scene {
     }
 
     fn grasp(gr: &RawGrasp) -> Result<Grasp> {
-        let force = positive("grasp.force", gr.force)?;
-        let friction = positive("grasp.friction", gr.friction)?;
+        let force = bounded("grasp.force", positive("grasp.force", gr.force)?, 1e-6, MAX_FORCE)?;
+        let friction = bounded("grasp.friction", positive("grasp.friction", gr.friction)?, 1e-6, MAX_FRICTION)?;
         let pressure = match gr.pressure.as_deref() {
             None | Some("uniform") => Pressure::Uniform,
             Some("hertzian") => Pressure::Hertzian,
@@ -394,7 +441,9 @@ impl Scene {
             }
         };
         let pad = match gr.pad_shape.as_deref() {
-            None | Some("circle") => PadShape::Circle { radius: positive("grasp.pad_radius", gr.pad_radius)? },
+            None | Some("circle") => PadShape::Circle {
+                radius: bounded("grasp.pad_radius", positive("grasp.pad_radius", gr.pad_radius)?, 1e-6, 10.0)?,
+            },
             Some("rectangle") => {
                 if gr.pad_radius.is_some() {
                     return Err(Error::scene(
@@ -432,7 +481,7 @@ impl Scene {
         if name.trim().is_empty() {
             return Err(Error::scene(format!("{field}.name"), "must not be empty"));
         }
-        let friction = non_negative(&format!("{field}.friction"), p.friction)?;
+        let friction = bounded(&format!("{field}.friction"), non_negative(&format!("{field}.friction"), p.friction)?, 0.0, MAX_FRICTION)?;
         let raw_pts = p.points.clone().ok_or_else(|| Error::scene(format!("{field}.points"), "is required"))?;
         if raw_pts.is_empty() || raw_pts.len() > 2 {
             return Err(Error::scene(
@@ -453,11 +502,12 @@ impl Scene {
             if d > tol {
                 return Err(Error::scene(f, format!("{q:?} is not on the object outline (it is {d:.3e} m away)")));
             }
-            let eps = 1e-3 * size;
-            if !outline.contains(&(q + normal * eps)) || outline.contains(&(q - normal * eps)) {
+            if !normal_fits(outline, &q, &normal, tol) {
                 return Err(Error::scene(
                     format!("{field}.normal"),
-                    format!("must point into the object at {f} (the pusher pushes the object along it)"),
+                    format!(
+                        "must be the inward normal of the outline at {f} (or, at a corner, between the inward normals of its two edges): the pusher pushes the object along it"
+                    ),
                 ));
             }
             points.push(q);
@@ -467,17 +517,16 @@ impl Scene {
             if seg.norm() <= tol {
                 return Err(Error::scene(format!("{field}.points"), "the two points of a line pusher coincide"));
             }
-            if seg.normalize().dot(&normal).abs() > 1e-3 {
-                return Err(Error::scene(
-                    format!("{field}.normal"),
-                    "must be perpendicular to the line pusher (its two points)",
-                ));
-            }
-            let mid = (points[0] + points[1]) * 0.5;
-            if outline.boundary_distance(&mid) > tol {
+            // both points on one straight edge of the outline, the normal being its inward normal
+            let on_one_edge = outline.edges().any(|(a, b)| {
+                point_segment_distance(&points[0], &a, &b) <= tol
+                    && point_segment_distance(&points[1], &a, &b) <= tol
+                    && perp(&(b - a)).normalize().dot(&normal) > 1.0 - 1e-6
+            });
+            if !on_one_edge {
                 return Err(Error::scene(
                     format!("{field}.points"),
-                    "a line pusher must lie along a straight part of the outline",
+                    "a line pusher must lie along one straight edge of the outline, with the edge's inward normal as `normal`",
                 ));
             }
         }
@@ -619,7 +668,7 @@ impl Scene {
     pub fn checked_frame(&self, q: &[f64; 3]) -> Result<SupportFrame> {
         self.check_pose(q)?;
         let f = self.frame(q);
-        if f.hold_ratio >= 1.0 {
+        if !(f.hold_ratio < 1.0) {
             return Err(Error::GraspCannotHold { pose: *q, ratio: f.hold_ratio });
         }
         Ok(f)
@@ -647,7 +696,7 @@ impl Scene {
     /// The push of `pusher` at pose `q`; fails if the support cannot hold the object there.
     pub fn push(&self, q: &[f64; 3], pusher: usize) -> Result<PlanarPush> {
         let p = self.push_unchecked(q, pusher)?;
-        if p.hold_ratio() >= 1.0 {
+        if !(p.hold_ratio() < 1.0) {
             return Err(Error::GraspCannotHold { pose: *q, ratio: p.hold_ratio() });
         }
         Ok(p)

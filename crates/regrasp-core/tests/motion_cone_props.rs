@@ -328,31 +328,101 @@ fn exact_test_matches_brute_force_lp() {
     use proptest::test_runner::TestRunner;
     let mut runner = TestRunner::deterministic();
     let strat = (block_case(), -3.2f64..3.2, -1.5f64..1.5, proptest::collection::vec(0.0f64..1.0, 4), any::<bool>());
-    let (mut checked, mut inside, mut disagree) = (0, 0, Vec::new());
+    let (mut checked, mut disagree) = ([0usize; 2], Vec::new());
+    let mut inside = [0usize; 2];
     for _ in 0..3000 {
         let (b, a1, a2, w, near) = strat.new_tree(&mut runner).unwrap().current();
         let raw = raw_scene(&b);
         let Ok(scene) = Scene::from_raw(raw.clone()) else { continue };
         let push = scene.push(&b.pose, 0).unwrap();
         let mut v = twist_from_angles(a1, a2, scene.length);
+        let kind = b.line as usize;
         if near {
-            // a ray of the cone plus a perturbation of ~20% of its size
-            let p: Vec3 = push.pusher_edges().iter().zip(&w).map(|(e, x)| e.wrench * *x).sum();
-            if let Some(r) = push.ray(&p) {
-                v = r + v * 0.2;
+            if b.line {
+                // a ray of the cone plus a perturbation of ~20% of its size
+                let p: Vec3 = push.pusher_edges().iter().zip(&w).map(|(e, x)| e.wrench * *x).sum();
+                if let Some(r) = push.ray(&p) {
+                    v = r + v * 0.2;
+                }
+            } else {
+                // a point pusher: the twist its contact point's motion produces
+                let u = regrasp::geometry::Vec2::new(a1.cos(), a1.sin());
+                if let Some(t) = push.point_pusher_twist(&u, push.spec().friction_scale) {
+                    v = t;
+                }
             }
         }
         let c = push.classify(&v).unwrap();
         if c.margin.abs() < 1e-6 {
             continue;
         }
-        checked += 1;
-        inside += c.feasible as usize;
+        checked[kind] += 1;
+        inside[kind] += c.feasible as usize;
         if c.feasible != brute_force_sticks(&raw, &b.pose, &v) {
             disagree.push((b, v, c.margin));
         }
     }
     assert!(disagree.is_empty(), "{} disagreements, first: {:?}", disagree.len(), disagree.first());
-    assert!(checked > 2000, "only {checked} cases checked");
-    assert!(inside > 300 && checked - inside > 300, "inside {inside} of {checked}");
+    // [point, line]: enough cases of each kind, feasible and not
+    assert!(checked[0] > 500 && checked[1] > 1000, "checked {checked:?}");
+    assert!(inside[1] > 200 && checked[1] - inside[1] > 200, "line pushers: inside {inside:?} of {checked:?}");
+    assert!(inside[0] > 100 && checked[0] - inside[0] > 100, "point pushers: inside {inside:?} of {checked:?}");
+}
+
+fn low_friction_block() -> Scene {
+    Scene::from_toml_str(include_str!("../../../examples/block-low-friction.toml")).unwrap()
+}
+
+/// A frictionless line pusher is still a line pusher: its grip-force range is an exact
+/// interval (here a single force: the plane of its fan must contain the required wrench).
+#[test]
+fn frictionless_line_pusher_grip_range_matches_a_scan() {
+    let text = include_str!("../../../examples/block-low-friction.toml").replace("friction = 0.25", "friction = 0.0");
+    let scene = Scene::from_toml_str(&text).unwrap();
+    let i = scene.pusher_index("bottom").unwrap();
+    let q = [0.002, -0.003, 0.1];
+    let push = scene.push_unchecked(&q, i).unwrap();
+    // a twist from a feasible pusher wrench at 9 N per finger
+    let s9 = scene.with_grip_force(9.0);
+    let p9 = s9.push(&q, i).unwrap();
+    let w: Vec3 = p9.pusher_edges().iter().map(|e| e.wrench).sum::<Vec3>() * 0.5;
+    let v = p9.ray(&w).unwrap();
+    assert!(p9.classify(&v).unwrap().feasible);
+    let r = push.grip_force_range(&v).unwrap().expect("the twist sticks at 9 N");
+    assert!((r.min - 9.0).abs() < 1e-6 && (r.max - 9.0).abs() < 1e-6, "{r:?}");
+    for f in [5.0, 8.9, 9.1, 20.0] {
+        assert!(!scene.with_grip_force(f).push(&q, i).unwrap().classify(&v).unwrap().feasible, "{f} N");
+    }
+}
+
+/// Only the direction of a twist matters, however large or small its numbers.
+#[test]
+fn huge_and_tiny_twists_give_the_same_answers() {
+    let scene = low_friction_block();
+    for name in ["bottom", "left"] {
+        let push = scene.push(&[0.003, 0.002, 0.2], scene.pusher_index(name).unwrap()).unwrap();
+        for v in [Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.01, 0.002, -0.3), Vec3::new(0.0, 1.0, 0.0)] {
+            let c = push.classify(&v).unwrap();
+            for k in [1e160, 1e-200] {
+                let ck = push.classify(&(v * k)).unwrap();
+                assert_eq!(c.feasible, ck.feasible, "{name} {v:?} x {k}");
+                assert!((c.margin - ck.margin).abs() < 1e-12);
+                let (p, pk) = (push.project(&v).unwrap(), push.project(&(v * k)).unwrap());
+                assert!((pk / k - p).amax() <= 1e-6 * p.amax().max(1e-300), "projection of {v:?} x {k}");
+            }
+        }
+    }
+}
+
+/// A grip too weak or too strong to represent is an error, never NaN.
+#[test]
+fn absurd_grip_forces_are_errors() {
+    let scene = low_friction_block();
+    let i = scene.pusher_index("left").unwrap();
+    for f in [1e-300, 1e-30] {
+        assert!(scene.with_grip_force(f).push(&[0.0, 0.0, 0.0], i).is_err(), "{f}");
+    }
+    let text = include_str!("../../../examples/block-low-friction.toml").replace("force = 20.0", "force = 1e300");
+    let e = Scene::from_toml_str(&text).unwrap_err();
+    assert!(e.to_string().contains("grasp.force"), "{e}");
 }

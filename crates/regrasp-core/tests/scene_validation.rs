@@ -463,14 +463,19 @@ fn t_shape_notch_is_not_admissible() {
 // ---------------------------------------------------------------------------------------------
 // Regressions
 
-/// The line of a TOML error is the line the offending key starts on (was one short when the
-/// error started a line).
+/// A TOML error names the key's dotted path and the line the offending key starts on (the
+/// line was one short when the error started a line).
 #[test]
 fn toml_error_names_the_offending_line() {
     let text = edit("material = \"aluminium 6061\"", "material = \"aluminium 6061\"\ncolour = \"red\"");
     let line = text.lines().position(|l| l.starts_with("colour")).unwrap() + 1;
     let field = expect_scene_error("unknown key", &text);
-    assert_eq!(field, format!("(line {line})"));
+    assert_eq!(field, "object.colour");
+    let msg = Scene::from_toml_str(&text).unwrap_err().to_string();
+    assert!(msg.contains(&format!("line {line}")), "{msg}");
+    // a value of the wrong type names its field too
+    let text = edit("mass = 0.130", "mass = \"heavy\"");
+    assert_eq!(expect_scene_error("string mass", &text), "object.mass");
 }
 
 /// An object that slides down its incline is reported on a surface field (was `grasp.force`),
@@ -486,4 +491,32 @@ fn sliding_surface_scene_names_a_surface_field() {
     let no_task = edit_text(include_str!("../../../examples/block-on-incline.toml"), "friction = 0.35", "friction = 0.1");
     let field = expect_scene_error("sliding surface without a task", &no_task);
     assert!(field.starts_with("surface."), "field `{field}`");
+}
+
+/// Pushers along a whole face, at either corner, and with normals that do not fit the outline.
+#[test]
+fn pusher_geometry_is_checked_against_the_outline() {
+    let base = include_str!("../../../examples/block-low-friction.toml");
+    let with_bottom = |points: &str, normal: &str| {
+        base.replace("points = [[-0.02, -0.04], [0.02, -0.04]]\nnormal = [0.0, 1.0]", &format!("points = {points}\nnormal = {normal}"))
+    };
+    // a line pusher covering the whole bottom face, corners included
+    assert!(Scene::from_toml_str(&with_bottom("[[-0.025, -0.04], [0.025, -0.04]]", "[0.0, 1.0]")).is_ok());
+    // point pushers at either bottom corner, pushing up
+    assert!(Scene::from_toml_str(&with_bottom("[[-0.025, -0.04]]", "[0.0, 1.0]")).is_ok());
+    assert!(Scene::from_toml_str(&with_bottom("[[0.025, -0.04]]", "[0.0, 1.0]")).is_ok());
+    // at a corner, diagonally inwards is fine, outwards is not
+    assert!(Scene::from_toml_str(&with_bottom("[[0.025, -0.04]]", "[-0.7071, 0.7071]")).is_ok());
+    let e = Scene::from_toml_str(&with_bottom("[[0.025, -0.04]]", "[0.7071, 0.7071]")).unwrap_err();
+    assert!(e.to_string().contains("pushers[0].normal"), "{e}");
+    // a point pusher in the middle of a face must push along the face's normal
+    let e = Scene::from_toml_str(&with_bottom("[[0.0, -0.04]]", "[0.9987, 0.05]")).unwrap_err();
+    assert!(e.to_string().contains("pushers[0].normal"), "{e}");
+    // a line pusher whose segment leaves the outline (crosses the object) is rejected
+    let t = include_str!("../../../examples/t-shape.toml").replace(
+        "points = [[-0.03, 0.04], [0.03, 0.04]]\nnormal = [0.0, -1.0]",
+        "points = [[-0.035, 0.02], [0.015, 0.02]]\nnormal = [0.0, 1.0]",
+    );
+    let e = Scene::from_toml_str(&t).unwrap_err();
+    assert!(e.to_string().contains("pushers[0]"), "{e}");
 }

@@ -8,7 +8,11 @@ use pyo3::types::PyDict;
 use regrasp::friction_cone::{ConeShape, ContactLimit};
 use regrasp::geometry::{Vec2, Vec3};
 use regrasp::motion_cone::{project_onto_generators, Classification, PlanarPush};
+use regrasp::mncp::{self, FrictionLaw, NormalLaw, Side};
+use regrasp::quasistatic::{self, Options, SupportModel};
 use regrasp::{batch, Error};
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
 /// Raise the Python exception (defined in `regrasp.errors`) matching a core error.
 fn to_py(err: Error) -> PyErr {
@@ -78,6 +82,155 @@ fn classification_dict<'py>(py: Python<'py>, c: &Classification) -> PyResult<Bou
     d.set_item("pusher_wrench", c.pusher_wrench.as_slice().to_vec())?;
     d.set_item("support_wrench", c.support_wrench.as_slice().to_vec())?;
     Ok(d)
+}
+
+
+fn dvec<'py>(py: Python<'py>, v: &DVector<f64>) -> Bound<'py, PyArray1<f64>> {
+    Array1::from(v.as_slice().to_vec()).into_pyarray(py)
+}
+
+fn dmat<'py>(py: Python<'py>, m: &DMatrix<f64>) -> Bound<'py, PyArray2<f64>> {
+    Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
+}
+
+fn residuals_dict<'py>(py: Python<'py>, r: &mncp::Residuals) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("newton_euler", r.newton_euler)?;
+    d.set_item("normal_feasibility", r.normal_feasibility)?;
+    d.set_item("normal_complementarity", r.normal_complementarity)?;
+    d.set_item("cone", r.cone)?;
+    d.set_item("friction_complementarity", r.friction_complementarity)?;
+    d.set_item("dissipation", r.dissipation)?;
+    Ok(d)
+}
+
+fn solution_dict<'py>(py: Python<'py>, p: &mncp::Problem, s: &mncp::Solution) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("twist", dvec(py, &s.twist))?;
+    d.set_item("pusher_twist", dvec(py, &s.pusher_twist))?;
+    d.set_item("normal_forces", Array1::from(s.normal_forces.clone()).into_pyarray(py))?;
+    d.set_item("friction_forces", s.friction_forces.iter().map(|f| dvec(py, f)).collect::<Vec<_>>())?;
+    d.set_item("normal_velocities", Array1::from(s.normal_velocities.clone()).into_pyarray(py))?;
+    d.set_item("tangent_velocities", s.tangent_velocities.iter().map(|f| dvec(py, f)).collect::<Vec<_>>())?;
+    d.set_item("states", s.states.iter().map(|x| x.label()).collect::<Vec<_>>())?;
+    d.set_item("labels", p.contacts.iter().map(|c| c.label.clone()).collect::<Vec<_>>())?;
+    d.set_item("residuals", residuals_dict(py, &s.residuals)?)?;
+    d.set_item("max_residual", s.residuals.max())?;
+    d.set_item("iterations", s.iterations)?;
+    Ok(d)
+}
+
+fn options(support: &str, rings: usize, points: usize, merge_fingers: bool, h: f64, speed: f64) -> PyResult<Options> {
+    let support = match support {
+        "points" => SupportModel::Points { rings, points, merge_fingers },
+        "limit_surface" => SupportModel::LimitSurface,
+        other => return Err(arg_err("support", format!("must be \"points\" or \"limit_surface\", got {other:?}"))),
+    };
+    if !(h > 0.0) || !(speed > 0.0) {
+        return Err(arg_err("h", "time step and speed must be positive"));
+    }
+    if rings == 0 && points == 0 {
+        return Err(arg_err("points", "give rings > 0 or points > 0"));
+    }
+    Ok(Options { support, h, speed, ..Options::default() })
+}
+
+/// One instantaneous quasi-static problem (thesis §3.2): contacts, mass matrix, gravity.
+#[pyclass(module = "regrasp._core", frozen)]
+struct MncpProblem {
+    inner: mncp::Problem,
+}
+
+#[pymethods]
+impl MncpProblem {
+    #[getter]
+    fn dim(&self) -> usize {
+        self.inner.dim
+    }
+    #[getter]
+    fn labels(&self) -> Vec<String> {
+        self.inner.contacts.iter().map(|c| c.label.clone()).collect()
+    }
+
+    /// Forward problem: pusher twist given; returns the solution as a dict.
+    fn solve_forward<'py>(&self, py: Python<'py>, pusher_twist: Vec<f64>) -> PyResult<Bound<'py, PyDict>> {
+        let u = DVector::from_vec(pusher_twist);
+        let s = py.allow_threads(|| mncp::solve_forward(&self.inner, &u, &mncp::Settings::default())).map_err(to_py)?;
+        solution_dict(py, &self.inner, &s)
+    }
+
+    /// Inverse problem: object twist given; returns the pusher motion and forces.
+    fn solve_inverse<'py>(&self, py: Python<'py>, twist: Vec<f64>) -> PyResult<Bound<'py, PyDict>> {
+        let v = DVector::from_vec(twist);
+        let s = py.allow_threads(|| mncp::solve_inverse(&self.inner, &v, &mncp::Settings::default())).map_err(to_py)?;
+        solution_dict(py, &self.inner, &s)
+    }
+
+    /// Scaled violation of every constraint for a candidate solution (e.g. the reference's).
+    fn residuals<'py>(
+        &self,
+        py: Python<'py>,
+        twist: Vec<f64>,
+        pusher_twist: Vec<f64>,
+        normal_forces: Vec<f64>,
+        friction_forces: Vec<Vec<f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let n = self.inner.contacts.len();
+        if twist.len() != self.inner.dim || pusher_twist.len() != self.inner.dim || normal_forces.len() != n || friction_forces.len() != n {
+            return Err(arg_err("solution", "sizes do not match the problem"));
+        }
+        let ft: Vec<DVector<f64>> = friction_forces.into_iter().map(DVector::from_vec).collect();
+        for (c, f) in self.inner.contacts.iter().zip(&ft) {
+            if f.len() != c.tangent_dim() {
+                return Err(arg_err("friction_forces", format!("contact {} needs {} components", c.label, c.tangent_dim())));
+            }
+        }
+        let r = mncp::residuals(&self.inner, &DVector::from_vec(twist), &DVector::from_vec(pusher_twist), &normal_forces, &ft);
+        residuals_dict(py, &r)
+    }
+
+    /// The problem's data (for the reference solver and for inspection).
+    fn data<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let p = &self.inner;
+        let d = PyDict::new(py);
+        d.set_item("dim", p.dim)?;
+        d.set_item("mass", dmat(py, &p.mass))?;
+        d.set_item("wrench", dvec(py, &p.wrench))?;
+        d.set_item("h", p.h)?;
+        d.set_item("force_scale", p.force_scale)?;
+        d.set_item("velocity_scale", p.velocity_scale)?;
+        let mut cs = Vec::new();
+        for c in &p.contacts {
+            let e = PyDict::new(py);
+            e.set_item("label", &c.label)?;
+            e.set_item("side", match c.side { Side::Finger => "finger", Side::Pusher => "pusher", Side::Fixed => "fixed" })?;
+            match c.normal {
+                NormalLaw::Fixed(f) => {
+                    e.set_item("normal", "fixed")?;
+                    e.set_item("normal_force", f)?;
+                }
+                NormalLaw::Unilateral => e.set_item("normal", "unilateral")?,
+            }
+            match &c.friction {
+                FrictionLaw::Coulomb(mu) => {
+                    e.set_item("friction", "coulomb")?;
+                    e.set_item("mu", *mu)?;
+                }
+                FrictionLaw::Ellipsoid(a) => {
+                    e.set_item("friction", "ellipsoid")?;
+                    e.set_item("A", dmat(py, a))?;
+                }
+            }
+            e.set_item("jn", dvec(py, &c.jn))?;
+            e.set_item("jt", dmat(py, &c.jt))?;
+            e.set_item("jn_other", dvec(py, &c.jn_other))?;
+            e.set_item("jt_other", dmat(py, &c.jt_other))?;
+            e.set_item("gap", c.gap)?;
+            cs.push(e);
+        }
+        d.set_item("contacts", cs)?;
+        Ok(d)
+    }
 }
 
 /// A validated planar scene (immutable).
@@ -286,6 +439,124 @@ impl Scene {
         ContactLimit::ALL.iter().map(|l| l.label()).collect()
     }
 
+    /// The quasi-static problem of `pusher` (or no pusher) at `pose`.
+    #[pyo3(signature = (pose, pusher=None, support="points", rings=3, points=0, merge_fingers=true, h=1.0, speed=0.01))]
+    #[allow(clippy::too_many_arguments)]
+    fn quasistatic_problem(
+        &self,
+        pose: Vec<f64>,
+        pusher: Option<&str>,
+        support: &str,
+        rings: usize,
+        points: usize,
+        merge_fingers: bool,
+        h: f64,
+        speed: f64,
+    ) -> PyResult<MncpProblem> {
+        let q = pose3(&pose)?;
+        let opts = options(support, rings, points, merge_fingers, h, speed)?;
+        let p = match pusher {
+            Some(name) => {
+                let i = self.inner.pusher_index(name).map_err(to_py)?;
+                quasistatic::push_problem(&self.inner, &q, i, &opts)
+            }
+            None => {
+                self.inner.check_pose(&q).map_err(to_py)?;
+                quasistatic::planar_problem(&self.inner, &q, None, &opts)
+            }
+        }
+        .map_err(to_py)?;
+        Ok(MncpProblem { inner: p })
+    }
+
+    /// Instantaneous pushes: pusher `pusher` at pose i moving with twist i (object frame).
+    /// Returns (sticks (n,), object twists (n, 3), max residual (n,), errors (None if solved)).
+    #[pyo3(signature = (poses, pusher, twists, support="points", rings=3, points=0, merge_fingers=true))]
+    #[allow(clippy::type_complexity, clippy::too_many_arguments)]
+    fn push_outcomes<'py>(
+        &self,
+        py: Python<'py>,
+        poses: PyReadonlyArray2<f64>,
+        pusher: &str,
+        twists: PyReadonlyArray2<f64>,
+        support: &str,
+        rings: usize,
+        points: usize,
+        merge_fingers: bool,
+    ) -> PyResult<(Bound<'py, PyArray1<bool>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Vec<Option<String>>)> {
+        let q = rows3("poses", &poses)?;
+        let t = rows3("twists", &twists)?;
+        if q.len() != t.len() {
+            return Err(arg_err("twists", format!("has {} rows but poses has {}", t.len(), q.len())));
+        }
+        let i = self.inner.pusher_index(pusher).map_err(to_py)?;
+        let opts = options(support, rings, points, merge_fingers, 1.0, 0.01)?;
+        let res: Vec<_> = py.allow_threads(|| {
+            q.par_iter()
+                .zip(t.par_iter())
+                .with_min_len(4)
+                .map(|(qq, tt)| quasistatic::push_outcome(&self.inner, qq, i, &Vec3::from(*tt), &opts))
+                .collect()
+        });
+        let n = q.len();
+        let mut sticks = Array1::from_elem(n, false);
+        let mut tw = Array2::zeros((n, 3));
+        let mut resid = Array1::from_elem(n, f64::NAN);
+        let mut errors = Vec::with_capacity(n);
+        for (k, r) in res.into_iter().enumerate() {
+            match r {
+                Ok(o) => {
+                    sticks[k] = o.sticks;
+                    for c in 0..3 {
+                        tw[(k, c)] = o.solution.twist[c];
+                    }
+                    resid[k] = o.solution.residuals.max();
+                    errors.push(None);
+                }
+                Err(e) => errors.push(Some(e.to_string())),
+            }
+        }
+        Ok((sticks.into_pyarray(py), tw.into_pyarray(py), resid.into_pyarray(py), errors))
+    }
+
+    /// Explicit time stepping of one push (pusher body twist constant, object frame at t = 0).
+    #[pyo3(signature = (pose, pusher, twist, duration, dt, support="points", rings=3, points=0, merge_fingers=true))]
+    #[allow(clippy::too_many_arguments)]
+    fn simulate_push<'py>(
+        &self,
+        py: Python<'py>,
+        pose: Vec<f64>,
+        pusher: &str,
+        twist: Vec<f64>,
+        duration: f64,
+        dt: f64,
+        support: &str,
+        rings: usize,
+        points: usize,
+        merge_fingers: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let q = pose3(&pose)?;
+        let u = vec3("twist", &twist)?;
+        let i = self.inner.pusher_index(pusher).map_err(to_py)?;
+        let opts = options(support, rings, points, merge_fingers, dt, 0.01)?;
+        let tr = py
+            .allow_threads(|| quasistatic::simulate_push(&self.inner, &q, i, &u, duration, dt, &opts))
+            .map_err(to_py)?;
+        let rows = |v: &Vec<[f64; 3]>| Array2::from_shape_fn((v.len(), 3), |(i, j)| v[i][j]);
+        let d = PyDict::new(py);
+        d.set_item("t", Array1::from(tr.t.clone()).into_pyarray(py))?;
+        d.set_item("pose", rows(&tr.pose).into_pyarray(py))?;
+        d.set_item("pusher_pose", rows(&tr.pusher_pose).into_pyarray(py))?;
+        d.set_item("twist", rows(&tr.twist).into_pyarray(py))?;
+        d.set_item("pusher_wrench", rows(&tr.pusher_wrench).into_pyarray(py))?;
+        d.set_item("support_wrench", rows(&tr.support_wrench).into_pyarray(py))?;
+        d.set_item("pusher_slip", Array1::from(tr.pusher_slip.clone()).into_pyarray(py))?;
+        d.set_item("pusher_contacts", Array1::from(tr.pusher_contacts.iter().map(|x| *x as u32).collect::<Vec<_>>()).into_pyarray(py))?;
+        d.set_item("pusher_sticking", Array1::from(tr.pusher_sticking.iter().map(|x| *x as u32).collect::<Vec<_>>()).into_pyarray(py))?;
+        d.set_item("residual", Array1::from(tr.residual.clone()).into_pyarray(py))?;
+        Ok(d)
+    }
+
     /// Messages of the batch status codes.
     #[staticmethod]
     fn status_messages() -> Vec<(u8, &'static str)> {
@@ -334,10 +605,10 @@ impl MotionCone {
     fn hold_ratio(&self) -> f64 {
         self.push.hold_ratio()
     }
-    /// Whether the pusher's generalized friction cone has an interior (line pusher).
+    /// Whether the pusher is a line pusher (two rigidly connected points).
     #[getter]
-    fn solid(&self) -> bool {
-        self.push.pusher_cone().is_solid()
+    fn line(&self) -> bool {
+        self.push.spec().pusher.is_line()
     }
     /// Generators of the polyhedral approximation, one unit twist a row.
     #[getter]
@@ -462,7 +733,7 @@ impl MotionCone {
         if u.len() != 2 || !u.iter().all(|x| x.is_finite()) {
             return Err(arg_err("u", "must be 2 finite numbers"));
         }
-        if self.push.pusher_cone().is_solid() {
+        if self.push.spec().pusher.is_line() {
             return Err(arg_err("pusher", "point_pusher_twist needs a point pusher"));
         }
         let s = self.push.spec().friction_scale;
@@ -485,6 +756,7 @@ impl MotionCone {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_class::<MotionCone>()?;
+    m.add_class::<MncpProblem>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
