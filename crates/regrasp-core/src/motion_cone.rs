@@ -511,11 +511,11 @@ pub fn project_exact(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> Vec
 }
 
 /// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images of
-/// the boundary fans of `W_p`). Each fan is sampled until consecutive rays are less than 2°
+/// the boundary fans of `W_p`). Each fan is sampled until consecutive rays are less than 4°
 /// apart (the boundary can turn quickly where gravity matters most), then the best two local
 /// maxima are refined by golden-section search. Returns the cosine and the unit ray.
 fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> (f64, Vec3) {
-    const MAX_STEP: f64 = 0.035; // rad between consecutive samples
+    const MAX_STEP: f64 = 0.07; // rad between consecutive samples
     const MAX_SAMPLES: usize = 4096;
     let m = &model.metric;
     let ds = m.twist(d).normalize();
@@ -531,49 +531,62 @@ fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> 
         }
     };
     let mut best = (f64::NEG_INFINITY, Vec3::zeros());
-    for (i, j) in model.cone.boundary_segments() {
+    // sample every boundary fan finely enough, keeping (segment, samples)
+    let segments = model.cone.boundary_segments();
+    let mut sampled: Vec<Vec<Sample>> = Vec::with_capacity(segments.len());
+    for &(i, j) in &segments {
         let (ea, eb) = (model.cone.edges[i], model.cone.edges[j]);
         let at = |t: f64| ea * (1.0 - t) + eb * t;
         if i == j {
-            let s = sample(&ea, 0.0);
-            if s.1 > best.0 {
-                best = (s.1, s.3);
-            }
+            sampled.push(vec![sample(&ea, 0.0)]);
             continue;
         }
-        let mut pts: Vec<Sample> = (0..=8).map(|k| sample(&at(k as f64 / 8.0), k as f64 / 8.0)).collect();
-        loop {
-            let mut next = Vec::with_capacity(pts.len() * 2);
-            let mut split = false;
-            for w in pts.windows(2) {
-                next.push(w[0]);
-                let gap = w[0].2.cross(&w[1].2).norm().atan2(w[0].2.dot(&w[1].2));
-                if gap > MAX_STEP && w[1].0 - w[0].0 > 1e-9 && pts.len() < MAX_SAMPLES {
-                    let t = 0.5 * (w[0].0 + w[1].0);
-                    next.push(sample(&at(t), t));
-                    split = true;
-                }
-            }
-            next.push(*pts.last().expect("samples"));
-            pts = next;
-            if !split {
-                break;
+        // depth-first subdivision of each interval until its end rays are close
+        let cos_step = MAX_STEP.cos();
+        let mut pts: Vec<Sample> = Vec::with_capacity(64);
+        let mut stack: Vec<Sample> = Vec::with_capacity(32);
+        let first = sample(&at(0.0), 0.0);
+        pts.push(first);
+        for k in (1..=8).rev() {
+            stack.push(sample(&at(k as f64 / 8.0), k as f64 / 8.0));
+        }
+        while let Some(right) = stack.pop() {
+            let left = *pts.last().expect("samples");
+            if left.2.dot(&right.2) < cos_step && right.0 - left.0 > 1e-9 && pts.len() + stack.len() < MAX_SAMPLES {
+                let t = 0.5 * (left.0 + right.0);
+                stack.push(right);
+                stack.push(sample(&at(t), t));
+            } else {
+                pts.push(right);
             }
         }
-        // the two best local maxima
-        let mut peaks: Vec<usize> = (0..pts.len())
-            .filter(|&k| (k == 0 || pts[k].1 >= pts[k - 1].1) && (k + 1 == pts.len() || pts[k].1 >= pts[k + 1].1))
-            .collect();
-        peaks.sort_by(|a, b| pts[*b].1.total_cmp(&pts[*a].1));
-        for &k in peaks.iter().take(2) {
+        sampled.push(pts);
+    }
+    let top = sampled.iter().flatten().map(|s| s.1).fold(f64::NEG_INFINITY, f64::max);
+    // between samples at most MAX_STEP apart the cosine can rise by about MAX_STEP²/2 above
+    // the better sample: refine every local maximum within that of the best one
+    let slack = MAX_STEP * MAX_STEP;
+    for (seg, pts) in sampled.iter().enumerate() {
+        let (i, j) = segments[seg];
+        let (ea, eb) = (model.cone.edges[i], model.cone.edges[j]);
+        let at = |t: f64| ea * (1.0 - t) + eb * t;
+        for k in 0..pts.len() {
+            let is_peak = (k == 0 || pts[k].1 >= pts[k - 1].1) && (k + 1 == pts.len() || pts[k].1 >= pts[k + 1].1);
+            if !is_peak || pts[k].1 < top - slack {
+                continue;
+            }
             if pts[k].1 > best.0 {
                 best = (pts[k].1, pts[k].3);
+            }
+            if pts.len() < 2 {
+                continue;
             }
             let (mut lo, mut hi) = (pts[k.saturating_sub(1)].0, pts[(k + 1).min(pts.len() - 1)].0);
             let g = 0.5 * (5f64.sqrt() - 1.0);
             let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
             let (mut f1, mut f2) = (sample(&at(x1), x1), sample(&at(x2), x2));
-            while hi - lo > 1e-10 {
+            let stop = 1e-7 * (hi - lo);
+            while hi - lo > stop {
                 if f1.1 >= f2.1 {
                     hi = x2;
                     x2 = x1;
