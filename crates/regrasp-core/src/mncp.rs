@@ -365,30 +365,47 @@ fn metric_inv(law: &FrictionLaw) -> Option<DMatrix<f64>> {
     }
 }
 
+/// Per-contact data fixed during a solve.
+struct Pre {
+    /// `J_tᵀ` (d × k).
+    jt_t: DMatrix<f64>,
+    /// `ρ G⁻¹ J_t` and `ρ G⁻¹ b_t` (the friction projection's velocity term).
+    gjt: DMatrix<f64>,
+    gbt: DVector<f64>,
+    /// Constant part of the normal velocity: `−J_n,other U + gap/h`.
+    bn: f64,
+}
+
 struct Newton<'a> {
     p: &'a Problem,
-    u: &'a DVector<f64>,
     lay: Layout,
     rho_n: f64,
-    /// Per contact: the step ρ of the friction projection, scaled so that `ρ G⁻¹ u` is of the
-    /// size of a friction force.
-    rho_t: Vec<f64>,
-    ginv: Vec<Option<DMatrix<f64>>>,
+    pre: Vec<Pre>,
 }
 
 impl<'a> Newton<'a> {
-    fn new(p: &'a Problem, u: &'a DVector<f64>) -> Self {
+    fn new(p: &'a Problem, u: &DVector<f64>) -> Self {
         let rho = p.force_scale / p.velocity_scale;
-        let ginv: Vec<Option<DMatrix<f64>>> = p.contacts.iter().map(|c| metric_inv(&c.friction)).collect();
-        let rho_t = ginv
+        let pre = p
+            .contacts
             .iter()
-            .map(|g| match g {
-                None => rho,
-                // |A⁻¹u| ≈ (μN)² |u|: divide by the largest force-force entry
-                Some(g) => rho / g[(0, 0)].max(g[(1, 1)]).max(1e-300),
+            .map(|c| {
+                let g = metric_inv(&c.friction);
+                // the step ρ of the projection, scaled so that ρ G⁻¹ u is of the size of a
+                // friction force: |A⁻¹u| ≈ (μN)² |u| for an ellipsoid
+                let rho_t = match &g {
+                    None => rho,
+                    Some(g) => rho / g[(0, 0)].max(g[(1, 1)]).max(1e-300),
+                };
+                let bt = -(&c.jt_other * u);
+                let (gjt, gbt) = match &g {
+                    None => (&c.jt * rho_t, bt * rho_t),
+                    Some(g) => (g * &c.jt * rho_t, g * bt * rho_t),
+                };
+                Pre { jt_t: c.jt.transpose(), gjt, gbt, bn: -c.jn_other.dot(u) + c.gap / p.h }
             })
             .collect();
-        Self { p, u, lay: Layout::new(p), rho_n: rho, rho_t, ginv }
+        Self { p, lay: Layout::new(p), rho_n: rho, pre }
     }
 
     fn unpack(&self, x: &DVector<f64>) -> (DVector<f64>, Vec<f64>, Vec<DVector<f64>>) {
@@ -412,48 +429,56 @@ impl<'a> Newton<'a> {
         let p = self.p;
         let d = p.dim;
         let n = self.lay.n;
-        let (v, fns, fts) = self.unpack(x);
+        let v = x.rows(0, d);
         let mut f = DVector::zeros(n);
         let mut j = if jac { Some(DMatrix::zeros(n, n)) } else { None };
-        // Newton–Euler (scaled by 1/force_scale)
         let sf = 1.0 / p.force_scale;
-        let mut ne = &p.wrench - &p.mass * &v;
+        // Newton–Euler (scaled by 1/force_scale)
+        let mut ne = &p.wrench - &p.mass * v;
         if let Some(j) = j.as_mut() {
-            j.view_mut((0, 0), (d, d)).copy_from(&(-&p.mass * sf));
+            let mut blk = j.view_mut((0, 0), (d, d));
+            blk.copy_from(&p.mass);
+            blk *= -sf;
         }
         for (i, c) in p.contacts.iter().enumerate() {
-            ne += &c.jn * fns[i] + c.jt.transpose() * &fts[i];
-            if let Some(j) = j.as_mut() {
-                if let Some(k) = self.lay.normal[i] {
-                    j.view_mut((0, k), (d, 1)).copy_from(&(&c.jn * sf));
-                }
-                j.view_mut((0, self.lay.tangent[i]), (d, c.tangent_dim())).copy_from(&(c.jt.transpose() * sf));
-            }
-        }
-        f.rows_mut(0, d).copy_from(&(ne * sf));
-        // contact equations (scaled by 1/force_scale)
-        for (i, c) in p.contacts.iter().enumerate() {
-            let (un, ut) = p.velocities(c, &v, self.u);
-            if let Some(k) = self.lay.normal[i] {
-                // F = f_n − max(0, f_n − ρ u_n)
-                let z = fns[i] - self.rho_n * un;
-                let (m, _, dm) = smax(0.0, z, e * p.force_scale);
-                f[k] = (fns[i] - m) * sf;
-                if let Some(j) = j.as_mut() {
-                    j[(k, k)] = (1.0 - dm) * sf;
-                    j.view_mut((k, 0), (1, d)).copy_from(&(c.jn.transpose() * (dm * self.rho_n * sf)));
-                }
-            }
+            let pre = &self.pre[i];
             let kt = c.tangent_dim();
             let t0 = self.lay.tangent[i];
-            let (gu, gjt) = match &self.ginv[i] {
-                None => (ut.clone(), c.jt.clone()),
-                Some(g) => (g * &ut, g * &c.jt),
+            let f_n = match self.lay.normal[i] {
+                Some(k) => x[k],
+                None => normal_force(c, 0.0),
             };
-            let y = &fts[i] - &gu * self.rho_t[i];
+            let ft = x.rows(t0, kt);
+            ne.axpy(f_n, &c.jn, 1.0);
+            ne.gemv(1.0, &pre.jt_t, &ft, 1.0);
+            if let Some(j) = j.as_mut() {
+                if let Some(k) = self.lay.normal[i] {
+                    let mut col = j.view_mut((0, k), (d, 1));
+                    col.copy_from(&c.jn);
+                    col *= sf;
+                }
+                let mut blk = j.view_mut((0, t0), (d, kt));
+                blk.copy_from(&pre.jt_t);
+                blk *= sf;
+            }
+            // normal: F = f_n − max(0, f_n − ρ u_n)
+            if let Some(k) = self.lay.normal[i] {
+                let un = c.jn.dot(&v) + pre.bn;
+                let z = f_n - self.rho_n * un;
+                let (m, _, dm) = smax(0.0, z, e * p.force_scale);
+                f[k] = (f_n - m) * sf;
+                if let Some(j) = j.as_mut() {
+                    j[(k, k)] = (1.0 - dm) * sf;
+                    for col in 0..d {
+                        j[(k, col)] = c.jn[col] * dm * self.rho_n * sf;
+                    }
+                }
+            }
+            // friction: F = f_t − P(f_t − ρ G⁻¹ u_t)
+            let y = ft - (&pre.gjt * v + &pre.gbt);
             let (r, dr_dfn) = match &c.friction {
                 FrictionLaw::Coulomb(mu) => {
-                    let (m, _, dm) = smax(0.0, fns[i], e * p.force_scale);
+                    let (m, _, dm) = smax(0.0, f_n, e * p.force_scale);
                     (mu * m, mu * dm)
                 }
                 FrictionLaw::Ellipsoid(_) => (1.0, 0.0),
@@ -463,18 +488,25 @@ impl<'a> Newton<'a> {
                 FrictionLaw::Ellipsoid(_) => e,
             };
             let (proj, dp, dpr) = project(&c.friction, &y, r, pe);
-            f.rows_mut(t0, kt).copy_from(&((&fts[i] - proj) * sf));
+            let mut fr = f.rows_mut(t0, kt);
+            fr.copy_from(&(ft - proj));
+            fr *= sf;
             if let Some(j) = j.as_mut() {
                 // dF/df_t = I − dP; dF/dV = dP ρ G⁻¹ J_t; dF/df_n = −dP/dr · dr/df_n
-                let dft = DMatrix::identity(kt, kt) - &dp;
-                j.view_mut((t0, t0), (kt, kt)).copy_from(&(dft * sf));
-                let dv = &dp * &gjt * self.rho_t[i];
-                j.view_mut((t0, 0), (kt, d)).copy_from(&(dv * sf));
+                let mut blk = j.view_mut((t0, t0), (kt, kt));
+                blk.copy_from(&(DMatrix::identity(kt, kt) - &dp));
+                blk *= sf;
+                let mut blk = j.view_mut((t0, 0), (kt, d));
+                blk.copy_from(&(&dp * &pre.gjt));
+                blk *= sf;
                 if let Some(k) = self.lay.normal[i] {
-                    j.view_mut((t0, k), (kt, 1)).copy_from(&(-dpr * dr_dfn * sf));
+                    let mut col = j.view_mut((t0, k), (kt, 1));
+                    col.copy_from(&dpr);
+                    col *= -dr_dfn * sf;
                 }
             }
         }
+        f.rows_mut(0, d).copy_from(&(ne * sf));
         (f, j)
     }
 
@@ -586,10 +618,21 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
         }
         None
     };
-    // 2. Smoothing Newton: solve the equations with max and the projections smoothed by ε,
-    //    from ε = 1 (in units of the force scale) down to 1e-10, each solve warm-starting the
-    //    next, then polish with the exact equations (semismooth Newton).
     let nw = Newton::new(p, u);
+    // 2. Semismooth Newton on the exact equations from the object moving with the pusher: fast
+    //    when it converges (slides near the sticking solution mostly do).
+    {
+        let mut x0 = DVector::zeros(nw.lay.n);
+        x0.rows_mut(0, d).copy_from(u);
+        let (x, _, it) = nw.solve(x0, 0.0, settings.tolerance, 25);
+        let (v, fns, fts) = nw.unpack(&x);
+        if let Some(s) = keep(finish(p, v, u.clone(), fns, fts, it)) {
+            return Ok(s);
+        }
+    }
+    // 3. Smoothing Newton: the equations with max and the projections smoothed by ε, from
+    //    ε = 1 (in units of the force scale) down to 1e-10, each solve warm-starting the next,
+    //    then polished with the exact equations.
     let smooth_then_exact = |x0: DVector<f64>| -> (DVector<f64>, usize) {
         let mut x = x0;
         let mut its = 0;
@@ -598,7 +641,7 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
             let (xe, _, it) = nw.solve(x.clone(), e, 0.1 * e, 40);
             its += it;
             x = xe;
-            e *= 0.2;
+            e *= 0.1;
         }
         let (xe, _, it) = nw.solve(x, 0.0, settings.tolerance, settings.max_iterations);
         (xe, its + it)
