@@ -1,4 +1,4 @@
-"""Command line: ``regrasp cone | approx-error | bench | demo``.
+"""Command line: ``regrasp cone | approx-error | validate | simulate | push | bench | demo``.
 
 Exit status: 0 success, 1 the task cannot be done (reason printed), 2 invalid input.
 """
@@ -151,6 +151,73 @@ def cmd_demo(a) -> int:
     return 0
 
 
+def cmd_validate(a) -> int:
+    from .quasistatic import format_confusion, validate
+
+    scene = Scene.load(a.scene)
+    engines = [e.strip() for e in a.engines.split(",")]
+    for e in engines:
+        if e not in ("quasistatic",):
+            raise ArgumentError(f"invalid `--engines`: unknown engine {e!r} (available: quasistatic)", "--engines")
+    res = validate(scene, a.pushes, a.seed, support=a.support)
+    print(json.dumps(res) if a.json else format_confusion(res))
+    return 0
+
+
+def cmd_simulate(a) -> int:
+    from .quasistatic import load_plan, replay_plan
+
+    scene = Scene.load(a.scene)
+    plan = load_plan(a.plan)
+    if a.engine != "quasistatic":
+        raise ArgumentError(f"invalid `--engine`: {a.engine!r} is not available (quasistatic)", "--engine")
+    rep = replay_plan(scene, plan, dt=a.dt)
+    if a.plot:
+        from .plotting import plot_replay
+
+        plot_replay(scene, rep, a.plot)
+    out = rep.to_json()
+    if a.json:
+        print(json.dumps(out))
+    else:
+        print(f"{scene.name}: replayed {len(rep.steps)} pushes in the {rep.engine} simulator")
+        for k, st in enumerate(rep.steps, 1):
+            print(f"  {k:2d} {st['pusher']:12s} {st['duration']:6.2f} s  slip {1e3 * st['slip']:.3f} mm")
+        print(f"  final pose {np.round(rep.final_pose, 5).tolist()}, error to goal {np.round(rep.goal_error, 5).tolist()}: "
+              f"{'success' if rep.success else 'outside the tolerance'}; largest pusher slip {1e3 * rep.max_pusher_slip:.3f} mm")
+    return 0 if rep.success else 1
+
+
+def cmd_push(a) -> int:
+    from .quasistatic import simulate_push
+
+    scene = Scene.load(a.scene)
+    pose = _floats(a.pose, 3, "--pose")
+    twist = _floats(a.twist, 3, "--twist")
+    tr = simulate_push(scene, pose, a.pusher, twist, a.duration, a.dt)
+    if a.plot:
+        from .plotting import plot_push
+
+        plot_push(scene, tr, a.pusher, twist, a.plot)
+    out = {
+        "scene": scene.name, "pusher": a.pusher, "twist": twist.tolist(),
+        "final_pose": tr["pose"][-1].tolist(),
+        "max_pusher_slip_speed": float(tr["pusher_slip"].max()),
+        "pusher_sticking_share": float(np.mean(tr["pusher_sticking"] == np.maximum(tr["pusher_contacts"], 1))),
+        "max_residual": float(tr["residual"].max()),
+    }
+    if a.json:
+        out["t"] = tr["t"].tolist()
+        out["pose"] = tr["pose"].tolist()
+        out["pusher_wrench"] = tr["pusher_wrench"].tolist()
+        print(json.dumps(out))
+    else:
+        print(f"{scene.name}: pusher '{a.pusher}' with twist {twist.tolist()} for {a.duration} s")
+        print(f"  final pose {np.round(out['final_pose'], 5).tolist()}; pusher sticks in {100 * out['pusher_sticking_share']:.0f}% "
+              f"of the steps; largest constraint residual {out['max_residual']:.1e}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="regrasp", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -177,6 +244,36 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--quick", action="store_true", help="10,000 cones instead of 100,000")
     b.add_argument("-n", type=int, default=100_000)
     b.set_defaults(fn=cmd_bench)
+
+    v = sub.add_parser("validate", help="motion-cone predictions against the simulators")
+    v.add_argument("scene")
+    v.add_argument("--pushes", type=int, default=2000)
+    v.add_argument("--engines", default="quasistatic")
+    v.add_argument("--seed", type=int, default=0)
+    v.add_argument("--support", default="points", choices=["points", "limit_surface"],
+                   help="finger pads as point sets (default) or as the motion cones' limit surface")
+    v.add_argument("--json", action="store_true")
+    v.set_defaults(fn=cmd_validate)
+
+    s = sub.add_parser("simulate", help="replay a plan in a simulator")
+    s.add_argument("scene")
+    s.add_argument("--plan", required=True)
+    s.add_argument("--engine", default="quasistatic")
+    s.add_argument("--dt", type=float, default=0.05)
+    s.add_argument("--plot", metavar="PNG")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(fn=cmd_simulate)
+
+    p = sub.add_parser("push", help="simulate one push and plot object motion and contact forces")
+    p.add_argument("scene")
+    p.add_argument("--pose", required=True, help="x,z,theta")
+    p.add_argument("--pusher", required=True)
+    p.add_argument("--twist", required=True, help="pusher body twist vx,vz,omega (object frame at the start)")
+    p.add_argument("--duration", type=float, default=1.0)
+    p.add_argument("--dt", type=float, default=0.02)
+    p.add_argument("--plot", metavar="PNG")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(fn=cmd_push)
 
     d = sub.add_parser("demo", help="the bundled example end to end, writing its figures")
     d.add_argument("--out", default="out/demo")

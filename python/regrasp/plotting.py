@@ -162,3 +162,73 @@ def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def _axes_pose(ax, t, q, label_prefix="", style=None):
+    style = style or {}
+    ax[0].plot(t, 1e3 * q[:, 0], label=f"{label_prefix}x", **style)
+    ax[0].plot(t, 1e3 * q[:, 1], label=f"{label_prefix}z", **style)
+    ax[1].plot(t, np.degrees(q[:, 2]), label=f"{label_prefix}theta", **style)
+
+
+def plot_push(scene, tr: dict, pusher: str, twist, path) -> Path:
+    """Object pose in the grasp and contact forces over time for one simulated push."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    t = tr["t"]
+    _axes_pose(ax, t, tr["pose"])
+    ax[0].set_ylabel("object position in the grasp [mm]")
+    ax[1].set_ylabel("object angle in the grasp [deg]")
+    wp, ws = tr["pusher_wrench"], tr["support_wrench"]
+    ax[2].plot(t, wp[:, 0], label="pusher f_x")
+    ax[2].plot(t, wp[:, 1], label="pusher f_z")
+    ax[2].plot(t, ws[:, 0], "--", label="fingers f_x")
+    ax[2].plot(t, ws[:, 1], "--", label="fingers f_z")
+    ax[2].set_ylabel("force on the object (object frame) [N]")
+    slip = tr["pusher_slip"] > 1e-6
+    for a in ax:
+        a.set_xlabel("t [s]")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+        if slip.any():
+            a.fill_between(t, 0, 1, where=slip, color="tab:red", alpha=0.08, transform=a.get_xaxis_transform())
+    fig.suptitle(f"{scene.name}: pusher '{pusher}', body twist {np.round(twist, 4).tolist()} "
+                 f"(shaded: the pusher slips)")
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_replay(scene, rep, path, extra=None) -> Path:
+    """Planned against executed object pose in the grasp over a replayed plan."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    _axes_pose(ax, rep.t, rep.planned, "planned ", dict(ls="--", color="0.5"))
+    _axes_pose(ax, rep.t, rep.poses, f"{rep.engine} ")
+    for name, r in (extra or {}).items():
+        _axes_pose(ax, r.t, r.poses, f"{name} ", dict(ls=":"))
+    ax[0].set_ylabel("object position in the grasp [mm]")
+    ax[1].set_ylabel("object angle in the grasp [deg]")
+    for a in ax:
+        a.set_xlabel("t [s]")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7)
+    fig.suptitle(f"{scene.name}: plan replayed ({'success' if rep.success else 'outside tolerance'}, "
+                 f"largest pusher slip {1e3 * rep.max_pusher_slip:.2f} mm)")
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
