@@ -170,8 +170,23 @@ def sample_push(scene: Scene, pose, pusher: str, kind: str, rng):
     E = cone._core.pusher_edges
     if cone.is_line_pusher:
         if kind == "inside":
-            w = rng.dirichlet(np.ones(len(E))) @ E
-            u = cone.ray(w)
+            # uniform over the twist directions inside the exact cone (rejection from a cap
+            # around it)
+            from .report import _cap
+
+            G = scene.metric_twist(cone.generators)
+            axis = G.sum(axis=0)
+            axis = axis / np.linalg.norm(axis)
+            radius = min(np.pi, 1.2 * max(np.arccos(np.clip(G @ axis, -1, 1))))
+            u = None
+            for _ in range(50):
+                cand = scene.metric_twist_inv(_cap(axis, radius, 64, rng))
+                inside = np.asarray(cone.contains(cand))
+                if inside.any():
+                    u = cand[np.flatnonzero(inside)[0]]
+                    break
+            if u is None:
+                u = cone.ray(rng.dirichlet(np.ones(len(E))) @ E)
         elif kind == "near":
             i, j = cone._core.boundary_segments[rng.integers(len(cone._core.boundary_segments))]
             t = rng.uniform()
@@ -206,8 +221,8 @@ def sample_push(scene: Scene, pose, pusher: str, kind: str, rng):
 
 def validate(scene: Scene, pushes: int = 2000, seed: int = 0, support: str = "points", rings: int = 3,
              progress: bool = False) -> dict:
-    """Random pushes (a third inside the motion cone, a third within 5° of its boundary, a third
-    in random directions) at random poses; the exact motion-cone prediction of stick or slip at
+    """Random pushes (a third drawn uniformly among the twist directions inside the motion cone,
+    a third within 5° of its boundary, a third in random directions) at random poses; the exact motion-cone prediction of stick or slip at
     the pusher against the quasi-static simulator's outcome."""
     if pushes < 1:
         raise ArgumentError(f"invalid `pushes`: must be at least 1 (got {pushes})", "pushes")

@@ -385,7 +385,13 @@ struct Newton<'a> {
 
 impl<'a> Newton<'a> {
     fn new(p: &'a Problem, u: &DVector<f64>) -> Self {
-        let rho = p.force_scale / p.velocity_scale;
+        Self::with_rho(p, u, 1.0)
+    }
+
+    /// `rho_scale` multiplies the projection steps ρ (any ρ > 0 gives the same solutions; it
+    /// changes the Newton iterations' basin of convergence).
+    fn with_rho(p: &'a Problem, u: &DVector<f64>, rho_scale: f64) -> Self {
+        let rho = rho_scale * p.force_scale / p.velocity_scale;
         let pre = p
             .contacts
             .iter()
@@ -608,16 +614,17 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
     }
     let d = p.dim;
     let mut best: Option<(f64, Solution)> = None;
-    let mut keep = |sol: Solution| -> Option<Solution> {
+    /// Keeps the best attempt; returns the solution when it is accepted.
+    fn consider(best: &mut Option<(f64, Solution)>, sol: Solution, accept: f64) -> Option<Solution> {
         let r = sol.residuals.max();
-        if r <= settings.accept {
+        if r <= accept {
             return Some(sol);
         }
         if best.as_ref().is_none_or(|(b, _)| r < *b) {
-            best = Some((r, sol));
+            *best = Some((r, sol));
         }
         None
-    };
+    }
     let nw = Newton::new(p, u);
     // 2. Semismooth Newton on the exact equations from the object moving with the pusher: fast
     //    when it converges (slides near the sticking solution mostly do).
@@ -626,7 +633,7 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
         x0.rows_mut(0, d).copy_from(u);
         let (x, _, it) = nw.solve(x0, 0.0, settings.tolerance, 25);
         let (v, fns, fts) = nw.unpack(&x);
-        if let Some(s) = keep(finish(p, v, u.clone(), fns, fts, it)) {
+        if let Some(s) = consider(&mut best, finish(p, v, u.clone(), fns, fts, it), settings.accept) {
             return Ok(s);
         }
     }
@@ -661,17 +668,42 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
         x0.rows_mut(0, d).copy_from(&v0);
         starts.push(x0);
     }
-    for x0 in starts {
+    for x0 in &starts {
         let (x, its) = smooth_then_exact(x0.clone());
         let (v, fns, fts) = nw.unpack(&x);
-        if let Some(s) = keep(finish(p, v, u.clone(), fns, fts, its)) {
+        if let Some(s) = consider(&mut best, finish(p, v, u.clone(), fns, fts, its), settings.accept) {
             return Ok(s);
         }
         // plain semismooth Newton from the same start
-        let (x, _, it) = nw.solve(x0, 0.0, settings.tolerance, settings.max_iterations);
+        let (x, _, it) = nw.solve(x0.clone(), 0.0, settings.tolerance, settings.max_iterations);
         let (v, fns, fts) = nw.unpack(&x);
-        if let Some(s) = keep(finish(p, v, u.clone(), fns, fts, it)) {
+        if let Some(s) = consider(&mut best, finish(p, v, u.clone(), fns, fts, it), settings.accept) {
             return Ok(s);
+        }
+    }
+    // 4. Other projection steps ρ (same solutions, other basins of convergence), continuing
+    //    from the best point found so far as well as from the starts.
+    for rho_scale in [0.1, 10.0, 0.01, 100.0] {
+        let nr = Newton::with_rho(p, u, rho_scale);
+        let mut from = starts.clone();
+        if let Some((_, b)) = &best {
+            from.insert(0, pack(&nr, b));
+        }
+        for x0 in from {
+            let mut x = x0;
+            let mut its = 0;
+            let mut e = 1.0;
+            while e > 1e-10 {
+                let (xe, _, it) = nr.solve(x.clone(), e, 0.1 * e, 40);
+                its += it;
+                x = xe;
+                e *= 0.3;
+            }
+            let (x, _, it) = nr.solve(x, 0.0, settings.tolerance, settings.max_iterations);
+            let (v, fns, fts) = nr.unpack(&x);
+            if let Some(s) = consider(&mut best, finish(p, v, u.clone(), fns, fts, its + it), settings.accept) {
+                return Ok(s);
+            }
         }
     }
     let (r, sol) = best.expect("at least one attempt");

@@ -1,0 +1,166 @@
+"""The quasi-static complementarity simulator: residuals of every solve, agreement with the
+IPOPT reference, known cases, plan replay, validation output, and MuJoCo on a small case."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+import regrasp
+from regrasp import mncp_reference, quasistatic
+
+from .conftest import EXAMPLES, block_scenes
+
+SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+def load(d):
+    try:
+        return regrasp.Scene.from_dict(d)
+    except regrasp.SceneError as e:
+        assume(e.field != "grasp.force")
+        raise
+
+
+@SETTINGS
+@given(block_scenes(), st.floats(-np.pi, np.pi), st.floats(-1.5, 1.5), st.sampled_from(["points", "limit_surface"]))
+def test_every_forward_solve_meets_every_constraint(d, a, b, support):
+    sc = load(d)
+    q = d["task"]["start"]
+    u = sc.metric_twist_inv(np.array([np.cos(a) * np.cos(b), np.sin(a) * np.cos(b), np.sin(b)])) * 0.01
+    p = quasistatic.problem(sc, q, "p", support=support, rings=2)
+    sol = p.solve_forward(list(u))
+    assert sol["max_residual"] < 1e-6, sol["residuals"]
+    # the residuals recomputed from the returned forces agree
+    r = p.residuals(list(sol["twist"]), list(sol["pusher_twist"]), list(sol["normal_forces"]),
+                    [list(f) for f in sol["friction_forces"]])
+    assert max(r.values()) < 1e-6
+
+
+@SETTINGS
+@given(block_scenes(line=True), st.floats(-np.pi, np.pi), st.floats(-1.5, 1.5))
+def test_limit_surface_support_agrees_with_the_motion_cone(d, a, b):
+    sc = load(d)
+    q = d["task"]["start"]
+    u = sc.metric_twist_inv(np.array([np.cos(a) * np.cos(b), np.sin(a) * np.cos(b), np.sin(b)])) * 0.01
+    cone = sc.motion_cone(q, "p")
+    m = cone.margin(u)
+    assume(abs(m) > 1e-6)
+    st_, _, res, err = sc._core.push_outcomes(np.array([q]), "p", np.array([u]), "limit_surface", 1, 0, True)
+    assert err[0] is None and res[0] < 1e-6
+    assert bool(st_[0]) == (m > 0)
+
+
+def bench_problem():
+    sc = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    return sc, sc._core.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, 4, False)
+
+
+@pytest.mark.parametrize("u", [[0.01, 0.0, 0.0], [0.002, 0.01, 0.0], [0.01, 0.002, 0.3], [0.01, -0.003, -0.5]])
+def test_fast_and_reference_solvers_agree(u):
+    _, p = bench_problem()
+    fast = p.solve_forward(u)
+    ref = mncp_reference.solve(p, pusher_twist=u)
+    assert ref.max_residual < 1e-6 and fast["max_residual"] < 1e-6
+    # the object's motion is unique in these cases
+    assert np.allclose(fast["twist"], ref.twist, atol=1e-6 * 0.01 + 1e-7)
+
+
+def test_inverse_then_forward_round_trip_and_reference_inverse():
+    _, p = bench_problem()
+    v = [0.01, 0.001, 0.05]
+    inv = p.solve_inverse(v)
+    assert inv["max_residual"] < 1e-6
+    assert all(s == "stick" for s, lab in zip(inv["states"], inv["labels"]) if lab.startswith("pusher"))
+    fwd = p.solve_forward(list(inv["pusher_twist"]))
+    assert np.allclose(fwd["twist"], v, atol=1e-9)
+    ref = mncp_reference.solve(p, twist=v)
+    assert ref.max_residual < 1e-6
+    # the object's motion was given; a reference pusher motion reproduces it in the fast solver
+    fwd2 = p.solve_forward(list(ref.pusher_twist))
+    assert np.allclose(fwd2["twist"], v, atol=1e-6)
+    with pytest.raises(regrasp.ArgumentError):
+        p.solve_inverse([0.0, 0.01, 0.0])  # a side pusher cannot lift the block straight up
+
+
+def test_known_cases():
+    sc, p = bench_problem()
+    # inside the motion cone: the pusher sticks, the fingers slide
+    s = p.solve_forward([0.01, 0.0, 0.0])
+    assert [x for x, lab in zip(s["states"], s["labels"]) if lab.startswith("pusher")] == ["stick", "stick"]
+    assert all(x == "slide" for x, lab in zip(s["states"], s["labels"]) if lab.startswith("finger"))
+    # well outside: the pusher slips
+    s = p.solve_forward([0.0, 0.01, 0.0])
+    assert all(x != "stick" for x, lab in zip(s["states"], s["labels"]) if lab.startswith("pusher"))
+    # (almost) zero grip force: the object drops (in a unit step, at about g · 1 s)
+    loose = sc.with_grip_force(1e-6)
+    pz = loose._core.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, 4, False)
+    s = pz.solve_forward([0.01, 0.0, 0.0])
+    assert s["twist"][1] < -1.0, s["twist"]
+
+
+def test_long_push_and_plan_replay(tmp_path):
+    sc = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    tr = quasistatic.simulate_push(sc, [0, 0, 0], "left", [0.01, 0, 0], 1.0, 0.05)
+    assert tr["residual"].max() < 1e-6
+    assert np.allclose(tr["pose"][-1], [0.01, 0, 0], atol=1e-6)
+    # a two-push plan: up with the bottom pusher, then right with the left pusher
+    plan = {"scene": sc.name, "found": True, "path": [
+        {"pose": [0.0, 0.0, 0.0], "pusher": None},
+        {"pose": [0.0, 0.008, 0.0], "pusher": "bottom"},
+        {"pose": [0.012, 0.008, 0.0], "pusher": "left"}]}
+    f = tmp_path / "plan.json"
+    f.write_text(json.dumps(plan))
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "simulate", str(EXAMPLES / "block-low-friction.toml"),
+                        "--plan", str(f), "--engine", "quasistatic", "--json"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["success"] and out["engine"] == "quasistatic"
+    assert np.abs(out["goal_error"]).max() < 1e-4 and out["max_pusher_slip"] < 1e-6
+    # a plan that pushes up with the side pusher fails and says so
+    bad = dict(plan, path=plan["path"][:1] + [{"pose": [0.0, 0.008, 0.0], "pusher": "left"}])
+    f.write_text(json.dumps(bad))
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "simulate", str(EXAMPLES / "block-low-friction.toml"),
+                        "--plan", str(f), "--json"], capture_output=True, text=True)
+    assert r.returncode == 1 and json.loads(r.stdout)["max_pusher_slip"] > 1e-3
+
+
+def test_validate_json_and_agreement():
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "validate", str(EXAMPLES / "block-high-friction.toml"),
+                        "--pushes", "120", "--json"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert {"pushes", "agreement_quasistatic", "confusion_quasistatic"} <= set(out)
+    assert out["pushes"] == 120 and sum(out["confusion_quasistatic"].values()) == out["solved"]
+    assert out["agreement_quasistatic"] > 0.85
+    # with the motion cones' own limit surface as the pads, prediction and simulation coincide
+    ls = quasistatic.validate(regrasp.Scene.load(EXAMPLES / "block-high-friction.toml"), 90, 1, support="limit_surface")
+    assert ls["agreement_quasistatic"] > 0.99
+
+
+def test_push_cli_plot(tmp_path):
+    png = tmp_path / "push.png"
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "push", str(EXAMPLES / "block-low-friction.toml"),
+                        "--pose", "0,0,0", "--pusher", "left", "--twist", "0.01,0,0", "--duration", "0.5",
+                        "--plot", str(png), "--json"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["pusher_sticking_share"] == 1.0 and png.stat().st_size > 10_000
+
+
+def test_mujoco_agrees_with_the_quasistatic_pivot():
+    pytest.importorskip("mujoco")
+    from regrasp import mujoco_sim
+
+    sc = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    w = np.radians(10.0)
+    twist = [w * -0.04, 0.0, w]
+    qs = quasistatic.simulate_push(sc, [0, 0, 0], "bottom", twist, 3.0, 0.05)
+    mj = mujoco_sim.simulate_push(sc, [0, 0, 0], "bottom", twist, 3.0)
+    # the pusher slips in both: the object turns about half of the pusher's 30 degrees
+    assert 0.3 < qs["pose"][-1][2] / (3.0 * w) < 0.7
+    assert abs(mj["pose"][-1][2] - qs["pose"][-1][2]) < 0.15 * abs(qs["pose"][-1][2])
