@@ -112,7 +112,37 @@ def run(n: int = 100_000, reps: int = 11, baseline_reps: int = 3, scene_path=Non
         "baseline": "polyhedral projection (NNLS) called one by one from Python",
         "n": k,
     }
+    results.update(run_mncp(reps=reps))
     return results
+
+
+def run_mncp(reps: int = 11, ref_reps: int = 3) -> dict:
+    """One instantaneous quasi-static solve (two finger patches of 4 points, a line pusher):
+    the Rust solver against the IPOPT reference on the same problem, for a push that sticks, one
+    that slides and one that separates."""
+    from . import mncp_reference
+
+    scene = Scene.load(EXAMPLES / "block-low-friction.toml")
+    p = scene._core.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, 4, False)
+    out = {}
+    for name, u in (("stick", [0.01, 0.0, 0.0]), ("slide", [0.002, 0.01, 0.0]), ("separate", [-0.01, 0.0, 0.2])):
+        fast = p.solve_forward(u)
+        ref = mncp_reference.solve(p, pusher_twist=u)
+        m = 200
+        t_fast = _median_time(lambda: [p.solve_forward(u) for _ in range(m)], reps) / m
+        # IPOPT's own solve time (the casadi model is built outside it)
+        t_ref = float(np.median([mncp_reference.solve(p, pusher_twist=u).solve_time_s for _ in range(ref_reps)]))
+        out[f"mncp_forward_{name}"] = {
+            "median_s": t_fast,
+            "baseline_median_s": t_ref,
+            "ratio": t_ref / t_fast,
+            "baseline": "IPOPT solve (casadi), the thesis' NLP",
+            "n": 1,
+            "max_abs_twist_diff": float(np.abs(fast["twist"] - ref.twist).max()),
+            "residual_fast": fast["max_residual"],
+            "residual_reference": ref.max_residual,
+        }
+    return out
 
 
 def format_results(res: dict) -> str:
