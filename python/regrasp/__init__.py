@@ -11,6 +11,7 @@ Quick use::
 from ._core import __version__
 from .errors import ArgumentError, GraspError, RegraspError, SceneError
 from .scene import Classification, GravityFreeCone, MotionCone, MotionConeBatch, Pusher, Scene, Task
+from .scene3d import Scene3D
 
 __all__ = [
     "__version__",
@@ -24,5 +25,6 @@ __all__ = [
     "MotionConeBatch",
     "Pusher",
     "Scene",
+    "Scene3D",
     "Task",
 ]

@@ -11,7 +11,9 @@ pub mod metric;
 pub mod mncp;
 pub mod motion_cone;
 pub mod quasistatic;
+pub mod quasistatic3d;
 pub mod scene;
+pub mod scene3d;
 
 pub use error::{Error, Result};
 pub use metric::Metric;

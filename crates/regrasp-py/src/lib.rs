@@ -10,6 +10,8 @@ use regrasp::geometry::{Vec2, Vec3};
 use regrasp::motion_cone::{project_onto_generators, Classification, PlanarPush};
 use regrasp::mncp::{self, FrictionLaw, NormalLaw, Side};
 use regrasp::quasistatic::{self, Options, SupportModel};
+use regrasp::quasistatic3d;
+use regrasp::scene3d::{self, Scene3};
 use regrasp::{batch, Error};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -569,6 +571,107 @@ fn status_array<'py>(py: Python<'py>, st: &[batch::Status]) -> Bound<'py, PyArra
     Array1::from(st.iter().map(|s| *s as u8).collect::<Vec<u8>>()).into_pyarray(py)
 }
 
+/// A validated 3-D scene (box or convex mesh object).
+#[pyclass(module = "regrasp._core", frozen)]
+struct Scene3D {
+    inner: Scene3,
+}
+
+fn pose7(v: &[f64]) -> PyResult<nalgebra::Isometry3<f64>> {
+    if v.len() != 7 {
+        return Err(arg_err("pose", "must be [x, y, z, qw, qx, qy, qz]"));
+    }
+    let a: [f64; 7] = std::array::from_fn(|i| v[i]);
+    scene3d::pose_from_array("pose", &a).map_err(|e| match e {
+        Error::Scene { message, .. } => arg_err("pose", message),
+        e => to_py(e),
+    })
+}
+
+#[pymethods]
+impl Scene3D {
+    /// Parse and validate a 3-D scene; `base` is the folder mesh paths are relative to.
+    #[staticmethod]
+    #[pyo3(signature = (text, base=None))]
+    fn from_toml(text: &str, base: Option<String>) -> PyResult<Self> {
+        Scene3::from_toml_str(text, base.as_deref().map(std::path::Path::new)).map(|inner| Self { inner }).map_err(to_py)
+    }
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name.clone()
+    }
+    #[getter]
+    fn pusher_names(&self) -> Vec<String> {
+        self.inner.pushers.iter().map(|p| p.name.clone()).collect()
+    }
+    #[getter]
+    fn length(&self) -> f64 {
+        self.inner.length
+    }
+    #[getter]
+    fn mass(&self) -> f64 {
+        self.inner.mass
+    }
+    #[getter]
+    fn inertia<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        Array2::from_shape_fn((3, 3), |(i, j)| self.inner.inertia[(i, j)]).into_pyarray(py)
+    }
+    #[getter]
+    fn task(&self) -> ([f64; 7], [f64; 7], [f64; 4]) {
+        (scene3d::pose_to_array(&self.inner.start), scene3d::pose_to_array(&self.inner.goal), self.inner.tolerance)
+    }
+    /// Vertices (n, 3) and triangles (m, 3) of the object's mesh.
+    fn mesh<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>) {
+        let v = &self.inner.mesh.vertices;
+        let t = &self.inner.mesh.triangles;
+        (
+            Array2::from_shape_fn((v.len(), 3), |(i, j)| v[i][j]).into_pyarray(py),
+            Array2::from_shape_fn((t.len(), 3), |(i, j)| t[i][j] as u32).into_pyarray(py),
+        )
+    }
+    /// Contact points (object frame) of the two finger pads at `pose`.
+    fn pad_contacts(&self, pose: Vec<f64>) -> PyResult<Vec<Vec<[f64; 3]>>> {
+        let p = pose7(&pose)?;
+        Ok(self.inner.pad_contacts(&p).iter().map(|s| s.iter().map(|v| [v.x, v.y, v.z]).collect()).collect())
+    }
+    /// The quasi-static problem of `pusher` in contact at its points, at `pose`.
+    #[pyo3(signature = (pose, pusher, h=1.0))]
+    fn quasistatic_problem(&self, pose: Vec<f64>, pusher: &str, h: f64) -> PyResult<MncpProblem> {
+        let p = pose7(&pose)?;
+        let i = self.inner.pusher_index(pusher).map_err(to_py)?;
+        Ok(MncpProblem { inner: quasistatic3d::push_problem(&self.inner, &p, i, h).map_err(to_py)? })
+    }
+    /// Time stepping of one push (pusher body twist [v, ω] constant, object frame at t = 0).
+    fn simulate_push<'py>(
+        &self,
+        py: Python<'py>,
+        pose: Vec<f64>,
+        pusher: &str,
+        twist: Vec<f64>,
+        duration: f64,
+        dt: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let p = pose7(&pose)?;
+        if twist.len() != 6 || !twist.iter().all(|x| x.is_finite()) {
+            return Err(arg_err("twist", "must be 6 finite numbers [vx, vy, vz, wx, wy, wz]"));
+        }
+        let u: [f64; 6] = std::array::from_fn(|i| twist[i]);
+        let i = self.inner.pusher_index(pusher).map_err(to_py)?;
+        let tr = py
+            .allow_threads(|| quasistatic3d::simulate_push(&self.inner, &p, i, &u, duration, dt, &mncp::Settings::default()))
+            .map_err(to_py)?;
+        let d = PyDict::new(py);
+        d.set_item("t", Array1::from(tr.t.clone()).into_pyarray(py))?;
+        d.set_item("pose", Array2::from_shape_fn((tr.pose.len(), 7), |(i, j)| tr.pose[i][j]).into_pyarray(py))?;
+        d.set_item("twist", Array2::from_shape_fn((tr.twist.len(), 6), |(i, j)| tr.twist[i][j]).into_pyarray(py))?;
+        d.set_item("pusher_slip", Array1::from(tr.pusher_slip.clone()).into_pyarray(py))?;
+        d.set_item("pusher_contacts", Array1::from(tr.pusher_contacts.iter().map(|x| *x as u32).collect::<Vec<_>>()).into_pyarray(py))?;
+        d.set_item("pusher_sticking", Array1::from(tr.pusher_sticking.iter().map(|x| *x as u32).collect::<Vec<_>>()).into_pyarray(py))?;
+        d.set_item("residual", Array1::from(tr.residual.clone()).into_pyarray(py))?;
+        Ok(d)
+    }
+}
+
 /// The motion cone of one pusher at one pose.
 #[pyclass(module = "regrasp._core", frozen)]
 struct MotionCone {
@@ -757,6 +860,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_class::<MotionCone>()?;
     m.add_class::<MncpProblem>()?;
+    m.add_class::<Scene3D>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,0 +1,303 @@
+//! Spatial scenes as complementarity problems ([`crate::mncp`]) and their time stepping.
+//!
+//! The object's twist is the body twist `[v, ω]` (object frame, about the object-frame origin).
+//! Finger pads are the contact points of [`Scene3::pad_contacts`] with equal shares of the grip
+//! force and Coulomb discs in the pad plane (the force-controlled fingers follow the object
+//! along the grasp axis, so the normal force is given, not the normal velocity). A pusher is a
+//! rigid point set with unilateral contacts and Coulomb cones (two tangent directions).
+
+use crate::error::{Error, Result};
+use crate::mncp::{self, Contact, ContactState, FrictionLaw, NormalLaw, Problem, Settings, Side, Solution};
+use crate::scene3d::{Scene3, V3};
+use nalgebra::{DMatrix, DVector, Isometry3, Matrix3, Translation3, UnitQuaternion};
+
+fn skew(r: &V3) -> Matrix3<f64> {
+    Matrix3::new(0.0, -r.z, r.y, r.z, 0.0, -r.x, -r.y, r.x, 0.0)
+}
+
+/// Two unit tangents completing `n` to an orthonormal frame.
+fn tangents(n: &V3) -> (V3, V3) {
+    let a = if n.x.abs() < 0.9 { V3::x() } else { V3::y() };
+    let t1 = n.cross(&a).normalize();
+    (t1, n.cross(&t1))
+}
+
+/// Row `[dᵀ, (r × d)ᵀ]`: the velocity along `d` of object point `r` for body twist `[v, ω]`.
+fn row(r: &V3, d: &V3) -> [f64; 6] {
+    let m = r.cross(d);
+    [d.x, d.y, d.z, m.x, m.y, m.z]
+}
+
+/// The problem at pose `pose`, with pusher contacts at object-frame points `points` (gaps
+/// `gaps`, common normal `normal`, friction `mu`), over a step `h`.
+pub fn problem(
+    scene: &Scene3,
+    pose: &Isometry3<f64>,
+    pusher: Option<(f64, &[V3], &[f64], V3)>,
+    h: f64,
+    speed: f64,
+) -> Result<Problem> {
+    let d = 6;
+    let mut contacts = Vec::new();
+    let pads = scene.pad_contacts(pose);
+    let inv_rot = pose.rotation.inverse();
+    for (side, pts) in pads.iter().enumerate() {
+        if pts.is_empty() {
+            return Err(Error::arg("pose", format!("finger pad {side} does not touch the object")));
+        }
+        let sign = if side == 0 { 1.0 } else { -1.0 };
+        let n = inv_rot * V3::new(0.0, -sign, 0.0);
+        let (t1, t2) = tangents(&n);
+        let share = scene.grip_force / pts.len() as f64;
+        for (k, r) in pts.iter().enumerate() {
+            let mut jt = DMatrix::zeros(2, d);
+            jt.row_mut(0).copy_from_slice(&row(r, &t1));
+            jt.row_mut(1).copy_from_slice(&row(r, &t2));
+            contacts.push(Contact {
+                label: format!("finger{side}[{k}]"),
+                side: Side::Finger,
+                normal: NormalLaw::Fixed(share),
+                friction: FrictionLaw::Coulomb(scene.grip_friction),
+                jn: DVector::from_row_slice(&row(r, &n)),
+                jt,
+                jn_other: DVector::zeros(d),
+                jt_other: DMatrix::zeros(2, d),
+                gap: 0.0,
+            });
+        }
+    }
+    if let Some((mu, points, gaps, normal)) = pusher {
+        let n = normal.normalize();
+        let (t1, t2) = tangents(&n);
+        for (k, (r, g)) in points.iter().zip(gaps).enumerate() {
+            let mut jt = DMatrix::zeros(2, d);
+            jt.row_mut(0).copy_from_slice(&row(r, &t1));
+            jt.row_mut(1).copy_from_slice(&row(r, &t2));
+            let jn = DVector::from_row_slice(&row(r, &n));
+            contacts.push(Contact {
+                label: format!("pusher[{k}]"),
+                side: Side::Pusher,
+                normal: NormalLaw::Unilateral,
+                friction: FrictionLaw::Coulomb(mu),
+                jn_other: jn.clone(),
+                jt_other: jt.clone(),
+                jn,
+                jt,
+                gap: *g,
+            });
+        }
+    }
+    // the fingers' normal forces are given: they must not push the object along the grasp axis
+    // on their own (equal and opposite totals), their moments are balanced by the pad frictions
+    let m = scene.mass;
+    let c = scene.com;
+    let cx = skew(&c);
+    let mut mass = DMatrix::zeros(6, 6);
+    mass.view_mut((0, 0), (3, 3)).copy_from(&(Matrix3::identity() * m));
+    mass.view_mut((0, 3), (3, 3)).copy_from(&(-cx * m));
+    mass.view_mut((3, 0), (3, 3)).copy_from(&(cx * m));
+    mass.view_mut((3, 3), (3, 3)).copy_from(&(scene.inertia - cx * cx * m));
+    let f = inv_rot * (scene.gravity * m);
+    let tq = c.cross(&f);
+    let wrench = DVector::from_row_slice(&[f.x, f.y, f.z, tq.x, tq.y, tq.z]);
+    Ok(Problem {
+        dim: d,
+        mass: mass / h,
+        wrench,
+        contacts,
+        h,
+        force_scale: 2.0 * scene.grip_force * scene.grip_friction + m * scene.gravity.norm(),
+        velocity_scale: speed,
+        length: scene.length,
+    })
+}
+
+/// The problem of pusher `pusher` in contact at its scene points, at pose `pose`.
+pub fn push_problem(scene: &Scene3, pose: &Isometry3<f64>, pusher: usize, h: f64) -> Result<Problem> {
+    let p = scene.pushers.get(pusher).ok_or_else(|| Error::arg("pusher", format!("index {pusher} out of range")))?;
+    let gaps = vec![0.0; p.points.len()];
+    problem(scene, pose, Some((p.friction, &p.points, &gaps, p.normal)), h, 0.01)
+}
+
+/// `exp` of a body twist `[v, ω]` applied over `dt` (right multiplication).
+pub fn integrate(pose: &Isometry3<f64>, u: &[f64; 6], dt: f64) -> Isometry3<f64> {
+    let v = V3::new(u[0], u[1], u[2]) * dt;
+    let w = V3::new(u[3], u[4], u[5]) * dt;
+    let th = w.norm();
+    let wx = skew(&w);
+    let (a, b) = if th < 1e-8 { (0.5 - th * th / 24.0, 1.0 / 6.0 - th * th / 120.0) } else {
+        ((1.0 - th.cos()) / (th * th), (th - th.sin()) / (th * th * th))
+    };
+    let vmat = Matrix3::identity() + wx * a + wx * wx * b;
+    let step = Isometry3::from_parts(Translation3::from(vmat * v), UnitQuaternion::from_scaled_axis(w));
+    pose * step
+}
+
+/// Body twist of frame `b` expressed in frame `a` (`rel = a⁻¹ b`).
+fn twist_in(rel: &Isometry3<f64>, u: &[f64; 6]) -> [f64; 6] {
+    let (v, w) = (V3::new(u[0], u[1], u[2]), V3::new(u[3], u[4], u[5]));
+    let rw = rel.rotation * w;
+    let rv = rel.rotation * v + rel.translation.vector.cross(&rw);
+    [rv.x, rv.y, rv.z, rw.x, rw.y, rw.z]
+}
+
+/// A recorded 3-D push.
+#[derive(Clone, Debug, Default)]
+pub struct Trajectory3 {
+    pub t: Vec<f64>,
+    pub pose: Vec<[f64; 7]>,
+    pub twist: Vec<[f64; 6]>,
+    pub pusher_slip: Vec<f64>,
+    pub pusher_contacts: Vec<usize>,
+    pub pusher_sticking: Vec<usize>,
+    pub residual: Vec<f64>,
+}
+
+/// Simulates a push in 3-D: the pusher starts at its scene points with the object at `start`
+/// and moves with constant body twist `u` (its frame = the object frame at the start).
+pub fn simulate_push(
+    scene: &Scene3,
+    start: &Isometry3<f64>,
+    pusher: usize,
+    u: &[f64; 6],
+    duration: f64,
+    dt: f64,
+    settings: &Settings,
+) -> Result<Trajectory3> {
+    if !(dt > 0.0) || !(duration >= 0.0) || !duration.is_finite() {
+        return Err(Error::arg("dt", "time step and duration must be positive and finite"));
+    }
+    let pz = scene.pushers.get(pusher).ok_or_else(|| Error::arg("pusher", format!("index {pusher} out of range")))?;
+    let steps = (duration / dt).round() as usize;
+    let (mut q, mut qp) = (*start, *start);
+    let speed = V3::new(u[0], u[1], u[2]).norm() + V3::new(u[3], u[4], u[5]).norm() * scene.length;
+    let reach = 0.002 + 2.0 * dt * speed;
+    let mut tr = Trajectory3::default();
+    for k in 0..=steps {
+        let t = k as f64 * dt;
+        let rel = q.inverse() * qp;
+        let normal = rel.rotation * pz.normal;
+        let (mut pts, mut gaps) = (Vec::new(), Vec::new());
+        for p in &pz.points {
+            let r = (rel * nalgebra::Point3::from(*p)).coords;
+            let gap = scene.mesh.signed_distance(&r);
+            if gap < reach {
+                pts.push(r);
+                gaps.push(gap);
+            }
+        }
+        let prob = problem(scene, &q, Some((pz.friction, &pts, &gaps, normal)), dt, speed.max(1e-3))?;
+        let uo = twist_in(&rel, u);
+        let sol: Solution = mncp::solve_forward(&prob, &DVector::from_row_slice(&uo), settings)
+            .map_err(|e| Error::arg("push", format!("at t = {t:.3} s: {e}")))?;
+        let v: [f64; 6] = std::array::from_fn(|i| sol.twist[i]);
+        let (mut slip, mut n_contact, mut n_stick) = (0.0f64, 0, 0);
+        for (i, c) in prob.contacts.iter().enumerate() {
+            if c.side == Side::Pusher && sol.states[i] != ContactState::Separate {
+                n_contact += 1;
+                slip = slip.max(sol.tangent_velocities[i].norm());
+                n_stick += (sol.states[i] == ContactState::Stick) as usize;
+            }
+        }
+        tr.t.push(t);
+        tr.pose.push(crate::scene3d::pose_to_array(&q));
+        tr.twist.push(v);
+        tr.pusher_slip.push(slip);
+        tr.pusher_contacts.push(n_contact);
+        tr.pusher_sticking.push(n_stick);
+        tr.residual.push(sol.residuals.max());
+        if k < steps {
+            q = integrate(&q, &v, dt);
+            qp = integrate(&qp, u, dt);
+        }
+    }
+    Ok(tr)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quasistatic::{self, Options, SupportModel};
+    use crate::Scene;
+
+    const BLOCK3: &str = r#"
+dimension = 3
+name = "block-3d"
+[object]
+shape = "box"
+size = [0.05, 0.012, 0.08]
+mass = 0.13
+[grasp]
+force = 20.0
+friction = 0.6
+pad_radius = 0.007
+[[pushers]]
+name = "left"
+friction = 0.25
+points = [[-0.025, 0.0, -0.03], [-0.025, 0.0, 0.03]]
+normal = [1.0, 0.0, 0.0]
+[task]
+start = [0, 0, 0, 1, 0, 0, 0]
+goal = [0, 0, 0, 1, 0, 0, 0]
+tolerance = [0.001, 0.001, 0.001, 0.0175]
+"#;
+
+    #[test]
+    fn box_mass_properties() {
+        let m = crate::scene3d::ConvexMesh::cuboid(&V3::new(0.2, 0.4, 0.6));
+        let (vol, c, i) = m.mass_properties();
+        assert!((vol - 0.048).abs() < 1e-12 && c.norm() < 1e-12);
+        // unit density: I_xx = V (b² + c²) / 12
+        assert!((i[(0, 0)] - (0.16 + 0.36) / 12.0).abs() < 1e-12, "{i}");
+        assert!((i[(2, 2)] - (0.04 + 0.16) / 12.0).abs() < 1e-12);
+        assert!(i[(0, 1)].abs() < 1e-12);
+        let cube = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 3 4 8 7\nf 1 5 8 4\nf 2 3 7 6\n";
+        let m = crate::scene3d::ConvexMesh::from_obj(cube).unwrap();
+        let (vol, c, _) = m.mass_properties();
+        assert!((vol - 1.0).abs() < 1e-12 && (c - V3::new(0.5, 0.5, 0.5)).norm() < 1e-12);
+        // a dent makes it non-convex
+        let dented = cube.replace("v 1 1 1", "v 0.4 0.4 0.4");
+        assert!(crate::scene3d::ConvexMesh::from_obj(&dented).is_err());
+    }
+
+    /// A planar push of a box in 3-D gives the planar model's answer (same pad points).
+    #[test]
+    fn planar_case_matches_the_planar_model() {
+        let s3 = Scene3::from_toml_str(BLOCK3, None).unwrap();
+        let s2 = Scene::from_toml_str(include_str!("../../../examples/block-low-friction.toml")).unwrap();
+        let opts = Options { support: SupportModel::Points { rings: 0, points: 8, merge_fingers: false }, ..Options::default() };
+        let i2 = s2.pusher_index("left").unwrap();
+        let i3 = s3.pusher_index("left").unwrap();
+        for u2 in [[0.01, 0.0, 0.0], [0.01, 0.002, 0.1], [0.002, 0.01, 0.0], [0.005, -0.004, -0.4]] {
+            let out2 = quasistatic::push_outcome(&s2, &[0.0, 0.0, 0.0], i2, &crate::geometry::Vec3::from(u2), &opts).unwrap();
+            // planar [vx, vz, ω] (ω counter-clockwise in the X-Z drawing) = spatial [vx, 0, vz, 0, −ω, 0]
+            let u3 = [u2[0], 0.0, u2[1], 0.0, -u2[2], 0.0];
+            let p3 = push_problem(&s3, &Isometry3::identity(), i3, 1.0).unwrap();
+            let sol = mncp::solve_forward(&p3, &DVector::from_row_slice(&u3), &Settings::default()).unwrap();
+            assert!(sol.residuals.max() < 1e-6);
+            let v3 = [sol.twist[0], sol.twist[2], -sol.twist[4]];
+            let v2 = out2.solution.twist;
+            for k in 0..3 {
+                assert!((v3[k] - v2[k]).abs() < 1e-7 * (1.0 + v2[k].abs()), "{u2:?}: 3-D {v3:?} vs planar {v2}");
+            }
+            assert!(sol.twist[1].abs() < 1e-9 && sol.twist[3].abs() < 1e-7 && sol.twist[5].abs() < 1e-7, "{}", sol.twist);
+        }
+    }
+
+    #[test]
+    fn time_stepping_moves_the_box_with_a_sticking_pusher() {
+        let s3 = Scene3::from_toml_str(BLOCK3, None).unwrap();
+        let tr = simulate_push(&s3, &Isometry3::identity(), 0, &[0.01, 0.0, 0.0, 0.0, 0.0, 0.0], 1.0, 0.1, &Settings::default()).unwrap();
+        let last = tr.pose.last().unwrap();
+        assert!((last[0] - 0.01).abs() < 1e-6 && last[2].abs() < 1e-6, "{last:?}");
+        assert!(tr.residual.iter().all(|r| *r < 1e-6));
+        assert!(tr.pusher_sticking.iter().all(|n| *n == 2));
+    }
+
+    #[test]
+    fn exp_map_composes() {
+        let p = integrate(&Isometry3::identity(), &[0.0, 0.0, 1.0, 0.0, std::f64::consts::PI, 0.0], 1.0);
+        // a half turn about y while moving along z: a semicircle of diameter 2/π in x
+        assert!((p.translation.x - 2.0 / std::f64::consts::PI).abs() < 1e-12, "{p}");
+    }
+}
