@@ -101,7 +101,9 @@ def cmd_cone(a) -> int:
 def cmd_approx_error(a) -> int:
     from .report import approximation_report, format_report
 
-    paths = a.scenes or sorted(EXAMPLES.glob("*.toml"))
+    from .scene3d import is_3d
+
+    paths = a.scenes or [p for p in sorted(EXAMPLES.glob("*.toml")) if not is_3d(p)]
     scenes = [Scene.load(p) for p in paths]
     forces = _floats(a.forces, len(a.forces.split(",")), "--forces")
     if a.samples < 1:
