@@ -12,6 +12,7 @@ from ._core import __version__
 from .errors import ArgumentError, GraspError, RegraspError, SceneError
 from .scene import Classification, GravityFreeCone, MotionCone, MotionConeBatch, Pusher, Scene, Task
 from .scene3d import Scene3D
+from .plan import Plan, plan
 
 __all__ = [
     "__version__",
@@ -26,5 +27,7 @@ __all__ = [
     "Pusher",
     "Scene",
     "Scene3D",
+    "Plan",
+    "plan",
     "Task",
 ]

@@ -1,4 +1,4 @@
-"""Command line: ``regrasp cone | approx-error | validate | simulate | push | bench | demo``.
+"""Command line: ``regrasp plan | cone | approx-error | validate | simulate | push | bench | demo``.
 
 Exit status: 0 success, 1 the task cannot be done (reason printed), 2 invalid input.
 """
@@ -128,29 +128,43 @@ def cmd_bench(a) -> int:
 
 
 def cmd_demo(a) -> int:
-    from .plotting import plot_motion_cone
-    from .report import approximation_report, format_report
+    from .plan import plan
+    from .plotting import animate_plan, plot_motion_cone, plot_plan
 
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    path = EXAMPLES / "block-low-friction.toml"
+    path = EXAMPLES / "t-shape.toml"
     scene = Scene.load(path)
-    start = scene.task.start
-    print(f"demo: motion cones of every pusher of {path.name} at the start pose {start.tolist()}")
-    reports = []
-    for p in scene.pusher_names:
-        rep = cone_report(scene, start, p)
-        fig = plot_motion_cone(scene.motion_cone(start, p), out / f"cone-{p}.png")
-        reports.append(rep)
-        mn = rep["min_grip_force"]
-        print(f"  {p:8s} {rep['pusher_kind']:5s} pusher: {len(rep['generators'])} generators, "
-              f"central push sticks above {mn:.2f} N per finger -> {fig}")
-    (out / "cones.json").write_text(json.dumps(reports, indent=1))
-    rows = approximation_report([scene], (5.0, 20.0, 80.0), samples=5000)
-    print("\npolyhedral approximation vs exact cone (share of random pushes misclassified):")
-    print(format_report(rows))
-    print(f"\nwrote {out / 'cones.json'} and {len(reports)} figures in {out}")
-    return 0
+    t = scene.task
+    print(f"demo: regrasp of the T-shaped object ({path.name}) from {t.start.tolist()} to {t.goal.tolist()}")
+    p = plan(scene, seed=a.seed)
+    p.save(out / "t-shape-plan.json")
+    plot_plan(scene, p, out / "t-shape-plan.png")
+    animate_plan(scene, p, out / "t-shape-plan.gif")
+    run, prev = [], None
+    for k in p.path[1:]:
+        if k["pusher"] != prev:
+            run.append([k["pusher"], 0])
+            prev = k["pusher"]
+        run[-1][1] += 1
+    print(f"  {'plan found' if p.found else 'NO plan found'} in {1e3 * p.planning_time_s:.2f} ms: {len(p.path) - 1} steps, "
+          f"{p.switch_overs} switch-overs ({' -> '.join(f'{n} x{c}' for n, c in run)})")
+    print(f"  every step sticks along its length by the exact motion-cone test: {p.valid}")
+    # the motion cones the first push relies on
+    first = p.path[1]["pusher"] if len(p.path) > 1 else scene.pusher_names[0]
+    plot_motion_cone(scene.motion_cone(t.start, first), out / f"cone-{first}.png")
+    # and the plan replayed in the quasi-static simulator
+    from .quasistatic import replay_plan
+
+    rep = replay_plan(scene, p.to_json())
+    from .plotting import plot_replay
+
+    plot_replay(scene, rep, out / "t-shape-replay.png")
+    print(f"  replayed in the quasi-static simulator: final pose {np.round(rep.final_pose, 4).tolist()}, "
+          f"error {np.round(1e3 * rep.goal_error[:2], 2).tolist()} mm / {np.degrees(rep.goal_error[2]):.2f} deg, "
+          f"{'within' if rep.success else 'outside'} the tolerance")
+    print(f"wrote {out}/t-shape-plan.json, t-shape-plan.png, t-shape-plan.gif, t-shape-replay.png, cone-{first}.png")
+    return 0 if p.found else 1
 
 
 def cmd_validate(a) -> int:
@@ -247,9 +261,64 @@ def cmd_push(a) -> int:
     return 0
 
 
+def cmd_plan(a) -> int:
+    from .plan import plan
+
+    scene = Scene.load(a.scene)
+    start = None if a.start is None else _floats(a.start, 3, "--start")
+    goal = None if a.goal is None else _floats(a.goal, 3, "--goal")
+    if scene.task is None and (start is None or goal is None):
+        raise ArgumentError("invalid `scene`: it has no [task]; give --start and --goal", "task")
+    p = plan(scene, start, goal, seed=a.seed, time_limit=a.time_limit, propagation=a.propagation)
+    if a.out:
+        p.save(a.out)
+    if a.plot:
+        from .plotting import plot_plan
+
+        plot_plan(scene, p, a.plot)
+    if a.animate:
+        from .plotting import animate_plan
+
+        animate_plan(scene, p, a.animate)
+    if a.json:
+        print(json.dumps(p.to_json()))
+    else:
+        head = "plan found" if p.found else f"no plan found ({p.stop_reason}); best partial plan"
+        print(f"{scene.name}: {head}: {len(p.path) - 1} steps, {p.switch_overs} switch-overs, "
+              f"{p.nodes} nodes, {1e3 * p.planning_time_s:.2f} ms ({p.propagation}, seed {p.seed})")
+        run, prev = [], None
+        for k in p.path[1:]:
+            if k["pusher"] != prev:
+                run.append([k["pusher"], 0])
+                prev = k["pusher"]
+            run[-1][1] += 1
+        print("  pushes: " + " -> ".join(f"{n} x{c}" for n, c in run))
+        print(f"  every step sticks along its length (exact test): {p.valid} (smallest margin "
+              f"{min(p.step_margins, default=0):.3f})")
+        if not p.found:
+            print(f"  the best partial plan ends {1e3 * p.goal_distance:.2f} mm (metric) from the goal")
+    if not p.found:
+        print(f"regrasp: no plan found: {p.stop_reason}", file=sys.stderr)
+        return 1
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="regrasp", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
+
+    pl = sub.add_parser("plan", help="plan a regrasp (T-RRT* with motion-cone propagation)")
+    pl.add_argument("scene")
+    pl.add_argument("--out", metavar="PLAN.json")
+    pl.add_argument("--seed", type=int, default=0)
+    pl.add_argument("--time-limit", type=float, default=10.0)
+    pl.add_argument("--propagation", default="motion_cone", choices=["motion_cone", "stable_check", "mncp"])
+    pl.add_argument("--start", help="x,z,theta (default: the scene's task)")
+    pl.add_argument("--goal", help="x,z,theta (default: the scene's task)")
+    pl.add_argument("--plot", metavar="PNG")
+    pl.add_argument("--animate", metavar="GIF")
+    pl.add_argument("--json", action="store_true")
+    pl.set_defaults(fn=cmd_plan)
 
     c = sub.add_parser("cone", help="motion cone of a pusher at a pose")
     c.add_argument("scene")
@@ -307,6 +376,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser("demo", help="the bundled example end to end, writing its figures")
     d.add_argument("--out", default="out/demo")
+    d.add_argument("--seed", type=int, default=0)
     d.set_defaults(fn=cmd_demo)
     return ap
 

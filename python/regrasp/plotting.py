@@ -232,3 +232,139 @@ def plot_replay(scene, rep, path, extra=None) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+PUSHER_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive"]
+
+
+def _object_at(scene, q):
+    c, s = np.cos(q[2]), np.sin(q[2])
+    R = np.array([[c, -s], [s, c]])
+    return scene.outline @ R.T + q[:2]
+
+
+def _pusher_at(scene, q, name):
+    p = scene.pusher(name)
+    c, s = np.cos(q[2]), np.sin(q[2])
+    R = np.array([[c, -s], [s, c]])
+    return p.points @ R.T + q[:2], R @ p.normal
+
+
+def plot_plan(scene, plan, path) -> Path:
+    """The object in the grasp (gripper frame) at the plan's knots, the finger pad, and each
+    push coloured by its pusher (thesis Figs 4-11..4-14); beside it the pose over the steps."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, Polygon
+
+    names = scene.pusher_names
+    color = {n: PUSHER_COLORS[i % len(PUSHER_COLORS)] for i, n in enumerate(names)}
+    poses = plan.poses
+    fig, ax = plt.subplots(1, 2, figsize=(13, 5.5), gridspec_kw={"width_ratios": [1.2, 1]})
+    a = ax[0]
+    n = len(poses)
+    for i, q in enumerate(poses):
+        last = i in (0, n - 1)
+        pusher = plan.path[i]["pusher"]
+        col = "k" if i == 0 else color[pusher]
+        a.add_patch(Polygon(_object_at(scene, q), closed=True, fill=last, alpha=0.15 if last else 0.5,
+                            edgecolor=col, facecolor=col, lw=1.5 if last else 0.6))
+        if pusher is not None:
+            pts, nrm = _pusher_at(scene, q, pusher)
+            a.plot(*pts.T, "-o", color=color[pusher], ms=3, lw=3)
+    if scene.task is not None:
+        a.add_patch(Polygon(_object_at(scene, scene.task.goal), closed=True, fill=False, ls="--", edgecolor="0.3", lw=1.2))
+    pad = scene.pad
+    if pad is not None:
+        a.add_patch(Circle((0, 0), pad[1], color="0.2", alpha=0.6, zorder=5))
+    for nm in names:
+        a.plot([], [], color=color[nm], lw=3, label=f"pusher {nm}")
+    a.plot([], [], "k", label="start (filled)")
+    a.plot([], [], "--", color="0.3", label="goal")
+    a.set_aspect("equal")
+    a.autoscale_view()
+    a.set_xlabel("x in the gripper frame [m]")
+    a.set_ylabel("z in the gripper frame [m]")
+    a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    a.set_title("object in the grasp at the plan's knots (pad in grey)")
+    b = ax[1]
+    k = np.arange(n)
+    b.plot(k, 1e3 * poses[:, 0], "-o", ms=3, label="x [mm]")
+    b.plot(k, 1e3 * poses[:, 1], "-o", ms=3, label="z [mm]")
+    b.plot(k, np.degrees(poses[:, 2]), "-o", ms=3, label="theta [deg]")
+    for i in range(1, n):
+        b.axvspan(i - 1, i, color=color[plan.path[i]["pusher"]], alpha=0.12, lw=0)
+    b.set_xlabel("knot")
+    b.legend(fontsize=8)
+    b.grid(alpha=0.3)
+    b.set_title("pose in the grasp (bands: pusher of each step)")
+    fig.suptitle(f"{scene.name}: {'plan' if plan.found else 'best partial plan'} with {n - 1} steps, "
+                 f"{plan.switch_overs} switch-overs, found in {1e3 * plan.planning_time_s:.1f} ms ({plan.propagation})")
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> Path:
+    """A GIF of the plan: the object moving in the grasp, the active pusher drawn in colour."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    from matplotlib.patches import Circle, Polygon
+
+    from .quasistatic import body_twist, integrate_pose
+
+    names = scene.pusher_names
+    color = {n: PUSHER_COLORS[i % len(PUSHER_COLORS)] for i, n in enumerate(names)}
+    frames = []
+    for i in range(1, len(plan.path)):
+        a, b = plan.path[i - 1]["pose"], plan.path[i]["pose"]
+        xi = body_twist(a, b)
+        for f in range(frames_per_step):
+            frames.append((integrate_pose(a, xi, f / frames_per_step), plan.path[i]["pusher"]))
+    frames.append((np.asarray(plan.path[-1]["pose"]), plan.path[-1]["pusher"]))
+    allpts = np.vstack([_object_at(scene, q) for q, _ in frames])
+    lo, hi = allpts.min(axis=0) - 0.01, allpts.max(axis=0) + 0.01
+    fig, ax = plt.subplots(figsize=(5, 5 * (hi[1] - lo[1]) / max(hi[0] - lo[0], 1e-9)))
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+    obj = Polygon(_object_at(scene, frames[0][0]), closed=True, facecolor="0.8", edgecolor="k")
+    ax.add_patch(obj)
+    if scene.task is not None:
+        ax.add_patch(Polygon(_object_at(scene, scene.task.goal), closed=True, fill=False, ls="--", edgecolor="0.4"))
+    pad = scene.pad
+    if pad is not None:
+        ax.add_patch(Circle((0, 0), pad[1], color="0.2", zorder=5))
+    (line,) = ax.plot([], [], "-", lw=5)
+    title = ax.set_title("")
+
+    def draw(k):
+        q, pusher = frames[k]
+        obj.set_xy(_object_at(scene, q))
+        if pusher is None:
+            line.set_data([], [])
+        else:
+            pts, nrm = _pusher_at(scene, q, pusher)
+            if len(pts) == 1:
+                pts = np.vstack([pts[0] - 0.004 * np.array([-nrm[1], nrm[0]]), pts[0] + 0.004 * np.array([-nrm[1], nrm[0]])])
+            pts = pts - 0.0015 * nrm
+            line.set_data(*pts.T)
+            line.set_color(color[pusher])
+        title.set_text(f"{scene.name}: pusher {pusher or '-'}")
+        return obj, line, title
+
+    anim = FuncAnimation(fig, draw, frames=len(frames), blit=False)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    anim.save(path, writer=PillowWriter(fps=fps))
+    plt.close(fig)
+    return path

@@ -14,6 +14,7 @@ pub mod quasistatic;
 pub mod quasistatic3d;
 pub mod scene;
 pub mod scene3d;
+pub mod trrt;
 
 pub use error::{Error, Result};
 pub use metric::Metric;

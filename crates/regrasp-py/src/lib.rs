@@ -12,6 +12,7 @@ use regrasp::mncp::{self, FrictionLaw, NormalLaw, Side};
 use regrasp::quasistatic::{self, Options, SupportModel};
 use regrasp::quasistatic3d;
 use regrasp::scene3d::{self, Scene3};
+use regrasp::trrt;
 use regrasp::{batch, Error};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -557,6 +558,93 @@ impl Scene {
         d.set_item("pusher_sticking", Array1::from(tr.pusher_sticking.iter().map(|x| *x as u32).collect::<Vec<_>>()).into_pyarray(py))?;
         d.set_item("residual", Array1::from(tr.residual.clone()).into_pyarray(py))?;
         Ok(d)
+    }
+
+    /// T-RRT* regrasp plan (see `regrasp.plan`). Returns a dict.
+    #[pyo3(signature = (start=None, goal=None, seed=0, time_limit=10.0, propagation="motion_cone", max_nodes=20000,
+                        step=None, goal_bias=0.2, margin=0.01, neighbour_steps=2.0, cost_threshold=f64::INFINITY,
+                        checks=4, random_tries=8, connect=true, plain=false))]
+    #[allow(clippy::too_many_arguments)]
+    fn plan<'py>(
+        &self,
+        py: Python<'py>,
+        start: Option<Vec<f64>>,
+        goal: Option<Vec<f64>>,
+        seed: u64,
+        time_limit: f64,
+        propagation: &str,
+        max_nodes: usize,
+        step: Option<f64>,
+        goal_bias: f64,
+        margin: f64,
+        neighbour_steps: f64,
+        cost_threshold: f64,
+        checks: usize,
+        random_tries: usize,
+        connect: bool,
+        plain: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let start = start.map(|v| pose3(&v)).transpose().map_err(|_| arg_err("start", "must be 3 finite numbers"))?;
+        let goal = goal.map(|v| pose3(&v)).transpose().map_err(|_| arg_err("goal", "must be 3 finite numbers"))?;
+        let settings = trrt::Settings {
+            seed,
+            time_limit,
+            max_nodes,
+            step,
+            goal_bias,
+            margin,
+            neighbour_steps,
+            cost_threshold,
+            checks,
+            random_tries,
+            connect,
+            plain,
+            propagation: trrt::Propagation::parse(propagation).map_err(to_py)?,
+            ..trrt::Settings::default()
+        };
+        let r = py.allow_threads(|| trrt::plan(&self.inner, start, goal, &settings)).map_err(to_py)?;
+        let d = PyDict::new(py);
+        d.set_item("scene", &self.inner.name)?;
+        d.set_item("found", r.found)?;
+        d.set_item("stop_reason", r.stop_reason.label())?;
+        d.set_item("planning_time_s", r.planning_time_s)?;
+        d.set_item("nodes", r.nodes)?;
+        d.set_item("iterations", r.iterations)?;
+        d.set_item("switch_overs", r.switch_overs)?;
+        d.set_item("cost", r.cost)?;
+        d.set_item("goal_distance", r.goal_distance)?;
+        d.set_item("propagation", settings.propagation.label())?;
+        d.set_item("seed", seed)?;
+        let path = r
+            .path
+            .iter()
+            .map(|(q, p)| -> PyResult<Bound<'py, PyDict>> {
+                let k = PyDict::new(py);
+                k.set_item("pose", q.to_vec())?;
+                k.set_item("pusher", p.map(|i| self.inner.pushers[i].name.clone()))?;
+                Ok(k)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        d.set_item("path", path)?;
+        Ok(d)
+    }
+
+    /// Smallest exact-test margin along each step of a path (poses, pusher names).
+    #[pyo3(signature = (poses, pushers, checks=16))]
+    fn validate_path(&self, poses: Vec<Vec<f64>>, pushers: Vec<Option<String>>, checks: usize) -> PyResult<Vec<f64>> {
+        if poses.len() != pushers.len() {
+            return Err(arg_err("path", "poses and pushers differ in length"));
+        }
+        let mut path = Vec::new();
+        for (i, (q, p)) in poses.iter().zip(&pushers).enumerate() {
+            let q = pose3(q).map_err(|_| arg_err(&format!("path[{i}].pose"), "must be 3 finite numbers"))?;
+            let p = match p {
+                None => None,
+                Some(n) => Some(self.inner.pusher_index(n).map_err(|_| arg_err(&format!("path[{i}].pusher"), format!("no pusher {n:?}")))?),
+            };
+            path.push((q, p));
+        }
+        trrt::validate_path(&self.inner, &path, checks).map_err(to_py)
     }
 
     /// Messages of the batch status codes.
