@@ -71,7 +71,7 @@ class Plan:
         Path(path).write_text(json.dumps(self.to_json(), indent=1))
 
 
-def validate(scene: Scene, path: list, checks: int = 16) -> list:
+def validate(scene: Scene, path: list, checks: int = 64) -> list:
     """Smallest exact-test margin along each step of ``path`` (see :attr:`Plan.step_margins`)."""
     poses = [list(map(float, k["pose"])) for k in path]
     pushers = [k["pusher"] for k in path]

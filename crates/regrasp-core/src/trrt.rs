@@ -111,7 +111,7 @@ impl Default for Settings {
             goal_bias: 0.2,
             step: None,
             margin: 0.01,
-            checks: 4,
+            checks: 16,
             k: 1.0,
             t0: 0.1,
             alpha: 2.0,
@@ -243,18 +243,29 @@ impl<'a> Planner<'a> {
     }
 
     /// Whether pusher `p` can move the object with body twist `tw` (unit time) from `q`: the
-    /// exact test at `checks` poses along the step, margin ≥ `margin` at the start.
+    /// exact test at `checks` poses along the step (margin ≥ `margin` at the start, ≥ half
+    /// of it further on), and the pad on the object all along: at each interior pose its
+    /// clearance exceeds how far it moves to the neighbouring poses, so it cannot leave the
+    /// object between them.
     fn step_feasible(&self, q: &[f64; 3], tw: &Vec3, p: usize, margin: f64) -> bool {
         let model = &self.scene.pushers[p].model;
         let n = self.s.checks.max(1);
+        let poses: Vec<[f64; 3]> = (0..=n).map(|k| if k == 0 { *q } else { integrate(q, tw, k as f64 / n as f64) }).collect();
+        let pad = |x: &[f64; 3]| rot(-x[2]) * Vec2::new(-x[0], -x[1]);
+        let pads: Vec<Vec2> = poses.iter().map(pad).collect();
         for k in 0..=n {
-            let qk = if k == 0 { *q } else { integrate(q, tw, k as f64 / n as f64) };
-            let Some(f) = self.frame(&qk) else { return false };
+            let Some(f) = self.frame(&poses[k]) else { return false };
+            if k > 0 && k < n {
+                let reach = (pads[k] - pads[k - 1]).norm().max((pads[k + 1] - pads[k]).norm());
+                if self.scene.pad_clearance(&poses[k]) < 1.1 * reach {
+                    return false;
+                }
+            }
             if k == n {
                 break; // the end pose: on the object and held; its twist is the next step's
             }
             let m = f.classify(model, tw).margin;
-            if m < if k == 0 { margin } else { -1e-9 } {
+            if m < if k == 0 { margin } else { 0.5 * margin } {
                 return false;
             }
         }
@@ -378,7 +389,7 @@ impl<'a> Planner<'a> {
         // a step of the unit length along the projection, halved until feasible along it
         let mut tw = v * (self.step.min(len) / m.twist_norm(&v));
         for _ in 0..4 {
-            if self.step_feasible(&q, &tw, p, 0.0) {
+            if self.step_feasible(&q, &tw, p, self.s.margin) {
                 return Some((integrate(&q, &tw, 1.0), p, tw));
             }
             tw *= 0.5;
@@ -567,7 +578,7 @@ impl<'a> Planner<'a> {
             }
             for p in self.pusher_order(self.nodes[k].pusher) {
                 let c = self.nodes[k].cost + self.edge_cost(self.nodes[k].pusher, p, len);
-                if c < best.2 - 1e-12 && self.step_feasible(&qk, &tw, p, 0.0) {
+                if c < best.2 - 1e-12 && self.step_feasible(&qk, &tw, p, self.s.margin) {
                     best = (k, p, c);
                     break;
                 }
@@ -593,7 +604,7 @@ impl<'a> Planner<'a> {
             let tw = body_twist(&qi, &self.nodes[k].q);
             let len = m.twist_norm(&tw);
             let c = self.nodes[i].cost + self.edge_cost(self.nodes[i].pusher, pk, len);
-            if c < self.nodes[k].cost - 1e-12 && !self.is_ancestor(k, i) && self.step_feasible(&qi, &tw, pk, 0.0) {
+            if c < self.nodes[k].cost - 1e-12 && !self.is_ancestor(k, i) && self.step_feasible(&qi, &tw, pk, self.s.margin) {
                 let delta = self.nodes[k].cost - c;
                 let old = self.nodes[k].parent.expect("not the root");
                 self.nodes[old].children.retain(|&x| x != k);

@@ -563,7 +563,7 @@ impl Scene {
     /// T-RRT* regrasp plan (see `regrasp.plan`). Returns a dict.
     #[pyo3(signature = (start=None, goal=None, seed=0, time_limit=10.0, propagation="motion_cone", max_nodes=20000,
                         step=None, goal_bias=0.2, margin=0.01, neighbour_steps=2.0, cost_threshold=f64::INFINITY,
-                        checks=4, random_tries=8, connect=true, plain=false))]
+                        checks=16, random_tries=8, connect=true, plain=false))]
     #[allow(clippy::too_many_arguments)]
     fn plan<'py>(
         &self,

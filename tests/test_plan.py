@@ -1,0 +1,99 @@
+"""The regrasp planner on the bundled examples, its baselines, the CLI and bad requests."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import regrasp
+from regrasp.quasistatic import replay_plan
+
+from .conftest import EXAMPLES
+
+PLANNED = ["block-low-friction", "block-high-friction", "block-xztheta", "t-shape", "block-tilted-gripper"]
+
+
+@pytest.mark.parametrize("name", PLANNED)
+def test_every_example_plans_for_20_seeds(name):
+    sc = regrasp.Scene.load(EXAMPLES / f"{name}.toml")
+    t = sc.task
+    switches, plain_switches = [], []
+    for seed in range(20):
+        p = regrasp.plan(sc, seed=seed, time_limit=5.0)
+        assert p.found, (seed, p.stop_reason)
+        assert p.valid, (seed, min(p.step_margins))
+        end = p.poses[-1]
+        assert np.all(np.abs(end - t.goal) <= t.tolerance), (seed, end)
+        assert np.allclose(p.poses[0], t.start)
+        switches.append(p.switch_overs)
+        plain_switches.append(regrasp.plan(sc, seed=seed, time_limit=5.0, plain=True).switch_overs)
+    assert np.mean(switches) < np.mean(plain_switches), (switches, plain_switches)
+
+
+def test_high_friction_pushers_give_one_direct_side_push():
+    sc = regrasp.Scene.load(EXAMPLES / "block-high-friction.toml")
+    p = regrasp.plan(sc, seed=0)
+    assert p.switch_overs == 0 and set(p.pushers[1:]) == {"left"}
+    # with the low-friction pushers the same diagonal needs more than one pusher
+    lo = regrasp.plan(regrasp.Scene.load(EXAMPLES / "block-low-friction.toml"), seed=0)
+    assert len(set(lo.pushers[1:])) >= 2
+
+
+@pytest.mark.parametrize("propagation", ["stable_check", "mncp"])
+def test_baselines_plan_too(propagation):
+    sc = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    p = regrasp.plan(sc, seed=1, propagation=propagation, time_limit=20.0)
+    assert p.found and p.propagation == propagation
+
+
+def test_plans_replay_in_the_quasistatic_simulator():
+    sc = regrasp.Scene.load(EXAMPLES / "t-shape.toml")
+    p = regrasp.plan(sc, seed=2)
+    rep = replay_plan(sc, p.to_json())
+    assert rep.success, rep.goal_error
+
+
+def test_plan_cli_writes_the_contract_file(tmp_path):
+    out, png, gif = tmp_path / "p.json", tmp_path / "p.png", tmp_path / "p.gif"
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "plan", str(EXAMPLES / "block-xztheta.toml"), "--out",
+                        str(out), "--seed", "4", "--plot", str(png), "--animate", str(gif)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(out.read_text())
+    for k in ("scene", "found", "stop_reason", "planning_time_s", "nodes", "switch_overs", "path"):
+        assert k in d
+    assert d["found"] and d["stop_reason"] == "goal_reached" and d["path"][0]["pusher"] is None
+    assert all(isinstance(k["pusher"], str) for k in d["path"][1:])
+    assert png.stat().st_size > 20_000 and gif.stat().st_size > 20_000
+    # the plan file replays with `regrasp simulate`
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "simulate", str(EXAMPLES / "block-xztheta.toml"), "--plan",
+                        str(out), "--json"], capture_output=True, text=True)
+    assert r.returncode == 0 and json.loads(r.stdout)["success"], r.stdout + r.stderr
+
+
+def test_unreachable_goal_exits_1_with_the_best_partial_plan(tmp_path):
+    text = (EXAMPLES / "block-low-friction.toml").read_text()
+    parts = text.split("[[pushers]]")
+    top = [p for p in parts[1:] if 'name = "top"' in p][0]
+    f = tmp_path / "top-only.toml"
+    f.write_text(parts[0] + "[[pushers]]" + top)
+    out = tmp_path / "p.json"
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "plan", str(f), "--time-limit", "0.3", "--out", str(out)],
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "no plan found" in r.stderr
+    d = json.loads(out.read_text())
+    assert d["found"] is False and d["stop_reason"] == "time_limit" and len(d["path"]) >= 1
+
+
+def test_bad_requests():
+    sc = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    with pytest.raises(regrasp.ArgumentError) as e:
+        regrasp.plan(sc, start=[0.03, 0.0, 0.0])
+    assert e.value.field == "start"
+    with pytest.raises(regrasp.ArgumentError):
+        regrasp.plan(sc, goal=[np.nan, 0.0, 0.0])
+    with pytest.raises(regrasp.ArgumentError):
+        regrasp.plan(sc, propagation="teleport")
+    p = regrasp.plan(sc, time_limit=0.0, connect=False)
+    assert not p.found and p.stop_reason == "time_limit" and len(p.path) == 1
