@@ -14,4 +14,12 @@ if __name__ == "__main__":
     plot_motion_cone(block.motion_cone([0, 0, 0], "left"), OUT / "cone-left-20N.png")
     xzt = regrasp.Scene.load(ROOT / "examples" / "block-xztheta.toml")
     plot_motion_cone(xzt.with_grip_force(5.0).motion_cone([0, 0, 0], "corner"), OUT / "cone-corner-5N.png")
-    print("wrote", *sorted(p.name for p in OUT.glob("*.png")))
+    from regrasp.plotting import animate_plan, plot_plan
+
+    for name in ("t-shape", "block-xztheta", "block-low-friction", "block-high-friction"):
+        sc = regrasp.Scene.load(ROOT / "examples" / f"{name}.toml")
+        p = regrasp.plan(sc, seed=0)
+        plot_plan(sc, p, OUT / f"plan-{name}.png")
+        if name in ("t-shape", "block-xztheta"):
+            animate_plan(sc, p, OUT / f"plan-{name}.gif")
+    print("wrote", *sorted(p.name for p in OUT.glob("*.png")), *sorted(p.name for p in OUT.glob("*.gif")))

@@ -113,7 +113,45 @@ def run(n: int = 100_000, reps: int = 11, baseline_reps: int = 3, scene_path=Non
         "n": k,
     }
     results.update(run_mncp(reps=reps))
+    results.update(run_planner())
     return results
+
+
+PLANNED = ("block-low-friction", "block-high-friction", "block-xztheta", "t-shape", "block-tilted-gripper")
+
+
+def run_planner(seeds: int = 10, time_limit: float = 30.0, examples=PLANNED) -> dict:
+    """The planner table (thesis Table 4.2): median planning time over ``seeds`` seeds for each
+    example and each propagation, measured in the same run, with the baselines' ratios."""
+    from .plan import plan
+
+    out = {}
+    for name in examples:
+        scene = Scene.load(EXAMPLES / f"{name}.toml")
+        stats = {}
+        for prop in ("motion_cone", "stable_check", "mncp"):
+            runs = [plan(scene, seed=k, propagation=prop, time_limit=time_limit) for k in range(seeds)]
+            stats[prop] = {
+                "median_s": float(np.median([r.planning_time_s for r in runs])),
+                "found": sum(r.found for r in runs),
+                "valid": sum(r.found and r.valid for r in runs),
+                "switch_overs": float(np.median([r.switch_overs for r in runs])),
+                "nodes": float(np.median([r.nodes for r in runs])),
+            }
+        mc = stats["motion_cone"]
+        for prop in ("stable_check", "mncp"):
+            b = stats[prop]
+            out[f"plan_{name}_vs_{prop}"] = {
+                "median_s": mc["median_s"],
+                "baseline_median_s": b["median_s"],
+                "ratio": b["median_s"] / max(mc["median_s"], 1e-9),
+                "baseline": f"same T-RRT*, {prop} propagation",
+                "n": seeds,
+                "found": mc["found"], "baseline_found": b["found"],
+                "valid": mc["valid"], "baseline_valid": b["valid"],
+                "switch_overs": mc["switch_overs"], "baseline_switch_overs": b["switch_overs"],
+            }
+    return out
 
 
 def run_mncp(reps: int = 11, ref_reps: int = 3) -> dict:

@@ -820,8 +820,9 @@ pub fn stable_push_lp(scene: &Scene, q: &[f64; 3], pusher: usize, tw: &Vec3) -> 
 }
 
 /// Checks a path with the exact motion-cone test at `checks` poses along each step; returns
-/// the smallest margin of each step (negative: infeasible somewhere) or an error naming the
-/// first step that leaves the admissible set or cannot be held.
+/// the smallest margin of each step (negative: the pusher would slip somewhere along it; −1:
+/// the finger pad leaves the object or the grasp cannot hold it somewhere along the step). An
+/// error names a step whose pusher is missing or unknown.
 pub fn validate_path(scene: &Scene, path: &[([f64; 3], Option<usize>)], checks: usize) -> Result<Vec<f64>> {
     let mut out = Vec::new();
     for (i, w) in path.windows(2).enumerate() {
@@ -835,15 +836,12 @@ pub fn validate_path(scene: &Scene, path: &[([f64; 3], Option<usize>)], checks: 
         let n = checks.max(1);
         for k in 0..=n {
             let qk = integrate(&a, &tw, k as f64 / n as f64);
-            if !scene.admissible(&qk) {
-                return Err(Error::arg(format!("path[{}]", i + 1), "the finger pad leaves the object along the step"));
-            }
-            let f = scene.frame(&qk);
-            if !(f.hold_ratio < 1.0) {
-                return Err(Error::arg(format!("path[{}]", i + 1), "the grasp cannot hold the object along the step"));
+            if !scene.admissible(&qk) || !(scene.frame(&qk).hold_ratio < 1.0) {
+                worst = -1.0;
+                break;
             }
             if k < n && tw.amax() > 0.0 {
-                worst = worst.min(f.classify(&scene.pushers[p].model, &tw).margin);
+                worst = worst.min(scene.frame(&qk).classify(&scene.pushers[p].model, &tw).margin);
             }
         }
         out.push(if worst.is_finite() { worst } else { 0.0 });
