@@ -12,7 +12,7 @@ all: build
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q "maturin>=1.5,<2" "numpy>=1.24" "scipy>=1.10" "matplotlib>=3.7" "casadi>=3.6" "mujoco>=3.1" "pytest>=7" "hypothesis>=6.80"
+	$(BIN)/pip install -q "maturin>=1.5,<2" "numpy>=1.24" "scipy>=1.10" "matplotlib>=3.7" "casadi>=3.6" "mujoco>=3.1" "tqdm>=4.60" "ray>=2.9" "pytest>=7" "hypothesis>=6.80"
 	touch $@
 
 setup: $(STAMP)

@@ -10,7 +10,7 @@ from scipy.optimize import linprog
 import regrasp
 from regrasp.reference import RefParams, generators_numpy
 
-from .conftest import block_dict, block_scenes, twist_dirs
+from .conftest import block_scenes, twist_dirs
 
 SETTINGS = settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
@@ -55,10 +55,13 @@ def lp_sticks(d, twist) -> bool:
             cols.append([dvec[0], dvec[1], r[0] * dvec[1] - r[1] * dvec[0]])
     A_eq = np.array(cols).T
     m = len(p["points"])
-    A_ub, b_ub = [], []
+    A_ub = []  # |f_t| <= mu f_n at each point
     for i in range(m):
-        row = np.zeros(2 * m); row[2 * i + 1] = 1; row[2 * i] = -p["friction"]; A_ub.append(row)
-        row = np.zeros(2 * m); row[2 * i + 1] = -1; row[2 * i] = -p["friction"]; A_ub.append(row)
+        for sign in (1, -1):
+            row = np.zeros(2 * m)
+            row[2 * i + 1] = sign
+            row[2 * i] = -p["friction"]
+            A_ub.append(row)
     bounds = [(0, None) if j % 2 == 0 else (None, None) for j in range(2 * m)]
     scale = np.abs(w).max()
     res = linprog(np.zeros(2 * m), A_ub=np.array(A_ub), b_ub=np.zeros(len(A_ub)), A_eq=A_eq, b_eq=w / scale,

@@ -168,15 +168,15 @@ def cmd_demo(a) -> int:
 
 
 def cmd_validate(a) -> int:
-    from .quasistatic import format_confusion, validate
+    from .validation import format_validation, validate
 
     scene = Scene.load(a.scene)
-    engines = [e.strip() for e in a.engines.split(",")]
-    for e in engines:
-        if e not in ("quasistatic",):
-            raise ArgumentError(f"invalid `--engines`: unknown engine {e!r} (available: quasistatic)", "--engines")
-    res = validate(scene, a.pushes, a.seed, support=a.support)
-    print(json.dumps(res) if a.json else format_confusion(res))
+    engines = tuple(e.strip() for e in a.engines.split(",") if e.strip())
+    if a.workers is not None and a.workers < 1:
+        raise ArgumentError("invalid `--workers`: must be at least 1", "--workers")
+    res = validate(scene, a.pushes, a.seed, engines=engines, support=a.support, workers=a.workers,
+                   ray_address=a.ray, progress=not a.json and a.pushes >= 500)
+    print(json.dumps(res) if a.json else format_validation(res))
     return 0
 
 
@@ -185,9 +185,26 @@ def cmd_simulate(a) -> int:
 
     scene = Scene.load(a.scene)
     plan = load_plan(a.plan)
-    if a.engine != "quasistatic":
-        raise ArgumentError(f"invalid `--engine`: {a.engine!r} is not available (quasistatic)", "--engine")
-    rep = replay_plan(scene, plan, dt=a.dt)
+    if a.engine == "quasistatic":
+        rep = replay_plan(scene, plan, dt=a.dt)
+    elif a.engine == "mujoco":
+        from .mujoco_exec import Perturbation, execute_plan
+
+        for name in ("scale_friction", "scale_grip", "scale_mass"):
+            v = getattr(a, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ArgumentError(f"invalid `--{name.replace('_', '-')}`: must be a positive factor", name)
+        if not (0 <= a.perturb < 1):
+            raise ArgumentError("invalid `--perturb`: a spread in [0, 1)", "--perturb")
+        base = Perturbation(a.scale_friction, a.scale_grip, a.scale_mass)
+        pert = Perturbation.draw(a.perturb, np.random.default_rng(a.seed), base) if a.perturb > 0 else base
+        rep = execute_plan(scene, plan, pert)
+        if a.video:
+            from .mujoco_exec import animate_execution
+
+            animate_execution(scene, rep, a.video)
+    else:
+        raise ArgumentError(f"invalid `--engine`: {a.engine!r} (quasistatic or mujoco)", "--engine")
     if a.plot:
         from .plotting import plot_replay
 
@@ -198,7 +215,7 @@ def cmd_simulate(a) -> int:
     else:
         print(f"{scene.name}: replayed {len(rep.steps)} pushes in the {rep.engine} simulator")
         for k, st in enumerate(rep.steps, 1):
-            print(f"  {k:2d} {st['pusher']:12s} {st['duration']:6.2f} s  slip {1e3 * st['slip']:.3f} mm")
+            print(f"  {k:2d} {st['pusher']:12s} slip {1e3 * st['slip']:.3f} mm")
         print(f"  final pose {np.round(rep.final_pose, 5).tolist()}, error to goal {np.round(rep.goal_error, 5).tolist()}: "
               f"{'success' if rep.success else 'outside the tolerance'}; largest pusher slip {1e3 * rep.max_pusher_slip:.3f} mm")
     return 0 if rep.success else 1
@@ -346,18 +363,27 @@ def build_parser() -> argparse.ArgumentParser:
     v = sub.add_parser("validate", help="motion-cone predictions against the simulators")
     v.add_argument("scene")
     v.add_argument("--pushes", type=int, default=2000)
-    v.add_argument("--engines", default="quasistatic")
+    v.add_argument("--engines", default="quasistatic", help="comma-separated: quasistatic,mujoco")
     v.add_argument("--seed", type=int, default=0)
+    v.add_argument("--workers", type=int, help="local processes for MuJoCo (default: all cores)")
+    v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
     v.add_argument("--support", default="points", choices=["points", "limit_surface"],
-                   help="finger pads as point sets (default) or as the motion cones' limit surface")
+                   help="quasi-static pads as point sets (default) or as the motion cones' limit surface")
     v.add_argument("--json", action="store_true")
     v.set_defaults(fn=cmd_validate)
 
     s = sub.add_parser("simulate", help="replay a plan in a simulator")
     s.add_argument("scene")
     s.add_argument("--plan", required=True)
-    s.add_argument("--engine", default="quasistatic")
-    s.add_argument("--dt", type=float, default=0.05)
+    s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"])
+    s.add_argument("--dt", type=float, default=0.05, help="quasi-static time step [s]")
+    s.add_argument("--scale-friction", type=float, default=1.0, help="MuJoCo: factor on every friction coefficient")
+    s.add_argument("--scale-grip", type=float, default=1.0, help="MuJoCo: factor on the grip force")
+    s.add_argument("--scale-mass", type=float, default=1.0, help="MuJoCo: factor on the object's mass")
+    s.add_argument("--perturb", type=float, default=0.0,
+                   help="MuJoCo: also draw each factor uniformly in [1-P, 1+P] from --seed")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo: an animation of the execution")
     s.add_argument("--plot", metavar="PNG")
     s.add_argument("--json", action="store_true")
     s.set_defaults(fn=cmd_simulate)

@@ -242,6 +242,12 @@ class MotionConeBatch:
         return out
 
 
+def _rebuild_scene(kind: str, text: str, path, grip=None):
+    s = Scene.from_toml(text) if kind == "toml" else Scene(_core.Scene.from_json(text), None, ("json", text))
+    s.path = None if path is None else Path(path)
+    return s if grip is None else s.with_grip_force(grip)
+
+
 def _non_finite(x, path: str):
     """Dotted path of the first non-finite number in a nested dict/list, or None."""
     if isinstance(x, dict):
@@ -270,9 +276,18 @@ def _jsonable(x):
 class Scene:
     """A validated planar scene. Load with :meth:`Scene.load` (TOML) or :meth:`Scene.from_dict`."""
 
-    def __init__(self, core: "_core.Scene", path: Optional[Path] = None):
+    def __init__(self, core: "_core.Scene", path: Optional[Path] = None, source: Optional[tuple] = None):
         self._core = core
         self.path = path
+        #: ("toml" | "json", text) the scene was built from (to rebuild it in other processes)
+        self.source = source
+
+    def __reduce__(self):
+        if self.source is None:
+            raise TypeError("this scene has no source text to be pickled from")
+        kind, text = self.source
+        return (_rebuild_scene, (kind, text, None if self.path is None else str(self.path),
+                                 getattr(self, "_grip_override", None)))
 
     @classmethod
     def load(cls, path) -> "Scene":
@@ -281,11 +296,11 @@ class Scene:
             text = p.read_text()
         except OSError as e:
             raise ArgumentError(f"invalid `path`: cannot read {p}: {e}", "path") from e
-        return cls(_core.Scene.from_toml(text), p)
+        return cls(_core.Scene.from_toml(text), p, ("toml", text))
 
     @classmethod
     def from_toml(cls, text: str) -> "Scene":
-        return cls(_core.Scene.from_toml(text))
+        return cls(_core.Scene.from_toml(text), None, ("toml", text))
 
     @classmethod
     def from_dict(cls, d: dict) -> "Scene":
@@ -297,7 +312,7 @@ class Scene:
             text = json.dumps(d, allow_nan=False, default=_jsonable)
         except (TypeError, ValueError) as e:
             raise SceneError(f"scene is not serializable: {e}", None) from e
-        return cls(_core.Scene.from_json(text))
+        return cls(_core.Scene.from_json(text), None, ("json", text))
 
     def __repr__(self) -> str:
         return f"Scene({self.name!r}, kind={self.kind}, pushers={self.pusher_names})"
@@ -378,7 +393,11 @@ class Scene:
         return None if t is None else Task(*(np.array(x) for x in t))
 
     def with_grip_force(self, force: float) -> "Scene":
-        return Scene(self._core.with_grip_force(float(force)), self.path)
+        """The same scene with another grip force per finger (not re-validated: the task's
+        poses may not be held at that force)."""
+        s = Scene(self._core.with_grip_force(float(force)), self.path, self.source)
+        s._grip_override = float(force)
+        return s
 
     def admissible(self, pose) -> bool | np.ndarray:
         """Whether the whole finger pad lies on the object at ``pose`` (or each row of an array)."""

@@ -305,6 +305,15 @@ impl Scene {
         }
         m.into_pyarray(py)
     }
+    /// The `k` of the support's limit surface (its largest friction moment per unit μN).
+    #[getter]
+    fn pad_limit_surface_k(&self) -> f64 {
+        match &self.inner.support {
+            regrasp::scene::Support::Grasp(g) => g.limit_surface.k(),
+            regrasp::scene::Support::Surface(s) => s.limit_surface.k(),
+        }
+    }
+
     /// Pad description: ("circle", radius) or ("rectangle", width, height); None on a surface.
     #[getter]
     fn pad(&self) -> Option<(String, f64, f64)> {

@@ -1,0 +1,85 @@
+"""Execution in MuJoCo (the real engine): the grasp holds without creep under our contact
+settings, pushes stick or slip as the motion cones say, plans execute, validation runs over
+processes and over a local Ray instance."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import regrasp
+from regrasp.mujoco_exec import Perturbation, execute_plan
+from regrasp.mujoco_model import SOFT, convex_pieces, creep
+from regrasp.mujoco_sim import PushRig
+from regrasp.validation import validate
+
+from .conftest import EXAMPLES
+
+mujoco = pytest.importorskip("mujoco")
+
+
+def test_a_held_object_does_not_creep_with_our_settings():
+    s = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    ours, soft = creep(s, duration=1.0), creep(s, duration=1.0, contact=SOFT)
+    assert ours < 1e-5, ours  # rigid Coulomb friction holds it: a few micrometres at most
+    assert soft > 1e-3, soft  # soft, pyramidal contact without no-slip lets it slide down
+
+
+def test_non_convex_outline_is_a_union_of_convex_pieces():
+    t = regrasp.Scene.load(EXAMPLES / "t-shape.toml")
+    pieces = convex_pieces(t.outline)
+    area = lambda p: 0.5 * abs(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))  # noqa: E731
+    assert len(pieces) >= 2 and sum(area(p) for p in pieces) == pytest.approx(area(t.outline))
+    assert creep(t, duration=0.5) < 1e-5
+
+
+def test_pushes_stick_inside_the_cone_and_slip_outside():
+    s = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    rig = PushRig(s, "left")
+    # along the normal: inside the motion cone; straight up with a side pusher: far outside
+    assert s.motion_cone([0, 0, 0], "left").contains([0.01, 0, 0])
+    assert rig.slip_fraction([0, 0, 0], [0.01, 0, 0]) < 0.02
+    assert rig.slip_fraction([0, 0, 0], [0.0, 0.01, 0]) > 0.5
+
+
+def test_plans_execute_in_mujoco_with_perturbed_physics():
+    for name in ("block-low-friction", "t-shape"):
+        s = regrasp.Scene.load(EXAMPLES / f"{name}.toml")
+        p = regrasp.plan(s, seed=1).to_json()
+        rng = np.random.default_rng(7)
+        rep = execute_plan(s, p, Perturbation.draw(0.1, rng))
+        assert rep.success, (name, rep.goal_error)
+        assert rep.poses.shape[1] == 3 and len(rep.t) == len(rep.poses)
+
+
+def test_simulate_cli_mujoco(tmp_path):
+    s = regrasp.Scene.load(EXAMPLES / "block-high-friction.toml")
+    f = tmp_path / "plan.json"
+    regrasp.plan(s, seed=0).save(f)
+    gif = tmp_path / "run.gif"
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "simulate", str(EXAMPLES / "block-high-friction.toml"),
+                        "--plan", str(f), "--engine", "mujoco", "--json", "--perturb", "0.1", "--seed", "2",
+                        "--video", str(gif)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert set(out) >= {"engine", "final_pose", "goal_error", "success", "max_pusher_slip"} and out["engine"] == "mujoco"
+    assert gif.stat().st_size > 10_000
+    # a plan that asks the side pusher to lift the block fails, exit 1
+    bad = {"path": [{"pose": [0, 0, 0], "pusher": None}, {"pose": [0.0, 0.008, 0.0], "pusher": "left"}]}
+    f.write_text(json.dumps(bad))
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "simulate", str(EXAMPLES / "block-high-friction.toml"),
+                        "--plan", str(f), "--engine", "mujoco", "--json"], capture_output=True, text=True)
+    assert r.returncode == 1 and not json.loads(r.stdout)["success"]
+
+
+def test_validation_over_processes_and_ray():
+    s = regrasp.Scene.load(EXAMPLES / "block-high-friction.toml")
+    a = validate(s, 30, seed=3, engines=("quasistatic", "mujoco"), workers=2)
+    assert a["solved_mujoco"] == 30 and {"agreement_mujoco", "confusion_mujoco", "agreement_quasistatic"} <= set(a)
+    assert a["agreement_mujoco"] >= 0.7
+    pytest.importorskip("ray")
+    b = validate(s, 30, seed=3, engines=("mujoco",), workers=2, ray_address="local")
+    # the same pushes, the same outcomes, wherever they run
+    assert b["confusion_mujoco"] == a["confusion_mujoco"]
