@@ -83,3 +83,19 @@ def test_validation_over_processes_and_ray():
     b = validate(s, 30, seed=3, engines=("mujoco",), workers=2, ray_address="local")
     # the same pushes, the same outcomes, wherever they run
     assert b["confusion_mujoco"] == a["confusion_mujoco"]
+
+
+def test_point_pusher_sticks_while_the_object_turns_about_it():
+    # a point pusher (the corner of a fixture) turns the block about the pad: its contact does
+    # not slide on the object although the pusher–object relative pose changes a lot
+    s = regrasp.Scene.load(EXAMPLES / "block-xztheta.toml")
+    rig = PushRig(s, "corner")
+    cone = s.motion_cone([0, 0, 0], "corner")
+    r = s.pusher("corner").points[0]
+    a, b = (g[:2] + g[2] * np.array([-r[1], r[0]]) for g in cone.generators[:2])
+    u = a / np.linalg.norm(a) + b / np.linalg.norm(b)  # the middle of the contact-velocity wedge
+    u = np.r_[0.01 * u / np.linalg.norm(u), 0.0]
+    assert cone.contains(cone.point_pusher_twist(u[:2]))
+    assert rig.slip_fraction([0, 0, 0], u) < 0.05
+    # pulled along the face, it slides
+    assert rig.slip_fraction([0, 0, 0], [0.01, 0.0, 0.0]) > 0.2

@@ -114,7 +114,41 @@ def run(n: int = 100_000, reps: int = 11, baseline_reps: int = 3, scene_path=Non
     }
     results.update(run_mncp(reps=reps))
     results.update(run_planner())
+    results.update(run_mujoco())
     return results
+
+
+def run_mujoco(steps: int = 4000) -> dict:
+    """MuJoCo's speed on the gripper scene (steps per second) beside the quasi-static
+    simulator's time for the same push (10 mm at 10 mm/s)."""
+    import mujoco
+
+    from .mujoco_sim import PushRig
+    from .quasistatic import simulate_push
+
+    scene = Scene.load(EXAMPLES / "block-low-friction.toml")
+    rig = PushRig(scene, "left")
+    rig.reset([0.0, 0.0, 0.0])
+
+    def run_steps():
+        for _ in range(steps):
+            mujoco.mj_step(rig.model, rig.data)
+
+    t_steps = _median_time(run_steps, 3)
+    duration = 1.0
+    t_mj = _median_time(lambda: rig.push([0, 0, 0], [0.01, 0, 0], duration, settle=0.0, record_dt=duration), 3)
+    t_qs = _median_time(lambda: simulate_push(scene, [0, 0, 0], "left", [0.01, 0, 0], duration, 0.05), 3)
+    return {
+        "mujoco_steps": {
+            "median_s": t_steps / steps, "baseline_median_s": t_steps / steps, "ratio": 1.0,
+            "baseline": f"(MuJoCo step, timestep {rig.contact.timestep} s: {steps / t_steps:.0f} steps/s)",
+            "steps_per_s": steps / t_steps,
+        },
+        "push_10mm_quasistatic_vs_mujoco": {
+            "median_s": t_qs, "baseline_median_s": t_mj, "ratio": t_mj / t_qs,
+            "baseline": "the same push in MuJoCo (quasi-static: 20 steps of 50 ms)",
+        },
+    }
 
 
 PLANNED = ("block-low-friction", "block-high-friction", "block-xztheta", "t-shape", "block-tilted-gripper")

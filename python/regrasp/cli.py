@@ -1,4 +1,4 @@
-"""Command line: ``regrasp plan | cone | approx-error | validate | simulate | push | bench | demo``.
+"""Command line: ``regrasp plan | cone | approx-error | validate | simulate | control | push | bench | demo``.
 
 Exit status: 0 success, 1 the task cannot be done (reason printed), 2 invalid input.
 """
@@ -278,6 +278,55 @@ def cmd_push(a) -> int:
     return 0
 
 
+def _mode_scene(scene: Scene, a) -> Scene:
+    """The scene in the cone mode the flags ask for (--robust, --uncertainty, --fixtureless)."""
+    if getattr(a, "robust", False) and getattr(a, "fixtureless", False):
+        raise ArgumentError("invalid `--robust`: choose --robust or --fixtureless, not both", "--robust")
+    if getattr(a, "robust", False) or getattr(a, "uncertainty", None):
+        u = None
+        if getattr(a, "uncertainty", None):
+            v = _floats(a.uncertainty, 4, "--uncertainty")
+            u = dict(zip(("pusher_friction", "finger_friction", "grip_force", "mass"), v.tolist()))
+        return scene.robust(u)
+    if getattr(a, "fixtureless", False):
+        return scene.fixtureless()
+    return scene
+
+
+def cmd_control(a) -> int:
+    from .control import Poke, control
+    from .mujoco_exec import Perturbation
+    from .quasistatic import load_plan
+
+    scene = Scene.load(a.scene)
+    plan = load_plan(a.plan)
+    for name in ("scale_friction", "scale_grip", "scale_mass"):
+        v = getattr(a, name)
+        if not (np.isfinite(v) and v > 0):
+            raise ArgumentError(f"invalid `--{name.replace('_', '-')}`: must be a positive factor", name)
+    if not (a.noise >= 0 and np.isfinite(a.noise)):
+        raise ArgumentError("invalid `--noise`: must be a non-negative standard deviation", "--noise")
+    pokes = [Poke.parse(t) for t in a.poke or []]
+    start_error = np.zeros(3) if a.start_error is None else _floats(a.start_error, 3, "--start-error")
+    ctrl_scene = _mode_scene(scene, a)
+    res = control(scene, plan, engine=a.engine, policy="open_loop" if a.open_loop else "mpc", pokes=pokes,
+                  start_error=start_error, perturb=Perturbation(a.scale_friction, a.scale_grip, a.scale_mass),
+                  controller_scene=ctrl_scene, noise=a.noise, seed=a.seed, dt=a.dt, horizon=a.horizon)
+    if a.plot:
+        from .plotting import plot_control
+
+        plot_control(scene, res, a.plot)
+    out = res.to_json()
+    if a.json:
+        print(json.dumps(out))
+    else:
+        print(f"{scene.name}: {res.policy} in {res.engine}: {'success' if res.success else 'failure'} "
+              f"after {res.t[-1]:.1f} s, {res.replans} re-plans, median MPC step {1e3 * res.mpc_step_median_s:.3f} ms; "
+              f"final pose {np.round(res.final_pose, 5).tolist()}, error {np.round(res.goal_error, 5).tolist()}"
+              + (f" ({res.failure})" if res.failure else ""))
+    return 0 if res.success else 1
+
+
 def cmd_plan(a) -> int:
     from .plan import plan
 
@@ -286,6 +335,7 @@ def cmd_plan(a) -> int:
     goal = None if a.goal is None else _floats(a.goal, 3, "--goal")
     if scene.task is None and (start is None or goal is None):
         raise ArgumentError("invalid `scene`: it has no [task]; give --start and --goal", "task")
+    scene = _mode_scene(scene, a)
     p = plan(scene, start, goal, seed=a.seed, time_limit=a.time_limit, propagation=a.propagation)
     if a.out:
         p.save(a.out)
@@ -335,7 +385,35 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--plot", metavar="PNG")
     pl.add_argument("--animate", metavar="GIF")
     pl.add_argument("--json", action="store_true")
+    pl.add_argument("--robust", action="store_true",
+                    help="plan with robust motion cones for the scene's [uncertainty] (or --uncertainty)")
+    pl.add_argument("--uncertainty", metavar="P,F,N,M",
+                    help="relative spreads of pusher friction, finger friction, grip force, mass (implies --robust)")
+    pl.add_argument("--fixtureless", action="store_true",
+                    help="plan only with fixtureless-fixturing pushes (invariant to mass, grip force, finger friction)")
     pl.set_defaults(fn=cmd_plan)
+
+    k = sub.add_parser("control", help="track a plan with the MPC (closed loop) in a simulator")
+    k.add_argument("scene")
+    k.add_argument("--plan", required=True)
+    k.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"])
+    k.add_argument("--poke", action="append", metavar="T,dx,dz,dtheta",
+                   help="displace the object in the grasp at time T [s] (repeatable)")
+    k.add_argument("--start-error", metavar="dx,dz,dtheta", help="the object starts this far from the plan's start")
+    k.add_argument("--scale-friction", type=float, default=1.0, help="factor on every friction coefficient of the world")
+    k.add_argument("--scale-grip", type=float, default=1.0, help="factor on the world's grip force")
+    k.add_argument("--scale-mass", type=float, default=1.0, help="factor on the object's mass in the world")
+    k.add_argument("--robust", action="store_true", help="constrain the MPC with robust cones (scene's [uncertainty])")
+    k.add_argument("--uncertainty", metavar="P,F,N,M", help="spreads for the robust cones (implies --robust)")
+    k.add_argument("--fixtureless", action="store_true", help="constrain the MPC with fixtureless-fixturing cones")
+    k.add_argument("--open-loop", action="store_true", help="execute the plan open loop instead (for comparison)")
+    k.add_argument("--noise", type=float, default=0.0, help="pose measurement noise, standard deviation [m]")
+    k.add_argument("--dt", type=float, default=0.1, help="control period [s]")
+    k.add_argument("--horizon", type=int, default=5)
+    k.add_argument("--seed", type=int, default=0)
+    k.add_argument("--plot", metavar="PNG", help="planned against executed poses, pokes marked")
+    k.add_argument("--json", action="store_true")
+    k.set_defaults(fn=cmd_control)
 
     c = sub.add_parser("cone", help="motion cone of a pusher at a pose")
     c.add_argument("scene")

@@ -209,3 +209,121 @@ def animate_execution(scene: Scene, rep: Replay, path, fps: int = 20, every: int
         anim.save(path, writer=PillowWriter(fps=fps))
     plt.close(fig)
     return path
+
+
+class WorldRig:
+    """MuJoCo in the world's view, driven push by push (for closed-loop control): every pusher's
+    feature is parked; a push with a new pusher brings its feature against the object where the
+    controller believes it is (12 mm back along the push normal, then the gripper approaches
+    until the feature touches the object), then moves the gripper with the inverse of the
+    virtual pusher's motion; a poke displaces the object in the grasp (the feature backs off
+    first)."""
+
+    APPROACH = 0.012  # m
+
+    def __init__(self, scene: Scene, q0, perturb: Perturbation = Perturbation(), contact: Contact = Contact(),
+                 settle: float = 0.2):
+        import mujoco
+
+        self.scene, self.contact = scene, contact
+        q0 = np.asarray(q0, float)
+        fake = {"path": [{"pose": q0.tolist(), "pusher": None}] + [{"pose": q0.tolist(), "pusher": p} for p in scene.pusher_names]}
+        self.model = mujoco.MjModel.from_xml_string(build(scene, fake, perturb, contact))
+        self.data = mujoco.MjData(self.model)
+        self.data.ctrl[:] = scene.grip_force * perturb.grip
+        self.grip = Driver(self.model, "gripper")
+        self.g = np.zeros(3)
+        self.grip.set(self.data, self.g)
+        mujoco.mj_forward(self.model, self.data)
+        self.dt = contact.timestep
+        self.current = None  # (pusher, mocap id, feature frame F, world normal)
+        self.feature_geoms = {}
+        for p in scene.pusher_names:
+            bid = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, f"feature_{p}")
+            self.feature_geoms[p] = {i for i in range(self.model.ngeom) if self.model.geom_bodyid[i] == bid}
+        self.idle(settle)
+
+    def _step(self, g):
+        import mujoco
+
+        self.grip.move(self.data, g, self.dt)
+        self.g = np.asarray(g, float)
+        mujoco.mj_step(self.model, self.data)
+
+    def pose(self) -> np.ndarray:
+        """The object's pose in the grasp."""
+        return compose(inverse(self.g), planar_pose(self.model, self.data, "object"))
+
+    def idle(self, duration: float):
+        for _ in range(max(1, int(round(duration / self.dt)))):
+            self._step(self.g)
+
+    def _touching(self, pusher: str) -> bool:
+        ids = self.feature_geoms[pusher]
+        return any(self.data.contact[i].geom1 in ids or self.data.contact[i].geom2 in ids for i in range(self.data.ncon))
+
+    def back_off(self, speed: float = 0.01):
+        """Moves the gripper away from the current feature and parks it (a switch-over)."""
+        if self.current is None:
+            return
+        _, fm, _, n_w = self.current
+        g1 = self.g.copy()
+        n = max(1, int(round(0.002 / speed / self.dt)))
+        for i in range(1, n + 1):
+            self._step(g1 + np.array([0.002 * n_w[0], 0.002 * n_w[1], 0.0]) * i / n)
+        self.data.mocap_pos[fm] = PARK
+        self.current = None
+
+    def bring(self, pusher: str, belief, speed: float = 0.01):
+        """Brings ``pusher``'s feature against the object, placed where it would meet the object
+        at the believed pose ``belief`` (in the grasp)."""
+        import mujoco
+
+        self.back_off(speed)
+        fm = int(self.model.body_mocapid[mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, f"feature_{pusher}")])
+        p = self.scene.pusher(pusher)
+        n_obj = p.normal / np.linalg.norm(p.normal)
+        F = compose(self.g, np.asarray(belief, float))
+        c, s = np.cos(F[2]), np.sin(F[2])
+        n_w = np.array([c * n_obj[0] - s * n_obj[1], s * n_obj[0] + c * n_obj[1]])
+        self.data.mocap_pos[fm] = [F[0] - self.APPROACH * n_w[0], 0.0, F[1] - self.APPROACH * n_w[1]]
+        self.data.mocap_quat[fm] = quat_y(F[2])
+        F = F - np.array([self.APPROACH * n_w[0], self.APPROACH * n_w[1], 0.0])
+        # approach until touching (at most twice the approach distance)
+        step = speed * self.dt
+        for _ in range(int(2 * self.APPROACH / step)):
+            if self._touching(pusher):
+                break
+            self._step(self.g - np.array([step * n_w[0], step * n_w[1], 0.0]))
+        self.current = (pusher, fm, F, n_w)
+
+    def push(self, pusher: str, twist, duration: float, belief=None):
+        """The object (believed at ``belief``) pushed with body twist ``twist`` for ``duration``
+        against ``pusher``'s feature: the gripper moves so that the feature, seen from the
+        gripper, follows the object's intended motion."""
+        belief = self.pose() if belief is None else np.asarray(belief, float)
+        if self.current is None or self.current[0] != pusher:
+            self.bring(pusher, belief)
+        F = self.current[2]
+        P0 = compose(inverse(self.g), F)  # the feature (virtual pusher) in the grasp
+        b = belief
+        rel = compose(inverse(b), P0)
+        n = max(1, int(round(duration / self.dt)))
+        tw = np.asarray(twist, float)
+        for i in range(1, n + 1):
+            P = compose(integrate_pose(b, tw, duration * i / n), rel)
+            self._step(compose(F, inverse(P)))
+
+    def poke(self, delta):
+        """Displaces the object in the grasp by ``delta`` (the current feature backs off first)."""
+        import mujoco
+
+        self.back_off()
+        q = self.pose() + np.asarray(delta, float)
+        w = compose(self.g, q)
+        a = int(self.model.jnt_qposadr[0])
+        self.data.qpos[a:a + 3] = [w[0], 0.0, w[1]]
+        self.data.qpos[a + 3:a + 7] = [np.cos(-w[2] / 2), 0.0, np.sin(-w[2] / 2), 0.0]
+        self.data.qvel[int(self.model.jnt_dofadr[0]):int(self.model.jnt_dofadr[0]) + 6] = 0.0
+        mujoco.mj_forward(self.model, self.data)
+        self.idle(0.1)

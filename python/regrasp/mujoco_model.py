@@ -26,6 +26,7 @@ from .scene import Scene
 
 THICKNESS = 0.012  # m, the object's thickness along the grasp axis
 PAD_DEPTH = 0.004  # m
+FEATURE_RADIUS = 0.002  # m, the cylinder of a point pusher's feature
 
 
 @dataclass(frozen=True)
@@ -213,8 +214,8 @@ def feature_xml(scene: Scene, pusher: str, name: str, friction_scale: float = 1.
         g = (f'<geom type="box" size="0.003 {depth} {half:.9g}" pos="{mid[0]:.9g} 0 {mid[1]:.9g}" '
              f'quat="{_fmt(quat_y(ang))}" friction="{mu:.9g} 0 0" condim="3" {FEATURE_BITS}/>')
     else:
-        c = p.points[0] - n * 0.002
-        g = (f'<geom type="cylinder" size="0.002 {depth}" pos="{c[0]:.9g} 0 {c[1]:.9g}" euler="90 0 0" '
+        c = p.points[0] - n * FEATURE_RADIUS
+        g = (f'<geom type="cylinder" size="{FEATURE_RADIUS} {depth}" pos="{c[0]:.9g} 0 {c[1]:.9g}" euler="90 0 0" '
              f'friction="{mu:.9g} 0 0" condim="3" {FEATURE_BITS}/>')
     return f'<body name="{name}" mocap="true" pos="{_fmt(park)}">{g}</body>'
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .mujoco_model import (Contact, Driver, compose, driven_body_xml, feature_xml, header, inverse, object_xml,
+from .mujoco_model import (FEATURE_RADIUS, Contact, Driver, compose, driven_body_xml, feature_xml, header, inverse, object_xml,
                            pads_xml, planar_pose)
 from .quasistatic import integrate_pose
 from .scene import Scene
@@ -83,15 +83,40 @@ class PushRig:
 
     def slip_fraction(self, pose, twist, distance: float = 0.003, speed: float = 0.01) -> float:
         """How far the pusher and the object move apart over a short push, as a share of the
-        push: the change of their relative pose (metric [Δx, Δz, L Δθ]) over the push's length."""
+        push: the change of their relative pose (metric [Δx, Δz, L Δθ]) over the push's length;
+        for a point pusher, the slide of its contact point on the object."""
         tw = np.asarray(twist, float)
         norm = float(np.linalg.norm(self.scene.metric_twist(tw)))
         tw = tw / norm * speed
+        pts = self.scene.pusher(self.pusher).points
+        if len(pts) == 1:
+            return self._point_slip(pose, tw, distance, speed, pts[0])
         r = self.push(pose, tw, distance / speed, record_dt=distance / speed)
         rel0 = compose(inverse(r["pusher_pose"][0]), r["pose"][0])
         rel1 = compose(inverse(r["pusher_pose"][-1]), r["pose"][-1])
         d = rel1 - rel0
         return float(np.sqrt(d[0] ** 2 + d[1] ** 2 + (self.scene.length * d[2]) ** 2) / distance)
+
+    def _point_slip(self, pose, twist, distance, speed, c) -> float:
+        """A point pusher sticks when its contact does not slide on the object (the object may
+        turn about it, rolling on the feature's small cylinder): the tangential slide at the
+        contact, integrated over the push (every 2.5 ms)."""
+        n = self.scene.pusher(self.pusher).normal
+        n = n / np.linalg.norm(n)
+        r = self.push(pose, twist, distance / speed, record_dt=0.0025)
+        centre = np.r_[c - FEATURE_RADIUS * n, 0.0]
+        slide = 0.0
+        for k in range(len(r["t"]) - 1):
+            q0, q1 = r["pose"][k], r["pose"][k + 1]
+            p0, p1 = r["pusher_pose"][k], r["pusher_pose"][k + 1]
+            cw, sw = np.cos(q0[2]), np.sin(q0[2])
+            nw = np.array([cw * n[0] - sw * n[1], sw * n[0] + cw * n[1]])
+            x = compose(p0, centre)[:2] + FEATURE_RADIUS * nw  # the contact point (world)
+            mo = compose(inverse(q0), np.r_[x, 0.0])  # material points there
+            mp = compose(inverse(p0), np.r_[x, 0.0])
+            d = (compose(q1, mo)[:2] - x) - (compose(p1, mp)[:2] - x)
+            slide += abs(d[0] * nw[1] - d[1] * nw[0])
+        return float(slide / distance)
 
     def sticks(self, pose, twist, distance: float = 0.003, speed: float = 0.01, ratio: float = 0.02) -> bool:
         """Whether the pusher and the object move together over a short push: their relative

@@ -368,3 +368,54 @@ def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> 
     anim.save(path, writer=PillowWriter(fps=fps))
     plt.close(fig)
     return path
+
+
+def plot_control(scene, res, path, extra=None) -> Path:
+    """Planned (reference) against executed poses of a controlled run, pokes and re-plans marked
+    (like the thesis' Figs 5-8..5-11): x, z and θ over time, and the path in the X–Z plane."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    _axes_pose(ax[:2], res.t, res.reference, "reference ", dict(ls="--", color="0.5"))
+    _axes_pose(ax[:2], res.t, res.poses, f"{res.policy} ({res.engine}) ")
+    for name, r in (extra or {}).items():
+        _axes_pose(ax[:2], r.t, r.poses, f"{name} ", dict(ls=":"))
+    for t, d in res.pokes:
+        for a in ax[:2]:
+            a.axvline(t, color="tab:red", lw=0.8, alpha=0.6)
+        ax[0].annotate("poke", (t, ax[0].get_ylim()[1]), color="tab:red", fontsize=7, va="top")
+    rp = [res.t[i] for i, s in enumerate(res.statuses) if s == "replanned"]
+    for t in rp:
+        for a in ax[:2]:
+            a.axvline(t, color="tab:purple", lw=0.8, ls="-.", alpha=0.7)
+    ax[0].set_ylabel("object position in the grasp [mm]")
+    ax[1].set_ylabel("object angle in the grasp [deg]")
+    for a in ax[:2]:
+        a.set_xlabel("t [s]")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7)
+    # the path in the X–Z plane
+    a = ax[2]
+    a.plot(1e3 * res.reference[:, 0], 1e3 * res.reference[:, 1], "--", color="0.5", label="reference")
+    a.plot(1e3 * res.poses[:, 0], 1e3 * res.poses[:, 1], "-", color="tab:blue", label="executed")
+    a.plot(1e3 * res.poses[0, 0], 1e3 * res.poses[0, 1], "o", color="tab:blue")
+    if scene.task is not None:
+        g, tol = scene.task.goal, scene.task.tolerance
+        a.add_patch(plt.Rectangle((1e3 * (g[0] - tol[0]), 1e3 * (g[1] - tol[1])), 2e3 * tol[0], 2e3 * tol[1],
+                                  color="tab:green", alpha=0.3, label="goal tolerance"))
+    a.set_xlabel("x [mm]")
+    a.set_ylabel("z [mm]")
+    a.set_aspect("equal", adjustable="datalim")
+    a.grid(alpha=0.3)
+    a.legend(fontsize=7)
+    fig.suptitle(f"{scene.name}: {res.policy} in {res.engine} — {'success' if res.success else 'failure'}, "
+                 f"{res.replans} re-plans, {len(res.pokes)} pokes" + (f" ({res.failure})" if res.failure else ""))
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

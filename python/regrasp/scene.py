@@ -242,10 +242,13 @@ class MotionConeBatch:
         return out
 
 
-def _rebuild_scene(kind: str, text: str, path, grip=None):
+def _rebuild_scene(kind: str, text: str, path, grip=None, ops=()):
     s = Scene.from_toml(text) if kind == "toml" else Scene(_core.Scene.from_json(text), None, ("json", text))
     s.path = None if path is None else Path(path)
-    return s if grip is None else s.with_grip_force(grip)
+    s = s if grip is None else s.with_grip_force(grip)
+    for name, kw in ops:
+        s = getattr(s, name)(**kw)
+    return s
 
 
 def _non_finite(x, path: str):
@@ -287,7 +290,7 @@ class Scene:
             raise TypeError("this scene has no source text to be pickled from")
         kind, text = self.source
         return (_rebuild_scene, (kind, text, None if self.path is None else str(self.path),
-                                 getattr(self, "_grip_override", None)))
+                                 getattr(self, "_grip_override", None), getattr(self, "_ops", ())))
 
     @classmethod
     def load(cls, path) -> "Scene":
@@ -398,6 +401,68 @@ class Scene:
         s = Scene(self._core.with_grip_force(float(force)), self.path, self.source)
         s._grip_override = float(force)
         return s
+
+    def _view(self, core, op: str, **kw) -> "Scene":
+        s = Scene(core, self.path, self.source)
+        if hasattr(self, "_grip_override"):
+            s._grip_override = self._grip_override
+        s._ops = tuple(getattr(self, "_ops", ())) + ((op, kw),)
+        return s
+
+    @property
+    def mode(self) -> str:
+        """Which motion cones this scene answers with: "nominal", "robust" or "fixtureless"."""
+        return self._core.mode
+
+    @property
+    def uncertainty(self) -> Optional[dict]:
+        """The ``[uncertainty]`` table (relative spreads), or None."""
+        return self._core.uncertainty
+
+    @property
+    def rho(self) -> Optional[float]:
+        """ρ = μ_s N / (m g), the one number mass, grip force and finger friction enter the
+        planar motion cone through (grasp scenes)."""
+        return self._core.rho
+
+    def scaled(self, finger_friction: float = 1.0, grip: float = 1.0, mass: float = 1.0,
+               pusher_friction: float = 1.0, mode: str = "nominal") -> "Scene":
+        """A copy with the finger friction, grip force, mass and every pusher's friction
+        multiplied by the given factors, answering with the cones of ``mode``."""
+        core = self._core.scaled(float(finger_friction), float(grip), float(mass), float(pusher_friction), mode)
+        return self._view(core, "scaled", finger_friction=finger_friction, grip=grip, mass=mass,
+                          pusher_friction=pusher_friction, mode=mode)
+
+    def robust(self, uncertainty: Optional[dict] = None) -> "Scene":
+        """The robust view (thesis §5.1): the worst case of the ranges (ρ_min = μ_s,min N_min /
+        (m_max g), lowest pusher friction) whose cones are V(ρ_min) ∩ V_gf — the pushes that
+        stick for every value in the ranges. ``uncertainty``: relative spreads
+        ``{"pusher_friction", "finger_friction", "grip_force", "mass"}`` (default: the scene's
+        ``[uncertainty]`` table)."""
+        u = dict(self.uncertainty or {}) if uncertainty is None else dict(uncertainty)
+        if uncertainty is None and self.uncertainty is None:
+            raise ArgumentError("invalid `uncertainty`: the scene has no [uncertainty] table; give the spreads", "uncertainty")
+        keys = ("pusher_friction", "finger_friction", "grip_force", "mass")
+        for k, v in u.items():
+            if k not in keys:
+                raise ArgumentError(f"invalid `uncertainty.{k}`: unknown (expected {', '.join(keys)})", f"uncertainty.{k}")
+            if not (isinstance(v, (int, float)) and np.isfinite(v) and 0 <= v < 1):
+                raise ArgumentError(f"invalid `uncertainty.{k}`: must be a relative spread in [0, 1) (got {v!r})",
+                                    f"uncertainty.{k}")
+        f = {k: float(u.get(k, 0.0)) for k in keys}
+        s = self.scaled(1 - f["finger_friction"], 1 - f["grip_force"], 1 + f["mass"], 1 - f["pusher_friction"], "robust")
+        return s
+
+    def fixtureless(self) -> "Scene":
+        """Fixtureless fixturing (CASE 2018): only pushes by pushers that carry the object's
+        weight, inside their gravity-free cones — invariant to mass, grip force and finger
+        friction; the object stays put against the feature while the fingers slide over it."""
+        return self._view(self._core.scaled(1.0, 1.0, 1.0, 1.0, "fixtureless"), "fixtureless")
+
+    def carries_weight(self, pose, pusher: str) -> bool:
+        """Whether ``pusher`` alone can carry the object's weight at ``pose`` (the invariant case
+        of §5.1: its gravity-free pushes stick for any mass, grip force and finger friction)."""
+        return self._core.carries_weight(list(_vec(pose, 3, "pose")), pusher)
 
     def admissible(self, pose) -> bool | np.ndarray:
         """Whether the whole finger pad lies on the object at ``pose`` (or each row of an array)."""

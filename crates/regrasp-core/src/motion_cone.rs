@@ -25,6 +25,7 @@ use crate::friction_cone::{ConeShape, ContactLimit, EdgeWrench, PolyhedralCone, 
 use crate::geometry::{cross2, perp, Mat3, Vec2, Vec3};
 use crate::limit_surface::LimitSurface;
 use crate::metric::Metric;
+use crate::robust::{mode_margin, ConeMode};
 
 /// Tolerance of the exact membership test on the (dimensionless) margin.
 pub const MEMBERSHIP_TOL: f64 = 1e-9;
@@ -74,13 +75,15 @@ pub struct SupportFrame {
     pub ug: Vec3,
     /// `√(u_gᵀ A u_g)`: < 1 when the support holds the object against gravity.
     pub hold_ratio: f64,
+    /// Which cone the exact test answers for (nominal, robust, fixtureless; [`crate::robust`]).
+    pub mode: ConeMode,
 }
 
 impl SupportFrame {
     pub fn new(a: Mat3, a_inv: Mat3, js: Mat3, js_inv: Mat3, gravity: Vec3) -> Self {
         let ug = js_inv.tr_mul(&gravity);
         let hold_ratio = ug.dot(&(a * ug)).sqrt();
-        Self { a, a_inv, js, js_inv, gravity, ug, hold_ratio }
+        Self { a, a_inv, js, js_inv, gravity, ug, hold_ratio, mode: ConeMode::Nominal }
     }
 
     /// The motion-cone ray (unit twist in `metric`) of pusher wrench direction `p`;
@@ -128,6 +131,7 @@ impl SupportFrame {
         let support = self.support_load(v);
         let wp = support - self.gravity;
         let (margin, limit) = model.membership(&wp);
+        let margin = mode_margin(self.mode, self, model, margin, &support);
         Classification { feasible: margin >= -MEMBERSHIP_TOL, margin, limit, pusher_wrench: wp, support_wrench: support }
     }
 }
@@ -148,6 +152,8 @@ pub struct PushSpec {
     pub metric: Metric,
     /// The pose, for error messages.
     pub pose: [f64; 3],
+    /// Nominal, robust or fixtureless cone ([`crate::robust`]).
+    pub mode: ConeMode,
     /// Grip force of each finger per unit `friction_scale` (`1/(2μ_s)` for a two-pad grasp);
     /// `None` when the normal force is not a free parameter (object on a surface).
     pub grip_per_scale: Option<f64>,
@@ -209,13 +215,14 @@ impl PlanarPush {
             .support_jacobian
             .try_inverse()
             .ok_or_else(|| Error::arg("support_jacobian", "is singular"))?;
-        let frame = SupportFrame::new(
+        let mut frame = SupportFrame::new(
             spec.limit_surface.matrix(spec.friction_scale),
             spec.limit_surface.matrix_inv(spec.friction_scale),
             spec.support_jacobian,
             js_inv,
             spec.gravity,
         );
+        frame.mode = spec.mode;
         Ok(Self { spec, frame, model })
     }
 
@@ -264,10 +271,16 @@ impl PlanarPush {
         self.frame.ray(p, &self.spec.metric)
     }
 
-    /// Generators of the polyhedral approximation: one ray per edge of `W_p`, unit twists.
+    /// Generators of the polyhedral approximation: one ray per edge of `W_p`, unit twists (in
+    /// the robust and fixtureless modes, those of [`crate::robust::generators`]).
     pub fn generators(&self) -> Result<Vec<Vec3>> {
         self.check_hold()?;
-        Ok(self.model.edges.iter().filter_map(|e| self.ray(&e.wrench)).collect())
+        Ok(crate::robust::generators(&self.frame, &self.model))
+    }
+
+    /// Whether the pusher alone can carry the object's weight (the invariant case, §5.1).
+    pub fn carries_weight(&self) -> bool {
+        crate::robust::carries_weight(&self.frame, &self.model)
     }
 
     /// Generators of the gravity-free cone `J_s⁻¹ A J_s⁻ᵀ e_i`, unit twists.
@@ -508,6 +521,48 @@ pub fn project_exact(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> Vec
     } else {
         Vec3::zeros()
     }
+}
+
+/// Closest twist to `want` in the cone (of the frame's mode) with at least margin `margin`: the
+/// projection on the polyhedral cone of its generators when the exact test accepts it, else the
+/// exact projection, then moved towards the mean of the generators until the margin holds.
+/// `None` when the cone is empty or the support cannot hold the object.
+pub fn project_with_margin(frame: &SupportFrame, model: &PusherModel, want: &Vec3, margin_min: f64) -> Option<Vec3> {
+    let m = &model.metric;
+    let gens = crate::robust::generators(frame, model);
+    if gens.is_empty() || (frame.mode == ConeMode::Nominal && gens.len() != model.edges.len()) {
+        return None;
+    }
+    let gs: Vec<Vec3> = gens.iter().map(|g| m.twist(g)).collect();
+    let (pp, _) = project_onto_generators(&gs, &m.twist(want));
+    let mut v = m.twist_inv(&pp);
+    if v.amax() == 0.0 || frame.classify(model, &v).margin < 0.0 {
+        v = project_exact(frame, model, want);
+        if v.amax() == 0.0 {
+            return None;
+        }
+    }
+    let margin = |x: &Vec3| frame.classify(model, x).margin;
+    if margin(&v) >= margin_min {
+        return Some(v);
+    }
+    // towards the mean of the cone's rays
+    let centre = gens.iter().fold(Vec3::zeros(), |a, g| a + g);
+    if centre.amax() == 0.0 || margin(&centre) < margin_min {
+        return (margin(&v) >= 0.0).then_some(v);
+    }
+    let (vn, cn) = (m.twist_norm(&v), m.twist_norm(&centre));
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        let x = v / vn * (1.0 - mid) + centre / cn * mid;
+        if margin(&x) >= margin_min {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some((v / vn * (1.0 - hi) + centre / cn * hi) * vn)
 }
 
 /// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images of

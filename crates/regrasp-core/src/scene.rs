@@ -11,6 +11,7 @@ use crate::gravity::gravity_wrench;
 use crate::limit_surface::{LimitSurface, Pressure, PressureDistribution};
 use crate::metric::Metric;
 use crate::motion_cone::{PlanarPush, PushSpec, PusherModel, SupportFrame};
+use crate::robust::{ConeMode, Uncertainty};
 use serde::{Deserialize, Serialize};
 
 // ---------------------------------------------------------------------------------------------
@@ -27,6 +28,17 @@ pub struct RawScene {
     pub gravity: Option<RawGravity>,
     pub pushers: Option<Vec<RawPusher>>,
     pub task: Option<RawTask>,
+    pub uncertainty: Option<RawUncertainty>,
+}
+
+/// `[uncertainty]`: relative spreads (0.2 = ±20%) of the parameters the plan must survive.
+#[derive(Deserialize, Serialize, Default, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+pub struct RawUncertainty {
+    pub pusher_friction: Option<f64>,
+    pub finger_friction: Option<f64>,
+    pub grip_force: Option<f64>,
+    pub mass: Option<f64>,
 }
 
 #[derive(Deserialize, Serialize, Default, Debug, Clone)]
@@ -152,6 +164,10 @@ pub struct Scene {
     pub task: Option<Task>,
     /// Characteristic length L [m]: the radius of gyration of the outline about the COM.
     pub length: f64,
+    /// The optional `[uncertainty]` table (relative spreads, [`crate::robust`]).
+    pub uncertainty: Option<Uncertainty>,
+    /// Which motion cones the scene answers with (nominal unless made robust or fixtureless).
+    pub mode: ConeMode,
 }
 
 /// Whether `n` is an admissible pushing direction at boundary point `q`: the inward normal of
@@ -370,7 +386,20 @@ impl Scene {
             pushers,
             task: None,
             length,
+            uncertainty: None,
+            mode: ConeMode::Nominal,
         };
+        if let Some(u) = &raw.uncertainty {
+            scene.uncertainty = Some(
+                Uncertainty {
+                    pusher_friction: u.pusher_friction.unwrap_or(0.0),
+                    finger_friction: u.finger_friction.unwrap_or(0.0),
+                    grip_force: u.grip_force.unwrap_or(0.0),
+                    mass: u.mass.unwrap_or(0.0),
+                }
+                .checked()?,
+            );
+        }
 
         match (&raw.task, &scene.support) {
             (None, Support::Grasp(_)) => return Err(Error::scene("task", "table is required")),
@@ -661,7 +690,9 @@ impl Scene {
         let f = Vec2::new(cs * d.x + sn * d.y, -sn * d.x + cs * d.y);
         let wg = Vec3::new(f.x, f.y, self.com.x * f.y - self.com.y * f.x);
         let k = 1.0 / (s * s);
-        SupportFrame::new(ls.b * k, ls.b_inv * (s * s), js, js_inv, wg)
+        let mut f = SupportFrame::new(ls.b * k, ls.b_inv * (s * s), js, js_inv, wg);
+        f.mode = self.mode;
+        f
     }
 
     /// Checks a pose and returns its frame; the error says what is wrong.
@@ -686,6 +717,7 @@ impl Scene {
             gravity: self.gravity_wrench(q),
             metric: self.metric(),
             pose: *q,
+            mode: self.mode,
             grip_per_scale: match &self.support {
                 Support::Grasp(g) => Some(1.0 / (2.0 * g.friction)),
                 Support::Surface(_) => None,

@@ -21,7 +21,7 @@
 use crate::error::{Error, Result};
 use crate::geometry::{rot, Vec2, Vec3};
 use crate::mncp;
-use crate::motion_cone::{project_exact, project_onto_generators, SupportFrame};
+use crate::motion_cone::{project_with_margin, SupportFrame};
 use crate::quasistatic::{self, integrate, Options as QsOptions, SupportModel};
 use crate::scene::Scene;
 use kiddo::{KdTree, SquaredEuclidean};
@@ -397,46 +397,9 @@ impl<'a> Planner<'a> {
         None
     }
 
-    /// Closest twist to `want` in pusher `p`'s cone with at least the settings' margin: the
-    /// projection on the polyhedral cone when the exact test accepts it, else the exact
-    /// projection, then moved towards the cone's interior until the margin holds.
+    /// Closest twist to `want` in pusher `p`'s cone with at least the settings' margin.
     fn project_with_margin(&self, frame: &SupportFrame, p: usize, want: &Vec3) -> Option<Vec3> {
-        let model = &self.scene.pushers[p].model;
-        let m = &model.metric;
-        let gens: Vec<Vec3> = model.edges.iter().filter_map(|e| frame.ray(&e.wrench, m)).collect();
-        if gens.len() != model.edges.len() {
-            return None;
-        }
-        let gs: Vec<Vec3> = gens.iter().map(|g| m.twist(g)).collect();
-        let (pp, _) = project_onto_generators(&gs, &m.twist(want));
-        let mut v = m.twist_inv(&pp);
-        if v.amax() == 0.0 || frame.classify(model, &v).margin < 0.0 {
-            v = project_exact(frame, model, want);
-            if v.amax() == 0.0 {
-                return None;
-            }
-        }
-        let margin = |x: &Vec3| frame.classify(model, x).margin;
-        if margin(&v) >= self.s.margin {
-            return Some(v);
-        }
-        // towards the mean of the cone's rays
-        let centre = gens.iter().fold(Vec3::zeros(), |a, g| a + g);
-        if centre.amax() == 0.0 || margin(&centre) < self.s.margin {
-            return (margin(&v) >= 0.0).then_some(v);
-        }
-        let (vn, cn) = (m.twist_norm(&v), m.twist_norm(&centre));
-        let (mut lo, mut hi) = (0.0, 1.0);
-        for _ in 0..30 {
-            let mid = 0.5 * (lo + hi);
-            let x = v / vn * (1.0 - mid) + centre / cn * mid;
-            if margin(&x) >= self.s.margin {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        Some((v / vn * (1.0 - hi) + centre / cn * hi) * vn)
+        project_with_margin(frame, &self.scene.pushers[p].model, want, self.s.margin)
     }
 
     fn pusher_order(&self, first: Option<usize>) -> Vec<usize> {

@@ -656,6 +656,43 @@ impl Scene {
         trrt::validate_path(&self.inner, &path, checks).map_err(to_py)
     }
 
+    /// The cone mode: "nominal", "robust" or "fixtureless".
+    #[getter]
+    fn mode(&self) -> &'static str {
+        self.inner.mode.label()
+    }
+
+    /// The `[uncertainty]` table as a dict of relative spreads (None when absent).
+    #[getter]
+    fn uncertainty(&self) -> Option<std::collections::HashMap<&'static str, f64>> {
+        self.inner.uncertainty.map(|u| {
+            [("pusher_friction", u.pusher_friction), ("finger_friction", u.finger_friction), ("grip_force", u.grip_force), ("mass", u.mass)]
+                .into_iter()
+                .collect()
+        })
+    }
+
+    /// `ρ = μ_s N / (m g)` (grasp scenes).
+    #[getter]
+    fn rho(&self) -> Option<f64> {
+        regrasp::robust::rho(&self.inner)
+    }
+
+    /// A copy with scaled parameters and a cone mode (see `regrasp.robust`).
+    #[pyo3(signature = (finger_friction=1.0, grip=1.0, mass=1.0, pusher_friction=1.0, mode="nominal"))]
+    fn scaled(&self, finger_friction: f64, grip: f64, mass: f64, pusher_friction: f64, mode: &str) -> PyResult<Self> {
+        let mode = regrasp::robust::ConeMode::parse(mode).map_err(to_py)?;
+        regrasp::robust::scaled(&self.inner, finger_friction, grip, mass, pusher_friction, mode).map(|inner| Self { inner }).map_err(to_py)
+    }
+
+    /// Whether pusher `pusher` alone can carry the object's weight at pose `q` (the invariant case).
+    fn carries_weight(&self, q: Vec<f64>, pusher: &str) -> PyResult<bool> {
+        let q = pose3(&q)?;
+        let p = self.inner.pusher_index(pusher).map_err(to_py)?;
+        self.inner.check_pose(&q).map_err(to_py)?;
+        Ok(regrasp::robust::carries_weight(&self.inner.frame(&q), &self.inner.pushers[p].model))
+    }
+
     /// Messages of the batch status codes.
     #[staticmethod]
     fn status_messages() -> Vec<(u8, &'static str)> {
@@ -952,12 +989,151 @@ impl MotionCone {
     }
 }
 
+/// The MPC controller (Rust `regrasp::mpc`): a plan's reference, the scene's cones.
+#[pyclass(module = "regrasp._core", unsendable)]
+struct Mpc {
+    inner: regrasp::mpc::Mpc,
+    names: Vec<String>,
+}
+
+fn path_from(scene: &regrasp::Scene, poses: &[Vec<f64>], pushers: &[Option<String>]) -> PyResult<Vec<([f64; 3], Option<usize>)>> {
+    if poses.len() != pushers.len() {
+        return Err(arg_err("plan", "poses and pushers differ in length"));
+    }
+    let mut path = Vec::new();
+    for (i, (q, p)) in poses.iter().zip(pushers).enumerate() {
+        let q = pose3(q).map_err(|_| arg_err(&format!("plan.path[{i}].pose"), "must be 3 finite numbers"))?;
+        let p = match p {
+            None => None,
+            Some(n) => Some(scene.pusher_index(n).map_err(|_| arg_err(&format!("plan.path[{i}].pusher"), format!("no pusher {n:?} in the scene")))?),
+        };
+        path.push((q, p));
+    }
+    Ok(path)
+}
+
+#[pymethods]
+impl Mpc {
+    #[new]
+    #[pyo3(signature = (scene, poses, pushers, goal=None, dt=0.1, horizon=5, speed=0.01, stage_weight=1.0,
+                        terminal_weight=5.0, effort_weight=1e-3, margin=0.01, stall_steps=10, max_replans=5,
+                        replan_time_limit=2.0, seed=0))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        scene: &Scene,
+        poses: Vec<Vec<f64>>,
+        pushers: Vec<Option<String>>,
+        goal: Option<Vec<f64>>,
+        dt: f64,
+        horizon: usize,
+        speed: f64,
+        stage_weight: f64,
+        terminal_weight: f64,
+        effort_weight: f64,
+        margin: f64,
+        stall_steps: usize,
+        max_replans: usize,
+        replan_time_limit: f64,
+        seed: u64,
+    ) -> PyResult<Self> {
+        let path = path_from(&scene.inner, &poses, &pushers)?;
+        let goal = goal.map(|g| pose3(&g)).transpose().map_err(|_| arg_err("goal", "must be 3 finite numbers"))?;
+        for (name, v) in [("dt", dt), ("speed", speed), ("stage_weight", stage_weight), ("terminal_weight", terminal_weight)] {
+            if !(v > 0.0) || !v.is_finite() {
+                return Err(arg_err(name, format!("must be positive and finite (got {v})")));
+            }
+        }
+        if !(effort_weight >= 0.0) || !(margin >= 0.0) {
+            return Err(arg_err("effort_weight", "effort_weight and margin must be non-negative"));
+        }
+        let settings = regrasp::mpc::MpcSettings {
+            dt,
+            horizon,
+            speed,
+            stage_weight,
+            terminal_weight,
+            effort_weight,
+            margin,
+            stall_steps,
+            max_replans,
+            planner: trrt::Settings { time_limit: replan_time_limit, seed, ..trrt::Settings::default() },
+            ..regrasp::mpc::MpcSettings::default()
+        };
+        let inner = regrasp::mpc::Mpc::new(&scene.inner, &path, goal, settings).map_err(to_py)?;
+        Ok(Self { inner, names: scene.inner.pushers.iter().map(|p| p.name.clone()).collect() })
+    }
+
+    /// One control step from the measured pose: a dict with status, pusher, twist, knot,
+    /// tracking_error, projected, solve_time_s, replan_time_s.
+    fn step<'py>(&mut self, py: Python<'py>, pose: Vec<f64>) -> PyResult<Bound<'py, PyDict>> {
+        let q = pose3(&pose)?;
+        let c = self.inner.step(&q).map_err(to_py)?;
+        let d = PyDict::new(py);
+        d.set_item("status", c.status.label())?;
+        d.set_item("pusher", c.pusher.map(|i| self.names[i].clone()))?;
+        d.set_item("twist", vec![c.twist.x, c.twist.y, c.twist.z])?;
+        d.set_item("knot", c.knot)?;
+        d.set_item("tracking_error", c.tracking_error)?;
+        d.set_item("projected", c.projected)?;
+        d.set_item("solve_time_s", c.solve_time_s)?;
+        d.set_item("replan_time_s", c.replan_time_s)?;
+        Ok(d)
+    }
+
+    /// The QP at pose `pose` with the reference after knot `knot`: per horizon step a dict with
+    /// the pusher, generators (k, 3) and weights (k,); and whether clarabel solved it.
+    fn solve_qp<'py>(&self, py: Python<'py>, pose: Vec<f64>, knot: usize) -> PyResult<(Vec<Bound<'py, PyDict>>, bool)> {
+        let q = pose3(&pose)?;
+        let sol = self.inner.solve_qp(&q, knot.min(self.inner.knots().len() - 1)).map_err(to_py)?;
+        let steps = sol
+            .steps
+            .iter()
+            .map(|(p, g, w)| -> PyResult<Bound<'py, PyDict>> {
+                let d = PyDict::new(py);
+                d.set_item("pusher", self.names[*p].clone())?;
+                let mut a = Array2::<f64>::zeros((g.len(), 3));
+                for (i, v) in g.iter().enumerate() {
+                    for k in 0..3 {
+                        a[(i, k)] = v[k];
+                    }
+                }
+                d.set_item("generators", a.into_pyarray(py))?;
+                d.set_item("weights", w.clone())?;
+                Ok(d)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        Ok((steps, sol.status_ok))
+    }
+
+    /// Reference knots (n, 3) and the pusher reaching each.
+    #[getter]
+    fn knots<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let k = self.inner.knots();
+        let mut a = Array2::<f64>::zeros((k.len(), 3));
+        for (i, q) in k.iter().enumerate() {
+            for j in 0..3 {
+                a[(i, j)] = q[j];
+            }
+        }
+        a.into_pyarray(py)
+    }
+    #[getter]
+    fn knot_pushers(&self) -> Vec<Option<String>> {
+        self.inner.knot_pushers().iter().map(|p| p.map(|i| self.names[i].clone())).collect()
+    }
+    #[getter]
+    fn replans(&self) -> usize {
+        self.inner.replans
+    }
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_class::<MotionCone>()?;
     m.add_class::<MncpProblem>()?;
     m.add_class::<Scene3D>()?;
+    m.add_class::<Mpc>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
