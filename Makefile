@@ -33,7 +33,7 @@ demo: build
 	$(BIN)/regrasp demo --out $(OUT)/demo
 
 bench: build
-	cargo bench -p regrasp-core --bench cones
+	cargo bench -p regrasp-core --bench cones --bench mncp --bench mpc
 	$(BIN)/regrasp bench --json
 
 clean:

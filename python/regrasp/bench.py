@@ -115,6 +115,7 @@ def run(n: int = 100_000, reps: int = 11, baseline_reps: int = 3, scene_path=Non
     results.update(run_mncp(reps=reps))
     results.update(run_planner())
     results.update(run_mujoco())
+    results.update(run_mpc())
     return results
 
 
@@ -149,6 +150,71 @@ def run_mujoco(steps: int = 4000) -> dict:
             "baseline": "the same push in MuJoCo (quasi-static: 20 steps of 50 ms)",
         },
     }
+
+
+def _mpc_qp_scipy(scene: Scene, q, steps, targets, speed=0.01, dt=0.1, stage=1.0, terminal=5.0, effort=1e-3):
+    """The MPC's QP (see crates/regrasp-core/src/mpc.rs) solved by scipy's SLSQP: the baseline."""
+    from scipy.optimize import minimize
+
+    L = scene.length
+    ds = speed * dt
+    gens = [np.asarray(st["generators"]) for st in steps]
+    sizes = [len(g) for g in gens]
+    n = sum(sizes)
+    offs = np.cumsum([0] + sizes[:-1])
+    B = np.zeros((3, n))
+    T = []
+    for i, g in enumerate(gens):
+        th = q[2] if i == 0 else targets[i - 1][2]
+        c, s_ = np.cos(th), np.sin(th)
+        for k, v in enumerate(g):
+            B[:, offs[i] + k] = [c * v[0] - s_ * v[1], s_ * v[0] + c * v[1], L * v[2]]
+        T.append(scene.metric_twist(g) if len(g) else np.zeros((0, 3)))
+    q0 = np.array([q[0], q[1], L * q[2]]) / ds
+    P = 2 * effort * np.eye(n)
+    c = np.zeros(n)
+    for i, t in enumerate(targets[:len(gens)]):
+        w = terminal if i + 1 == len(gens) else stage
+        up = offs[i] + sizes[i]
+        M = np.zeros((3, n))
+        M[:, :up] = B[:, :up]
+        e0 = q0 - np.array([t[0], t[1], L * t[2]]) / ds
+        P += 2 * w * M.T @ M
+        c += 2 * w * M.T @ e0
+    cons = [{"type": "ineq", "fun": (lambda a, i=i: 1.0 - np.sum((a[offs[i]:offs[i] + sizes[i]] @ T[i]) ** 2))}
+            for i in range(len(gens)) if sizes[i]]
+    r = minimize(lambda a: 0.5 * a @ P @ a + c @ a, np.zeros(n), jac=lambda a: P @ a + c, bounds=[(0, 10)] * n,
+                 constraints=cons, method="SLSQP", options={"ftol": 1e-10, "maxiter": 200})
+    return r.x * speed
+
+
+def run_mpc(reps: int = 200) -> dict:
+    """One MPC step (Rust: closest knot, cones of the horizon, the QP with clarabel, the exact
+    check) against the same QP solved by scipy's SLSQP (the QP alone, generators given)."""
+    from . import _core
+    from .plan import plan
+
+    out = {}
+    for name in ("block-high-friction", "t-shape"):
+        scene = Scene.load(EXAMPLES / f"{name}.toml")
+        p = plan(scene, seed=0)
+        poses = [k["pose"] for k in p.path]
+        q = (np.asarray(poses[0]) + [0.0005, -0.0005, 0.01]).tolist()
+        times = []
+        for _ in range(reps):
+            m = _core.Mpc(scene._core, poses, p.pushers)
+            times.append(m.step(q)["solve_time_s"])
+        m = _core.Mpc(scene._core, poses, p.pushers)
+        steps, _ = m.solve_qp(q, 0)
+        knots = np.asarray(m.knots)
+        targets = [knots[min(1 + i, len(knots) - 1)] for i in range(len(steps))]
+        t_base = _median_time(lambda: _mpc_qp_scipy(scene, q, steps, targets), 5)
+        t = float(np.median(times))
+        out[f"mpc_step_{name}"] = {
+            "median_s": t, "baseline_median_s": t_base, "ratio": t_base / t,
+            "baseline": "the same QP alone (generators given) with scipy SLSQP",
+        }
+    return out
 
 
 PLANNED = ("block-low-friction", "block-high-friction", "block-xztheta", "t-shape", "block-tilted-gripper")

@@ -98,7 +98,7 @@ class QuasistaticPlant:
 
 def _plant(engine: str, scene: Scene, q0, perturb: Perturbation):
     if engine == "quasistatic":
-        world = scene.scaled(perturb.friction, perturb.grip, perturb.mass, perturb.friction)
+        world = scene.scaled(perturb.friction, perturb.grip, perturb.mass, perturb.pusher)
         return QuasistaticPlant(world, q0)
     from .mujoco_exec import WorldRig
 
@@ -170,9 +170,11 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
             refs.append(knots[min(c["knot"], len(knots) - 1)])
             sts.append(c["status"])
             used.append(c["pusher"])
-            if c["status"] == "at_goal" and not pending:
-                break
-            if c["status"] == "stuck":
+            if c["status"] == "at_goal":
+                if not pending:
+                    break
+                plant.idle(dt)
+            elif c["status"] == "stuck":
                 stuck += 1
                 if stuck >= 3 and not pending:
                     failure = "stuck: no push of the plan helps and re-planning found none"

@@ -32,6 +32,12 @@ class Perturbation:
     friction: float = 1.0
     grip: float = 1.0
     mass: float = 1.0
+    #: factor on the features' (pushers') friction; None: ``friction``
+    pusher_friction: float | None = None
+
+    @property
+    def pusher(self) -> float:
+        return self.friction if self.pusher_friction is None else self.pusher_friction
 
     @classmethod
     def draw(cls, spread: float, rng, base: "Perturbation" = None) -> "Perturbation":
@@ -58,7 +64,7 @@ def build(scene: Scene, plan: dict, perturb: Perturbation = Perturbation(), cont
     assets, obj = object_xml(scene, q0, mass_scale=perturb.mass)
     pads, acts = pads_xml(scene, friction_scale=perturb.friction)
     used = sorted({k["pusher"] for k in plan["path"][1:]})
-    feats = "\n".join(feature_xml(scene, p, f"feature_{p}", perturb.friction, PARK) for p in used)
+    feats = "\n".join(feature_xml(scene, p, f"feature_{p}", perturb.pusher, PARK) for p in used)
     return (f'<mujoco model="{scene.name}-execution">{header(scene, contact)}<asset>{assets}</asset>\n'
             f'<worldbody>\n{obj}\n{driven_body_xml("gripper", pads)}\n{feats}\n</worldbody>\n'
             f'<actuator>{acts}</actuator></mujoco>')

@@ -15,11 +15,14 @@
 //! up to a fast twist that goes nowhere).
 //! The positions are eliminated, so the QP has only the non-negative weights (clarabel).
 //! The first step's twist `G₁α₁` is checked with the exact test at `q₁` and projected into the
-//! exact cone (with a margin) when the polyhedral approximation overshoots it.
+//! exact cone (with a margin) when the polyhedral approximation overshoots it; and since the
+//! polyhedral approximation can also miss directions of the exact cone, each step's generators
+//! include the reference's own twist (or its projection on the exact cone).
 //!
-//! Re-planning (Fig 5-11): when no push of the horizon helps (the command vanishes) or the
-//! distance to the goal has not shrunk for `stall_steps` steps, the T-RRT* planner is called
-//! from the measured pose.
+//! Re-planning (Fig 5-11): when no push of the horizon helps (the command vanishes), or the
+//! distance to the goal has not shrunk for `stall_steps` steps, or the object is off the plan by
+//! more than `replan_error` steps and not getting closer for `stall_steps` steps, the T-RRT*
+//! planner is called from the measured pose.
 
 use crate::error::{Error, Result};
 use crate::geometry::{rot, Vec2, Vec3};
@@ -53,7 +56,13 @@ pub struct MpcSettings {
     pub stall_steps: usize,
     /// Progress smaller than this fraction of a step does not count.
     pub progress: f64,
+    /// Off the plan by more than this many steps without getting closer for `stall_steps`
+    /// steps: re-plan (Fig 5-11).
+    pub replan_error: f64,
     pub max_replans: usize,
+    /// The goal is reached within this fraction of the task's tolerance (or within the
+    /// tolerance once progress stops).
+    pub goal_fraction: f64,
     /// Planner settings for re-planning.
     pub planner: trrt::Settings,
 }
@@ -70,7 +79,9 @@ impl Default for MpcSettings {
             margin: 0.01,
             stall_steps: 10,
             progress: 0.05,
+            replan_error: 2.0,
             max_replans: 5,
+            goal_fraction: 0.5,
             planner: trrt::Settings { time_limit: 2.0, ..trrt::Settings::default() },
         }
     }
@@ -139,6 +150,8 @@ pub struct Mpc {
     last_knot: usize,
     best_goal_distance: f64,
     since_progress: usize,
+    best_tracking: f64,
+    since_tracking: usize,
     pub replans: usize,
 }
 
@@ -194,6 +207,8 @@ impl Mpc {
             last_knot: 0,
             best_goal_distance: f64::INFINITY,
             since_progress: 0,
+            best_tracking: f64::INFINITY,
+            since_tracking: 0,
             replans: 0,
         })
     }
@@ -211,8 +226,9 @@ impl Mpc {
         ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (l * (a[2] - b[2])).powi(2)).sqrt()
     }
 
-    fn at_goal(&self, q: &[f64; 3]) -> bool {
-        (0..3).all(|k| (q[k] - self.goal[k]).abs() <= self.tol[k])
+    /// Within `fraction` of the task's tolerance of the goal.
+    fn within(&self, q: &[f64; 3], fraction: f64) -> bool {
+        (0..3).all(|k| (q[k] - self.goal[k]).abs() <= fraction * self.tol[k])
     }
 
     /// Closest knot in a window around the last one.
@@ -230,6 +246,7 @@ impl Mpc {
         let ds = s.speed * s.dt;
         let n_knots = self.knots.len();
         let last_pusher = self.pushers.iter().rev().find_map(|p| *p);
+        let metric = self.scene.metric();
         let mut steps: Vec<(usize, Vec<Vec3>, [f64; 3])> = Vec::with_capacity(s.horizon);
         for i in 0..s.horizon {
             let r = (j + 1 + i).min(n_knots - 1);
@@ -237,7 +254,25 @@ impl Mpc {
             let at = if i == 0 { *q } else { self.knots[(j + i).min(n_knots - 1)] };
             let gens = if self.scene.admissible(&at) {
                 let f = self.scene.frame(&at);
-                if f.hold_ratio < 1.0 { generators(&f, &self.scene.pushers[p].model) } else { Vec::new() }
+                if f.hold_ratio < 1.0 {
+                    let model = &self.scene.pushers[p].model;
+                    let mut g = generators(&f, model);
+                    // the polyhedral approximation may miss the reference's own direction (it is
+                    // not the exact cone): add the reference twist, or its projection on the
+                    // exact cone, as one more generator
+                    let d = body_twist(&at, &self.knots[r]);
+                    if metric.twist_norm(&d) > 1e-12 && !g.is_empty() {
+                        if let Some(u) = project_with_margin(&f, model, &d, s.margin) {
+                            let n = metric.twist_norm(&u);
+                            if n > 1e-12 {
+                                g.push(u / n);
+                            }
+                        }
+                    }
+                    g
+                } else {
+                    Vec::new()
+                }
             } else {
                 Vec::new()
             };
@@ -286,7 +321,6 @@ impl Mpc {
         for k in 0..n {
             a[k][k] = -1.0;
         }
-        let metric = self.scene.metric();
         for (i, (_, gens, _)) in steps.iter().enumerate() {
             for k in 0..sizes[i] {
                 a[n + i][offs[i] + k] = 1.0;
@@ -345,6 +379,8 @@ impl Mpc {
         self.last_knot = 0;
         self.best_goal_distance = f64::INFINITY;
         self.since_progress = 0;
+        self.best_tracking = f64::INFINITY;
+        self.since_tracking = 0;
         true
     }
 
@@ -354,9 +390,6 @@ impl Mpc {
             return Err(Error::arg("pose", "has a non-finite component"));
         }
         let t0 = Instant::now();
-        if self.at_goal(q) {
-            return Ok(self.command(q, Status::AtGoal, None, Vec3::zeros(), false, t0, 0.0));
-        }
         // progress towards the goal
         let dg = self.dist(q, &self.goal);
         let ds = self.settings.speed * self.settings.dt;
@@ -366,15 +399,31 @@ impl Mpc {
         } else {
             self.since_progress += 1;
         }
+        // done well inside the tolerance, or inside it once progress stops
+        if self.within(q, self.settings.goal_fraction) || (self.within(q, 1.0) && self.since_progress >= 3) {
+            return Ok(self.command(q, Status::AtGoal, None, Vec3::zeros(), false, t0, 0.0));
+        }
+        // the error from the plan: off by more than `replan_error` steps and not shrinking
+        let te = self.dist(q, &self.knots[self.closest_knot(q)]);
+        if te > self.settings.replan_error * ds && te > self.best_tracking - self.settings.progress * ds {
+            self.since_tracking += 1;
+        } else {
+            self.since_tracking = 0;
+        }
+        self.best_tracking = self.best_tracking.min(te);
+        if te <= self.settings.replan_error * ds {
+            self.best_tracking = te;
+        }
         let mut status = Status::Tracking;
         let mut replan_time = 0.0;
-        if self.since_progress >= self.settings.stall_steps {
+        if self.since_progress >= self.settings.stall_steps || self.since_tracking >= self.settings.stall_steps {
             let tr = Instant::now();
             if self.replan(q) {
                 status = Status::Replanned;
             }
             replan_time += tr.elapsed().as_secs_f64();
             self.since_progress = 0;
+            self.since_tracking = 0;
             self.best_goal_distance = dg;
         }
         for attempt in 0..2 {

@@ -186,7 +186,7 @@ pub fn generators(frame: &SupportFrame, model: &PusherModel) -> Vec<Vec3> {
                     }
                     let at = |s: f64| m.twist_inv(&(a * (1.0 - s) + b * s));
                     let (mut lo, mut hi) = (0.0, 1.0);
-                    for _ in 0..40 {
+                    for _ in 0..24 {
                         let mid = 0.5 * (lo + hi);
                         if margin(&at(mid)) >= 0.0 {
                             lo = mid;

@@ -123,6 +123,11 @@ fn mpc_qp_respects_its_cone_constraints_and_tracks() {
     // at the goal it stops
     let g = s.task.unwrap().goal;
     assert_eq!(mpc.step(&g).unwrap().status, Status::AtGoal);
+    // just inside the tolerance it keeps pushing while it makes progress
+    let tol = s.task.unwrap().tolerance;
+    let edge = [g[0] - 0.9 * tol[0], g[1], g[2]];
+    let mut fresh = Mpc::new(&s, &r.path, None, MpcSettings::default()).unwrap();
+    assert_ne!(fresh.step(&edge).unwrap().status, Status::AtGoal);
 }
 
 #[test]
