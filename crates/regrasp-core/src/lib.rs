@@ -17,6 +17,7 @@ pub mod robust;
 pub mod scene;
 pub mod scene3d;
 pub mod trrt;
+pub mod trrt3d;
 
 pub use error::{Error, Result};
 pub use metric::Metric;

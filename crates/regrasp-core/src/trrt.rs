@@ -191,6 +191,48 @@ pub fn body_twist(a: &[f64; 3], b: &[f64; 3]) -> Vec3 {
     Vec3::new((s * d.x + c * d.y) / det, (-c * d.x + s * d.y) / det, w)
 }
 
+/// The T-RRT transition test (Jaillet, Cortés & Siméon 2010) with its temperature adaptation:
+/// reject above `c_max`; accept downhill; uphill with probability `exp(−slope / (K T))`,
+/// cooling by `α` after an uphill success and heating by `α` after `n_fail` failures.
+#[derive(Clone, Debug)]
+pub struct Transition {
+    pub temperature: f64,
+    pub fails: usize,
+    pub c_max: f64,
+    pub k: f64,
+    pub alpha: f64,
+    pub n_fail: usize,
+}
+
+impl Transition {
+    pub fn new(s: &Settings, c_max: f64) -> Self {
+        Self { temperature: s.t0, fails: 0, c_max, k: s.k, alpha: s.alpha, n_fail: s.n_fail }
+    }
+
+    /// From cost `c_near` to `c_new` over a step of `steps` (length / L).
+    pub fn test<R: Rng>(&mut self, rng: &mut R, c_near: f64, c_new: f64, steps: f64) -> bool {
+        if c_new > self.c_max {
+            return false;
+        }
+        if c_new <= c_near {
+            return true;
+        }
+        let slope = (c_new - c_near) / steps.max(1e-12);
+        if rng.random::<f64>() < (-slope / (self.k * self.temperature)).exp() {
+            self.temperature /= self.alpha;
+            self.fails = 0;
+            true
+        } else {
+            self.fails += 1;
+            if self.fails > self.n_fail {
+                self.temperature *= self.alpha;
+                self.fails = 0;
+            }
+            false
+        }
+    }
+}
+
 struct Planner<'a> {
     scene: &'a Scene,
     s: &'a Settings,
@@ -201,9 +243,7 @@ struct Planner<'a> {
     rng: ChaCha8Rng,
     nodes: Vec<Node>,
     tree: KdTree<f64, 3>,
-    temperature: f64,
-    fails: usize,
-    c_max: f64,
+    transition: Transition,
     bounds: ([f64; 2], [f64; 2], [f64; 2]),
     qs_opts: QsOptions,
 }
@@ -490,25 +530,7 @@ impl<'a> Planner<'a> {
         if self.s.plain {
             return true;
         }
-        if c_new > self.c_max {
-            return false;
-        }
-        if c_new <= c_near {
-            return true;
-        }
-        let slope = (c_new - c_near) / (d / self.l).max(1e-12);
-        if self.rng.random::<f64>() < (-slope / (self.s.k * self.temperature)).exp() {
-            self.temperature /= self.s.alpha;
-            self.fails = 0;
-            true
-        } else {
-            self.fails += 1;
-            if self.fails > self.s.n_fail {
-                self.temperature *= self.s.alpha;
-                self.fails = 0;
-            }
-            false
-        }
+        self.transition.test(&mut self.rng, c_near, c_new, d / self.l)
     }
 
     fn add(&mut self, q: [f64; 3], parent: usize, pusher: usize, cost: f64) -> usize {
@@ -652,13 +674,11 @@ pub fn plan_tree(
         rng: ChaCha8Rng::seed_from_u64(settings.seed),
         nodes: vec![Node { q: start, parent: None, pusher: None, cost: 0.0, children: Vec::new() }],
         tree: KdTree::new(),
-        temperature: settings.t0,
-        fails: 0,
-        c_max: 0.0,
+        transition: Transition::new(settings, 0.0),
         bounds: ([-reach, reach], [-reach, reach], [tlo, thi]),
         qs_opts: QsOptions { support: SupportModel::Points { rings: 2, points: 0, merge_fingers: true }, ..QsOptions::default() },
     };
-    pl.c_max = settings.c_max * pl.cost_to_go(&start).max(1.0);
+    pl.transition.c_max = settings.c_max * pl.cost_to_go(&start).max(1.0);
     let k0 = pl.key(&start);
     pl.tree.add(&k0, 0);
     let t0 = Instant::now();
@@ -846,20 +866,18 @@ mod tests {
             rng: ChaCha8Rng::seed_from_u64(1),
             nodes: vec![],
             tree: KdTree::new(),
-            temperature: 0.1,
-            fails: 0,
-            c_max: 10.0,
+            transition: Transition { temperature: 0.1, ..Transition::new(&settings, 10.0) },
             bounds: ([0.0; 2], [0.0; 2], [0.0; 2]),
             qs_opts: QsOptions::default(),
         };
         assert!(pl.transition(1.0, 0.9, 0.003), "downhill is always accepted");
         assert!(!pl.transition(1.0, 11.0, 0.003), "above c_max is rejected");
         // steep uphill is rejected and, after n_fail rejections, the temperature rises
-        let t = pl.temperature;
+        let t = pl.transition.temperature;
         for _ in 0..=settings.n_fail {
             assert!(!pl.transition(1.0, 2.0, 0.003 * s.length / s.length));
         }
-        assert!(pl.temperature > t);
+        assert!(pl.transition.temperature > t);
     }
 
     /// After choose-parent and rewiring, every node's cost is its parent's plus the edge cost.
