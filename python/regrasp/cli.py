@@ -183,6 +183,22 @@ def cmd_validate(a) -> int:
 def cmd_simulate(a) -> int:
     from .quasistatic import load_plan, replay_plan
 
+    from .scene3d import Scene3D, is_3d
+
+    if is_3d(a.scene):
+        if a.engine != "quasistatic":
+            raise ArgumentError("invalid `--engine`: 3-D plans replay in the quasi-static simulator", "--engine")
+        s3 = Scene3D.load(a.scene)
+        try:
+            plan3 = json.loads(Path(a.plan).read_text())
+        except (OSError, ValueError) as e:
+            raise ArgumentError(f"invalid `--plan`: cannot read {a.plan}: {e}", "--plan") from e
+        r = s3.replay(plan3)
+        out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success")}
+        out["max_pusher_slip"] = None
+        print(json.dumps(out) if a.json else f"{s3.name}: replayed: {'success' if r['success'] else 'outside the tolerance'}, "
+              f"error {np.round(r['goal_error'], 5).tolist()}")
+        return 0 if r["success"] else 1
     scene = Scene.load(a.scene)
     plan = load_plan(a.plan)
     if a.engine == "quasistatic":
@@ -327,9 +343,39 @@ def cmd_control(a) -> int:
     return 0 if res.success else 1
 
 
+def _plan3d(a) -> int:
+    from .scene3d import Scene3D
+
+    if a.robust or a.fixtureless or a.uncertainty or a.propagation != "motion_cone" or a.plot or a.animate:
+        raise ArgumentError("invalid flags for a 3-D scene: it plans with the inverse dynamics only "
+                            "(no --robust/--fixtureless/--propagation/--plot/--animate; use --html)", "scene")
+    scene = Scene3D.load(a.scene)
+    start = None if a.start is None else _floats(a.start, 7, "--start")
+    goal = None if a.goal is None else _floats(a.goal, 7, "--goal")
+    p = scene.plan(start, goal, seed=a.seed, time_limit=a.time_limit)
+    if a.out:
+        Path(a.out).write_text(json.dumps(p, indent=1))
+    if getattr(a, "html", None):
+        from .viewer import write_html
+
+        write_html(scene, p, a.html)
+    if a.json:
+        print(json.dumps(p))
+    else:
+        head = "plan found" if p["found"] else f"no plan found ({p['stop_reason']}); best partial plan"
+        pushes = [k["pusher"] for k in p["path"][1:]]
+        print(f"{scene.name}: {head}: {len(pushes)} steps, {p['switch_overs']} switch-overs, {p['nodes']} nodes, "
+              f"{p['solves']} inverse/forward solves, {1e3 * p['planning_time_s']:.1f} ms (seed {p['seed']})")
+        print("  pushes: " + " -> ".join(pushes))
+    return 0 if p["found"] else 1
+
+
 def cmd_plan(a) -> int:
     from .plan import plan
+    from .scene3d import is_3d
 
+    if is_3d(a.scene):
+        return _plan3d(a)
     scene = Scene.load(a.scene)
     start = None if a.start is None else _floats(a.start, 3, "--start")
     goal = None if a.goal is None else _floats(a.goal, 3, "--goal")
@@ -391,6 +437,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="relative spreads of pusher friction, finger friction, grip force, mass (implies --robust)")
     pl.add_argument("--fixtureless", action="store_true",
                     help="plan only with fixtureless-fixturing pushes (invariant to mass, grip force, finger friction)")
+    pl.add_argument("--html", metavar="HTML", help="3-D scenes: an interactive 3-D view of the plan (self-contained page)")
     pl.set_defaults(fn=cmd_plan)
 
     k = sub.add_parser("control", help="track a plan with the MPC (closed loop) in a simulator")

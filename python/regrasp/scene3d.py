@@ -60,6 +60,73 @@ class Scene3D:
                                         float(duration), float(dt))
 
 
+    def plan(self, start=None, goal=None, seed: int = 0, time_limit: float = 10.0, **settings) -> dict:
+        """T-RRT* over SE(3) with inverse-dynamics unit steps (thesis §4.2): a plan dict like the
+        planar plan file (poses [x, y, z, qw, qx, qy, qz]; each step also carries the pusher's
+        body twist ``pusher_twist`` over unit time) plus ``solves`` and ``valid``."""
+        if not (np.isfinite(time_limit) and time_limit >= 0):
+            raise ArgumentError("invalid `time_limit`: must be a non-negative number of seconds", "time_limit")
+        s = None if start is None else [float(x) for x in start]
+        g = None if goal is None else [float(x) for x in goal]
+        r = self._core.plan(s, g, int(seed), float(time_limit), **settings)
+        r["valid"] = all(self.validate_path(r["path"])) if len(r["path"]) > 1 else True
+        return r
+
+    def validate_path(self, path: list) -> list:
+        """Whether each step of a 3-D plan's path can be taken by its pusher (see
+        ``regrasp::trrt3d::validate_path3``)."""
+        tw = [k.get("pusher_twist", [0.0] * 6) for k in path] if any("pusher_twist" in k for k in path) else None
+        return self._core.validate_path([list(map(float, k["pose"])) for k in path], [k["pusher"] for k in path], tw)
+
+    def replay(self, plan: dict, dt: float = 0.25) -> dict:
+        """Replays a 3-D plan in the quasi-static simulator: each step's pusher moves with the
+        step's twist for unit time from wherever the object is. Returns the final pose, the
+        error to the goal (position [m] and angle [rad]), success (within the task's tolerance)
+        and the poses after each step."""
+        path = plan["path"]
+        q = np.asarray(path[0]["pose"], float)
+        poses = [q]
+        for a, b in zip(path[:-1], path[1:]):
+            u = b.get("pusher_twist") or twist_between(a["pose"], b["pose"])
+            tr = self.simulate_push(q, b["pusher"], u, 1.0, dt)
+            q = np.asarray(tr["pose"][-1], float)
+            poses.append(q)
+        _, goal, tol = self.task
+        dp = q[:3] - goal[:3]
+        ang = quat_angle(q[3:], goal[3:])
+        ok = bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])
+        return {"engine": "quasistatic", "final_pose": q.tolist(), "goal_error": dp.tolist() + [ang], "success": ok,
+                "poses": np.array(poses)}
+
+
+def quat_angle(a, b) -> float:
+    """Angle [rad] of the rotation between unit quaternions a and b ([w, x, y, z])."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    d = abs(float(a @ b) / (np.linalg.norm(a) * np.linalg.norm(b)))
+    return float(2 * np.arccos(min(1.0, d)))
+
+
+def twist_between(a, b) -> list:
+    """The constant body twist taking pose a to pose b in unit time (SE(3) log)."""
+    from scipy.spatial.transform import Rotation
+
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    Ra = Rotation.from_quat([a[4], a[5], a[6], a[3]])
+    Rb = Rotation.from_quat([b[4], b[5], b[6], b[3]])
+    rel_R = Ra.inv() * Rb
+    p = Ra.inv().apply(b[:3] - a[:3])
+    w = rel_R.as_rotvec()
+    th = np.linalg.norm(w)
+    W = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+    if th < 1e-8:
+        A, B = 0.5, 1 / 6
+    else:
+        A, B = (1 - np.cos(th)) / th**2, (th - np.sin(th)) / th**3
+    V = np.eye(3) + A * W + B * W @ W
+    v = np.linalg.solve(V, p)
+    return [*v, *w]
+
+
 def is_3d(path) -> bool:
     """Whether a scene file is a 3-D scene (``dimension = 3``)."""
     import tomllib

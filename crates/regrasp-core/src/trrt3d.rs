@@ -11,15 +11,19 @@
 //!   length; for each pusher (evaluated in parallel) the inverse problem finds forces that make
 //!   the object move with that twist with the pusher sticking — accepted only when the solve
 //!   meets every constraint to 1e-6 — at the step's start and at `checks` poses along it, with
-//!   both pads on the object. If no pusher can, random directions within 60° of the desired one
-//!   are tried (the closest feasible kept).
+//!   both pads on the object. A point or edge contact does not fix the object's whole twist, and
+//!   a line contact's feasible twists are a 5-D subset: then the forward problem (the pusher
+//!   moving with the desired twist, 4 time steps) gives the motion the object makes, kept if the
+//!   pusher keeps contact and the object heads within 60° of the target (the plan stores the
+//!   pusher's twist, so a replay reproduces it). If no pusher can, random directions within 60° of the desired one are tried
+//!   (the closest first).
 //! * **Tree**: T-RRT transition test on the cost-to-go map ([`crate::trrt::Transition`]), RRT*
 //!   choose-parent and rewiring with the switch-over edge cost (0.1 same pusher, 1 switch), a
 //!   straight-push goal connection from each new node.
 
 use crate::error::{Error, Result};
 use crate::mncp;
-use crate::quasistatic3d::{integrate, push_problem};
+use crate::quasistatic3d::{integrate, push_problem, simulate_push};
 use crate::scene3d::{Scene3, V3};
 use crate::trrt::{Settings, StopReason, Transition};
 use kiddo::{KdTree, SquaredEuclidean};
@@ -69,6 +73,8 @@ pub struct Node3 {
     pub q: Isometry3<f64>,
     pub parent: Option<usize>,
     pub pusher: Option<usize>,
+    /// The pusher's body twist over the step from the parent (unit time).
+    pub twist: Twist6,
     pub cost: f64,
     pub children: Vec<usize>,
 }
@@ -79,6 +85,8 @@ pub struct PlanResult3 {
     pub found: bool,
     pub stop_reason: StopReason,
     pub path: Vec<(Isometry3<f64>, Option<usize>)>,
+    /// The pusher's body twist of each step (zero for the start).
+    pub twists: Vec<Twist6>,
     pub nodes: usize,
     pub iterations: usize,
     pub planning_time_s: f64,
@@ -141,6 +149,24 @@ pub fn step_feasible(scene: &Scene3, q: &Isometry3<f64>, u: &Twist6, p: usize, c
     true
 }
 
+/// The pose the object reaches when pusher `p` moves with body twist `u` for unit time from `q`
+/// (the forward problem, `n` time steps, every solve meeting its constraints to 1e-6), if the
+/// pusher keeps contact all along (it may slide: the plan replays the same pusher motion) and
+/// both pads stay on the object.
+pub fn simulate_step(scene: &Scene3, q: &Isometry3<f64>, u: &Twist6, p: usize, n: usize) -> Option<Isometry3<f64>> {
+    let tr = simulate_push(scene, q, p, u, 1.0, 1.0 / n.max(1) as f64, &mncp::Settings::default()).ok()?;
+    for k in 0..tr.t.len() {
+        if tr.pusher_contacts[k] == 0 {
+            return None;
+        }
+        let qk = crate::scene3d::pose_from_array("pose", &tr.pose[k]).ok()?;
+        if !pads_on(scene, &qk) {
+            return None;
+        }
+    }
+    crate::scene3d::pose_from_array("pose", tr.pose.last()?).ok()
+}
+
 impl<'a> Planner3<'a> {
     fn dist(&self, a: &Isometry3<f64>, b: &Isometry3<f64>) -> f64 {
         distance(self.l, a, b)
@@ -170,10 +196,33 @@ impl<'a> Planner3<'a> {
     }
 
     /// The first pusher (in `order`) that can take step `u` from `q`, pushers evaluated in
-    /// parallel.
-    fn feasible_pusher(&self, q: &Isometry3<f64>, u: &Twist6, order: &[usize]) -> Option<usize> {
-        let ok: Vec<bool> = order.par_iter().map(|&p| step_feasible(self.scene, q, u, p, self.s.checks, Some(&self.solves))).collect();
-        order.iter().zip(ok).find(|(_, o)| *o).map(|(p, _)| *p)
+    /// parallel, with the pose it reaches: `u` itself when the inverse problem accepts it along
+    /// the step; else (a point or edge contact does not fix the object's whole twist, and a
+    /// twist feasible at the step's start may not stay so) the pose the forward dynamics reach
+    /// while the pusher moves with `u` and keeps contact, if the motion still heads towards the
+    /// target (within 60°).
+    fn feasible_pusher(&self, q: &Isometry3<f64>, u: &Twist6, order: &[usize]) -> Option<(usize, Isometry3<f64>)> {
+        let l = self.l;
+        let len = twist_length(l, u);
+        let found: Vec<Option<Isometry3<f64>>> = order
+            .par_iter()
+            .map(|&p| {
+                if step_feasible(self.scene, q, u, p, self.s.checks, Some(&self.solves)) {
+                    return Some(integrate(q, u, 1.0));
+                }
+                self.solves.fetch_add(self.s.checks + 1, std::sync::atomic::Ordering::Relaxed);
+                let end = simulate_step(self.scene, q, u, p, self.s.checks)?;
+                let v = se3_log(q, &end);
+                let vl = twist_length(l, &v);
+                if vl < 0.2 * len {
+                    return None;
+                }
+                let m = |x: &Twist6| [x[0], x[1], x[2], l * x[3], l * x[4], l * x[5]];
+                let cos = m(&v).iter().zip(m(u).iter()).map(|(a, b)| a * b).sum::<f64>() / (vl * len);
+                (cos >= 0.5).then_some(end)
+            })
+            .collect();
+        order.iter().zip(found).find_map(|(p, w)| w.map(|w| (*p, w)))
     }
 
     fn gauss(&mut self) -> f64 {
@@ -203,6 +252,7 @@ impl<'a> Planner3<'a> {
     /// Propagation by the inverse dynamics: the desired unit step, else up to `random_tries`
     /// directions within 60° of it (closest first).
     fn propagate(&mut self, near: usize, target: &Isometry3<f64>) -> Option<(Isometry3<f64>, usize, Twist6)> {
+        // returns the new pose, the pusher and the pusher's twist
         let q = self.nodes[near].q;
         let xi = se3_log(&q, target);
         let len = twist_length(self.l, &xi);
@@ -212,8 +262,8 @@ impl<'a> Planner3<'a> {
         let scale = self.step.min(len) / len;
         let want: Twist6 = xi.map(|x| x * scale);
         let order = self.order(self.nodes[near].pusher);
-        if let Some(p) = self.feasible_pusher(&q, &want, &order) {
-            return Some((integrate(&q, &want, 1.0), p, want));
+        if let Some((p, end)) = self.feasible_pusher(&q, &want, &order) {
+            return Some((end, p, want));
         }
         // random directions around the desired one, in the metric's coordinates
         let wl = twist_length(self.l, &want);
@@ -234,16 +284,16 @@ impl<'a> Planner3<'a> {
         }
         cands.sort_by(|a, b| a.0.total_cmp(&b.0));
         for (_, u) in cands {
-            if let Some(p) = self.feasible_pusher(&q, &u, &order) {
-                return Some((integrate(&q, &u, 1.0), p, u));
+            if let Some((p, end)) = self.feasible_pusher(&q, &u, &order) {
+                return Some((end, p, u));
             }
         }
         None
     }
 
-    fn add(&mut self, q: Isometry3<f64>, parent: usize, pusher: usize, cost: f64) -> usize {
+    fn add(&mut self, q: Isometry3<f64>, parent: usize, pusher: usize, cost: f64, twist: Twist6) -> usize {
         let i = self.nodes.len();
-        self.nodes.push(Node3 { q, parent: Some(parent), pusher: Some(pusher), cost, children: Vec::new() });
+        self.nodes.push(Node3 { q, parent: Some(parent), pusher: Some(pusher), twist, cost, children: Vec::new() });
         self.nodes[parent].children.push(i);
         self.tree.add(&key(self.l, &q), i as u64);
         i
@@ -258,8 +308,8 @@ impl<'a> Planner3<'a> {
             .collect()
     }
 
-    fn choose_parent(&self, q: &Isometry3<f64>, near: usize, pusher: usize, len: f64) -> (usize, usize, f64) {
-        let mut best = (near, pusher, self.nodes[near].cost + self.edge_cost(self.nodes[near].pusher, pusher, len));
+    fn choose_parent(&self, q: &Isometry3<f64>, near: usize, pusher: usize, len: f64, twist: Twist6) -> (usize, usize, f64, Twist6) {
+        let mut best = (near, pusher, self.nodes[near].cost + self.edge_cost(self.nodes[near].pusher, pusher, len), twist);
         if self.s.neighbour_steps <= 0.0 {
             return best;
         }
@@ -274,7 +324,7 @@ impl<'a> Planner3<'a> {
             for p in self.order(self.nodes[k].pusher) {
                 let c = self.nodes[k].cost + self.edge_cost(self.nodes[k].pusher, p, l);
                 if c < best.2 - 1e-12 && step_feasible(self.scene, &qk, &u, p, self.s.checks, Some(&self.solves)) {
-                    best = (k, p, c);
+                    best = (k, p, c, u);
                     break;
                 }
             }
@@ -300,6 +350,7 @@ impl<'a> Planner3<'a> {
                 let old = self.nodes[k].parent.expect("not the root");
                 self.nodes[old].children.retain(|&x| x != k);
                 self.nodes[k].parent = Some(i);
+                self.nodes[k].twist = u;
                 self.nodes[i].children.push(k);
                 let mut stack = vec![k];
                 while let Some(n) = stack.pop() {
@@ -353,16 +404,16 @@ impl<'a> Planner3<'a> {
         for k in 0..n {
             qk = if k + 1 == n { self.goal } else { integrate(&qk, &u, 1.0) };
             let c = self.nodes[last].cost + self.edge_cost(self.nodes[last].pusher, p, d);
-            last = self.add(qk, last, p, c);
+            last = self.add(qk, last, p, c, u);
         }
         Some(last)
     }
 
-    fn path_to(&self, mut i: usize) -> Vec<(Isometry3<f64>, Option<usize>)> {
-        let mut out = vec![(self.nodes[i].q, self.nodes[i].pusher)];
+    fn path_to(&self, mut i: usize) -> Vec<(Isometry3<f64>, Option<usize>, Twist6)> {
+        let mut out = vec![(self.nodes[i].q, self.nodes[i].pusher, self.nodes[i].twist)];
         while let Some(p) = self.nodes[i].parent {
             i = p;
-            out.push((self.nodes[i].q, self.nodes[i].pusher));
+            out.push((self.nodes[i].q, self.nodes[i].pusher, self.nodes[i].twist));
         }
         out.reverse();
         out
@@ -396,7 +447,7 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
         step,
         goal,
         rng: ChaCha8Rng::seed_from_u64(settings.seed),
-        nodes: vec![Node3 { q: start, parent: None, pusher: None, cost: 0.0, children: Vec::new() }],
+        nodes: vec![Node3 { q: start, parent: None, pusher: None, twist: [0.0; 6], cost: 0.0, children: Vec::new() }],
         tree: KdTree::new(),
         transition: Transition::new(settings, 0.0),
         solves: std::sync::atomic::AtomicUsize::new(0),
@@ -441,8 +492,8 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
         if !pl.transition.test(&mut pl.rng, c_near, c_new, len / l) {
             continue;
         }
-        let (parent, p, cost) = pl.choose_parent(&q_new, near, pusher, len);
-        let i = pl.add(q_new, parent, p, cost);
+        let (parent, p, cost, tw) = pl.choose_parent(&q_new, near, pusher, len, u);
+        let i = pl.add(q_new, parent, p, cost, tw);
         pl.rewire(i);
         if pl.cost_to_go(&q_new) < pl.cost_to_go(&pl.nodes[closest].q) {
             closest = i;
@@ -458,9 +509,12 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
         }
     };
     let end = best.unwrap_or(closest);
-    let path = pl.path_to(end);
+    let full = pl.path_to(end);
+    let twists: Vec<Twist6> = full.iter().map(|x| x.2).collect();
+    let path: Vec<(Isometry3<f64>, Option<usize>)> = full.into_iter().map(|x| (x.0, x.1)).collect();
     let switch_overs = path.windows(2).skip(1).filter(|w| w[0].1 != w[1].1).count();
     Ok(PlanResult3 {
+        twists,
         found: best.is_some(),
         stop_reason: if best.is_some() { StopReason::GoalReached } else { stop },
         goal_distance: pl.dist(&path.last().expect("path").0, &goal),
@@ -474,9 +528,11 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
     })
 }
 
-/// Checks a 3-D path: for each step, whether its pusher can take it (inverse dynamics at 8
-/// poses along it, pads on the object). An error names a step without a valid pusher index.
-pub fn validate_path3(scene: &Scene3, path: &[(Isometry3<f64>, Option<usize>)]) -> Result<Vec<bool>> {
+/// Checks a 3-D path: for each step, whether its pusher can take it — the inverse problem along
+/// the constant twist between the poses (8 poses), or, given the pusher's twist of the step, the
+/// forward dynamics with the pusher sticking reach the next pose (within 1e-6 m / L). An error
+/// names a step without a valid pusher.
+pub fn validate_path3(scene: &Scene3, path: &[(Isometry3<f64>, Option<usize>)], twists: Option<&[Twist6]>) -> Result<Vec<bool>> {
     path.windows(2)
         .enumerate()
         .map(|(i, w)| {
@@ -484,7 +540,11 @@ pub fn validate_path3(scene: &Scene3, path: &[(Isometry3<f64>, Option<usize>)]) 
             if p >= scene.pushers.len() {
                 return Err(Error::arg(format!("path[{}].pusher", i + 1), "is not a pusher of the scene"));
             }
-            Ok(step_feasible(scene, &w[0].0, &se3_log(&w[0].0, &w[1].0), p, 8, None))
+            if step_feasible(scene, &w[0].0, &se3_log(&w[0].0, &w[1].0), p, 8, None) {
+                return Ok(true);
+            }
+            let Some(u) = twists.and_then(|t| t.get(i + 1)) else { return Ok(false) };
+            Ok(simulate_step(scene, &w[0].0, u, p, 4).is_some_and(|end| distance(scene.length, &end, &w[1].0) < 1e-6))
         })
         .collect()
 }

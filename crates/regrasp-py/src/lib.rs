@@ -755,6 +755,125 @@ impl Scene3D {
         (scene3d::pose_to_array(&self.inner.start), scene3d::pose_to_array(&self.inner.goal), self.inner.tolerance)
     }
     /// Vertices (n, 3) and triangles (m, 3) of the object's mesh.
+    /// T-RRT* over SE(3) with inverse-dynamics unit steps (`regrasp::trrt3d`). Returns a dict
+    /// like the planar plan (poses as [x, y, z, qw, qx, qy, qz]) plus the number of solves.
+    #[pyo3(signature = (start=None, goal=None, seed=0, time_limit=10.0, max_nodes=5000, step=None, goal_bias=0.3,
+                        neighbour_steps=1.5, random_tries=6, theta_margin=0.5, connect=true, cost_threshold=f64::INFINITY))]
+    #[allow(clippy::too_many_arguments)]
+    fn plan<'py>(
+        &self,
+        py: Python<'py>,
+        start: Option<Vec<f64>>,
+        goal: Option<Vec<f64>>,
+        seed: u64,
+        time_limit: f64,
+        max_nodes: usize,
+        step: Option<f64>,
+        goal_bias: f64,
+        neighbour_steps: f64,
+        random_tries: usize,
+        theta_margin: f64,
+        connect: bool,
+        cost_threshold: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let pose = |name: &str, v: Option<Vec<f64>>| -> PyResult<Option<nalgebra::Isometry3<f64>>> {
+            match v {
+                None => Ok(None),
+                Some(v) => {
+                    let a: [f64; 7] = v.try_into().map_err(|_| arg_err(name, "must have 7 numbers [x, y, z, qw, qx, qy, qz]"))?;
+                    scene3d::pose_from_array(name, &a).map(Some).map_err(to_py)
+                }
+            }
+        };
+        let (start, goal) = (pose("start", start)?, pose("goal", goal)?);
+        if !(goal_bias >= 0.0 && goal_bias <= 1.0) {
+            return Err(arg_err("goal_bias", "must be in [0, 1]"));
+        }
+        let settings = trrt::Settings {
+            seed,
+            time_limit,
+            max_nodes,
+            step,
+            goal_bias,
+            neighbour_steps,
+            random_tries,
+            theta_margin,
+            connect,
+            cost_threshold,
+            ..trrt::Settings::default()
+        };
+        let r = py.allow_threads(|| regrasp::trrt3d::plan3(&self.inner, start, goal, &settings)).map_err(to_py)?;
+        let d = PyDict::new(py);
+        d.set_item("scene", &self.inner.name)?;
+        d.set_item("found", r.found)?;
+        d.set_item("stop_reason", r.stop_reason.label())?;
+        d.set_item("planning_time_s", r.planning_time_s)?;
+        d.set_item("nodes", r.nodes)?;
+        d.set_item("iterations", r.iterations)?;
+        d.set_item("switch_overs", r.switch_overs)?;
+        d.set_item("cost", r.cost)?;
+        d.set_item("goal_distance", r.goal_distance)?;
+        d.set_item("solves", r.solves)?;
+        d.set_item("propagation", "mncp_inverse")?;
+        d.set_item("seed", seed)?;
+        let path = r
+            .path
+            .iter()
+            .zip(&r.twists)
+            .map(|((q, p), u)| -> PyResult<Bound<'py, PyDict>> {
+                let k = PyDict::new(py);
+                k.set_item("pose", scene3d::pose_to_array(q).to_vec())?;
+                k.set_item("pusher", p.map(|i| self.inner.pushers[i].name.clone()))?;
+                if p.is_some() {
+                    k.set_item("pusher_twist", u.to_vec())?;
+                }
+                Ok(k)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        d.set_item("path", path)?;
+        Ok(d)
+    }
+
+    /// Whether each step of a path (poses, pusher names) can be taken by its pusher (inverse
+    /// dynamics at 8 poses along it, pads on the object).
+    #[pyo3(signature = (poses, pushers, twists=None))]
+    fn validate_path(&self, poses: Vec<Vec<f64>>, pushers: Vec<Option<String>>, twists: Option<Vec<Vec<f64>>>) -> PyResult<Vec<bool>> {
+        let tw: Option<Vec<[f64; 6]>> = match twists {
+            None => None,
+            Some(t) => Some(
+                t.into_iter()
+                    .enumerate()
+                    .map(|(i, v)| v.try_into().map_err(|_| arg_err(&format!("path[{i}].pusher_twist"), "must have 6 numbers")))
+                    .collect::<PyResult<Vec<[f64; 6]>>>()?,
+            ),
+        };
+        if poses.len() != pushers.len() {
+            return Err(arg_err("path", "poses and pushers differ in length"));
+        }
+        let mut path = Vec::new();
+        for (i, (q, p)) in poses.into_iter().zip(pushers).enumerate() {
+            let a: [f64; 7] = q.try_into().map_err(|_| arg_err(&format!("path[{i}].pose"), "must have 7 numbers"))?;
+            let q = scene3d::pose_from_array(&format!("path[{i}].pose"), &a).map_err(to_py)?;
+            let p = match p {
+                None => None,
+                Some(n) => Some(self.inner.pusher_index(&n).map_err(to_py)?),
+            };
+            path.push((q, p));
+        }
+        regrasp::trrt3d::validate_path3(&self.inner, &path, tw.as_deref()).map_err(to_py)
+    }
+
+    /// Contact points (object frame) of pusher `name`.
+    fn pusher_points(&self, name: &str) -> PyResult<Vec<[f64; 3]>> {
+        let i = self.inner.pusher_index(name).map_err(to_py)?;
+        Ok(self.inner.pushers[i].points.iter().map(|p| [p.x, p.y, p.z]).collect())
+    }
+
+    #[getter]
+    fn pad_radius(&self) -> f64 {
+        self.inner.pad_radius
+    }
+
     fn mesh<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>) {
         let v = &self.inner.mesh.vertices;
         let t = &self.inner.mesh.triangles;

@@ -1,0 +1,92 @@
+"""3-D regrasp planning through the complementarity dynamics (thesis §4.2): T-RRT* over SE(3),
+inverse-dynamics step acceptance, replay, CLI and the browser view."""
+
+import json
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from regrasp.scene3d import Scene3D, quat_angle, twist_between
+from regrasp.viewer import write_html
+
+from .conftest import EXAMPLES, ROOT
+
+THREE_D = ["offset-3d", "light-side-3d", "pivot-single-3d", "pivot-3d", "block-3d", "prism-3d"]
+
+
+@pytest.mark.parametrize("name", THREE_D)
+def test_every_3d_example_plans_and_replays(name):
+    s = Scene3D.load(EXAMPLES / f"{name}.toml")
+    for seed in (0, 1):
+        p = s.plan(seed=seed, time_limit=20)
+        assert p["found"] and p["valid"], (name, seed, p["stop_reason"])
+        r = s.replay(p)
+        assert r["success"], (name, seed, r["goal_error"])
+
+
+def test_pivoting_with_a_switch_over_and_with_one_pusher():
+    p = Scene3D.load(EXAMPLES / "pivot-3d.toml").plan(seed=0)
+    assert p["switch_overs"] >= 1 and {"corner", "ground"} <= {k["pusher"] for k in p["path"][1:]}
+    p1 = Scene3D.load(EXAMPLES / "pivot-single-3d.toml").plan(seed=0)
+    assert {k["pusher"] for k in p1["path"][1:]} == {"corner"}
+    # the block turned about the grasp axis (Y)
+    q = np.array(p1["path"][-1]["pose"])
+    assert quat_angle(q[3:], [1, 0, 0, 0]) > 0.38 and abs(q[4]) < 1e-6 and abs(q[6]) < 1e-6
+
+
+def test_inverse_dynamics_step_acceptance():
+    s = Scene3D.load(EXAMPLES / "offset-3d.toml")
+    ident = [0, 0, 0, 1, 0, 0, 0]
+    # the side pusher can slide the block along +X in the grasp, not pull it along -X or lift it
+    assert s.validate_path([{"pose": ident, "pusher": None}, {"pose": [0.004, 0, 0, 1, 0, 0, 0], "pusher": "left"}]) == [True]
+    assert s.validate_path([{"pose": ident, "pusher": None}, {"pose": [-0.004, 0, 0, 1, 0, 0, 0], "pusher": "left"}]) == [False]
+    assert s.validate_path([{"pose": ident, "pusher": None}, {"pose": [0, 0, 0.004, 1, 0, 0, 0], "pusher": "left"}]) == [False]
+    # an edge contact cannot translate the block without turning it (the moment about the grasp
+    # axis must be balanced by the pads' torsional friction)
+    e = Scene3D.load(EXAMPLES / "pivot-single-3d.toml")
+    assert e.validate_path([{"pose": ident, "pusher": None}, {"pose": [0.004, 0, 0, 1, 0, 0, 0], "pusher": "corner"}]) == [False]
+
+
+def test_se3_twist_between_inverts_the_plan_steps():
+    s = Scene3D.load(EXAMPLES / "pivot-3d.toml")
+    p = s.plan(seed=0)
+    for a, b in zip(p["path"][:-1], p["path"][1:]):
+        u = twist_between(a["pose"], b["pose"])
+        tr = s.simulate_push(a["pose"], b["pusher"], u, 1.0, 0.5)
+        assert np.all(np.isfinite(tr["pose"]))
+    # the log of a pure rotation about Y is that rotation
+    u = twist_between([0, 0, 0, 1, 0, 0, 0], [0, 0, 0, np.cos(0.2), 0, np.sin(0.2), 0])
+    assert np.allclose(u, [0, 0, 0, 0, 0.4, 0], atol=1e-12)
+
+
+def test_plan_and_simulate_cli_3d(tmp_path):
+    f, html = tmp_path / "plan.json", tmp_path / "view.html"
+    scene = str(EXAMPLES / "pivot-3d.toml")
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "plan", scene, "--out", str(f), "--html", str(html), "--json"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["found"] and out["path"][1]["pusher_twist"] and html.stat().st_size > 3000
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "simulate", scene, "--plan", str(f), "--json"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0 and json.loads(r.stdout)["success"], r.stderr
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "plan", scene, "--robust"], capture_output=True, text=True)
+    assert r.returncode == 2 and "3-D" in r.stderr
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="needs node to run the page's script")
+def test_browser_view_draws_every_frame(tmp_path):
+    s = Scene3D.load(EXAMPLES / "pivot-3d.toml")
+    p = s.plan(seed=0)
+    page = write_html(s, p, tmp_path / "view.html")
+    r = subprocess.run(["node", str(ROOT / "tests" / "js" / "run_viewer.js"), str(page)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    for fr in out["frames"]:
+        assert fr["finite"] and fr["drawn"] == out["triangles"] + 2  # every face and both pads
+        assert fr["pusher_dots"] >= 2  # the active pusher's contacts
+    assert "pusher corner" in out["frames"][0]["info"] and "pusher ground" in out["frames"][-1]["info"]
+    assert np.allclose(out["frames"][-1]["pose"], p["path"][-1]["pose"], atol=1e-9)
