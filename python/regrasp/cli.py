@@ -186,17 +186,20 @@ def cmd_simulate(a) -> int:
     from .scene3d import Scene3D, is_3d
 
     if is_3d(a.scene):
-        if a.engine != "quasistatic":
-            raise ArgumentError("invalid `--engine`: 3-D plans replay in the quasi-static simulator", "--engine")
         s3 = Scene3D.load(a.scene)
         try:
             plan3 = json.loads(Path(a.plan).read_text())
         except (OSError, ValueError) as e:
             raise ArgumentError(f"invalid `--plan`: cannot read {a.plan}: {e}", "--plan") from e
-        r = s3.replay(plan3)
+        if a.engine == "mujoco":
+            from .mujoco3d import execute_plan3d
+
+            r = execute_plan3d(s3, plan3, a.scale_friction, a.scale_grip, a.scale_mass)
+        else:
+            r = s3.replay(plan3)
         out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success")}
         out["max_pusher_slip"] = None
-        print(json.dumps(out) if a.json else f"{s3.name}: replayed: {'success' if r['success'] else 'outside the tolerance'}, "
+        print(json.dumps(out) if a.json else f"{s3.name}: {r['engine']}: {'success' if r['success'] else 'outside the tolerance'}, "
               f"error {np.round(r['goal_error'], 5).tolist()}")
         return 0 if r["success"] else 1
     scene = Scene.load(a.scene)

@@ -754,7 +754,28 @@ impl Scene3D {
     fn task(&self) -> ([f64; 7], [f64; 7], [f64; 4]) {
         (scene3d::pose_to_array(&self.inner.start), scene3d::pose_to_array(&self.inner.goal), self.inner.tolerance)
     }
-    /// Vertices (n, 3) and triangles (m, 3) of the object's mesh.
+    #[getter]
+    fn com(&self) -> [f64; 3] {
+        [self.inner.com.x, self.inner.com.y, self.inner.com.z]
+    }
+    #[getter]
+    fn grip_force(&self) -> f64 {
+        self.inner.grip_force
+    }
+    #[getter]
+    fn grip_friction(&self) -> f64 {
+        self.inner.grip_friction
+    }
+    #[getter]
+    fn gravity(&self) -> [f64; 3] {
+        [self.inner.gravity.x, self.inner.gravity.y, self.inner.gravity.z]
+    }
+    /// Pusher `name`: (points (object frame), normal, friction).
+    fn pusher_spec(&self, name: &str) -> PyResult<(Vec<[f64; 3]>, [f64; 3], f64)> {
+        let i = self.inner.pusher_index(name).map_err(to_py)?;
+        let p = &self.inner.pushers[i];
+        Ok((p.points.iter().map(|v| [v.x, v.y, v.z]).collect(), [p.normal.x, p.normal.y, p.normal.z], p.friction))
+    }
     /// T-RRT* over SE(3) with inverse-dynamics unit steps (`regrasp::trrt3d`). Returns a dict
     /// like the planar plan (poses as [x, y, z, qw, qx, qy, qz]) plus the number of solves.
     #[pyo3(signature = (start=None, goal=None, seed=0, time_limit=10.0, max_nodes=5000, step=None, goal_bias=0.3,
@@ -874,6 +895,7 @@ impl Scene3D {
         self.inner.pad_radius
     }
 
+    /// Vertices (n, 3) and triangles (m, 3) of the object's mesh.
     fn mesh<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>) {
         let v = &self.inner.mesh.vertices;
         let t = &self.inner.mesh.triangles;

@@ -1,0 +1,227 @@
+"""3-D plans executed in MuJoCo (planner's view: the gripper's pads fixed, each pusher's feature
+on a driven 6-DoF body that follows the plan's pusher motion).
+
+The object: a box or the scene's convex mesh, with its mass, centre of mass and inertia. The pads:
+as in the planar model (``regrasp.mujoco_model``), one contact point each through a large sphere
+on a slide joint along Y, squeezed by a force actuator, with sliding friction ``μ_s`` and
+torsional friction ``(2/3) r μ_s`` (the pad's ring of points at 2/3 of its radius in the
+quasi-static model). Features: a 1.5 mm sphere behind a point pusher, a capsule behind a line
+pusher, a thin plate behind a patch. A push with a new pusher brings its feature 2 mm behind
+where it meets the object (where the object is), approaches until it touches, then moves with
+the plan's pusher twist of each step over unit time (the step's `pusher_twist`, else the twist
+between the poses). Same contact settings as the planar model (elliptic cones, impratio, no-slip).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import ArgumentError
+from .mujoco_model import PAD_SPHERE, Contact
+
+BITS_OBJ, BITS_PAD, BITS_FEAT = 'contype="1" conaffinity="3"', 'contype="2" conaffinity="0"', 'contype="4" conaffinity="1"'
+PARK = np.array([0.0, 0.0, 5.0])
+R_FEATURE = 0.0015
+GAP = 0.002
+
+
+def _f(a) -> str:
+    return " ".join(f"{x:.9g}" for x in np.ravel(a))
+
+
+def _qmul(a, b):
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+def _rot(q, v):
+    p = _qmul(_qmul(q, np.r_[0.0, v]), q * np.array([1, -1, -1, -1]))
+    return p[1:]
+
+
+def compose(a, b):
+    """Pose a ∘ b ([x, y, z, qw, qx, qy, qz])."""
+    return np.r_[a[:3] + _rot(a[3:], b[:3]), _qmul(a[3:], b[3:])]
+
+
+def inverse(a):
+    qi = a[3:] * np.array([1, -1, -1, -1])
+    return np.r_[-_rot(qi, a[:3]), qi]
+
+
+def _exp(u, t):
+    """exp of body twist u over time t as a pose."""
+    from scipy.spatial.transform import Rotation
+
+    v, w = np.asarray(u[:3], float) * t, np.asarray(u[3:], float) * t
+    th = np.linalg.norm(w)
+    W = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+    A, B = (0.5, 1 / 6) if th < 1e-8 else ((1 - np.cos(th)) / th**2, (th - np.sin(th)) / th**3)
+    p = (np.eye(3) + A * W + B * W @ W) @ v
+    q = Rotation.from_rotvec(w).as_quat()
+    return np.r_[p, q[3], q[0], q[1], q[2]]
+
+
+def feature_geoms(scene, name: str, friction: float) -> str:
+    pts, n, _ = scene._core.pusher_spec(name)
+    pts, n = np.asarray(pts, float), np.asarray(n, float) / np.linalg.norm(n)
+    g = f'friction="{friction:.9g} 0 0" condim="3" {BITS_FEAT}'
+    if len(pts) == 1:
+        return f'<geom type="sphere" size="{R_FEATURE}" pos="{_f(pts[0] - n * R_FEATURE)}" {g}/>'
+    if len(pts) == 2:
+        a, b = pts - n * R_FEATURE
+        return f'<geom type="capsule" size="{R_FEATURE}" fromto="{_f(a)} {_f(b)}" {g}/>'
+    # a plate behind the patch, in the frame (t1, t2, n)
+    a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+    t1 = np.cross(n, a)
+    t1 /= np.linalg.norm(t1)
+    t2 = np.cross(n, t1)
+    c = pts.mean(axis=0)
+    e1, e2 = np.abs((pts - c) @ t1).max(), np.abs((pts - c) @ t2).max()
+    from scipy.spatial.transform import Rotation
+
+    q = Rotation.from_matrix(np.c_[t1, t2, n]).as_quat()
+    return (f'<geom type="box" size="{e1:.9g} {e2:.9g} 0.0015" pos="{_f(c - n * 0.0015)}" '
+            f'quat="{q[3]:.9g} {q[0]:.9g} {q[1]:.9g} {q[2]:.9g}" {g}/>')
+
+
+def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
+          contact: Contact = Contact()) -> str:
+    v, t = scene.mesh()
+    v, t = np.asarray(v, float), np.asarray(t, int)
+    m = scene.mass * mass_scale
+    I = np.asarray(scene.inertia, float) * mass_scale
+    com = np.asarray(scene._core.com, float)
+    s0 = np.asarray(start, float)
+    asset = f'<mesh name="obj" vertex="{_f(v)}" face="{_f(t)}"/>'
+    obj = (f'<body name="object" pos="{_f(s0[:3])}" quat="{_f(s0[3:])}"><freejoint/>'
+           f'<inertial pos="{_f(com)}" mass="{m:.9g}" fullinertia="{I[0,0]:.9g} {I[1,1]:.9g} {I[2,2]:.9g} {I[0,1]:.9g} {I[0,2]:.9g} {I[1,2]:.9g}"/>'
+           f'<geom type="mesh" mesh="obj" friction="0 0 0" condim="4" {BITS_OBJ}/></body>')
+    mu = scene._core.grip_friction * friction_scale
+    k = 2.0 / 3.0 * scene._core.pad_radius
+    # pads at the object's extreme points along ±Y at the start
+    w = np.array([compose(s0, np.r_[x, 1, 0, 0, 0])[:3] for x in v])
+    pads = []
+    for name, sign in (("pad_left", 1), ("pad_right", -1)):
+        y = np.max(sign * w[:, 1]) * sign
+        pads.append(f'<body name="{name}" pos="0 {y:.9g} 0" gravcomp="1"><joint name="{name}" type="slide" axis="0 1 0" damping="20"/>'
+                    f'<geom type="sphere" size="{PAD_SPHERE}" pos="0 {sign * PAD_SPHERE:.9g} 0" mass="0.05" '
+                    f'friction="{mu:.9g} {k * mu:.9g} 0" condim="4" {BITS_PAD}/></body>')
+    feats = []
+    for p in scene.pusher_names:
+        _, _, fr = scene._core.pusher_spec(p)
+        feats.append(f'<body name="feature_{p}" pos="0 0 0" gravcomp="1">'
+                     f'<joint name="feature_{p}_x" type="slide" axis="1 0 0"/><joint name="feature_{p}_y" type="slide" axis="0 1 0"/>'
+                     f'<joint name="feature_{p}_z" type="slide" axis="0 0 1"/><joint name="feature_{p}_r" type="ball"/>'
+                     f'<inertial pos="0 0 0" mass="1000" diaginertia="1000 1000 1000"/>'
+                     f'{feature_geoms(scene, p, fr * friction_scale)}</body>')
+    g = np.asarray(scene._core.gravity, float)
+    acts = ('<motor joint="pad_left" gear="-1" ctrllimited="false"/><motor joint="pad_right" gear="1" ctrllimited="false"/>')
+    return (f'<mujoco model="{scene.name}"><option timestep="{contact.timestep}" gravity="{_f(g)}" cone="{contact.cone}" '
+            f'impratio="{contact.impratio}" noslip_iterations="{contact.noslip_iterations}"/>'
+            f'<default><geom solref="{contact.solref}" solimp="{contact.solimp}"/></default>'
+            f'<asset>{asset}</asset><worldbody>{obj}{"".join(pads)}{"".join(feats)}</worldbody>'
+            f'<actuator>{acts}</actuator></mujoco>')
+
+
+class Driver6:
+    """Sets a driven 6-DoF body's pose and velocity each step (slides + ball joint)."""
+
+    def __init__(self, model, name: str):
+        import mujoco
+
+        j = lambda s: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{name}_{s}")  # noqa: E731
+        self.qa = [int(model.jnt_qposadr[j(s)]) for s in "xyz"]
+        self.da = [int(model.jnt_dofadr[j(s)]) for s in "xyz"]
+        self.qr, self.dr = int(model.jnt_qposadr[j("r")]), int(model.jnt_dofadr[j("r")])
+        self.pose = np.r_[PARK, 1, 0, 0, 0]
+
+    def set(self, data, pose, vel=np.zeros(6)):
+        for k in range(3):
+            data.qpos[self.qa[k]] = pose[k]
+            data.qvel[self.da[k]] = vel[k]
+        data.qpos[self.qr:self.qr + 4] = pose[3:]
+        data.qvel[self.dr:self.dr + 3] = vel[3:]
+        self.pose = np.asarray(pose, float)
+
+    def move(self, data, pose, dt):
+        from scipy.spatial.transform import Rotation
+
+        pose = np.asarray(pose, float)
+        r0 = Rotation.from_quat([*self.pose[4:], self.pose[3]])
+        r1 = Rotation.from_quat([*pose[4:], pose[3]])
+        w = (r0.inv() * r1).as_rotvec() / dt  # body frame
+        self.set(data, self.pose, np.r_[(pose[:3] - self.pose[:3]) / dt, w])
+        self.pose = pose
+
+
+def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
+                   contact: Contact = Contact(), settle: float = 0.2) -> dict:
+    """Executes a 3-D plan in MuJoCo; returns the final pose, the error to the goal (position,
+    angle), success and the recorded poses."""
+    import mujoco
+
+    from .scene3d import quat_angle, twist_between
+
+    path = plan["path"]
+    for i, k in enumerate(path[1:], 1):
+        if k["pusher"] not in scene.pusher_names:
+            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r}", f"plan.path[{i}].pusher")
+    model = mujoco.MjModel.from_xml_string(build(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact))
+    data = mujoco.MjData(model)
+    data.ctrl[:] = scene._core.grip_force * grip_scale
+    drivers = {p: Driver6(model, f"feature_{p}") for p in scene.pusher_names}
+    for i, (p, d) in enumerate(drivers.items()):
+        d.set(data, np.r_[PARK + [0.1 * i, 0, 0], 1, 0, 0, 0])
+    mujoco.mj_forward(model, data)
+    dt = contact.timestep
+    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "object")
+    obj = lambda: np.r_[data.xpos[bid], data.xquat[bid]]  # noqa: E731
+
+    def step(moves=()):
+        for d, pose in moves:
+            d.move(data, pose, dt)
+        for d in drivers.values():
+            if all(d is not m[0] for m in moves):
+                d.move(data, d.pose, dt)
+        mujoco.mj_step(model, data)
+
+    for _ in range(int(settle / dt)):
+        step()
+    poses, current, P = [obj()], None, None
+    for a, b in zip(path[:-1], path[1:]):
+        p = b["pusher"]
+        d = drivers[p]
+        if current != p:
+            if current is not None:
+                drivers[current].move(data, np.r_[PARK, 1, 0, 0, 0], dt)
+            _, n, _ = scene._core.pusher_spec(p)
+            n = np.asarray(n, float) / np.linalg.norm(n)
+            q = obj()
+            P = compose(q, np.r_[-GAP * n, 1, 0, 0, 0])  # the feature's frame, backed off
+            d.set(data, P)
+            mujoco.mj_forward(model, data)
+            # approach along the normal until touching (at most 3 gaps)
+            ids = {i for i in range(model.ngeom) if model.geom_bodyid[i] == model.body(f"feature_{p}").id}
+            for _ in range(int(3 * GAP / (0.005 * dt))):
+                if any(data.contact[i].geom1 in ids or data.contact[i].geom2 in ids for i in range(data.ncon)):
+                    break
+                P = compose(P, np.r_[n * 0.005 * dt, 1, 0, 0, 0])
+                step([(d, P)])
+            current = p
+        u = np.asarray(b.get("pusher_twist") or twist_between(a["pose"], b["pose"]), float)
+        P0 = P.copy()
+        nsteps = int(round(1.0 / dt))
+        for k in range(1, nsteps + 1):
+            P = compose(P0, _exp(u, k / nsteps))
+            step([(d, P)])
+        poses.append(obj())
+    q = obj()
+    _, goal, tol = scene.task
+    dp = q[:3] - goal[:3]
+    ang = quat_angle(q[3:], goal[3:])
+    ok = bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])
+    return {"engine": "mujoco", "final_pose": q.tolist(), "goal_error": dp.tolist() + [ang], "success": ok,
+            "poses": np.array(poses)}
