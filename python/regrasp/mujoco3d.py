@@ -87,8 +87,11 @@ def feature_geoms(scene, name: str, friction: float) -> str:
             f'quat="{q[3]:.9g} {q[0]:.9g} {q[1]:.9g} {q[2]:.9g}" {g}/>')
 
 
+PAD_BALL = 0.001  # m, the small spheres of a ring pad
+
+
 def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
-          contact: Contact = Contact()) -> str:
+          contact: Contact = Contact(), pad: str = "point") -> str:
     v, t = scene.mesh()
     v, t = np.asarray(v, float), np.asarray(t, int)
     m = scene.mass * mass_scale
@@ -104,11 +107,20 @@ def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, ma
     # pads at the object's extreme points along ±Y at the start
     w = np.array([compose(s0, np.r_[x, 1, 0, 0, 0])[:3] for x in v])
     pads = []
+    rho = 2.0 / 3.0 * scene._core.pad_radius
     for name, sign in (("pad_left", 1), ("pad_right", -1)):
         y = np.max(sign * w[:, 1]) * sign
+        if pad == "ring":
+            # 8 point contacts on a ring at 2/3 of the pad's radius: the quasi-static model's pad
+            geoms = "".join(
+                f'<geom type="sphere" size="{PAD_BALL}" pos="{rho * np.cos(a):.9g} {sign * PAD_BALL:.9g} {rho * np.sin(a):.9g}" '
+                f'mass="0.01" friction="{mu:.9g} 0 0" condim="3" {BITS_PAD}/>'
+                for a in 2 * np.pi * (np.arange(8) + 0.5) / 8)
+        else:
+            geoms = (f'<geom type="sphere" size="{PAD_SPHERE}" pos="0 {sign * PAD_SPHERE:.9g} 0" mass="0.05" '
+                     f'friction="{mu:.9g} {k * mu:.9g} 0" condim="4" {BITS_PAD}/>')
         pads.append(f'<body name="{name}" pos="0 {y:.9g} 0" gravcomp="1"><joint name="{name}" type="slide" axis="0 1 0" damping="20"/>'
-                    f'<geom type="sphere" size="{PAD_SPHERE}" pos="0 {sign * PAD_SPHERE:.9g} 0" mass="0.05" '
-                    f'friction="{mu:.9g} {k * mu:.9g} 0" condim="4" {BITS_PAD}/></body>')
+                    f'{geoms}</body>')
     feats = []
     for p in scene.pusher_names:
         _, _, fr = scene._core.pusher_spec(p)
@@ -158,7 +170,7 @@ class Driver6:
 
 
 def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
-                   contact: Contact = Contact(), settle: float = 0.2) -> dict:
+                   contact: Contact = Contact(), settle: float = 0.2, pad: str = "point") -> dict:
     """Executes a 3-D plan in MuJoCo; returns the final pose, the error to the goal (position,
     angle), success and the recorded poses."""
     import mujoco
@@ -169,7 +181,9 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
     for i, k in enumerate(path[1:], 1):
         if k["pusher"] not in scene.pusher_names:
             raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r}", f"plan.path[{i}].pusher")
-    model = mujoco.MjModel.from_xml_string(build(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact))
+    if pad not in ("point", "ring"):
+        raise ArgumentError(f"invalid `pad`: 'point' or 'ring' (got {pad!r})", "pad")
+    model = mujoco.MjModel.from_xml_string(build(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact, pad))
     data = mujoco.MjData(model)
     data.ctrl[:] = scene._core.grip_force * grip_scale
     drivers = {p: Driver6(model, f"feature_{p}") for p in scene.pusher_names}
