@@ -156,12 +156,7 @@ def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
         or f"{cone.scene.name}: pusher '{cone.pusher}' at pose [{q[0]:.4f}, {q[1]:.4f}, {q[2]:.3f}]"
         f" — grip {cone.scene.grip_force} N, gravity uses {100 * cone.hold_ratio:.1f}% of the pad friction"
     )
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def _axes_pose(ax, t, q, label_prefix="", style=None):
@@ -198,12 +193,7 @@ def plot_push(scene, tr: dict, pusher: str, twist, path) -> Path:
             a.fill_between(t, 0, 1, where=slip, color="tab:red", alpha=0.08, transform=a.get_xaxis_transform())
     fig.suptitle(f"{scene.name}: pusher '{pusher}', body twist {np.round(twist, 4).tolist()} "
                  f"(shaded: the pusher slips)")
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def plot_replay(scene, rep, path, extra=None) -> Path:
@@ -226,6 +216,13 @@ def plot_replay(scene, rep, path, extra=None) -> Path:
         a.legend(fontsize=7)
     fig.suptitle(f"{scene.name}: plan replayed ({'success' if rep.success else 'outside tolerance'}, "
                  f"largest pusher slip {1e3 * rep.max_pusher_slip:.2f} mm)")
+    return _save(fig, path)
+
+
+def _save(fig, path) -> Path:
+    """Lays out, writes (creating the folder) and closes a figure."""
+    import matplotlib.pyplot as plt
+
     fig.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -302,12 +299,7 @@ def plot_plan(scene, plan, path) -> Path:
     b.set_title("pose in the grasp (bands: pusher of each step)")
     fig.suptitle(f"{scene.name}: {'plan' if plan.found else 'best partial plan'} with {n - 1} steps, "
                  f"{plan.switch_overs} switch-overs, found in {1e3 * plan.planning_time_s:.1f} ms ({plan.propagation})")
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> Path:
@@ -413,12 +405,7 @@ def plot_control(scene, res, path, extra=None) -> Path:
     a.legend(fontsize=7)
     fig.suptitle(f"{scene.name}: {res.policy} in {res.engine} — {'success' if res.success else 'failure'}, "
                  f"{res.replans} re-plans, {len(res.pokes)} pokes" + (f" ({res.failure})" if res.failure else ""))
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def animate_plan3d(scene, plan: dict, path, fps: int = 12, frames_per_step: int = 6) -> Path:

@@ -626,6 +626,22 @@ impl<'a> Planner<'a> {
     }
 }
 
+/// The planners' stopping rule: a goal node whose cost is at most the threshold, or a budget
+/// (time, nodes, iterations) spent.
+pub fn stop_reason(s: &Settings, best_cost: Option<f64>, t0: &Instant, nodes: usize, iterations: usize) -> Option<StopReason> {
+    if best_cost.is_some_and(|c| c <= s.cost_threshold) {
+        Some(StopReason::GoalReached)
+    } else if t0.elapsed().as_secs_f64() >= s.time_limit {
+        Some(StopReason::TimeLimit)
+    } else if nodes >= s.max_nodes {
+        Some(StopReason::NodeLimit)
+    } else if iterations >= s.max_iterations {
+        Some(StopReason::IterationLimit)
+    } else {
+        None
+    }
+}
+
 /// Plans a regrasp from `start` to `goal` (defaults: the scene's task).
 pub fn plan(scene: &Scene, start: Option<[f64; 3]>, goal: Option<[f64; 3]>, settings: &Settings) -> Result<PlanResult> {
     plan_tree(scene, start, goal, settings).map(|(r, _)| r)
@@ -689,19 +705,8 @@ pub fn plan_tree(
     let mut closest = best_goal.unwrap_or(0);
     let mut iterations = 0;
     let stop = loop {
-        if let Some(g) = best_goal {
-            if pl.nodes[g].cost <= settings.cost_threshold {
-                break StopReason::GoalReached;
-            }
-        }
-        if t0.elapsed().as_secs_f64() >= settings.time_limit {
-            break StopReason::TimeLimit;
-        }
-        if pl.nodes.len() >= settings.max_nodes {
-            break StopReason::NodeLimit;
-        }
-        if iterations >= settings.max_iterations {
-            break StopReason::IterationLimit;
+        if let Some(r) = stop_reason(settings, best_goal.map(|g| pl.nodes[g].cost), &t0, pl.nodes.len(), iterations) {
+            break r;
         }
         iterations += 1;
         let target = pl.sample();

@@ -25,7 +25,7 @@ use crate::error::{Error, Result};
 use crate::mncp;
 use crate::quasistatic3d::{integrate, push_problem, simulate_push};
 use crate::scene3d::{Scene3, V3};
-use crate::trrt::{Settings, StopReason, Transition};
+use crate::trrt::{stop_reason, Settings, StopReason, Transition};
 use kiddo::{KdTree, SquaredEuclidean};
 use nalgebra::{DVector, Isometry3, Matrix3, UnitQuaternion};
 use rand::{Rng, SeedableRng};
@@ -462,19 +462,8 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
     let mut closest = best.unwrap_or(0);
     let mut iterations = 0;
     let stop = loop {
-        if let Some(g) = best {
-            if pl.nodes[g].cost <= settings.cost_threshold {
-                break StopReason::GoalReached;
-            }
-        }
-        if t0.elapsed().as_secs_f64() >= settings.time_limit {
-            break StopReason::TimeLimit;
-        }
-        if pl.nodes.len() >= settings.max_nodes {
-            break StopReason::NodeLimit;
-        }
-        if iterations >= settings.max_iterations {
-            break StopReason::IterationLimit;
+        if let Some(r) = stop_reason(settings, best.map(|g| pl.nodes[g].cost), &t0, pl.nodes.len(), iterations) {
+            break r;
         }
         iterations += 1;
         let target = pl.sample();
