@@ -47,7 +47,7 @@ function view(v) {  // gripper frame -> camera (orbit), then perspective
   const cy = Math.cos(yaw), sy = Math.sin(yaw), cp = Math.cos(pitch), sp = Math.sin(pitch);
   let x = cy*v[0] + sy*v[1], y = -sy*v[0] + cy*v[1], z = v[2];
   const y2 = cp*y - sp*z, z2 = sp*y + cp*z;
-  const dist = 4 * D.size / zoom, s = 300 / (dist + y2) * D.scale * zoom;
+  const dist = 4 * D.size, s = 0.3 * cv.height * zoom * dist / (dist + y2) / D.size;
   return [cv.width/2 + x*s, cv.height/2 - z2*s, y2];
 }
 function draw() {
@@ -61,6 +61,9 @@ function draw() {
     const e1 = [b[0]-a[0], b[1]-a[1], b[2]-a[2]], e2 = [c[0]-a[0], c[1]-a[1], c[2]-a[2]];
     const n = [e1[1]*e2[2]-e1[2]*e2[1], e1[2]*e2[0]-e1[0]*e2[2], e1[0]*e2[1]-e1[1]*e2[0]];
     const nn = Math.hypot(...n) || 1, sh = Math.max(0.15, (n[0]*light[0]+n[1]*light[1]+n[2]*light[2]) / nn);
+    // a convex object: only the faces turned towards the camera (depth axis y2, camera at -y2)
+    const cy = Math.cos(yaw), sy = Math.sin(yaw), ny = -sy*n[0] + cy*n[1];
+    if (Math.cos(pitch)*ny - Math.sin(pitch)*n[2] > 0) continue;
     const P = [a, b, c].map(view);
     tris.push([P, (P[0][2]+P[1][2]+P[2][2]) / 3, `rgb(${Math.round(90+120*sh)},${Math.round(110+110*sh)},${Math.round(140+100*sh)})`]);
   }
@@ -69,20 +72,20 @@ function draw() {
   for (const sgn of [1, -1]) {
     let top = -1e9; for (const w of world) top = Math.max(top, sgn*w[1]);
     const ring = []; for (let k = 0; k < 24; k++) { const a = 2*Math.PI*k/24; ring.push(view([D.pad*Math.cos(a), sgn*top, D.pad*Math.sin(a)])); }
-    pads.push([ring, ring.reduce((s, p) => s + p[2], 0) / ring.length]);
+    // a pad on the object's near side is drawn over it, one on the far side is hidden by it
+    const facing = Math.cos(pitch)*(Math.cos(yaw)*sgn) < 0;
+    pads.push([ring, facing]);
   }
   tris.sort((x, y) => y[1] - x[1]);
   ctx.clearRect(0, 0, cv.width, cv.height);
-  const items = tris.map(t => ["t", t[1], t]).concat(pads.map(p => ["p", p[1], p]));
-  items.sort((x, y) => y[1] - x[1]);
   drawn = 0;
-  for (const [kind, , it] of items) {
-    ctx.beginPath();
-    const pts = kind === "t" ? it[0] : it[0];
-    ctx.moveTo(pts[0][0], pts[0][1]); for (const p of pts.slice(1)) ctx.lineTo(p[0], p[1]); ctx.closePath();
-    ctx.fillStyle = kind === "t" ? it[2] : "rgba(60,60,60,0.55)"; ctx.fill();
-    ctx.strokeStyle = "rgba(0,0,0,0.25)"; ctx.stroke(); drawn++;
-  }
+  const poly = (pts, fill, stroke) => {
+    ctx.beginPath(); ctx.moveTo(pts[0][0], pts[0][1]); for (const p of pts.slice(1)) ctx.lineTo(p[0], p[1]);
+    ctx.closePath(); ctx.fillStyle = fill; ctx.fill(); ctx.strokeStyle = stroke; ctx.stroke(); drawn++;
+  };
+  for (const [ring, facing] of pads) if (!facing) poly(ring, "rgba(60,60,60,0.55)", "rgba(0,0,0,0.3)");
+  for (const t of tris) poly(t[0], t[2], t[2]);
+  for (const [ring, facing] of pads) if (facing) poly(ring, "rgba(60,60,60,0.55)", "rgba(0,0,0,0.3)");
   // the pusher of the current step: its contact points, moving with the object
   const name = D.pushers_of_steps[Math.min(step, D.pushers_of_steps.length - 1)];
   if (name && D.pusher_points[name]) {
@@ -106,6 +109,21 @@ document.getElementById("play").addEventListener("click", () => { playing = !pla
 function tick() { if (!playing) return; slider.value = (Number(slider.value) + 5) % 1001; draw(); requestAnimationFrame(tick); }
 draw();
 window.regraspViewer = { draw, poseAt, drawn: () => drawn, setT: v => { slider.value = v; draw(); } };
+if (typeof location !== "undefined" && location.hash === "#selftest") {  // for tests in a headless browser: walk the plan, report
+  const frames = [];
+  for (const t of [0, 250, 500, 750, 1000]) {
+    slider.value = t; draw();
+    const [q] = poseAt(t / 1000);
+    const px = ctx.getImageData(0, 0, cv.width, cv.height).data;
+    let ink = 0; for (let i = 3; i < px.length; i += 4) if (px[i] > 0) ink++;
+    frames.push({ t, drawn, ink, pose: q, info: info.textContent });
+  }
+  yaw += 1.0; draw(); yaw -= 1.0;
+  const out = document.createElement("pre"); out.id = "selftest";
+  out.textContent = JSON.stringify({ triangles: D.triangles.length, frames });
+  document.body.appendChild(out);
+  slider.value = 500; draw();
+}
 </script></body></html>
 """
 
@@ -124,7 +142,6 @@ def page(scene, plan: dict) -> str:
         "pusher_points": {n: np.asarray(scene._core.pusher_points(n), float).tolist() for n in scene.pusher_names},
         "pad": float(scene._core.pad_radius),
         "size": size,
-        "scale": 1.0 / size,
     }
     text = json.dumps(data).replace("</", "<\\/")
     return PAGE.replace("__TITLE__", scene.name).replace("__DATA__", text)
