@@ -97,7 +97,7 @@ def test_3d_plans_execute_in_mujoco(tmp_path):
     pytest.importorskip("mujoco")
     from regrasp.mujoco3d import execute_plan3d
 
-    for name in ("offset-3d", "pivot-single-3d", "prism-3d"):
+    for name in ("offset-3d", "pivot-single-3d", "pivot-3d", "prism-3d"):
         s = Scene3D.load(EXAMPLES / f"{name}.toml")
         r = execute_plan3d(s, s.plan(seed=0))
         assert r["success"], (name, r["goal_error"])
