@@ -18,7 +18,7 @@ import numpy as np
 from . import _core
 from .errors import ArgumentError
 from .mujoco_exec import Perturbation
-from .quasistatic import body_twist, integrate_pose, simulate_push
+from .quasistatic import body_twist, simulate_push
 from .scene import Scene
 
 ENGINES = ("quasistatic", "mujoco")
@@ -223,12 +223,4 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
                          [(pk.t, pk.delta.tolist()) for pk in sorted(pokes, key=lambda k: k.t)], failure)
 
 
-def open_loop_plan_reference(scene: Scene, plan, dt: float = 0.1, speed: float = 0.01) -> np.ndarray:
-    """The plan resampled one control period apart (for figures)."""
-    p = _plan_dict(plan)
-    ctrl = _core.Mpc(scene._core, [list(map(float, k["pose"])) for k in p["path"]], [k["pusher"] for k in p["path"]],
-                     dt=dt, speed=speed)
-    return np.asarray(ctrl.knots)
-
-
-__all__ = ["Poke", "ControlResult", "control", "QuasistaticPlant", "integrate_pose"]
+__all__ = ["Poke", "ControlResult", "control", "QuasistaticPlant"]
