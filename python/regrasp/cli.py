@@ -192,9 +192,9 @@ def cmd_simulate(a) -> int:
         except (OSError, ValueError) as e:
             raise ArgumentError(f"invalid `--plan`: cannot read {a.plan}: {e}", "--plan") from e
         if a.engine == "mujoco":
-            from .mujoco3d import execute_plan3d
+            from .mujoco3d import execute_plan3d_world
 
-            r = execute_plan3d(s3, plan3, a.scale_friction, a.scale_grip, a.scale_mass)
+            r = execute_plan3d_world(s3, plan3, a.scale_friction, a.scale_grip, a.scale_mass)
         else:
             r = s3.replay(plan3)
         out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success")}

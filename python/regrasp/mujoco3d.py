@@ -1,5 +1,8 @@
-"""3-D plans executed in MuJoCo (planner's view: the gripper's pads fixed, each pusher's feature
-on a driven 6-DoF body that follows the plan's pusher motion).
+"""3-D plans executed in MuJoCo, in the world's view (:func:`execute_plan3d_world`: features fixed
+where each push needs them, the gripper — a driven 6-DoF body carrying the pads — moving with the
+inverse of the virtual pusher's motion; what `regrasp simulate SCENE_3D --engine mujoco` runs) or
+in the planner's view (:func:`execute_plan3d`: the pads fixed, each pusher's feature on a driven
+6-DoF body that follows the plan's pusher motion).
 
 The object: a box or the scene's convex mesh, with its mass, centre of mass and inertia. The pads:
 as in the planar model (``regrasp.mujoco_model``), one contact point each through a large sphere
@@ -90,8 +93,18 @@ def feature_geoms(scene, name: str, friction: float) -> str:
 PAD_BALL = 0.001  # m, the small spheres of a ring pad
 
 
+def _driven_joints(name: str) -> str:
+    """Slides along X, Y, Z and a ball joint of a heavy body driven by :class:`Driver6`."""
+    return (f'<joint name="{name}_x" type="slide" axis="1 0 0"/><joint name="{name}_y" type="slide" axis="0 1 0"/>'
+            f'<joint name="{name}_z" type="slide" axis="0 0 1"/><joint name="{name}_r" type="ball"/>'
+            f'<inertial pos="0 0 0" mass="1000" diaginertia="1000 1000 1000"/>')
+
+
 def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
-          contact: Contact = Contact(), pad: str = "point") -> str:
+          contact: Contact = Contact(), pad: str = "point", world: bool = False) -> str:
+    """MJCF of a 3-D execution: planner's view (pads fixed, features on driven 6-DoF bodies) or,
+    with ``world``, the world's view (the pads on a driven 6-DoF gripper, features fixed where
+    they are put: mocap bodies)."""
     v, t = scene.mesh()
     v, t = np.asarray(v, float), np.asarray(t, int)
     m = scene.mass * mass_scale
@@ -122,13 +135,16 @@ def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, ma
         pads.append(f'<body name="{name}" pos="0 {y:.9g} 0" gravcomp="1"><joint name="{name}" type="slide" axis="0 1 0" damping="20"/>'
                     f'{geoms}</body>')
     feats = []
-    for p in scene.pusher_names:
+    for i, p in enumerate(scene.pusher_names):
         _, _, fr = scene._core.pusher_spec(p)
-        feats.append(f'<body name="feature_{p}" pos="0 0 0" gravcomp="1">'
-                     f'<joint name="feature_{p}_x" type="slide" axis="1 0 0"/><joint name="feature_{p}_y" type="slide" axis="0 1 0"/>'
-                     f'<joint name="feature_{p}_z" type="slide" axis="0 0 1"/><joint name="feature_{p}_r" type="ball"/>'
-                     f'<inertial pos="0 0 0" mass="1000" diaginertia="1000 1000 1000"/>'
-                     f'{feature_geoms(scene, p, fr * friction_scale)}</body>')
+        if world:
+            feats.append(f'<body name="feature_{p}" mocap="true" pos="{_f(PARK + [0.1 * i, 0, 0])}">'
+                         f'{feature_geoms(scene, p, fr * friction_scale)}</body>')
+        else:
+            feats.append(f'<body name="feature_{p}" pos="0 0 0" gravcomp="1">{_driven_joints(f"feature_{p}")}'
+                         f'{feature_geoms(scene, p, fr * friction_scale)}</body>')
+    if world:
+        pads = [f'<body name="gripper" pos="0 0 0" gravcomp="1">{_driven_joints("gripper")}{"".join(pads)}</body>']
     g = np.asarray(scene._core.gravity, float)
     acts = ('<motor joint="pad_left" gear="-1" ctrllimited="false"/><motor joint="pad_right" gear="1" ctrllimited="false"/>')
     return (f'<mujoco model="{scene.name}"><option timestep="{contact.timestep}" gravity="{_f(g)}" cone="{contact.cone}" '
@@ -239,3 +255,76 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
     ok = bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])
     return {"engine": "mujoco", "final_pose": q.tolist(), "goal_error": dp.tolist() + [ang], "success": ok,
             "poses": np.array(poses)}
+
+
+def execute_plan3d_world(scene, plan: dict, friction_scale: float = 1.0, grip_scale: float = 1.0,
+                         mass_scale: float = 1.0, contact: Contact = Contact(), settle: float = 0.2,
+                         pad: str = "point") -> dict:
+    """Executes a 3-D plan in MuJoCo in the world's view: the features are fixed where each push
+    needs them (relative to where the gripper and the object are), the gripper moves with the
+    inverse of the virtual pusher's motion, backs off 2 mm between pushes (a switch-over). The
+    object's pose in the grasp is recorded."""
+    import mujoco
+
+    from .scene3d import quat_angle, twist_between
+
+    path = plan["path"]
+    for i, k in enumerate(path[1:], 1):
+        if k["pusher"] not in scene.pusher_names:
+            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r}", f"plan.path[{i}].pusher")
+    model = mujoco.MjModel.from_xml_string(build(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact,
+                                                 pad, world=True))
+    data = mujoco.MjData(model)
+    data.ctrl[:] = scene._core.grip_force * grip_scale
+    grip = Driver6(model, "gripper")
+    grip.set(data, np.r_[0, 0, 0, 1, 0, 0, 0])
+    mujoco.mj_forward(model, data)
+    dt = contact.timestep
+    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "object")
+    in_grasp = lambda: compose(inverse(grip.pose), np.r_[data.xpos[bid], data.xquat[bid]])  # noqa: E731
+
+    def step(G):
+        grip.move(data, G, dt)
+        mujoco.mj_step(model, data)
+
+    for _ in range(int(settle / dt)):
+        step(grip.pose)
+    poses, current = [in_grasp()], None
+    F = P = None
+    for a, b in zip(path[:-1], path[1:]):
+        p = b["pusher"]
+        if current != p:
+            if current is not None:  # back off, park the old feature
+                P0 = P.copy()
+                for k in range(1, int(GAP / (0.005 * dt)) + 1):
+                    P = compose(P0, np.r_[-n * 0.005 * dt * k, 1, 0, 0, 0])
+                    step(compose(F, inverse(P)))
+                data.mocap_pos[fm] = PARK
+            _, n, _ = scene._core.pusher_spec(p)
+            n = np.asarray(n, float) / np.linalg.norm(n)
+            fm = int(model.body_mocapid[model.body(f"feature_{p}").id])
+            P = compose(in_grasp(), np.r_[-GAP * n, 1, 0, 0, 0])  # the feature in the grasp, backed off
+            F = compose(grip.pose, P)  # ... and in the world, where it stays
+            data.mocap_pos[fm], data.mocap_quat[fm] = F[:3], F[3:]
+            mujoco.mj_forward(model, data)
+            ids = {i for i in range(model.ngeom) if model.geom_bodyid[i] == model.body(f"feature_{p}").id}
+            for _ in range(int(3 * GAP / (0.005 * dt))):
+                if any(data.contact[i].geom1 in ids or data.contact[i].geom2 in ids for i in range(data.ncon)):
+                    break
+                P = compose(P, np.r_[n * 0.005 * dt, 1, 0, 0, 0])
+                step(compose(F, inverse(P)))
+            current = p
+        u = np.asarray(b.get("pusher_twist") or twist_between(a["pose"], b["pose"]), float)
+        P0 = P.copy()
+        nsteps = int(round(1.0 / dt))
+        for k in range(1, nsteps + 1):
+            P = compose(P0, _exp(u, k / nsteps))
+            step(compose(F, inverse(P)))
+        poses.append(in_grasp())
+    q = in_grasp()
+    _, goal, tol = scene.task
+    dp = q[:3] - goal[:3]
+    ang = quat_angle(q[3:], goal[3:])
+    ok = bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])
+    return {"engine": "mujoco", "view": "world", "final_pose": q.tolist(), "goal_error": dp.tolist() + [ang],
+            "success": ok, "poses": np.array(poses)}
