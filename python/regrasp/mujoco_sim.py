@@ -82,9 +82,11 @@ class PushRig:
         return {"t": np.array(t), "pose": np.array(poses), "pusher_pose": np.array(pushers)}
 
     def slip_fraction(self, pose, twist, distance: float = 0.003, speed: float = 0.01) -> float:
-        """How far the pusher and the object move apart over a short push, as a share of the
-        push: the change of their relative pose (metric [Δx, Δz, L Δθ]) over the push's length;
-        for a point pusher, the slide of its contact point on the object."""
+        """How far the pusher and the object move apart at the contact over a short push, as a
+        share of the push: for a line pusher, the largest motion of the object relative to the
+        pusher at either end of the line — its slide along the contact and its lift-off (a roll
+        about the other end), pressing in by the soft contact's compliance left out; for a point
+        pusher, the slide of its contact on the object (the object may turn about it)."""
         tw = np.asarray(twist, float)
         norm = float(np.linalg.norm(self.scene.metric_twist(tw)))
         tw = tw / norm * speed
@@ -94,8 +96,17 @@ class PushRig:
         r = self.push(pose, tw, distance / speed, record_dt=distance / speed)
         rel0 = compose(inverse(r["pusher_pose"][0]), r["pose"][0])
         rel1 = compose(inverse(r["pusher_pose"][-1]), r["pose"][-1])
-        d = rel1 - rel0
-        return float(np.sqrt(d[0] ** 2 + d[1] ** 2 + (self.scene.length * d[2]) ** 2) / distance)
+        n = self.scene.pusher(self.pusher).normal
+        n = n / np.linalg.norm(n)
+        t = np.array([-n[1], n[0]])
+        worst = 0.0
+        for c in pts:
+            # the object's material point at contact point c, seen from the pusher, before and
+            # after: its slide along the contact, and how far it lifted off the pusher (pressing
+            # further in is the soft contact's compliance, not a slip)
+            d = compose(rel1, np.r_[c, 0.0])[:2] - compose(rel0, np.r_[c, 0.0])[:2]
+            worst = max(worst, float(np.hypot(d @ t, max(0.0, d @ n))))
+        return worst / distance
 
     def _point_slip(self, pose, twist, distance, speed, c) -> float:
         """A point pusher sticks when its contact does not slide on the object (the object may
@@ -119,9 +130,9 @@ class PushRig:
         return float(slide / distance)
 
     def sticks(self, pose, twist, distance: float = 0.003, speed: float = 0.01, ratio: float = 0.02) -> bool:
-        """Whether the pusher and the object move together over a short push: their relative
-        pose changes by less than ``ratio`` of the push (soft contacts creep by 0.3–1% of a push
-        when the pusher sticks)."""
+        """Whether the pusher and the object move together over a short push: they move apart at
+        the contact by less than ``ratio`` of the push (:meth:`slip_fraction`; soft contacts creep
+        by about 1% of a push when the pusher sticks)."""
         return self.slip_fraction(pose, twist, distance, speed) < ratio
 
 

@@ -4,10 +4,10 @@ boundary, a third in random directions — at random poses where the grasp holds
 motion-cone prediction (stick or slip at the pusher) against what the simulators do.
 
 Engines: ``quasistatic`` (our complementarity simulator, point-set pads) and ``mujoco`` (an
-independent engine: a 3 mm push at 10 mm/s; a line pusher sticks when the pusher–object
-relative pose changes by less than 2% of the push, a point pusher when its contact slides on the
-object by less than 2% of the push — MuJoCo's soft contacts creep by 0.3–1% of a push, and up to
-4% in rotation-heavy point pushes, while the pusher's force is well inside its friction cone). MuJoCo pushes are spread over local processes
+independent engine: a 3 mm push at 10 mm/s; the pusher sticks when, at the contact, the object
+moves relative to it by less than 2% of the push — a line pusher's slide or lift-off at either
+end, a point pusher's slide — MuJoCo's sticking soft contacts creep by about 1% of a push).
+MuJoCo pushes are spread over local processes
 (``workers``) or over a Ray cluster (``ray_address``; ``"local"`` starts a local Ray instance).
 """
 
