@@ -15,7 +15,9 @@ from regrasp import mncp_reference, quasistatic
 
 from .conftest import EXAMPLES, block_scenes
 
-SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# derandomized: the same examples on every run, so that CI is reproducible (a failure found by
+# a random run becomes a regression test below)
+SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
 
 
 def load(d):
@@ -39,6 +41,26 @@ def test_every_forward_solve_meets_every_constraint(d, a, b, support):
     r = p.residuals(list(sol["twist"]), list(sol["pusher_twist"]), list(sol["normal_forces"]),
                     [list(f) for f in sol["friction_forces"]])
     assert max(r.values()) < 1e-6
+
+
+@pytest.mark.xfail(strict=True, reason="known: the forward solve does not converge (residual 3e-4) for the "
+                                       "limit-surface pad model with no gravity and pusher friction 1 (found by hypothesis)")
+def test_known_non_convergence_limit_surface_pad_without_gravity():
+    d = {"name": "prop",
+         "object": {"outline": [[-0.03125, -0.0234375], [0.03125, -0.0234375], [0.03125, 0.0234375], [-0.03125, 0.0234375]],
+                    "mass": 0.5, "com": [0.001953125, 0.0029296875]},
+         "grasp": {"force": 5.0, "friction": 1.0, "pad_radius": 0.00390625},
+         "gravity": {"direction": [0.0, -1.0], "g": 0.0},
+         "pushers": [{"name": "p", "friction": 1.0, "points": [[-0.03125, 0.01875], [-0.03125, -0.01875]], "normal": [1.0, 0.0]}],
+         "task": {"start": [0.005126953125, 0.0048828125, 0.0], "goal": [0.005126953125, 0.0048828125, 0.0],
+                  "tolerance": [0.001, 0.001, 0.01]}}
+    sc = regrasp.Scene.from_dict(d)
+    a, b = 1.625, -1.125
+    u = sc.metric_twist_inv(np.array([np.cos(a) * np.cos(b), np.sin(a) * np.cos(b), np.sin(b)])) * 0.01
+    p = quasistatic.problem(sc, d["task"]["start"], "p", support="limit_surface", rings=2)
+    assert p.solve_forward(list(u))["max_residual"] < 1e-6
+    # the point-set pad model of the same case converges
+    assert quasistatic.problem(sc, d["task"]["start"], "p", support="points", rings=2).solve_forward(list(u))["max_residual"] < 1e-6
 
 
 @SETTINGS
