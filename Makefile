@@ -24,7 +24,7 @@ build: $(STAMP)
 test: test-rust test-python
 
 test-rust:
-	cargo test --release -p regrasp-core
+	PROPTEST_RNG_SEED=$${PROPTEST_RNG_SEED:-20261123} cargo test --release -p regrasp-core
 
 test-python: build
 	$(BIN)/pytest -q
