@@ -95,14 +95,14 @@ def test_browser_view_draws_every_frame(tmp_path):
 
 def test_3d_plans_execute_in_mujoco(tmp_path):
     pytest.importorskip("mujoco")
-    from regrasp.mujoco3d import execute_plan3d, execute_plan3d_world
+    from regrasp.mujoco3d import execute_plan3d
 
     for name in ("offset-3d", "pivot-single-3d", "pivot-3d", "prism-3d"):
         s = Scene3D.load(EXAMPLES / f"{name}.toml")
         p = s.plan(seed=0)
-        for run in (execute_plan3d_world, execute_plan3d):  # the world's view, the planner's view
-            r = run(s, p)
-            assert r["success"], (name, run.__name__, r["goal_error"])
+        for view in ("world", "planner"):
+            r = execute_plan3d(s, p, view=view)
+            assert r["success"], (name, view, r["goal_error"])
     f = tmp_path / "plan.json"
     s = Scene3D.load(EXAMPLES / "light-side-3d.toml")
     f.write_text(json.dumps(s.plan(seed=0)))

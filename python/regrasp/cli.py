@@ -192,9 +192,9 @@ def cmd_simulate(a) -> int:
         except (OSError, ValueError) as e:
             raise ArgumentError(f"invalid `--plan`: cannot read {a.plan}: {e}", "--plan") from e
         if a.engine == "mujoco":
-            from .mujoco3d import execute_plan3d_world
+            from .mujoco3d import execute_plan3d
 
-            r = execute_plan3d_world(s3, plan3, a.scale_friction, a.scale_grip, a.scale_mass)
+            r = execute_plan3d(s3, plan3, a.scale_friction, a.scale_grip, a.scale_mass)
         else:
             r = s3.replay(plan3)
         out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success")}
@@ -247,6 +247,11 @@ def cmd_push3d(a) -> int:
     pose = _floats(a.pose, 7, "--pose")
     twist = _floats(a.twist, 6, "--twist")
     tr = scene.simulate_push(pose, a.pusher, twist, a.duration, a.dt)
+    return _push_report(scene, a, twist, tr)
+
+
+def _push_report(scene, a, twist, tr: dict) -> int:
+    """What `regrasp push` prints for a simulated push (planar or 3-D)."""
     out = {
         "scene": scene.name, "pusher": a.pusher, "twist": twist.tolist(), "final_pose": tr["pose"][-1].tolist(),
         "max_pusher_slip_speed": float(tr["pusher_slip"].max()),
@@ -256,6 +261,8 @@ def cmd_push3d(a) -> int:
     if a.json:
         out["t"] = tr["t"].tolist()
         out["pose"] = tr["pose"].tolist()
+        if "pusher_wrench" in tr:
+            out["pusher_wrench"] = tr["pusher_wrench"].tolist()
         print(json.dumps(out))
     else:
         print(f"{scene.name}: pusher '{a.pusher}' with body twist {twist.tolist()} for {a.duration} s")
@@ -278,23 +285,7 @@ def cmd_push(a) -> int:
         from .plotting import plot_push
 
         plot_push(scene, tr, a.pusher, twist, a.plot)
-    out = {
-        "scene": scene.name, "pusher": a.pusher, "twist": twist.tolist(),
-        "final_pose": tr["pose"][-1].tolist(),
-        "max_pusher_slip_speed": float(tr["pusher_slip"].max()),
-        "pusher_sticking_share": float(np.mean(tr["pusher_sticking"] == np.maximum(tr["pusher_contacts"], 1))),
-        "max_residual": float(tr["residual"].max()),
-    }
-    if a.json:
-        out["t"] = tr["t"].tolist()
-        out["pose"] = tr["pose"].tolist()
-        out["pusher_wrench"] = tr["pusher_wrench"].tolist()
-        print(json.dumps(out))
-    else:
-        print(f"{scene.name}: pusher '{a.pusher}' with twist {twist.tolist()} for {a.duration} s")
-        print(f"  final pose {np.round(out['final_pose'], 5).tolist()}; pusher sticks in {100 * out['pusher_sticking_share']:.0f}% "
-              f"of the steps; largest constraint residual {out['max_residual']:.1e}")
-    return 0
+    return _push_report(scene, a, twist, tr)
 
 
 def _mode_scene(scene: Scene, a) -> Scene:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _core
 from .errors import ArgumentError
 from .mujoco_model import PAD_SPHERE, Contact
 
@@ -32,39 +33,18 @@ def _f(a) -> str:
     return " ".join(f"{x:.9g}" for x in np.ravel(a))
 
 
-def _qmul(a, b):
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
-
-
-def _rot(q, v):
-    p = _qmul(_qmul(q, np.r_[0.0, v]), q * np.array([1, -1, -1, -1]))
-    return p[1:]
-
-
-def compose(a, b):
+def compose(a, b) -> np.ndarray:
     """Pose a ∘ b ([x, y, z, qw, qx, qy, qz])."""
-    return np.r_[a[:3] + _rot(a[3:], b[:3]), _qmul(a[3:], b[3:])]
+    return np.array(_core.se3_compose(list(map(float, a)), list(map(float, b))))
 
 
-def inverse(a):
-    qi = a[3:] * np.array([1, -1, -1, -1])
-    return np.r_[-_rot(qi, a[:3]), qi]
+def inverse(a) -> np.ndarray:
+    return np.array(_core.se3_inverse(list(map(float, a))))
 
 
-def _exp(u, t):
-    """exp of body twist u over time t as a pose."""
-    from scipy.spatial.transform import Rotation
-
-    v, w = np.asarray(u[:3], float) * t, np.asarray(u[3:], float) * t
-    th = np.linalg.norm(w)
-    W = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
-    A, B = (0.5, 1 / 6) if th < 1e-8 else ((1 - np.cos(th)) / th**2, (th - np.sin(th)) / th**3)
-    p = (np.eye(3) + A * W + B * W @ W) @ v
-    q = Rotation.from_rotvec(w).as_quat()
-    return np.r_[p, q[3], q[0], q[1], q[2]]
+def _exp(u, t) -> np.ndarray:
+    """exp of body twist u over time t, as a pose."""
+    return np.array(_core.se3_integrate([0, 0, 0, 1, 0, 0, 0], list(map(float, u)), float(t)))
 
 
 def feature_geoms(scene, name: str, friction: float) -> str:
@@ -186,145 +166,103 @@ class Driver6:
 
 
 def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
-                   contact: Contact = Contact(), settle: float = 0.2, pad: str = "point") -> dict:
+                   contact: Contact = Contact(), settle: float = 0.2, pad: str = "point", view: str = "world") -> dict:
     """Executes a 3-D plan in MuJoCo; returns the final pose, the error to the goal (position,
-    angle), success and the recorded poses."""
+    angle), success and the object's pose in the grasp after each step.
+
+    ``view="world"``: each push's feature is fixed where the push needs it (2 mm back, then the
+    gripper approaches until it touches), the gripper moves with the inverse of the virtual
+    pusher's motion and backs off 2 mm before a switch-over. ``view="planner"``: the pads fixed,
+    the feature (on a driven body) follows the virtual pusher's motion. Either way the feature's
+    pose in the grasp, ``P``, follows the plan's pusher twists; only what moves differs."""
     import mujoco
 
-    from .scene3d import quat_angle, twist_between
+    from .scene3d import check_plan3d, quat_angle, twist_between
 
-    path = plan["path"]
-    for i, k in enumerate(path[1:], 1):
-        if k["pusher"] not in scene.pusher_names:
-            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r}", f"plan.path[{i}].pusher")
     if pad not in ("point", "ring"):
         raise ArgumentError(f"invalid `pad`: 'point' or 'ring' (got {pad!r})", "pad")
-    model = mujoco.MjModel.from_xml_string(build(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact, pad))
+    if view not in ("world", "planner"):
+        raise ArgumentError(f"invalid `view`: 'world' or 'planner' (got {view!r})", "view")
+    world = view == "world"
+    path = check_plan3d(scene, plan)
+    model = mujoco.MjModel.from_xml_string(build(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact,
+                                                 pad, world=world))
     data = mujoco.MjData(model)
     data.ctrl[:] = scene._core.grip_force * grip_scale
-    drivers = {p: Driver6(model, f"feature_{p}") for p in scene.pusher_names}
-    for i, (p, d) in enumerate(drivers.items()):
+    dt = contact.timestep
+    identity = np.r_[0.0, 0, 0, 1, 0, 0, 0]
+    grip = Driver6(model, "gripper") if world else None
+    drivers = {} if world else {p: Driver6(model, f"feature_{p}") for p in scene.pusher_names}
+    if world:
+        grip.set(data, identity)
+    for i, d in enumerate(drivers.values()):
         d.set(data, np.r_[PARK + [0.1 * i, 0, 0], 1, 0, 0, 0])
     mujoco.mj_forward(model, data)
-    dt = contact.timestep
     bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "object")
-    obj = lambda: np.r_[data.xpos[bid], data.xquat[bid]]  # noqa: E731
+    G = lambda: grip.pose if world else identity  # noqa: E731 - the gripper in the world
+    in_grasp = lambda: compose(inverse(G()), np.r_[data.xpos[bid], data.xquat[bid]])  # noqa: E731
+    state = {"pusher": None, "F": None}
 
-    def step(moves=()):
-        for d, pose in moves:
-            d.move(data, pose, dt)
-        for d in drivers.values():
-            if all(d is not m[0] for m in moves):
-                d.move(data, d.pose, dt)
+    def place(P):
+        """One time step with the active feature at pose ``P`` in the grasp (None: nothing moves)."""
+        if world:
+            grip.move(data, grip.pose if P is None else compose(state["F"], inverse(P)), dt)
+        for p, d in drivers.items():
+            d.move(data, P if p == state["pusher"] and P is not None else d.pose, dt)
         mujoco.mj_step(model, data)
 
-    for _ in range(int(settle / dt)):
-        step()
-    poses, current, P = [obj()], None, None
-    for a, b in zip(path[:-1], path[1:]):
-        p = b["pusher"]
-        d = drivers[p]
-        if current != p:
-            if current is not None:
-                drivers[current].move(data, np.r_[PARK, 1, 0, 0, 0], dt)
-            _, n, _ = scene._core.pusher_spec(p)
-            n = np.asarray(n, float) / np.linalg.norm(n)
-            q = obj()
-            P = compose(q, np.r_[-GAP * n, 1, 0, 0, 0])  # the feature's frame, backed off
-            d.set(data, P)
-            mujoco.mj_forward(model, data)
-            # approach along the normal until touching (at most 3 gaps)
-            ids = {i for i in range(model.ngeom) if model.geom_bodyid[i] == model.body(f"feature_{p}").id}
-            for _ in range(int(3 * GAP / (0.005 * dt))):
-                if any(data.contact[i].geom1 in ids or data.contact[i].geom2 in ids for i in range(data.ncon)):
-                    break
-                P = compose(P, np.r_[n * 0.005 * dt, 1, 0, 0, 0])
-                step([(d, P)])
-            current = p
-        u = np.asarray(b.get("pusher_twist") or twist_between(a["pose"], b["pose"]), float)
-        P0 = P.copy()
-        nsteps = int(round(1.0 / dt))
-        for k in range(1, nsteps + 1):
-            P = compose(P0, _exp(u, k / nsteps))
-            step([(d, P)])
-        poses.append(obj())
-    q = obj()
-    _, goal, tol = scene.task
-    dp = q[:3] - goal[:3]
-    ang = quat_angle(q[3:], goal[3:])
-    ok = bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])
-    return {"engine": "mujoco", "final_pose": q.tolist(), "goal_error": dp.tolist() + [ang], "success": ok,
-            "poses": np.array(poses)}
+    def put(p, P):
+        """Puts pusher ``p``'s feature at ``P`` in the grasp (where it stays, in the world's view)."""
+        fid = model.body(f"feature_{p}").id
+        if world:
+            state["F"] = compose(G(), P)
+            fm = int(model.body_mocapid[fid])
+            data.mocap_pos[fm], data.mocap_quat[fm] = state["F"][:3], state["F"][3:]
+        else:
+            drivers[p].set(data, P)
+        state["pusher"] = p
+        mujoco.mj_forward(model, data)
+        return {i for i in range(model.ngeom) if model.geom_bodyid[i] == fid}
 
-
-def execute_plan3d_world(scene, plan: dict, friction_scale: float = 1.0, grip_scale: float = 1.0,
-                         mass_scale: float = 1.0, contact: Contact = Contact(), settle: float = 0.2,
-                         pad: str = "point") -> dict:
-    """Executes a 3-D plan in MuJoCo in the world's view: the features are fixed where each push
-    needs them (relative to where the gripper and the object are), the gripper moves with the
-    inverse of the virtual pusher's motion, backs off 2 mm between pushes (a switch-over). The
-    object's pose in the grasp is recorded."""
-    import mujoco
-
-    from .scene3d import quat_angle, twist_between
-
-    path = plan["path"]
-    for i, k in enumerate(path[1:], 1):
-        if k["pusher"] not in scene.pusher_names:
-            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r}", f"plan.path[{i}].pusher")
-    model = mujoco.MjModel.from_xml_string(build(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact,
-                                                 pad, world=True))
-    data = mujoco.MjData(model)
-    data.ctrl[:] = scene._core.grip_force * grip_scale
-    grip = Driver6(model, "gripper")
-    grip.set(data, np.r_[0, 0, 0, 1, 0, 0, 0])
-    mujoco.mj_forward(model, data)
-    dt = contact.timestep
-    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "object")
-    in_grasp = lambda: compose(inverse(grip.pose), np.r_[data.xpos[bid], data.xquat[bid]])  # noqa: E731
-
-    def step(G):
-        grip.move(data, G, dt)
-        mujoco.mj_step(model, data)
+    def park(p):
+        if world:
+            data.mocap_pos[int(model.body_mocapid[model.body(f"feature_{p}").id])] = PARK
+        else:
+            drivers[p].set(data, np.r_[PARK, 1, 0, 0, 0])
 
     for _ in range(int(settle / dt)):
-        step(grip.pose)
-    poses, current = [in_grasp()], None
-    F = P = None
+        place(None)
+    poses, P, n = [in_grasp()], None, None
+    creep = 0.005 * dt  # approach and back-off at 5 mm/s
     for a, b in zip(path[:-1], path[1:]):
         p = b["pusher"]
-        if current != p:
-            if current is not None:  # back off, park the old feature
+        if state["pusher"] != p:
+            if state["pusher"] is not None:  # back off, park the old feature (a switch-over)
                 P0 = P.copy()
-                for k in range(1, int(GAP / (0.005 * dt)) + 1):
-                    P = compose(P0, np.r_[-n * 0.005 * dt * k, 1, 0, 0, 0])
-                    step(compose(F, inverse(P)))
-                data.mocap_pos[fm] = PARK
+                for k in range(1, int(GAP / creep) + 1):
+                    P = compose(P0, np.r_[-n * creep * k, 1, 0, 0, 0])
+                    place(P)
+                park(state["pusher"])
             _, n, _ = scene._core.pusher_spec(p)
             n = np.asarray(n, float) / np.linalg.norm(n)
-            fm = int(model.body_mocapid[model.body(f"feature_{p}").id])
-            P = compose(in_grasp(), np.r_[-GAP * n, 1, 0, 0, 0])  # the feature in the grasp, backed off
-            F = compose(grip.pose, P)  # ... and in the world, where it stays
-            data.mocap_pos[fm], data.mocap_quat[fm] = F[:3], F[3:]
-            mujoco.mj_forward(model, data)
-            ids = {i for i in range(model.ngeom) if model.geom_bodyid[i] == model.body(f"feature_{p}").id}
-            for _ in range(int(3 * GAP / (0.005 * dt))):
+            P = compose(in_grasp(), np.r_[-GAP * n, 1, 0, 0, 0])  # where it meets the object, backed off
+            ids = put(p, P)
+            for _ in range(int(3 * GAP / creep)):  # approach until touching (at most 3 gaps)
                 if any(data.contact[i].geom1 in ids or data.contact[i].geom2 in ids for i in range(data.ncon)):
                     break
-                P = compose(P, np.r_[n * 0.005 * dt, 1, 0, 0, 0])
-                step(compose(F, inverse(P)))
-            current = p
+                P = compose(P, np.r_[n * creep, 1, 0, 0, 0])
+                place(P)
         u = np.asarray(b.get("pusher_twist") or twist_between(a["pose"], b["pose"]), float)
         P0 = P.copy()
         nsteps = int(round(1.0 / dt))
         for k in range(1, nsteps + 1):
             P = compose(P0, _exp(u, k / nsteps))
-            step(compose(F, inverse(P)))
+            place(P)
         poses.append(in_grasp())
     q = in_grasp()
     _, goal, tol = scene.task
     dp = q[:3] - goal[:3]
     ang = quat_angle(q[3:], goal[3:])
     ok = bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])
-    return {"engine": "mujoco", "view": "world", "final_pose": q.tolist(), "goal_error": dp.tolist() + [ang],
+    return {"engine": "mujoco", "view": view, "final_pose": q.tolist(), "goal_error": dp.tolist() + [ang],
             "success": ok, "poses": np.array(poses)}

@@ -83,7 +83,7 @@ class Scene3D:
         step's twist for unit time from wherever the object is. Returns the final pose, the
         error to the goal (position [m] and angle [rad]), success (within the task's tolerance)
         and the poses after each step."""
-        path = plan["path"]
+        path = check_plan3d(self, plan)
         q = np.asarray(path[0]["pose"], float)
         poses = [q]
         for a, b in zip(path[:-1], path[1:]):
@@ -99,6 +99,29 @@ class Scene3D:
                 "poses": np.array(poses)}
 
 
+def check_plan3d(scene: "Scene3D", plan) -> list:
+    """The path of a 3-D plan, checked: poses of 7 numbers, known pushers, twists of 6 numbers.
+    Errors name the field."""
+    if not isinstance(plan, dict) or not isinstance(plan.get("path"), list) or len(plan["path"]) < 1:
+        raise ArgumentError("invalid `plan`: a dict with a non-empty `path` list", "plan.path")
+    for i, k in enumerate(plan["path"]):
+        if not isinstance(k, dict) or "pose" not in k:
+            raise ArgumentError(f"invalid `plan.path[{i}]`: needs a `pose`", f"plan.path[{i}].pose")
+        q = np.asarray(k["pose"], float)
+        if q.shape != (7,) or not np.all(np.isfinite(q)) or np.linalg.norm(q[3:]) < 1e-9:
+            raise ArgumentError(f"invalid `plan.path[{i}].pose`: 7 finite numbers [x, y, z, qw, qx, qy, qz]",
+                                f"plan.path[{i}].pose")
+        if i > 0 and k.get("pusher") not in scene.pusher_names:
+            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k.get('pusher')!r} in the scene",
+                                f"plan.path[{i}].pusher")
+        if i > 0 and k.get("pusher_twist") is not None:
+            u = np.asarray(k["pusher_twist"], float)
+            if u.shape != (6,) or not np.all(np.isfinite(u)):
+                raise ArgumentError(f"invalid `plan.path[{i}].pusher_twist`: 6 finite numbers",
+                                    f"plan.path[{i}].pusher_twist")
+    return plan["path"]
+
+
 def quat_angle(a, b) -> float:
     """Angle [rad] of the rotation between unit quaternions a and b ([w, x, y, z])."""
     a, b = np.asarray(a, float), np.asarray(b, float)
@@ -107,24 +130,8 @@ def quat_angle(a, b) -> float:
 
 
 def twist_between(a, b) -> list:
-    """The constant body twist taking pose a to pose b in unit time (SE(3) log)."""
-    from scipy.spatial.transform import Rotation
-
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    Ra = Rotation.from_quat([a[4], a[5], a[6], a[3]])
-    Rb = Rotation.from_quat([b[4], b[5], b[6], b[3]])
-    rel_R = Ra.inv() * Rb
-    p = Ra.inv().apply(b[:3] - a[:3])
-    w = rel_R.as_rotvec()
-    th = np.linalg.norm(w)
-    W = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
-    if th < 1e-8:
-        A, B = 0.5, 1 / 6
-    else:
-        A, B = (1 - np.cos(th)) / th**2, (th - np.sin(th)) / th**3
-    V = np.eye(3) + A * W + B * W @ W
-    v = np.linalg.solve(V, p)
-    return [*v, *w]
+    """The constant body twist taking pose a to pose b in unit time (SE(3) log, the core's)."""
+    return list(_core.se3_log([float(x) for x in a], [float(x) for x in b]))
 
 
 def is_3d(path) -> bool:

@@ -711,13 +711,15 @@ struct Scene3D {
     inner: Scene3,
 }
 
-fn pose7(v: &[f64]) -> PyResult<nalgebra::Isometry3<f64>> {
+/// A 3-D pose `[x, y, z, qw, qx, qy, qz]` from Python (the quaternion normalized); errors name
+/// the argument `name`.
+fn pose7(name: &str, v: &[f64]) -> PyResult<nalgebra::Isometry3<f64>> {
     if v.len() != 7 {
-        return Err(arg_err("pose", "must be [x, y, z, qw, qx, qy, qz]"));
+        return Err(arg_err(name, format!("must be [x, y, z, qw, qx, qy, qz] (got {} numbers)", v.len())));
     }
     let a: [f64; 7] = std::array::from_fn(|i| v[i]);
-    scene3d::pose_from_array("pose", &a).map_err(|e| match e {
-        Error::Scene { message, .. } => arg_err("pose", message),
+    scene3d::pose_from_array(name, &a).map_err(|e| match e {
+        Error::Scene { message, .. } => arg_err(name, message),
         e => to_py(e),
     })
 }
@@ -797,16 +799,8 @@ impl Scene3D {
         connect: bool,
         cost_threshold: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let pose = |name: &str, v: Option<Vec<f64>>| -> PyResult<Option<nalgebra::Isometry3<f64>>> {
-            match v {
-                None => Ok(None),
-                Some(v) => {
-                    let a: [f64; 7] = v.try_into().map_err(|_| arg_err(name, "must have 7 numbers [x, y, z, qw, qx, qy, qz]"))?;
-                    scene3d::pose_from_array(name, &a).map(Some).map_err(to_py)
-                }
-            }
-        };
-        let (start, goal) = (pose("start", start)?, pose("goal", goal)?);
+        let start = start.map(|v| pose7("start", &v)).transpose()?;
+        let goal = goal.map(|v| pose7("goal", &v)).transpose()?;
         if !(goal_bias >= 0.0 && goal_bias <= 1.0) {
             return Err(arg_err("goal_bias", "must be in [0, 1]"));
         }
@@ -859,22 +853,15 @@ impl Scene3D {
     /// dynamics at 8 poses along it, pads on the object).
     #[pyo3(signature = (poses, pushers, twists=None))]
     fn validate_path(&self, poses: Vec<Vec<f64>>, pushers: Vec<Option<String>>, twists: Option<Vec<Vec<f64>>>) -> PyResult<Vec<bool>> {
-        let tw: Option<Vec<[f64; 6]>> = match twists {
-            None => None,
-            Some(t) => Some(
-                t.into_iter()
-                    .enumerate()
-                    .map(|(i, v)| v.try_into().map_err(|_| arg_err(&format!("path[{i}].pusher_twist"), "must have 6 numbers")))
-                    .collect::<PyResult<Vec<[f64; 6]>>>()?,
-            ),
-        };
+        let tw: Option<Vec<[f64; 6]>> = twists
+            .map(|t| t.iter().enumerate().map(|(i, v)| twist6(&format!("path[{i}].pusher_twist"), v)).collect::<PyResult<Vec<_>>>())
+            .transpose()?;
         if poses.len() != pushers.len() {
             return Err(arg_err("path", "poses and pushers differ in length"));
         }
         let mut path = Vec::new();
         for (i, (q, p)) in poses.into_iter().zip(pushers).enumerate() {
-            let a: [f64; 7] = q.try_into().map_err(|_| arg_err(&format!("path[{i}].pose"), "must have 7 numbers"))?;
-            let q = scene3d::pose_from_array(&format!("path[{i}].pose"), &a).map_err(to_py)?;
+            let q = pose7(&format!("path[{i}].pose"), &q)?;
             let p = match p {
                 None => None,
                 Some(n) => Some(self.inner.pusher_index(&n).map_err(to_py)?),
@@ -906,13 +893,13 @@ impl Scene3D {
     }
     /// Contact points (object frame) of the two finger pads at `pose`.
     fn pad_contacts(&self, pose: Vec<f64>) -> PyResult<Vec<Vec<[f64; 3]>>> {
-        let p = pose7(&pose)?;
+        let p = pose7("pose", &pose)?;
         Ok(self.inner.pad_contacts(&p).iter().map(|s| s.iter().map(|v| [v.x, v.y, v.z]).collect()).collect())
     }
     /// The quasi-static problem of `pusher` in contact at its points, at `pose`.
     #[pyo3(signature = (pose, pusher, h=1.0))]
     fn quasistatic_problem(&self, pose: Vec<f64>, pusher: &str, h: f64) -> PyResult<MncpProblem> {
-        let p = pose7(&pose)?;
+        let p = pose7("pose", &pose)?;
         let i = self.inner.pusher_index(pusher).map_err(to_py)?;
         Ok(MncpProblem { inner: quasistatic3d::push_problem(&self.inner, &p, i, h).map_err(to_py)? })
     }
@@ -926,7 +913,7 @@ impl Scene3D {
         duration: f64,
         dt: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let p = pose7(&pose)?;
+        let p = pose7("pose", &pose)?;
         if twist.len() != 6 || !twist.iter().all(|x| x.is_finite()) {
             return Err(arg_err("twist", "must be 6 finite numbers [vx, vy, vz, wx, wy, wz]"));
         }
@@ -1268,6 +1255,41 @@ impl Mpc {
     }
 }
 
+fn twist6(name: &str, v: &[f64]) -> PyResult<[f64; 6]> {
+    let a: [f64; 6] = v.try_into().map_err(|_| arg_err(name, format!("must have 6 numbers [vx, vy, vz, wx, wy, wz], got {}", v.len())))?;
+    if !a.iter().all(|x| x.is_finite()) {
+        return Err(arg_err(name, "has a non-finite component"));
+    }
+    Ok(a)
+}
+
+/// The constant body twist taking pose `a` to pose `b` in unit time (SE(3) log).
+#[pyfunction]
+fn se3_log(a: Vec<f64>, b: Vec<f64>) -> PyResult<[f64; 6]> {
+    Ok(regrasp::trrt3d::se3_log(&pose7("a", &a)?, &pose7("b", &b)?))
+}
+
+/// `pose ∘ exp(t · twist)` (body twist; SE(3) exp).
+#[pyfunction]
+fn se3_integrate(pose: Vec<f64>, twist: Vec<f64>, t: f64) -> PyResult<[f64; 7]> {
+    if !t.is_finite() {
+        return Err(arg_err("t", "must be finite"));
+    }
+    Ok(scene3d::pose_to_array(&quasistatic3d::integrate(&pose7("pose", &pose)?, &twist6("twist", &twist)?, t)))
+}
+
+/// `a ∘ b` of two poses.
+#[pyfunction]
+fn se3_compose(a: Vec<f64>, b: Vec<f64>) -> PyResult<[f64; 7]> {
+    Ok(scene3d::pose_to_array(&(pose7("a", &a)? * pose7("b", &b)?)))
+}
+
+/// `a⁻¹`.
+#[pyfunction]
+fn se3_inverse(a: Vec<f64>) -> PyResult<[f64; 7]> {
+    Ok(scene3d::pose_to_array(&pose7("a", &a)?.inverse()))
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
@@ -1275,6 +1297,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<MncpProblem>()?;
     m.add_class::<Scene3D>()?;
     m.add_class::<Mpc>()?;
+    m.add_function(wrap_pyfunction!(se3_log, m)?)?;
+    m.add_function(wrap_pyfunction!(se3_integrate, m)?)?;
+    m.add_function(wrap_pyfunction!(se3_compose, m)?)?;
+    m.add_function(wrap_pyfunction!(se3_inverse, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
