@@ -16,6 +16,7 @@ pub mod quasistatic3d;
 pub mod robust;
 pub mod scene;
 pub mod scene3d;
+pub mod tree;
 pub mod trrt;
 pub mod trrt3d;
 

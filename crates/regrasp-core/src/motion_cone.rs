@@ -528,9 +528,14 @@ pub fn project_exact(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> Vec
 /// exact projection, then moved towards the mean of the generators until the margin holds.
 /// `None` when the cone is empty or the support cannot hold the object.
 pub fn project_with_margin(frame: &SupportFrame, model: &PusherModel, want: &Vec3, margin_min: f64) -> Option<Vec3> {
+    project_with_margin_on(frame, model, &crate::robust::generators(frame, model), want, margin_min)
+}
+
+/// [`project_with_margin`] with the cone's generators already computed (`gens`, unit twists).
+pub fn project_with_margin_on(frame: &SupportFrame, model: &PusherModel, gens: &[Vec3], want: &Vec3, margin_min: f64) -> Option<Vec3> {
     let m = &model.metric;
-    let gens = crate::robust::generators(frame, model);
-    if gens.is_empty() || (frame.mode == ConeMode::Nominal && gens.len() != model.edges.len()) {
+    // (a nominal cone with fewer rays than W_p has edges: the support cannot hold the object)
+    if gens.is_empty() || (frame.mode == ConeMode::Nominal && gens.len() < model.edges.len()) {
         return None;
     }
     let gs: Vec<Vec3> = gens.iter().map(|g| m.twist(g)).collect();
@@ -562,7 +567,9 @@ pub fn project_with_margin(frame: &SupportFrame, model: &PusherModel, want: &Vec
             lo = mid;
         }
     }
-    Some((v / vn * (1.0 - hi) + centre / cn * hi) * vn)
+    // the blend of two unit directions is shorter than either: back to the projection's speed
+    let x = v / vn * (1.0 - hi) + centre / cn * hi;
+    Some(x * (vn / m.twist_norm(&x)))
 }
 
 /// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images of
@@ -672,29 +679,40 @@ fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> 
 pub fn project_onto_generators(gens: &[Vec3], d: &Vec3) -> (Vec3, Vec<f64>) {
     let k = gens.len();
     let mut best = (d.norm_squared(), Vec3::zeros(), vec![0.0; k]);
-    for mask in 1u32..(1u32 << k) {
-        let idx: Vec<usize> = (0..k).filter(|i| mask & (1 << i) != 0).collect();
-        if idx.len() > 3 {
-            continue;
+    // every face spanned by 1, 2 or 3 generators: O(k³) small fixed-size solves
+    let mut consider = |idx: &[usize]| {
+        let n = idx.len();
+        let mut g = nalgebra::Matrix3::<f64>::zeros();
+        for (j, &i) in idx.iter().enumerate() {
+            g.set_column(j, &gens[i]);
         }
-        let g = nalgebra::Matrix3xX::from_columns(&idx.iter().map(|&i| gens[i]).collect::<Vec<_>>());
-        let gtg = g.transpose() * &g;
-        if gtg.determinant().abs() < 1e-14 * gtg.norm().powi(idx.len() as i32) {
-            continue;
+        let g = g.columns(0, n);
+        let gtg = g.transpose() * g;
+        if gtg.determinant().abs() < 1e-14 * gtg.norm().powi(n as i32) {
+            return;
         }
-        let Some(inv) = gtg.try_inverse() else { continue };
+        let Some(inv) = gtg.try_inverse() else { return };
         let alpha = inv * (g.transpose() * d);
         if alpha.iter().any(|&a| a < 0.0) {
-            continue;
+            return;
         }
-        let p = &g * &alpha;
+        let p: Vec3 = g * &alpha;
         let res = (d - p).norm_squared();
         if res < best.0 {
             let mut w = vec![0.0; k];
             for (j, &i) in idx.iter().enumerate() {
                 w[i] = alpha[j];
             }
-            best = (res, Vec3::new(p[0], p[1], p[2]), w);
+            best = (res, p, w);
+        }
+    };
+    for a in 0..k {
+        consider(&[a]);
+        for b in a + 1..k {
+            consider(&[a, b]);
+            for c in b + 1..k {
+                consider(&[a, b, c]);
+            }
         }
     }
     (best.1, best.2)

@@ -26,7 +26,7 @@
 
 use crate::error::{Error, Result};
 use crate::geometry::{rot, Vec2, Vec3};
-use crate::motion_cone::project_with_margin;
+use crate::motion_cone::project_with_margin_on;
 use crate::quasistatic::integrate;
 use crate::robust::generators;
 use crate::scene::Scene;
@@ -66,6 +66,36 @@ pub struct MpcSettings {
     /// Planner settings for re-planning.
     pub planner: trrt::Settings,
 }
+
+impl MpcSettings {
+    /// Checks every setting; the error names it.
+    pub fn check(&self) -> Result<()> {
+        for (name, v) in [("dt", self.dt), ("speed", self.speed), ("stage_weight", self.stage_weight),
+                          ("terminal_weight", self.terminal_weight), ("replan_error", self.replan_error)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::arg(name, format!("must be a finite, positive number (got {v})")));
+            }
+        }
+        for (name, v) in [("effort_weight", self.effort_weight), ("margin", self.margin), ("progress", self.progress)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::arg(name, format!("must be a finite, non-negative number (got {v})")));
+            }
+        }
+        if !(self.goal_fraction > 0.0 && self.goal_fraction <= 1.0) {
+            return Err(Error::arg("goal_fraction", format!("must be in (0, 1] (got {})", self.goal_fraction)));
+        }
+        if !(1..=MAX_HORIZON).contains(&self.horizon) {
+            return Err(Error::arg("horizon", format!("must be between 1 and {MAX_HORIZON} steps (got {})", self.horizon)));
+        }
+        if self.stall_steps == 0 {
+            return Err(Error::arg("stall_steps", "must be at least 1"));
+        }
+        self.planner.check()
+    }
+}
+
+/// Longest horizon (steps) of the QP.
+pub const MAX_HORIZON: usize = 200;
 
 impl Default for MpcSettings {
     fn default() -> Self {
@@ -153,23 +183,39 @@ pub struct Mpc {
     best_tracking: f64,
     since_tracking: usize,
     pub replans: usize,
+    /// Why the last re-planning failed (None if it did not).
+    pub last_replan_error: Option<String>,
 }
 
+/// Most knots a resampled plan may have (a typo in `dt` or `speed` must not exhaust memory).
+pub const MAX_KNOTS: usize = 1_000_000;
+
 /// Resamples a path (poses and the pusher reaching each) into knots `ds` apart (metric).
-pub fn resample(scene: &Scene, path: &[([f64; 3], Option<usize>)], ds: f64) -> (Vec<[f64; 3]>, Vec<Option<usize>>) {
+pub fn resample(scene: &Scene, path: &[([f64; 3], Option<usize>)], ds: f64) -> Result<(Vec<[f64; 3]>, Vec<Option<usize>>)> {
+    if path.is_empty() {
+        return Err(Error::arg("plan", "is empty"));
+    }
+    if !(ds.is_finite() && ds > 0.0) {
+        return Err(Error::arg("settings", format!("the knot spacing speed × dt must be positive (got {ds})")));
+    }
     let m = scene.metric();
+    let steps: Vec<f64> = path.windows(2).map(|w| m.twist_norm(&body_twist(&w[0].0, &w[1].0)) / ds).collect();
+    let total: f64 = steps.iter().map(|n| n.ceil().max(1.0)).sum();
+    if !(total <= MAX_KNOTS as f64) {
+        return Err(Error::arg("settings", format!("speed × dt = {ds:.3e} m would cut the plan into {total:.3e} knots (at most {MAX_KNOTS})")));
+    }
     let mut knots = vec![path[0].0];
     let mut pushers = vec![None];
-    for w in path.windows(2) {
+    for (w, n) in path.windows(2).zip(steps) {
         let (a, b) = (w[0].0, w[1].0);
         let xi = body_twist(&a, &b);
-        let n = (m.twist_norm(&xi) / ds).ceil().max(1.0) as usize;
+        let n = n.ceil().max(1.0) as usize;
         for k in 1..=n {
             knots.push(integrate(&a, &xi, k as f64 / n as f64));
             pushers.push(w[1].1);
         }
     }
-    (knots, pushers)
+    Ok((knots, pushers))
 }
 
 impl Mpc {
@@ -191,12 +237,16 @@ impl Mpc {
                 return Err(Error::arg(format!("plan.path[{i}].pusher"), "is missing"));
             }
         }
-        if !(settings.dt > 0.0) || !(settings.speed > 0.0) || settings.horizon == 0 {
-            return Err(Error::arg("settings", "dt and speed must be positive and the horizon at least 1"));
-        }
+        settings.check()?;
         let goal = goal.or(scene.task.map(|t| t.goal)).unwrap_or(path[path.len() - 1].0);
+        if !goal.iter().all(|x| x.is_finite()) {
+            return Err(Error::arg("goal", "has a non-finite component"));
+        }
+        if !scene.admissible(&goal) || !(scene.hold_ratio(&goal) < 1.0) {
+            return Err(Error::arg("goal", format!("{goal:?}: the pad is not on the object there or the grasp cannot hold it")));
+        }
         let tol = scene.task.map(|t| t.tolerance).unwrap_or([1e-3, 1e-3, 0.0175]);
-        let (knots, pushers) = resample(scene, path, settings.speed * settings.dt);
+        let (knots, pushers) = resample(scene, path, settings.speed * settings.dt)?;
         Ok(Self {
             scene: scene.clone(),
             settings,
@@ -210,6 +260,7 @@ impl Mpc {
             best_tracking: f64::INFINITY,
             since_tracking: 0,
             replans: 0,
+            last_replan_error: None,
         })
     }
 
@@ -242,6 +293,10 @@ impl Mpc {
 
     /// The QP from pose `q` with reference knots after `j`.
     pub fn solve_qp(&self, q: &[f64; 3], j: usize) -> Result<QpSolution> {
+        if !q.iter().all(|x| x.is_finite()) {
+            return Err(Error::arg("pose", "has a non-finite component"));
+        }
+        let j = j.min(self.knots.len() - 1);
         let s = &self.settings;
         let ds = s.speed * s.dt;
         let n_knots = self.knots.len();
@@ -262,7 +317,7 @@ impl Mpc {
                     // exact cone, as one more generator
                     let d = body_twist(&at, &self.knots[r]);
                     if metric.twist_norm(&d) > 1e-12 && !g.is_empty() {
-                        if let Some(u) = project_with_margin(&f, model, &d, s.margin) {
+                        if let Some(u) = project_with_margin_on(&f, model, &g, &d, s.margin) {
                             let n = metric.twist_norm(&u);
                             if n > 1e-12 {
                                 g.push(u / n);
@@ -369,11 +424,18 @@ impl Mpc {
         self.replans += 1;
         let mut ps = self.settings.planner.clone();
         ps.seed = ps.seed.wrapping_add(self.replans as u64);
-        let Ok(r) = trrt::plan(&self.scene, Some(*q), Some(self.goal), &ps) else { return false };
+        let r = match trrt::plan(&self.scene, Some(*q), Some(self.goal), &ps) {
+            Ok(r) => r,
+            Err(e) => {
+                self.last_replan_error = Some(e.to_string());
+                return false;
+            }
+        };
         if r.path.len() < 2 {
+            self.last_replan_error = Some(format!("the planner found no step from {q:?} ({})", r.stop_reason.label()));
             return false;
         }
-        let (k, p) = resample(&self.scene, &r.path, self.settings.speed * self.settings.dt);
+        let Ok((k, p)) = resample(&self.scene, &r.path, self.settings.speed * self.settings.dt) else { return false };
         self.knots = k;
         self.pushers = p;
         self.last_knot = 0;
@@ -389,6 +451,10 @@ impl Mpc {
         if !q.iter().all(|x| x.is_finite()) {
             return Err(Error::arg("pose", "has a non-finite component"));
         }
+        // the measured angle on the branch of the plan's (a measurement wrapped to (−π, π]
+        // must not look 2π away from a plan that crosses ±π)
+        let r = self.knots[self.last_knot.min(self.knots.len() - 1)][2];
+        let q = &[q[0], q[1], q[2] + std::f64::consts::TAU * ((r - q[2]) / std::f64::consts::TAU).round()];
         let t0 = Instant::now();
         // progress towards the goal
         let dg = self.dist(q, &self.goal);
@@ -442,7 +508,7 @@ impl Mpc {
                             v
                         } else {
                             projected = true;
-                            match project_with_margin(&f, model, &v, self.settings.margin) {
+                            match project_with_margin_on(&f, model, gens, &v, self.settings.margin) {
                                 Some(u) => u,
                                 None => Vec3::zeros(),
                             }

@@ -14,6 +14,9 @@ use crate::mncp::{self, Contact, ContactState, FrictionLaw, NormalLaw, Problem, 
 use crate::scene::{PadShape, Scene, Support};
 use nalgebra::{DMatrix, DVector};
 
+/// Most time steps one simulated push may take (a typo in `dt` must not run for hours).
+pub const MAX_STEPS: f64 = 1e6;
+
 /// How the support (finger pads, or the surface under the object) enters the problem.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SupportModel {
@@ -308,6 +311,9 @@ pub fn simulate_push(
 ) -> Result<Trajectory> {
     if !(dt > 0.0) || !(duration >= 0.0) || !duration.is_finite() {
         return Err(Error::arg("dt", "time step and duration must be positive and finite"));
+    }
+    if duration / dt > MAX_STEPS {
+        return Err(Error::arg("dt", format!("{:.0} time steps asked for (duration / dt); at most {MAX_STEPS:.0}", duration / dt)));
     }
     scene.check_pose(q0)?;
     let pz = scene.pushers.get(pusher).ok_or_else(|| Error::arg("pusher", format!("index {pusher} out of range")))?;

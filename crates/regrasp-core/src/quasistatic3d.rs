@@ -7,6 +7,7 @@
 //! rigid point set with unilateral contacts and Coulomb cones (two tangent directions).
 
 use crate::error::{Error, Result};
+use crate::quasistatic::MAX_STEPS;
 use crate::mncp::{self, Contact, ContactState, FrictionLaw, NormalLaw, Problem, Settings, Side, Solution};
 use crate::scene3d::{Scene3, V3};
 use nalgebra::{DMatrix, DVector, Isometry3, Matrix3, Translation3, UnitQuaternion};
@@ -166,6 +167,9 @@ pub fn simulate_push(
 ) -> Result<Trajectory3> {
     if !(dt > 0.0) || !(duration >= 0.0) || !duration.is_finite() {
         return Err(Error::arg("dt", "time step and duration must be positive and finite"));
+    }
+    if duration / dt > MAX_STEPS {
+        return Err(Error::arg("dt", format!("{:.0} time steps asked for (duration / dt); at most {MAX_STEPS:.0}", duration / dt)));
     }
     let pz = scene.pushers.get(pusher).ok_or_else(|| Error::arg("pusher", format!("index {pusher} out of range")))?;
     let steps = (duration / dt).round() as usize;

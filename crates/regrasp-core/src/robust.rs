@@ -155,47 +155,58 @@ pub fn mode_margin(mode: ConeMode, frame: &SupportFrame, model: &PusherModel, no
 
 /// Generators (unit twists) of a polyhedral cone inside the mode's cone: for the robust cone,
 /// the rays of `V(ρ_min)` and of `V_gf` that pass the robust test and the crossings of the robust
-/// boundary on the chords between them (exact where both cones are polyhedral, an inner
-/// approximation otherwise); for fixtureless fixturing the gravity-free rays (or none).
+/// boundary on the chords between them — an inside ray and an outside one, or two outside rays
+/// whose chord passes through the robust cone (the two cones crossing like a star) — reduced to
+/// the extreme rays (exact where both cones are polyhedral, an inner approximation otherwise);
+/// for fixtureless fixturing the gravity-free rays (or none).
 pub fn generators(frame: &SupportFrame, model: &PusherModel) -> Vec<Vec3> {
     let m = &model.metric;
-    let gf: Vec<Vec3> = model.edges.iter().map(|e| frame.gravity_free_ray(&e.wrench, m)).collect();
+    let gravity_free = || model.edges.iter().map(|e| frame.gravity_free_ray(&e.wrench, m)).collect::<Vec<Vec3>>();
     match frame.mode {
         ConeMode::Nominal => model.edges.iter().filter_map(|e| frame.ray(&e.wrench, m)).collect(),
         ConeMode::Fixtureless => {
             if carries_weight(frame, model) {
-                gf
+                gravity_free()
             } else {
                 Vec::new()
             }
         }
         ConeMode::Robust => {
             let mut cands: Vec<Vec3> = model.edges.iter().filter_map(|e| frame.ray(&e.wrench, m)).collect();
-            cands.extend(gf);
-            let margin = |v: &Vec3| frame.classify(model, v).margin;
-            let inside: Vec<bool> = cands.iter().map(|v| margin(v) >= -1e-9).collect();
+            cands.extend(gravity_free());
+            let inside_at = |v: &Vec3| frame.classify(model, v).margin >= 0.0;
+            let inside: Vec<bool> = cands.iter().map(|v| frame.classify(model, v).margin >= -1e-9).collect();
             let mut out: Vec<Vec3> = cands.iter().zip(&inside).filter(|(_, &i)| i).map(|(v, _)| *v).collect();
+            // the robust boundary between s_in (inside) and s_out on the chord a→b
+            let cross = |a: &Vec3, b: &Vec3, mut s_in: f64, mut s_out: f64| -> Vec3 {
+                let at = |s: f64| m.twist_inv(&(a * (1.0 - s) + b * s));
+                for _ in 0..24 {
+                    let mid = 0.5 * (s_in + s_out);
+                    if inside_at(&at(mid)) {
+                        s_in = mid;
+                    } else {
+                        s_out = mid;
+                    }
+                }
+                let v = at(s_in);
+                v / m.twist_norm(&v)
+            };
             for i in 0..cands.len() {
                 for j in 0..cands.len() {
-                    if !(inside[i] && !inside[j]) {
-                        continue;
-                    }
                     let (a, b) = (m.twist(&cands[i]), m.twist(&cands[j]));
-                    if a.dot(&b) < -0.999 {
+                    if i == j || a.dot(&b) < -0.999 {
                         continue;
                     }
-                    let at = |s: f64| m.twist_inv(&(a * (1.0 - s) + b * s));
-                    let (mut lo, mut hi) = (0.0, 1.0);
-                    for _ in 0..24 {
-                        let mid = 0.5 * (lo + hi);
-                        if margin(&at(mid)) >= 0.0 {
-                            lo = mid;
-                        } else {
-                            hi = mid;
+                    if inside[i] && !inside[j] {
+                        out.push(cross(&a, &b, 0.0, 1.0));
+                    } else if !inside[i] && !inside[j] && i < j {
+                        // both outside: the chord may still pass through the robust cone
+                        let at = |s: f64| m.twist_inv(&(a * (1.0 - s) + b * s));
+                        if let Some(s) = (1..8).map(|k| k as f64 / 8.0).find(|&s| inside_at(&at(s))) {
+                            out.push(cross(&a, &b, s, 0.0));
+                            out.push(cross(&a, &b, s, 1.0));
                         }
                     }
-                    let v = at(lo);
-                    out.push(v / m.twist_norm(&v));
                 }
             }
             extreme_rays(&out, m)

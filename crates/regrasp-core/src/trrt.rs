@@ -24,6 +24,7 @@ use crate::mncp;
 use crate::motion_cone::{project_with_margin, SupportFrame};
 use crate::quasistatic::{self, integrate, Options as QsOptions, SupportModel};
 use crate::scene::Scene;
+use crate::tree::{edge_cost, pusher_order, switch_overs, Tree, TreeNode};
 use kiddo::{KdTree, SquaredEuclidean};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -101,6 +102,46 @@ pub struct Settings {
     pub plain: bool,
 }
 
+impl Settings {
+    /// Checks every setting (NaN, negative or absurd values are errors naming the setting).
+    pub fn check(&self) -> Result<()> {
+        let finite_nonneg = |name: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 { Ok(()) } else { Err(Error::arg(name, format!("must be a finite, non-negative number (got {v})"))) }
+        };
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 { Ok(()) } else { Err(Error::arg(name, format!("must be a finite, positive number (got {v})"))) }
+        };
+        finite_nonneg("time_limit", self.time_limit)?;
+        if !(0.0..=1.0).contains(&self.goal_bias) {
+            return Err(Error::arg("goal_bias", format!("must be in [0, 1] (got {})", self.goal_bias)));
+        }
+        if let Some(step) = self.step {
+            positive("step", step)?;
+        }
+        finite_nonneg("margin", self.margin)?;
+        for (name, v) in [("k", self.k), ("t0", self.t0), ("c_max", self.c_max)] {
+            positive(name, v)?;
+        }
+        if !(self.alpha.is_finite() && self.alpha >= 1.0) {
+            return Err(Error::arg("alpha", format!("must be a finite factor >= 1 (got {})", self.alpha)));
+        }
+        for (name, v) in [("neighbour_steps", self.neighbour_steps), ("same_pusher_cost", self.same_pusher_cost),
+                          ("switch_cost", self.switch_cost), ("length_weight", self.length_weight), ("theta_margin", self.theta_margin)] {
+            finite_nonneg(name, v)?;
+        }
+        if self.cost_threshold.is_nan() {
+            return Err(Error::arg("cost_threshold", "is NaN"));
+        }
+        for (name, v, hi) in [("checks", self.checks, 10_000), ("random_tries", self.random_tries, 10_000),
+                              ("max_nodes", self.max_nodes, 100_000_000)] {
+            if v == 0 && name != "random_tries" || v > hi {
+                return Err(Error::arg(name, format!("must be between 1 and {hi} (got {v})")));
+            }
+        }
+        Ok(())
+    }
+}
+
 impl Default for Settings {
     fn default() -> Self {
         Self {
@@ -131,17 +172,8 @@ impl Default for Settings {
     }
 }
 
-/// A node of the tree.
-#[derive(Clone, Debug)]
-pub struct Node {
-    pub q: [f64; 3],
-    pub parent: Option<usize>,
-    /// The pusher of the step from the parent (None for the root).
-    pub pusher: Option<usize>,
-    /// Cumulative edge cost from the root.
-    pub cost: f64,
-    pub children: Vec<usize>,
-}
+/// A node of the planar tree (see [`crate::tree`]).
+pub type Node = TreeNode<[f64; 3], ()>;
 
 /// Why the planner stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -241,7 +273,7 @@ struct Planner<'a> {
     goal: [f64; 3],
     tol: [f64; 3],
     rng: ChaCha8Rng,
-    nodes: Vec<Node>,
+    nodes: Tree<[f64; 3], ()>,
     tree: KdTree<f64, 3>,
     transition: Transition,
     bounds: ([f64; 2], [f64; 2], [f64; 2]),
@@ -266,11 +298,8 @@ impl<'a> Planner<'a> {
     }
 
     fn edge_cost(&self, parent_pusher: Option<usize>, pusher: usize, length: f64) -> f64 {
-        let switch = match parent_pusher {
-            Some(p) if p == pusher => self.s.same_pusher_cost,
-            _ => self.s.switch_cost,
-        };
-        switch + self.s.length_weight * length / self.l
+        let s = self.s;
+        edge_cost(s.same_pusher_cost, s.switch_cost, s.length_weight, self.l, parent_pusher, pusher, length)
     }
 
     /// The frame at `q` when the pad is on the object and the grasp holds.
@@ -443,13 +472,7 @@ impl<'a> Planner<'a> {
     }
 
     fn pusher_order(&self, first: Option<usize>) -> Vec<usize> {
-        let n = self.scene.pushers.len();
-        let mut order: Vec<usize> = Vec::with_capacity(n);
-        if let Some(p) = first {
-            order.push(p);
-        }
-        order.extend((0..n).filter(|i| Some(*i) != first));
-        order
+        pusher_order(self.scene.pushers.len(), first)
     }
 
     /// Stable-check propagation (ICRA 2018): random step directions towards the target's
@@ -534,9 +557,7 @@ impl<'a> Planner<'a> {
     }
 
     fn add(&mut self, q: [f64; 3], parent: usize, pusher: usize, cost: f64) -> usize {
-        let i = self.nodes.len();
-        self.nodes.push(Node { q, parent: Some(parent), pusher: Some(pusher), cost, children: Vec::new() });
-        self.nodes[parent].children.push(i);
+        let i = self.nodes.add(q, parent, pusher, cost, ());
         let k = self.key(&q);
         self.tree.add(&k, i as u64);
         i
@@ -589,40 +610,14 @@ impl<'a> Planner<'a> {
             let tw = body_twist(&qi, &self.nodes[k].q);
             let len = m.twist_norm(&tw);
             let c = self.nodes[i].cost + self.edge_cost(self.nodes[i].pusher, pk, len);
-            if c < self.nodes[k].cost - 1e-12 && !self.is_ancestor(k, i) && self.step_feasible(&qi, &tw, pk, self.s.margin) {
-                let delta = self.nodes[k].cost - c;
-                let old = self.nodes[k].parent.expect("not the root");
-                self.nodes[old].children.retain(|&x| x != k);
-                self.nodes[k].parent = Some(i);
-                self.nodes[i].children.push(k);
-                // the subtree's costs all drop by delta (its pushers are unchanged)
-                let mut stack = vec![k];
-                while let Some(n) = stack.pop() {
-                    self.nodes[n].cost -= delta;
-                    stack.extend(self.nodes[n].children.iter().copied());
-                }
+            if c < self.nodes[k].cost - 1e-12 && !self.nodes.is_ancestor(k, i) && self.step_feasible(&qi, &tw, pk, self.s.margin) {
+                self.nodes.reparent(k, i, c, ());
             }
         }
     }
 
-    fn is_ancestor(&self, a: usize, mut b: usize) -> bool {
-        while let Some(p) = self.nodes[b].parent {
-            if p == a {
-                return true;
-            }
-            b = p;
-        }
-        false
-    }
-
-    fn path_to(&self, mut i: usize) -> Vec<([f64; 3], Option<usize>)> {
-        let mut out = vec![(self.nodes[i].q, self.nodes[i].pusher)];
-        while let Some(p) = self.nodes[i].parent {
-            i = p;
-            out.push((self.nodes[i].q, self.nodes[i].pusher));
-        }
-        out.reverse();
-        out
+    fn path_to(&self, i: usize) -> Vec<([f64; 3], Option<usize>)> {
+        self.nodes.path_to(i).into_iter().map(|(q, p, _)| (q, p)).collect()
     }
 }
 
@@ -669,9 +664,7 @@ pub fn plan_tree(
             return Err(Error::arg(name, format!("{q:?}: the grasp cannot hold the object against gravity there")));
         }
     }
-    if !(settings.time_limit >= 0.0) || !(settings.goal_bias >= 0.0 && settings.goal_bias <= 1.0) {
-        return Err(Error::arg("settings", "time_limit must be ≥ 0 and goal_bias in [0, 1]"));
-    }
+    settings.check()?;
     let l = scene.length;
     let step = settings.step.unwrap_or(0.1 * l);
     if !(step > 0.0) {
@@ -688,7 +681,7 @@ pub fn plan_tree(
         goal,
         tol,
         rng: ChaCha8Rng::seed_from_u64(settings.seed),
-        nodes: vec![Node { q: start, parent: None, pusher: None, cost: 0.0, children: Vec::new() }],
+        nodes: Tree::new(start, ()),
         tree: KdTree::new(),
         transition: Transition::new(settings, 0.0),
         bounds: ([-reach, reach], [-reach, reach], [tlo, thi]),
@@ -743,17 +736,13 @@ pub fn plan_tree(
             }
         }
     };
-    // rewiring may have lowered the cost of an earlier goal node
-    if let Some(g) = best_goal {
-        for (i, n) in pl.nodes.iter().enumerate() {
-            if pl.at_goal(&n.q) && n.cost < pl.nodes[g].cost {
-                best_goal = Some(i);
-            }
-        }
+    // rewiring may have made another goal node the cheapest
+    if best_goal.is_some() {
+        best_goal = pl.nodes.cheapest(|q| pl.at_goal(q));
     }
     let end = best_goal.unwrap_or(closest);
     let path = pl.path_to(end);
-    let switch_overs = path.windows(2).skip(1).filter(|w| w[0].1 != w[1].1).count();
+    let switch_overs = switch_overs(&pl.nodes.path_to(end));
     let result = PlanResult {
         found: best_goal.is_some(),
         stop_reason: if best_goal.is_some() { StopReason::GoalReached } else { stop },
@@ -765,7 +754,7 @@ pub fn plan_tree(
         planning_time_s: t0.elapsed().as_secs_f64(),
         switch_overs,
     };
-    Ok((result, pl.nodes))
+    Ok((result, pl.nodes.into_nodes()))
 }
 
 /// ICRA 2018 "stable check": is there a pusher force in its friction cone that, with the
@@ -869,7 +858,7 @@ mod tests {
             goal: [0.0; 3],
             tol: [1e-3; 3],
             rng: ChaCha8Rng::seed_from_u64(1),
-            nodes: vec![],
+            nodes: Tree::new([0.0; 3], ()),
             tree: KdTree::new(),
             transition: Transition { temperature: 0.1, ..Transition::new(&settings, 10.0) },
             bounds: ([0.0; 2], [0.0; 2], [0.0; 2]),

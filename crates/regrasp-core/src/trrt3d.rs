@@ -25,6 +25,7 @@ use crate::error::{Error, Result};
 use crate::mncp;
 use crate::quasistatic3d::{integrate, push_problem, simulate_push};
 use crate::scene3d::{Scene3, V3};
+use crate::tree::{edge_cost, pusher_order, switch_overs, Tree, TreeNode};
 use crate::trrt::{stop_reason, Settings, StopReason, Transition};
 use kiddo::{KdTree, SquaredEuclidean};
 use nalgebra::{DVector, Isometry3, Matrix3, UnitQuaternion};
@@ -67,17 +68,9 @@ pub fn twist_length(l: f64, u: &Twist6) -> f64 {
     (u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + l * l * (u[3] * u[3] + u[4] * u[4] + u[5] * u[5])).sqrt()
 }
 
-/// A node of the 3-D tree.
-#[derive(Clone, Debug)]
-pub struct Node3 {
-    pub q: Isometry3<f64>,
-    pub parent: Option<usize>,
-    pub pusher: Option<usize>,
-    /// The pusher's body twist over the step from the parent (unit time).
-    pub twist: Twist6,
-    pub cost: f64,
-    pub children: Vec<usize>,
-}
+/// A node of the 3-D tree (see [`crate::tree`]); its `edge` is the pusher's body twist over the
+/// step from the parent (unit time).
+pub type Node3 = TreeNode<Isometry3<f64>, Twist6>;
 
 /// The planner's answer.
 #[derive(Clone, Debug)]
@@ -104,10 +97,12 @@ struct Planner3<'a> {
     step: f64,
     goal: Isometry3<f64>,
     rng: ChaCha8Rng,
-    nodes: Vec<Node3>,
+    nodes: Tree<Isometry3<f64>, Twist6>,
     tree: KdTree<f64, 7>,
     transition: Transition,
     solves: std::sync::atomic::AtomicUsize,
+    /// The object's largest vertex distance from its frame.
+    reach: f64,
 }
 
 fn key(l: f64, q: &Isometry3<f64>) -> [f64; 7] {
@@ -184,15 +179,12 @@ impl<'a> Planner3<'a> {
     }
 
     fn edge_cost(&self, parent_pusher: Option<usize>, pusher: usize, length: f64) -> f64 {
-        let sw = if parent_pusher == Some(pusher) { self.s.same_pusher_cost } else { self.s.switch_cost };
-        sw + self.s.length_weight * length / self.l
+        let s = self.s;
+        edge_cost(s.same_pusher_cost, s.switch_cost, s.length_weight, self.l, parent_pusher, pusher, length)
     }
 
     fn order(&self, first: Option<usize>) -> Vec<usize> {
-        let n = self.scene.pushers.len();
-        let mut o: Vec<usize> = first.into_iter().collect();
-        o.extend((0..n).filter(|i| Some(*i) != first));
-        o
+        pusher_order(self.scene.pushers.len(), first)
     }
 
     /// The first pusher (in `order`) that can take step `u` from `q`, pushers evaluated in
@@ -204,11 +196,10 @@ impl<'a> Planner3<'a> {
     fn feasible_pusher(&self, q: &Isometry3<f64>, u: &Twist6, order: &[usize]) -> Option<(usize, Isometry3<f64>)> {
         let l = self.l;
         let len = twist_length(l, u);
-        let found: Vec<Option<Isometry3<f64>>> = order
-            .par_iter()
-            .map(|&p| {
+        // the first pusher in order that can (the later ones are not evaluated once it is known)
+        order.par_iter().find_map_first(|&p| {
                 if step_feasible(self.scene, q, u, p, self.s.checks, Some(&self.solves)) {
-                    return Some(integrate(q, u, 1.0));
+                    return Some((p, integrate(q, u, 1.0)));
                 }
                 self.solves.fetch_add(self.s.checks + 1, std::sync::atomic::Ordering::Relaxed);
                 let end = simulate_step(self.scene, q, u, p, self.s.checks)?;
@@ -219,10 +210,8 @@ impl<'a> Planner3<'a> {
                 }
                 let m = |x: &Twist6| [x[0], x[1], x[2], l * x[3], l * x[4], l * x[5]];
                 let cos = m(&v).iter().zip(m(u).iter()).map(|(a, b)| a * b).sum::<f64>() / (vl * len);
-                (cos >= 0.5).then_some(end)
-            })
-            .collect();
-        order.iter().zip(found).find_map(|(p, w)| w.map(|w| (*p, w)))
+                (cos >= 0.5).then_some((p, end))
+        })
     }
 
     fn gauss(&mut self) -> f64 {
@@ -237,7 +226,7 @@ impl<'a> Planner3<'a> {
             return self.goal;
         }
         let start = self.nodes[0].q;
-        let reach = self.scene.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let reach = self.reach;
         let t: f64 = self.rng.random();
         let rot = start.rotation.slerp(&self.goal.rotation, t);
         let ax = V3::new(self.gauss(), self.gauss(), self.gauss());
@@ -292,9 +281,7 @@ impl<'a> Planner3<'a> {
     }
 
     fn add(&mut self, q: Isometry3<f64>, parent: usize, pusher: usize, cost: f64, twist: Twist6) -> usize {
-        let i = self.nodes.len();
-        self.nodes.push(Node3 { q, parent: Some(parent), pusher: Some(pusher), twist, cost, children: Vec::new() });
-        self.nodes[parent].children.push(i);
+        let i = self.nodes.add(q, parent, pusher, cost, twist);
         self.tree.add(&key(self.l, &q), i as u64);
         i
     }
@@ -345,30 +332,13 @@ impl<'a> Planner3<'a> {
             let Some(pk) = self.nodes[k].pusher else { continue };
             let u = se3_log(&qi, &self.nodes[k].q);
             let c = self.nodes[i].cost + self.edge_cost(self.nodes[i].pusher, pk, twist_length(self.l, &u));
-            if c < self.nodes[k].cost - 1e-12 && !self.is_ancestor(k, i) && step_feasible(self.scene, &qi, &u, pk, self.s.checks, Some(&self.solves)) {
-                let delta = self.nodes[k].cost - c;
-                let old = self.nodes[k].parent.expect("not the root");
-                self.nodes[old].children.retain(|&x| x != k);
-                self.nodes[k].parent = Some(i);
-                self.nodes[k].twist = u;
-                self.nodes[i].children.push(k);
-                let mut stack = vec![k];
-                while let Some(n) = stack.pop() {
-                    self.nodes[n].cost -= delta;
-                    stack.extend(self.nodes[n].children.iter().copied());
-                }
+            if c < self.nodes[k].cost - 1e-12
+                && !self.nodes.is_ancestor(k, i)
+                && step_feasible(self.scene, &qi, &u, pk, self.s.checks, Some(&self.solves))
+            {
+                self.nodes.reparent(k, i, c, u);
             }
         }
-    }
-
-    fn is_ancestor(&self, a: usize, mut b: usize) -> bool {
-        while let Some(p) = self.nodes[b].parent {
-            if p == a {
-                return true;
-            }
-            b = p;
-        }
-        false
     }
 
     /// Straight push to the goal from node `i` (unit steps of one constant twist, one pusher).
@@ -409,15 +379,6 @@ impl<'a> Planner3<'a> {
         Some(last)
     }
 
-    fn path_to(&self, mut i: usize) -> Vec<(Isometry3<f64>, Option<usize>, Twist6)> {
-        let mut out = vec![(self.nodes[i].q, self.nodes[i].pusher, self.nodes[i].twist)];
-        while let Some(p) = self.nodes[i].parent {
-            i = p;
-            out.push((self.nodes[i].q, self.nodes[i].pusher, self.nodes[i].twist));
-        }
-        out.reverse();
-        out
-    }
 }
 
 /// Plans a 3-D regrasp from `start` to `goal` (defaults: the scene's task). Uses the planar
@@ -431,9 +392,7 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
             return Err(Error::arg(name, "the finger pads do not both touch the object there"));
         }
     }
-    if !(settings.time_limit >= 0.0) {
-        return Err(Error::arg("time_limit", "must be non-negative"));
-    }
+    settings.check()?;
     let l = scene.length;
     let step = settings.step.unwrap_or(0.2 * l);
     if !(step > 0.0) {
@@ -447,10 +406,11 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
         step,
         goal,
         rng: ChaCha8Rng::seed_from_u64(settings.seed),
-        nodes: vec![Node3 { q: start, parent: None, pusher: None, twist: [0.0; 6], cost: 0.0, children: Vec::new() }],
+        nodes: Tree::new(start, [0.0; 6]),
         tree: KdTree::new(),
         transition: Transition::new(settings, 0.0),
         solves: std::sync::atomic::AtomicUsize::new(0),
+        reach: scene.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max),
     };
     pl.transition.c_max = settings.c_max * pl.cost_to_go(&start).max(1.0);
     pl.tree.add(&key(l, &start), 0);
@@ -497,11 +457,15 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
             }
         }
     };
+    // rewiring may have made another goal node the cheapest
+    if best.is_some() {
+        best = pl.nodes.cheapest(|q| pl.at_goal(q));
+    }
     let end = best.unwrap_or(closest);
-    let full = pl.path_to(end);
+    let full = pl.nodes.path_to(end);
+    let switch_overs = switch_overs(&full);
     let twists: Vec<Twist6> = full.iter().map(|x| x.2).collect();
     let path: Vec<(Isometry3<f64>, Option<usize>)> = full.into_iter().map(|x| (x.0, x.1)).collect();
-    let switch_overs = path.windows(2).skip(1).filter(|w| w[0].1 != w[1].1).count();
     Ok(PlanResult3 {
         twists,
         found: best.is_some(),

@@ -70,15 +70,28 @@ fn invariant_case_is_detected_for_a_pusher_below() {
 }
 
 #[test]
-fn low_friction_side_pushers_have_no_robust_pushes() {
-    // μ_p = 0.25 side pushers only move the block by letting it slide down under gravity: with
-    // ±20% on everything none of those pushes is safe (thesis Fig 5-1)
+fn robust_cone_found_where_the_two_cones_cross() {
+    // μ_p = 0.25 side pushers move the block mostly by letting it slide down under gravity: with
+    // ±20% on everything, no ray of V(ρ_min) lies in V_gf and no ray of V_gf in V(ρ_min), yet
+    // the two cones cross (pivoting pushes); the robust cone is found on the chords between
+    // outside rays, and its generators stick in every sampled world
     let s = example("block-low-friction");
     let w = robust::worst_case(&s, &SPREAD).unwrap();
     let q = [0.002, -0.004, 0.05];
     let f = w.frame(&q);
-    for name in ["left", "right"] {
-        assert!(robust::generators(&f, &w.pushers[s.pusher_index(name).unwrap()].model).is_empty(), "{name}");
+    let p = s.pusher_index("left").unwrap();
+    let model = &w.pushers[p].model;
+    let m = model.metric;
+    let rays: Vec<Vec3> = model.edges.iter().filter_map(|e| f.ray(&e.wrench, &m)).collect();
+    let gf: Vec<Vec3> = model.edges.iter().map(|e| f.gravity_free_ray(&e.wrench, &m)).collect();
+    assert!(rays.iter().chain(&gf).all(|v| f.classify(model, v).margin < 0.0), "not the crossing case");
+    let gens = robust::generators(&f, model);
+    assert!(gens.len() >= 2);
+    for (a, b, c, d) in [(0.8, 0.8, 1.2, 0.8), (1.2, 1.2, 0.8, 1.2), (0.8, 1.2, 1.0, 1.0), (1.0, 1.0, 1.0, 1.0)] {
+        let sc = robust::scaled(&s, a, b, c, d, ConeMode::Nominal).unwrap();
+        for g in &gens {
+            assert!(sc.frame(&q).classify(&sc.pushers[p].model, g).margin >= -1e-7);
+        }
     }
 }
 

@@ -1166,14 +1166,6 @@ impl Mpc {
     ) -> PyResult<Self> {
         let path = path_from(&scene.inner, &poses, &pushers)?;
         let goal = goal.map(|g| pose3(&g)).transpose().map_err(|_| arg_err("goal", "must be 3 finite numbers"))?;
-        for (name, v) in [("dt", dt), ("speed", speed), ("stage_weight", stage_weight), ("terminal_weight", terminal_weight)] {
-            if !(v > 0.0) || !v.is_finite() {
-                return Err(arg_err(name, format!("must be positive and finite (got {v})")));
-            }
-        }
-        if !(effort_weight >= 0.0) || !(margin >= 0.0) {
-            return Err(arg_err("effort_weight", "effort_weight and margin must be non-negative"));
-        }
         let settings = regrasp::mpc::MpcSettings {
             dt,
             horizon,
@@ -1195,7 +1187,9 @@ impl Mpc {
     /// tracking_error, projected, solve_time_s, replan_time_s.
     fn step<'py>(&mut self, py: Python<'py>, pose: Vec<f64>) -> PyResult<Bound<'py, PyDict>> {
         let q = pose3(&pose)?;
-        let c = self.inner.step(&q).map_err(to_py)?;
+        let inner = &mut self.inner;
+        // a step may re-plan (up to the re-planning time limit): other Python threads run meanwhile
+        let c = py.allow_threads(|| inner.step(&q)).map_err(to_py)?;
         let d = PyDict::new(py);
         d.set_item("status", c.status.label())?;
         d.set_item("pusher", c.pusher.map(|i| self.names[i].clone()))?;
@@ -1252,6 +1246,11 @@ impl Mpc {
     #[getter]
     fn replans(&self) -> usize {
         self.inner.replans
+    }
+    /// Why the last re-planning failed (None if it did not).
+    #[getter]
+    fn replan_error(&self) -> Option<String> {
+        self.inner.last_replan_error.clone()
     }
 }
 
