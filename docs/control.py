@@ -161,13 +161,24 @@ def fixtureless(n):
     plans = {"fixtureless": regrasp.plan(s.fixtureless(), seed=0).to_json(), "nominal": regrasp.plan(s, seed=0).to_json()}
     out = {}
     for name, plan in plans.items():
-        ok = 0
-        for k in range(n):
-            d = Perturbation.draw(0.5, np.random.default_rng(20_000 + k))
-            pert = Perturbation(d.friction, d.grip, d.mass, pusher_friction=1.0)
-            ok += control(s, plan, engine="mujoco", policy="open_loop", perturb=pert).success
-        out[name] = {"success": ok, "runs": n}
-        print(f"{name} plan of block-fixtureless, open loop, ±50% finger friction/grip/mass: {ok}/{n}")
+        row = {"runs": n}
+        for engine in ("mujoco", "quasistatic"):
+            runs = []
+            for k in range(n):
+                d = Perturbation.draw(0.5, np.random.default_rng(20_000 + k))
+                pert = Perturbation(d.friction, d.grip, d.mass, pusher_friction=1.0)
+                r = control(s, plan, engine=engine, policy="open_loop", perturb=pert)
+                runs.append({"success": r.success, "goal_error": r.goal_error.tolist(),
+                             "factors": [d.friction, d.grip, d.mass]})
+            row[engine] = runs
+            row["success" if engine == "mujoco" else "success_quasistatic"] = sum(r["success"] for r in runs)
+            miss = [r for r in runs if not r["success"]]
+            print(f"{name} plan of block-fixtureless, open loop in {engine}, ±50% finger friction/grip/mass: "
+                  f"{n - len(miss)}/{n}" + "".join(
+                      f"\n  miss: error x, z {1e3 * r['goal_error'][0]:+.2f}, {1e3 * r['goal_error'][1]:+.2f} mm, "
+                      f"θ {1e3 * r['goal_error'][2]:+.1f} mrad at friction/grip/mass ×{r['factors'][0]:.2f}/"
+                      f"{r['factors'][1]:.2f}/{r['factors'][2]:.2f}" for r in miss))
+        out[name] = row
     return out
 
 

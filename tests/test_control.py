@@ -138,3 +138,40 @@ def test_plan_cli_robust_and_fixtureless(tmp_path):
     r = subprocess.run([sys.executable, "-m", "regrasp.cli", "plan", str(EXAMPLES / "block-low-friction.toml"), "--robust"],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "uncertainty" in r.stderr
+
+
+def test_control_arguments_are_checked(tmp_path):
+    f = tmp_path / "plan.json"
+    s = load("block-high-friction")
+    p = regrasp.plan(s, seed=0)
+    p.save(f)
+    cli = [sys.executable, "-m", "regrasp.cli"]
+    for extra, field in ((["--horizon", "0"], "--horizon"), (["--dt", "-1"], "--dt"), (["--scale-mass", "0"], "scale-mass")):
+        r = subprocess.run(cli + ["control", str(EXAMPLES / "block-high-friction.toml"), "--plan", str(f)] + extra,
+                           capture_output=True, text=True)
+        assert r.returncode == 2 and field in r.stderr, (extra, r.stderr)
+    # planar-only commands name the problem for a 3-D scene
+    for cmd in (["control", str(EXAMPLES / "pivot-3d.toml"), "--plan", str(f)], ["cone", str(EXAMPLES / "pivot-3d.toml"),
+                "--pose", "0,0,0", "--pusher", "ground"], ["validate", str(EXAMPLES / "pivot-3d.toml")]):
+        r = subprocess.run(cli + cmd, capture_output=True, text=True)
+        assert r.returncode == 2 and "3-D scene" in r.stderr, (cmd, r.stderr)
+    # a poke after the time limit is an error, not silently dropped; a late poke extends the default
+    with pytest.raises(ArgumentError, match="pokes"):
+        control(s, p, pokes=[Poke(50.0, np.zeros(3))], max_time=10.0)
+    r = control(s, p, pokes=[Poke(30.0, np.array([0.002, 0.0, 0.0]))])
+    assert r.t[-1] >= 30.0 and r.success
+    with pytest.raises(ArgumentError, match="horizon"):
+        control(s, p, horizon=-1)
+
+
+def test_simulate_cli_3d_rejects_planar_flags(tmp_path):
+    f = tmp_path / "plan.json"
+    s3 = regrasp.Scene3D.load(EXAMPLES / "offset-3d.toml")
+    f.write_text(json.dumps(s3.plan(seed=0)))
+    cli = [sys.executable, "-m", "regrasp.cli", "simulate", str(EXAMPLES / "offset-3d.toml"), "--plan", str(f)]
+    r = subprocess.run(cli + ["--video", str(tmp_path / "v.gif")], capture_output=True, text=True)
+    assert r.returncode == 2 and "planar only" in r.stderr
+    r = subprocess.run(cli + ["--scale-grip", "-1", "--engine", "mujoco"], capture_output=True, text=True)
+    assert r.returncode == 2 and "scale-grip" in r.stderr
+    r = subprocess.run(cli + ["--dt", "0.05", "--json"], capture_output=True, text=True)
+    assert r.returncode == 0 and json.loads(r.stdout)["success"], r.stderr

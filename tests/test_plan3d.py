@@ -54,9 +54,13 @@ def test_se3_twist_between_inverts_the_plan_steps():
     s = Scene3D.load(EXAMPLES / "pivot-3d.toml")
     p = s.plan(seed=0)
     for a, b in zip(p["path"][:-1], p["path"][1:]):
-        u = twist_between(a["pose"], b["pose"])
-        tr = s.simulate_push(a["pose"], b["pusher"], u, 1.0, 0.5)
-        assert np.all(np.isfinite(tr["pose"]))
+        # the stored pusher twist reproduces the step exactly; the SE(3) log between the poses
+        # (pusher sticking: the object's twist) reaches it to the simulator's step error
+        # (measured 26 um / 0.8 mrad on the corner pivot, 0 elsewhere)
+        for u, dp, da in ((b["pusher_twist"], 1e-9, 1e-6), (twist_between(a["pose"], b["pose"]), 1e-4, 2e-3)):
+            q = np.asarray(s.simulate_push(a["pose"], b["pusher"], u, 1.0, 0.25)["pose"][-1])
+            assert np.linalg.norm(q[:3] - np.asarray(b["pose"][:3])) < dp, (a, b, q)
+            assert quat_angle(q[3:], b["pose"][3:]) < da, (a, b, q)
     # the log of a pure rotation about Y is that rotation
     u = twist_between([0, 0, 0, 1, 0, 0, 0], [0, 0, 0, np.cos(0.2), 0, np.sin(0.2), 0])
     assert np.allclose(u, [0, 0, 0, 0, 0.4, 0], atol=1e-12)

@@ -121,3 +121,12 @@ def test_approximation_report_shows_the_polyhedral_error():
         e5 = by[(p, 5.0)]["false_inside"] + by[(p, 5.0)]["false_outside"]
         e80 = by[(p, 80.0)]["false_inside"] + by[(p, 80.0)]["false_outside"]
         assert e80 < e5
+
+
+def test_views_pickle_in_the_order_they_were_taken():
+    import pickle
+
+    s = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    for v in (s.scaled(mass=2.0).with_grip_force(7.0), s.with_grip_force(7.0).scaled(grip=2.0), s.robust({"mass": 0.2}).with_grip_force(9.0)):
+        w = pickle.loads(pickle.dumps(v))
+        assert (w.grip_force, w.rho, w.mode) == (v.grip_force, v.rho, v.mode)

@@ -65,7 +65,7 @@ def cone_report(scene: Scene, pose, pusher: str, twist=None) -> dict:
 
 
 def cmd_cone(a) -> int:
-    scene = Scene.load(a.scene)
+    scene = _load_planar(a.scene, "cone")
     pose = _floats(a.pose, 3, "--pose")
     twist = None if a.twist is None else _floats(a.twist, 3, "--twist")
     try:
@@ -167,10 +167,28 @@ def cmd_demo(a) -> int:
     return 0 if p.found else 1
 
 
+def _check_factors(a) -> None:
+    """--scale-friction/--scale-grip/--scale-mass must be positive finite factors."""
+    for name in ("scale_friction", "scale_grip", "scale_mass"):
+        v = getattr(a, name)
+        if not (np.isfinite(v) and v > 0):
+            raise ArgumentError(f"invalid `--{name.replace('_', '-')}`: must be a positive factor", name)
+
+
+def _load_planar(path, cmd: str) -> Scene:
+    """A planar scene for commands that have no 3-D counterpart (a clear error for a 3-D one)."""
+    from .scene3d import is_3d
+
+    if is_3d(path):
+        raise ArgumentError(f"invalid `scene`: `regrasp {cmd}` works on planar scenes; {path} is a 3-D scene "
+                            "(3-D scenes: plan, simulate, push)", "scene")
+    return Scene.load(path)
+
+
 def cmd_validate(a) -> int:
     from .validation import format_validation, validate
 
-    scene = Scene.load(a.scene)
+    scene = _load_planar(a.scene, "validate")
     engines = tuple(e.strip() for e in a.engines.split(",") if e.strip())
     if a.workers is not None and a.workers < 1:
         raise ArgumentError("invalid `--workers`: must be at least 1", "--workers")
@@ -185,7 +203,13 @@ def cmd_simulate(a) -> int:
 
     from .scene3d import Scene3D, is_3d
 
+    _check_factors(a)
+    if a.dt is not None and not (np.isfinite(a.dt) and a.dt > 0):
+        raise ArgumentError("invalid `--dt`: must be a positive time step [s]", "--dt")
     if is_3d(a.scene):
+        if a.perturb or a.video or a.plot:
+            raise ArgumentError("invalid flags for a 3-D scene: --perturb/--video/--plot are planar only "
+                                "(3-D: --scale-*, --dt, --json; `regrasp plan --html` for a view)", "scene")
         s3 = Scene3D.load(a.scene)
         try:
             plan3 = json.loads(Path(a.plan).read_text())
@@ -196,7 +220,7 @@ def cmd_simulate(a) -> int:
 
             r = execute_plan3d(s3, plan3, a.scale_friction, a.scale_grip, a.scale_mass)
         else:
-            r = s3.replay(plan3)
+            r = s3.replay(plan3, dt=0.25 if a.dt is None else a.dt)
         out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success")}
         out["max_pusher_slip"] = None
         print(json.dumps(out) if a.json else f"{s3.name}: {r['engine']}: {'success' if r['success'] else 'outside the tolerance'}, "
@@ -205,14 +229,10 @@ def cmd_simulate(a) -> int:
     scene = Scene.load(a.scene)
     plan = load_plan(a.plan)
     if a.engine == "quasistatic":
-        rep = replay_plan(scene, plan, dt=a.dt)
+        rep = replay_plan(scene, plan, dt=0.05 if a.dt is None else a.dt)
     elif a.engine == "mujoco":
         from .mujoco_exec import Perturbation, execute_plan
 
-        for name in ("scale_friction", "scale_grip", "scale_mass"):
-            v = getattr(a, name)
-            if not (np.isfinite(v) and v > 0):
-                raise ArgumentError(f"invalid `--{name.replace('_', '-')}`: must be a positive factor", name)
         if not (0 <= a.perturb < 1):
             raise ArgumentError("invalid `--perturb`: a spread in [0, 1)", "--perturb")
         base = Perturbation(a.scale_friction, a.scale_grip, a.scale_mass)
@@ -308,12 +328,13 @@ def cmd_control(a) -> int:
     from .mujoco_exec import Perturbation
     from .quasistatic import load_plan
 
-    scene = Scene.load(a.scene)
+    scene = _load_planar(a.scene, "control")
     plan = load_plan(a.plan)
-    for name in ("scale_friction", "scale_grip", "scale_mass"):
-        v = getattr(a, name)
-        if not (np.isfinite(v) and v > 0):
-            raise ArgumentError(f"invalid `--{name.replace('_', '-')}`: must be a positive factor", name)
+    _check_factors(a)
+    if a.horizon < 1:
+        raise ArgumentError(f"invalid `--horizon`: must be at least 1 step (got {a.horizon})", "--horizon")
+    if not (np.isfinite(a.dt) and a.dt > 0):
+        raise ArgumentError("invalid `--dt`: must be a positive control period [s]", "--dt")
     if not (a.noise >= 0 and np.isfinite(a.noise)):
         raise ArgumentError("invalid `--noise`: must be a non-negative standard deviation", "--noise")
     pokes = [Poke.parse(t) for t in a.poke or []]
@@ -495,7 +516,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("scene")
     s.add_argument("--plan", required=True)
     s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"])
-    s.add_argument("--dt", type=float, default=0.05, help="quasi-static time step [s]")
+    s.add_argument("--dt", type=float, help="quasi-static time step [s] (default 0.05 planar, 0.25 3-D)")
     s.add_argument("--scale-friction", type=float, default=1.0, help="MuJoCo: factor on every friction coefficient")
     s.add_argument("--scale-grip", type=float, default=1.0, help="MuJoCo: factor on the grip force")
     s.add_argument("--scale-mass", type=float, default=1.0, help="MuJoCo: factor on the object's mass")

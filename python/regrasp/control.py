@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _core
-from .errors import ArgumentError
+from .errors import ArgumentError, RegraspError
 from .mujoco_exec import Perturbation
 from .quasistatic import body_twist, simulate_push
 from .scene import Scene
@@ -130,6 +130,10 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
         raise ArgumentError(f"invalid `policy`: must be one of {POLICIES} (got {policy!r})", "policy")
     if not (dt > 0 and speed > 0 and np.isfinite(dt) and np.isfinite(speed)):
         raise ArgumentError("invalid `dt`/`speed`: must be positive", "dt")
+    if not isinstance(horizon, (int, np.integer)) or horizon < 1:
+        raise ArgumentError(f"invalid `horizon`: must be a whole number of steps >= 1 (got {horizon!r})", "horizon")
+    if max_time is not None and not (np.isfinite(max_time) and max_time > 0):
+        raise ArgumentError("invalid `max_time`: must be a positive number of seconds", "max_time")
     se = np.asarray(start_error, float)
     if se.shape != (3,) or not np.all(np.isfinite(se)):
         raise ArgumentError("invalid `start_error`: must be 3 finite numbers dx, dz, dtheta", "start_error")
@@ -144,8 +148,12 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
     ctrl = _core.Mpc(cscene._core, poses, names, goal.tolist(), dt=dt, horizon=horizon, speed=speed, seed=seed, **mpc)
     knots = np.asarray(ctrl.knots)
     knot_pushers = ctrl.knot_pushers
+    last_poke = max((pk.t for pk in pokes), default=0.0)
     if max_time is None:
-        max_time = 2.5 * len(knots) * dt + 6.0
+        # time for the plan at its speed, slack for re-plans, and for recovering after the last poke
+        max_time = max(2.5 * len(knots) * dt + 6.0, last_poke + 1.5 * len(knots) * dt + 6.0)
+    elif last_poke > max_time:
+        raise ArgumentError(f"invalid `pokes`: a poke at {last_poke} s comes after `max_time` ({max_time} s)", "pokes")
     q0 = np.asarray(poses[0], float) + se
     if not scene.admissible(q0):
         raise ArgumentError("invalid `start_error`: the object's start pose puts the pad off the object", "start_error")
@@ -164,7 +172,8 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
         qs.append(q)
         if policy == "mpc":
             c = ctrl.step(meas.tolist())
-            times.append(c["solve_time_s"])
+            if c["status"] in ("tracking", "replanned"):  # steps that solved the QP (not at goal or stuck)
+                times.append(c["solve_time_s"])
             if c["status"] == "replanned":
                 knots = np.asarray(ctrl.knots)
             refs.append(knots[min(c["knot"], len(knots) - 1)])
@@ -184,7 +193,7 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
                 stuck = 0
                 try:
                     plant.push(c["pusher"], c["twist"], dt, meas)
-                except Exception as e:  # noqa: BLE001 - the world rejected the push (e.g. the grasp lost the object)
+                except RegraspError as e:  # the world rejected the push (e.g. the grasp cannot hold the object)
                     failure = f"the world failed: {e}"
                     break
         else:
@@ -202,7 +211,7 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
                 used.append(knot_pushers[k + 1])
                 try:
                     plant.push(knot_pushers[k + 1], tw, dt, knots[k])
-                except Exception as e:  # noqa: BLE001
+                except RegraspError as e:
                     failure = f"the world failed: {e}"
                     break
                 k += 1

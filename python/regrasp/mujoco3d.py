@@ -1,8 +1,15 @@
-"""3-D plans executed in MuJoCo, in the world's view (:func:`execute_plan3d_world`: features fixed
-where each push needs them, the gripper — a driven 6-DoF body carrying the pads — moving with the
-inverse of the virtual pusher's motion; what `regrasp simulate SCENE_3D --engine mujoco` runs) or
-in the planner's view (:func:`execute_plan3d`: the pads fixed, each pusher's feature on a driven
-6-DoF body that follows the plan's pusher motion).
+"""3-D plans executed in MuJoCo (:func:`execute_plan3d`), in the world's view (``view="world"``,
+the default and what `regrasp simulate SCENE_3D --engine mujoco` runs: features fixed where each
+push needs them, the gripper — a driven 6-DoF body carrying the pads — moving with the inverse of
+the virtual pusher's motion) or in the planner's view (``view="planner"``: the pads fixed, each
+pusher's feature on a driven 6-DoF body that follows the plan's pusher motion).
+
+Gravity: the scene's gravity is given in the gripper frame, and the world's view keeps it there
+(MuJoCo's gravity is the scene's vector, the gripper starts at the identity): as the gripper
+turns with the inverse pusher motion, gravity in MuJoCo does not turn with it, while the planner
+assumed it fixed in the gripper frame. The bundled examples turn the gripper by at most their
+regrasp angle and execute within tolerance in both views (`docs/execution3d.py` prints both); a
+plan with large gripper rotations should be executed in the planner's view.
 
 The object: a box or the scene's convex mesh, with its mass, centre of mass and inertia. The pads:
 as in the planar model (``regrasp.mujoco_model``), one contact point each through a large sphere
@@ -21,16 +28,14 @@ import numpy as np
 
 from . import _core
 from .errors import ArgumentError
+from .mujoco_model import FEATURE_BITS as BITS_FEAT
+from .mujoco_model import OBJECT_BITS as BITS_OBJ
+from .mujoco_model import PAD_BITS as BITS_PAD
 from .mujoco_model import PAD_SPHERE, Contact
-
-BITS_OBJ, BITS_PAD, BITS_FEAT = 'contype="1" conaffinity="3"', 'contype="2" conaffinity="0"', 'contype="4" conaffinity="1"'
+from .mujoco_model import _fmt as _f
 PARK = np.array([0.0, 0.0, 5.0])
 R_FEATURE = 0.0015
 GAP = 0.002
-
-
-def _f(a) -> str:
-    return " ".join(f"{x:.9g}" for x in np.ravel(a))
 
 
 def compose(a, b) -> np.ndarray:
@@ -100,13 +105,12 @@ def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, ma
     # pads at the object's extreme points along ±Y at the start
     w = np.array([compose(s0, np.r_[x, 1, 0, 0, 0])[:3] for x in v])
     pads = []
-    rho = 2.0 / 3.0 * scene._core.pad_radius
     for name, sign in (("pad_left", 1), ("pad_right", -1)):
         y = np.max(sign * w[:, 1]) * sign
         if pad == "ring":
             # 8 point contacts on a ring at 2/3 of the pad's radius: the quasi-static model's pad
             geoms = "".join(
-                f'<geom type="sphere" size="{PAD_BALL}" pos="{rho * np.cos(a):.9g} {sign * PAD_BALL:.9g} {rho * np.sin(a):.9g}" '
+                f'<geom type="sphere" size="{PAD_BALL}" pos="{k * np.cos(a):.9g} {sign * PAD_BALL:.9g} {k * np.sin(a):.9g}" '
                 f'mass="0.01" friction="{mu:.9g} 0 0" condim="3" {BITS_PAD}/>'
                 for a in 2 * np.pi * (np.arange(8) + 0.5) / 8)
         else:
@@ -155,12 +159,9 @@ class Driver6:
         self.pose = np.asarray(pose, float)
 
     def move(self, data, pose, dt):
-        from scipy.spatial.transform import Rotation
-
         pose = np.asarray(pose, float)
-        r0 = Rotation.from_quat([*self.pose[4:], self.pose[3]])
-        r1 = Rotation.from_quat([*pose[4:], pose[3]])
-        w = (r0.inv() * r1).as_rotvec() / dt  # body frame
+        # body-frame angular velocity: the SO(3) log of the relative rotation (the ball joint's qvel)
+        w = np.array(_core.se3_log([0, 0, 0, *map(float, self.pose[3:])], [0, 0, 0, *map(float, pose[3:])]))[3:] / dt
         self.set(data, self.pose, np.r_[(pose[:3] - self.pose[:3]) / dt, w])
         self.pose = pose
 
@@ -252,7 +253,8 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
                     break
                 P = compose(P, np.r_[n * creep, 1, 0, 0, 0])
                 place(P)
-        u = np.asarray(b.get("pusher_twist") or twist_between(a["pose"], b["pose"]), float)
+        u = b.get("pusher_twist")
+        u = np.asarray(twist_between(a["pose"], b["pose"]) if u is None else u, float)
         P0 = P.copy()
         nsteps = int(round(1.0 / dt))
         for k in range(1, nsteps + 1):

@@ -274,9 +274,9 @@ class WorldRig:
             return
         _, fm, _, n_w = self.current
         g1 = self.g.copy()
-        n = max(1, int(round(0.002 / speed / self.dt)))
+        n = max(1, int(round(GAP / speed / self.dt)))
         for i in range(1, n + 1):
-            self._step(g1 + np.array([0.002 * n_w[0], 0.002 * n_w[1], 0.0]) * i / n)
+            self._step(g1 + np.array([GAP * n_w[0], GAP * n_w[1], 0.0]) * i / n)
         self.data.mocap_pos[fm] = PARK
         self.current = None
 

@@ -133,7 +133,10 @@ class PushRig:
         """Whether the pusher and the object move together over a short push: they move apart at
         the contact by less than ``ratio`` of the push (:meth:`slip_fraction`; soft contacts creep
         by about 1% of a push when the pusher sticks)."""
-        return self.slip_fraction(pose, twist, distance, speed) < ratio
+        f = self.slip_fraction(pose, twist, distance, speed)
+        if not np.isfinite(f):
+            raise FloatingPointError("the MuJoCo push diverged (non-finite poses)")
+        return f < ratio
 
 
 def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, record_dt: float = 0.02,

@@ -242,10 +242,10 @@ class MotionConeBatch:
         return out
 
 
-def _rebuild_scene(kind: str, text: str, path, grip=None, ops=()):
+def _rebuild_scene(kind: str, text: str, path, ops=()):
+    """The scene rebuilt from its source text and the views taken of it, in order (pickling)."""
     s = Scene.from_toml(text) if kind == "toml" else Scene(_core.Scene.from_json(text), None, ("json", text))
     s.path = None if path is None else Path(path)
-    s = s if grip is None else s.with_grip_force(grip)
     for name, kw in ops:
         s = getattr(s, name)(**kw)
     return s
@@ -290,7 +290,7 @@ class Scene:
             raise TypeError("this scene has no source text to be pickled from")
         kind, text = self.source
         return (_rebuild_scene, (kind, text, None if self.path is None else str(self.path),
-                                 getattr(self, "_grip_override", None), getattr(self, "_ops", ())))
+                                 getattr(self, "_ops", ())))
 
     @classmethod
     def load(cls, path) -> "Scene":
@@ -398,14 +398,11 @@ class Scene:
     def with_grip_force(self, force: float) -> "Scene":
         """The same scene with another grip force per finger (not re-validated: the task's
         poses may not be held at that force)."""
-        s = Scene(self._core.with_grip_force(float(force)), self.path, self.source)
-        s._grip_override = float(force)
-        return s
+        return self._view(self._core.with_grip_force(float(force)), "with_grip_force", force=float(force))
 
     def _view(self, core, op: str, **kw) -> "Scene":
+        """A view of this scene (a new core) that remembers how it was taken, so it pickles."""
         s = Scene(core, self.path, self.source)
-        if hasattr(self, "_grip_override"):
-            s._grip_override = self._grip_override
         s._ops = tuple(getattr(self, "_ops", ())) + ((op, kw),)
         return s
 

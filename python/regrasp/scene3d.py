@@ -75,7 +75,9 @@ class Scene3D:
     def validate_path(self, path: list) -> list:
         """Whether each step of a 3-D plan's path can be taken by its pusher (see
         ``regrasp::trrt3d::validate_path3``)."""
-        tw = [k.get("pusher_twist", [0.0] * 6) for k in path] if any("pusher_twist" in k for k in path) else None
+        path = check_plan3d(self, {"path": path})
+        has = [k.get("pusher_twist") is not None for k in path]
+        tw = [k["pusher_twist"] if h else [0.0] * 6 for k, h in zip(path, has)] if any(has) else None
         return self._core.validate_path([list(map(float, k["pose"])) for k in path], [k["pusher"] for k in path], tw)
 
     def replay(self, plan: dict, dt: float = 0.25) -> dict:
@@ -87,7 +89,8 @@ class Scene3D:
         q = np.asarray(path[0]["pose"], float)
         poses = [q]
         for a, b in zip(path[:-1], path[1:]):
-            u = b.get("pusher_twist") or twist_between(a["pose"], b["pose"])
+            u = b.get("pusher_twist")
+            u = twist_between(a["pose"], b["pose"]) if u is None else u
             tr = self.simulate_push(q, b["pusher"], u, 1.0, dt)
             q = np.asarray(tr["pose"][-1], float)
             poses.append(q)
@@ -107,7 +110,10 @@ def check_plan3d(scene: "Scene3D", plan) -> list:
     for i, k in enumerate(plan["path"]):
         if not isinstance(k, dict) or "pose" not in k:
             raise ArgumentError(f"invalid `plan.path[{i}]`: needs a `pose`", f"plan.path[{i}].pose")
-        q = np.asarray(k["pose"], float)
+        try:
+            q = np.asarray(k["pose"], float)
+        except (TypeError, ValueError):
+            q = np.full(1, np.nan)
         if q.shape != (7,) or not np.all(np.isfinite(q)) or np.linalg.norm(q[3:]) < 1e-9:
             raise ArgumentError(f"invalid `plan.path[{i}].pose`: 7 finite numbers [x, y, z, qw, qx, qy, qz]",
                                 f"plan.path[{i}].pose")
@@ -115,7 +121,10 @@ def check_plan3d(scene: "Scene3D", plan) -> list:
             raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k.get('pusher')!r} in the scene",
                                 f"plan.path[{i}].pusher")
         if i > 0 and k.get("pusher_twist") is not None:
-            u = np.asarray(k["pusher_twist"], float)
+            try:
+                u = np.asarray(k["pusher_twist"], float)
+            except (TypeError, ValueError):
+                u = np.full(1, np.nan)
             if u.shape != (6,) or not np.all(np.isfinite(u)):
                 raise ArgumentError(f"invalid `plan.path[{i}].pusher_twist`: 6 finite numbers",
                                     f"plan.path[{i}].pusher_twist")

@@ -18,7 +18,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from .errors import ArgumentError
+from .errors import ArgumentError, RegraspError
 from .quasistatic import SPEED
 from .scene import Scene
 
@@ -122,10 +122,11 @@ def _mujoco_chunk(scene: Scene, chunk: list) -> list:
 
     rigs, out = {}, []
     for i, pusher, pose, u in chunk:
+        if pusher not in rigs:  # building the model: an error here is the caller's, never swallowed
+            rigs[pusher] = PushRig(scene, pusher)
         try:
-            rig = rigs.get(pusher) or rigs.setdefault(pusher, PushRig(scene, pusher))
-            out.append((i, rig.sticks(pose, u)))
-        except Exception:  # an unstable simulation counts as unsolved, never as an answer
+            out.append((i, rigs[pusher].sticks(pose, u)))
+        except (RegraspError, FloatingPointError, ValueError):  # an unstable run counts as unsolved, never as an answer
             out.append((i, None))
     return out
 
@@ -193,6 +194,9 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
     for e in engines:
         if e not in ENGINES:
             raise ArgumentError(f"invalid `engines`: unknown engine {e!r} (available: {', '.join(ENGINES)})", "engines")
+    if "mujoco" in engines and scene.kind != "grasp":
+        raise ArgumentError(f"invalid `engines`: the MuJoCo model is a parallel-jaw grasp; scene {scene.name!r} "
+                            f"is a {scene.kind!r} scene (use quasistatic)", "engines")
     workers = workers or os.cpu_count() or 1
     rows = samples(scene, pushes, seed)
     pred = np.array([r[4] for r in rows])

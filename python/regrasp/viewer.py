@@ -144,7 +144,9 @@ def page(scene, plan: dict) -> str:
         "size": size,
     }
     text = json.dumps(data).replace("</", "<\\/")
-    return PAGE.replace("__TITLE__", scene.name).replace("__DATA__", text)
+    import html
+
+    return PAGE.replace("__TITLE__", html.escape(scene.name)).replace("__DATA__", text)
 
 
 def write_html(scene, plan: dict, path) -> Path:

@@ -1,6 +1,7 @@
-// Runs the viewer page's script in node with a minimal DOM and a recording canvas: the page
-// must parse its data, draw every triangle and both pads at every point of the plan, and react
-// to the slider. Prints a JSON summary.
+// Runs the viewer page's script in node with a minimal DOM and a recording canvas, sets its
+// slider to five times along the plan and prints, for each, what it drew (faces and pads filled,
+// pusher contact dots), the pose it shows and its info line, as JSON. The pytest that runs it
+// checks those (front faces drawn, pusher contacts shown, the last pose is the plan's).
 const fs = require("fs");
 const html = fs.readFileSync(process.argv[2], "utf8");
 const data = html.match(/<script id="data" type="application\/json">([\s\S]*?)<\/script>/)[1];

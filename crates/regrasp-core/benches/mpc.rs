@@ -19,9 +19,8 @@ fn bench(c: &mut Criterion) {
         let scene = Scene::load(&path).unwrap();
         for (label, s) in [("nominal", scene.clone()), ("robust", worst_case(&scene, &u).unwrap())] {
             let r = plan(&s, None, None, &Settings::default()).unwrap();
-            if !r.found {
-                continue;
-            }
+            // a missing plan is a regression, never a silently shorter benchmark
+            assert!(r.found, "no {label} plan for {name}: {}", r.stop_reason.label());
             let q0 = r.path[0].0;
             let q = [q0[0] + 0.0005, q0[1] - 0.0005, q0[2] + 0.01];
             g.bench_function(format!("step/{name}/{label}"), |b| {

@@ -529,6 +529,13 @@ mod tests {
             let g = Isometry3::from_parts(Translation3::new(0.3, -0.2, 0.1), UnitQuaternion::from_scaled_axis(V3::new(0.4, 1.0, -0.3)));
             let (d1, d2) = (distance(0.05, &a, &b), distance(0.05, &(g * a), &(g * b)));
             assert!((d1 - d2).abs() < 1e-9 && (d1 - distance(0.05, &b, &a)).abs() < 1e-9);
+            // and it is sqrt(|p|^2 + (L theta)^2) of the relative pose, theta from the rotation
+            // matrix's trace (an independent formula: cos theta = (tr R - 1) / 2)
+            let rel = a.inverse() * b;
+            let r = rel.rotation.to_rotation_matrix();
+            let th = ((r.matrix().trace() - 1.0) / 2.0).clamp(-1.0, 1.0).acos();
+            let want = (rel.translation.vector.norm_squared() + (0.05 * th).powi(2)).sqrt();
+            assert!((d1 - want).abs() < 1e-7, "{d1} vs {want}");
         }
     }
 

@@ -26,12 +26,15 @@ proptest! {
         case in common::block_case(),
         draws in proptest::collection::vec((0.0f64..1.0, 0.0f64..1.0, 0.0f64..1.0, 0.0f64..1.0), 8),
     ) {
-        let Some(scene) = common::scene(&case) else { return Ok(()) };
+        let scene = common::scene(&case);
+        prop_assume!(scene.is_some());
+        let scene = scene.unwrap();
         let worst = robust::worst_case(&scene, &SPREAD).unwrap();
         let q = case.pose;
         let fw = worst.frame(&q);
         prop_assume!(fw.hold_ratio < 0.95);
         let gens = robust::generators(&fw, &worst.pushers[0].model);
+        prop_assume!(!gens.is_empty());
         for (a, b, c, d) in draws {
             let s = robust::scaled(&scene, 0.8 + 0.4 * a, 0.8 + 0.4 * b, 0.8 + 0.4 * c, 0.8 + 0.4 * d, ConeMode::Nominal).unwrap();
             let f = s.frame(&q);
