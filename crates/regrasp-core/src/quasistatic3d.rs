@@ -4,7 +4,9 @@
 //! Finger pads are the contact points of [`Scene3::pad_contacts`] with equal shares of the grip
 //! force and Coulomb discs in the pad plane (the force-controlled fingers follow the object
 //! along the grasp axis, so the normal force is given, not the normal velocity). A pusher is a
-//! rigid point set with unilateral contacts and Coulomb cones (two tangent directions).
+//! rigid point set with unilateral contacts and Coulomb cones (two tangent directions); a plane
+//! pusher touches the object where it is lowest along the plane's normal at each time step
+//! (the contact point moves over the object as it rolls).
 
 use crate::error::{Error, Result};
 use crate::quasistatic::MAX_STEPS;
@@ -113,11 +115,13 @@ pub fn problem(
     })
 }
 
-/// The problem of pusher `pusher` in contact at its scene points, at pose `pose`.
+/// The problem of pusher `pusher` in contact at pose `pose` (its scene points, or for a plane
+/// the object's lowest points, [`Scene3::pusher_contacts`]).
 pub fn push_problem(scene: &Scene3, pose: &Isometry3<f64>, pusher: usize, h: f64) -> Result<Problem> {
     let p = scene.pushers.get(pusher).ok_or_else(|| Error::arg("pusher", format!("index {pusher} out of range")))?;
-    let gaps = vec![0.0; p.points.len()];
-    problem(scene, pose, Some((p.friction, &p.points, &gaps, p.normal)), h, 0.01)
+    let (points, normal) = scene.pusher_contacts(pusher, pose);
+    let gaps = vec![0.0; points.len()];
+    problem(scene, pose, Some((p.friction, &points, &gaps, normal)), h, 0.01)
 }
 
 /// `exp` of a body twist `[v, ω]` applied over `dt` (right multiplication).
@@ -155,7 +159,9 @@ pub struct Trajectory3 {
 }
 
 /// Simulates a push in 3-D: the pusher starts at its scene points with the object at `start`
-/// and moves with constant body twist `u` (its frame = the object frame at the start).
+/// and moves with constant body twist `u` (its frame = the object frame at the start). A plane
+/// starts touching the object's lowest points; at each step its contacts are the object's
+/// lowest points along its current normal, with their gaps to it.
 pub fn simulate_push(
     scene: &Scene3,
     start: &Isometry3<f64>,
@@ -177,17 +183,31 @@ pub fn simulate_push(
     let speed = V3::new(u[0], u[1], u[2]).norm() + V3::new(u[3], u[4], u[5]).norm() * scene.length;
     let reach = 0.002 + 2.0 * dt * speed;
     let mut tr = Trajectory3::default();
+    // in the pusher's frame (the object frame at the start): its points (or a point of the
+    // plane) and its normal
+    let (points0, normal0) = scene.pusher_contacts(pusher, start);
     for k in 0..=steps {
         let t = k as f64 * dt;
         let rel = q.inverse() * qp;
-        let normal = rel.rotation * pz.normal;
+        let normal = rel.rotation * normal0;
         let (mut pts, mut gaps) = (Vec::new(), Vec::new());
-        for p in &pz.points {
-            let r = (rel * nalgebra::Point3::from(*p)).coords;
-            let gap = scene.mesh.signed_distance(&r);
-            if gap < reach {
-                pts.push(r);
-                gaps.push(gap);
+        if pz.plane {
+            let on = (rel * nalgebra::Point3::from(points0[0])).coords;
+            for r in scene.lowest_points(&normal) {
+                let gap = normal.dot(&(r - on));
+                if gap < reach {
+                    pts.push(r);
+                    gaps.push(gap);
+                }
+            }
+        } else {
+            for p in &points0 {
+                let r = (rel * nalgebra::Point3::from(*p)).coords;
+                let gap = scene.signed_distance(&r);
+                if gap < reach {
+                    pts.push(r);
+                    gaps.push(gap);
+                }
             }
         }
         let prob = problem(scene, &q, Some((pz.friction, &pts, &gaps, normal)), dt, speed.max(1e-3))?;

@@ -1,13 +1,15 @@
-//! Spatial scenes (TOML, `dimension = 3`): an object that is a box or a convex mesh, a
-//! parallel-jaw grasp with circular pads, gravity, pushers and fixed features as rigid point
-//! sets (point, line or patch contacts), and the task as 3-D poses.
+//! Spatial scenes (TOML, `dimension = 3`): an object that is a box, a convex mesh or a sphere,
+//! a parallel-jaw grasp with circular pads, gravity, pushers and fixed features as rigid point
+//! sets (point, line or patch contacts) or as planes (the ground, a wall: a rolling contact,
+//! wherever the object touches the plane), and the task as 3-D poses.
 //!
 //! ```toml
 //! dimension = 3
 //! name = "block-pivot-3d"
 //!
 //! [object]
-//! shape = "box"                    # or "mesh" with mesh = "part.obj" (convex, object frame)
+//! shape = "box"                    # or "mesh" with mesh = "part.obj" (convex, object frame),
+//!                                  # or "sphere" with radius = 0.03 (centred on the frame)
 //! size = [0.05, 0.012, 0.08]       # box: full size along the object's x, y, z [m]
 //! mass = 0.13
 //! # com = [0, 0, 0]                # default: the volume centroid
@@ -26,6 +28,12 @@
 //! friction = 0.5
 //! points = [[-0.025, -0.006, -0.04], [0.025, -0.006, -0.04], [0.025, 0.006, -0.04]]  # object frame
 //! normal = [0.0, 0.0, 1.0]         # object frame, the direction the pusher pushes
+//!
+//! [[pushers]]                      # a plane: touches the object wherever it is lowest along
+//! name = "floor"                   # `normal`, so the contact point moves over the object as it
+//! friction = 0.8                   # rolls (a sphere on the ground); no `points`
+//! plane = true
+//! normal = [0.0, 0.0, 1.0]         # gripper frame (a floor: opposite to gravity)
 //!
 //! [task]
 //! start = [0, 0, 0, 1, 0, 0, 0]    # [x, y, z, qw, qx, qy, qz]: object frame in the gripper frame
@@ -50,6 +58,40 @@ pub struct ConvexMesh {
 }
 
 impl ConvexMesh {
+    /// An icosphere of radius `r`: an icosahedron subdivided `levels` times, vertices on the
+    /// sphere (a drawing of a sphere; 20·4^levels triangles).
+    pub fn icosphere(r: f64, levels: usize) -> Self {
+        let t = (1.0 + 5f64.sqrt()) / 2.0;
+        let mut v: Vec<V3> = [
+            [-1.0, t, 0.0], [1.0, t, 0.0], [-1.0, -t, 0.0], [1.0, -t, 0.0], [0.0, -1.0, t], [0.0, 1.0, t],
+            [0.0, -1.0, -t], [0.0, 1.0, -t], [t, 0.0, -1.0], [t, 0.0, 1.0], [-t, 0.0, -1.0], [-t, 0.0, 1.0],
+        ]
+        .iter()
+        .map(|a| V3::new(a[0], a[1], a[2]).normalize())
+        .collect();
+        let mut f: Vec<[usize; 3]> = vec![
+            [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2], [10, 7, 6], [7, 1, 8],
+            [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
+        ];
+        for _ in 0..levels {
+            let mut mid = std::collections::HashMap::new();
+            let mut m = |a: usize, b: usize, v: &mut Vec<V3>| -> usize {
+                *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    v.push(((v[a] + v[b]) / 2.0).normalize());
+                    v.len() - 1
+                })
+            };
+            f = f
+                .iter()
+                .flat_map(|&[a, b, c]| {
+                    let (ab, bc, ca) = (m(a, b, &mut v), m(b, c, &mut v), m(c, a, &mut v));
+                    [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
+                })
+                .collect();
+        }
+        Self::new(v.into_iter().map(|x| x * r).collect(), f).expect("an icosphere is a convex mesh")
+    }
+
     /// A box of full sizes `s`, centred at the origin.
     pub fn cuboid(s: &V3) -> Self {
         let h = s / 2.0;
@@ -166,19 +208,25 @@ impl ConvexMesh {
     }
 }
 
-/// A pusher or fixed feature: a rigid set of points with a common normal (object frame).
+/// A pusher or fixed feature: a rigid set of points with a common normal (object frame), or a
+/// plane (`plane`: `normal` in the gripper frame, `points` empty) that touches the object where
+/// it is lowest along the normal.
 #[derive(Clone, Debug)]
 pub struct Pusher3 {
     pub name: String,
     pub friction: f64,
     pub points: Vec<V3>,
     pub normal: V3,
+    pub plane: bool,
 }
 
 #[derive(Clone, Debug)]
 pub struct Scene3 {
     pub name: String,
+    /// The object's surface: exact for a box or a mesh, a drawing (an icosphere) for a sphere.
     pub mesh: ConvexMesh,
+    /// A sphere's radius (centred on the object frame's origin): its exact surface.
+    pub sphere: Option<f64>,
     pub mass: f64,
     pub com: V3,
     /// Inertia about the centre of mass [kg m²].
@@ -214,6 +262,7 @@ struct RawObject {
     shape: Option<String>,
     size: Option<[f64; 3]>,
     mesh: Option<String>,
+    radius: Option<f64>,
     mass: Option<f64>,
     com: Option<[f64; 3]>,
     material: Option<String>,
@@ -241,6 +290,7 @@ struct RawPusher {
     friction: Option<f64>,
     points: Option<Vec<[f64; 3]>>,
     normal: Option<[f64; 3]>,
+    plane: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -249,6 +299,14 @@ struct RawTask {
     start: Option<[f64; 7]>,
     goal: Option<[f64; 7]>,
     tolerance: Option<[f64; 4]>,
+}
+
+/// Signed distance to the object's surface: the sphere's exactly, else the mesh's.
+fn surface_distance(mesh: &ConvexMesh, sphere: Option<f64>, p: &V3) -> f64 {
+    match sphere {
+        Some(r) => p.norm() - r,
+        None => mesh.signed_distance(p),
+    }
 }
 
 fn req<T>(field: &str, v: Option<T>) -> Result<T> {
@@ -318,16 +376,25 @@ impl Scene3 {
                     .map_err(|e| Error::scene("object.mesh", format!("cannot read {}: {e}", path.display())))?;
                 ConvexMesh::from_obj(&text).map_err(|e| Error::scene("object.mesh", e))?
             }
-            Some(other) => return Err(Error::scene("object.shape", format!("must be \"box\" or \"mesh\" (got \"{other}\")"))),
-            None => return Err(Error::scene("object.shape", "is required (\"box\" or \"mesh\")")),
+            Some("sphere") => ConvexMesh::icosphere(pos("object.radius", obj.radius)?, 3),
+            Some(other) => return Err(Error::scene("object.shape", format!("must be \"box\", \"mesh\" or \"sphere\" (got \"{other}\")"))),
+            None => return Err(Error::scene("object.shape", "is required (\"box\", \"mesh\" or \"sphere\")")),
         };
+        let sphere = if obj.shape.as_deref() == Some("sphere") { obj.radius } else { None };
+        if sphere.is_none() && obj.radius.is_some() {
+            return Err(Error::scene("object.radius", "is for shape = \"sphere\""));
+        }
         let mass = pos("object.mass", obj.mass)?;
-        let (_, centroid, inertia_unit) = mesh.mass_properties();
+        let (_, centroid, inertia_unit) = match sphere {
+            // a solid sphere: I = (2/5) r² per unit mass
+            Some(r) => (4.0 / 3.0 * std::f64::consts::PI * r.powi(3), V3::zeros(), Matrix3::identity() * 0.4 * r * r),
+            None => mesh.mass_properties(),
+        };
         let com = match obj.com {
             Some(c) => vec3("object.com", c)?,
             None => centroid,
         };
-        if mesh.signed_distance(&com) > 0.0 {
+        if surface_distance(&mesh, sphere, &com) > 0.0 {
             return Err(Error::scene("object.com", "must lie inside the object"));
         }
         // uniform density; a moved centre of mass shifts the inertia by the parallel-axis rule
@@ -368,6 +435,13 @@ impl Scene3 {
                 return Err(Error::scene(format!("{f}.normal"), "must be non-zero"));
             }
             let normal = normal.normalize();
+            if p.plane == Some(true) {
+                if p.points.is_some() {
+                    return Err(Error::scene(format!("{f}.points"), "a plane has no points (it touches the object where it is lowest)"));
+                }
+                pushers.push(Pusher3 { name, friction, points: Vec::new(), normal, plane: true });
+                continue;
+            }
             let pts = req(&format!("{f}.points"), p.points)?;
             if pts.is_empty() {
                 return Err(Error::scene(format!("{f}.points"), "needs at least one point"));
@@ -375,16 +449,16 @@ impl Scene3 {
             let mut points = Vec::new();
             for (k, q) in pts.iter().enumerate() {
                 let q = vec3(&format!("{f}.points[{k}]"), *q)?;
-                let dist = mesh.signed_distance(&q);
+                let dist = surface_distance(&mesh, sphere, &q);
                 if dist.abs() > 1e-4 * size {
                     return Err(Error::scene(format!("{f}.points[{k}]"), format!("is not on the object's surface ({dist:.2e} m off)")));
                 }
-                if mesh.signed_distance(&(q + normal * 1e-3 * size)) > 0.0 {
+                if surface_distance(&mesh, sphere, &(q + normal * 1e-3 * size)) > 0.0 {
                     return Err(Error::scene(format!("{f}.normal"), "must point into the object"));
                 }
                 points.push(q);
             }
-            pushers.push(Pusher3 { name, friction, points, normal });
+            pushers.push(Pusher3 { name, friction, points, normal, plane: false });
         }
         if pushers.is_empty() {
             return Err(Error::scene("pushers", "at least one [[pushers]] is required"));
@@ -400,6 +474,7 @@ impl Scene3 {
         let s = Scene3 {
             name,
             mesh,
+            sphere,
             mass,
             com,
             inertia,
@@ -426,6 +501,35 @@ impl Scene3 {
         Self::from_toml_str(&text, path.parent())
     }
 
+    /// Signed distance of object-frame point `p` to the object's surface (positive outside).
+    pub fn signed_distance(&self, p: &V3) -> f64 {
+        surface_distance(&self.mesh, self.sphere, p)
+    }
+
+    /// The object's points lowest along `n` (object frame): where a plane with normal `n`
+    /// touches it — a sphere's one point, a mesh's vertex, edge or face (its vertices).
+    pub fn lowest_points(&self, n: &V3) -> Vec<V3> {
+        let n = n.normalize();
+        if let Some(r) = self.sphere {
+            return vec![-n * r];
+        }
+        let size = self.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let low = self.mesh.vertices.iter().map(|v| v.dot(&n)).fold(f64::INFINITY, f64::min);
+        self.mesh.vertices.iter().filter(|v| v.dot(&n) < low + 1e-6 * size).cloned().collect()
+    }
+
+    /// The contact points and normal (object frame) of pusher `p` brought against the object at
+    /// pose `pose`: a rigid pusher's own points, a plane's lowest points of the object.
+    pub fn pusher_contacts(&self, p: usize, pose: &Isometry3<f64>) -> (Vec<V3>, V3) {
+        let pz = &self.pushers[p];
+        if pz.plane {
+            let n = pose.rotation.inverse() * pz.normal;
+            (self.lowest_points(&n), n)
+        } else {
+            (pz.points.clone(), pz.normal)
+        }
+    }
+
     pub fn pusher_index(&self, name: &str) -> Result<usize> {
         self.pushers.iter().position(|p| p.name == name).ok_or_else(|| {
             let names: Vec<&str> = self.pushers.iter().map(|p| p.name.as_str()).collect();
@@ -439,6 +543,20 @@ impl Scene3 {
     pub fn pad_contacts(&self, pose: &Isometry3<f64>) -> [Vec<V3>; 2] {
         let inv = pose.inverse();
         let mut out: [Vec<V3>; 2] = [Vec::new(), Vec::new()];
+        if let Some(r) = self.sphere {
+            // a sphere pressed by a soft pad: the pad's ring of points on the tangent plane at
+            // the sphere's extreme point (the pad radius is the contact patch's)
+            for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
+                let tip = inv.rotation * V3::new(0.0, sign * r, 0.0);
+                let (t1, t2) = (inv.rotation * V3::x(), inv.rotation * V3::z());
+                for k in 0..8 {
+                    let a = std::f64::consts::PI * 2.0 * (k as f64 + 0.5) / 8.0;
+                    let rho = 2.0 / 3.0 * self.pad_radius;
+                    out[side].push(tip + t1 * (rho * a.cos()) + t2 * (rho * a.sin()));
+                }
+            }
+            return out;
+        }
         let size = self.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
         for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
             // pad normal (pointing into the object) is −sign·Y; the object's extreme along sign·Y

@@ -118,10 +118,42 @@ pub fn pads_on(scene: &Scene3, q: &Isometry3<f64>) -> bool {
     pads.iter().all(|p| !p.is_empty() && (p.len() >= 6 || p.len() <= 2))
 }
 
+/// The motion (body twist, object frame at `q`) of pusher `p` that makes the object follow `u`
+/// where they touch: a rigid pusher moves with `u` (it sticks); a plane rolls the object — it
+/// translates with the velocity of the object's contact point and turns only about its own
+/// normal, so it stays parallel to itself in the gripper frame (a floor stays level), and it
+/// presses into the object at least [`PLANE_PRESS`] of its sliding speed (a plane sliding
+/// along a held object leaves the contact force undetermined: the rigid model admits zero).
+pub fn pusher_motion(scene: &Scene3, q: &Isometry3<f64>, p: usize, u: &Twist6) -> Twist6 {
+    if !scene.pushers[p].plane {
+        return *u;
+    }
+    let (pts, n) = scene.pusher_contacts(p, q);
+    let c = pts.iter().sum::<V3>() / pts.len().max(1) as f64;
+    let (v, w) = (V3::new(u[0], u[1], u[2]), V3::new(u[3], u[4], u[5]));
+    let wn = n * n.dot(&w);
+    let vc = v + w.cross(&c);
+    let vt = vc - n * n.dot(&vc);
+    let vc = vt + n * n.dot(&vc).max(PLANE_PRESS * vt.norm());
+    let lin = vc - wn.cross(&c);
+    [lin.x, lin.y, lin.z, wn.x, wn.y, wn.z]
+}
+
+/// The least speed a plane pusher presses into the object, relative to its sliding speed.
+pub const PLANE_PRESS: f64 = 0.05;
+
 /// Whether pusher `p` can move the object with body twist `u` (unit time) from `q`: the inverse
 /// problem solves (pusher sticking) at the start and at `checks` poses along the step, both pads
-/// on the object all along.
+/// on the object all along. A plane sticks only to twists it can follow while staying parallel
+/// to itself (turning about its normal at most); others are forward-dynamics steps.
 pub fn step_feasible(scene: &Scene3, q: &Isometry3<f64>, u: &Twist6, p: usize, checks: usize, solves: Option<&std::sync::atomic::AtomicUsize>) -> bool {
+    if scene.pushers[p].plane {
+        let n = scene.pusher_contacts(p, q).1;
+        let w = V3::new(u[3], u[4], u[5]);
+        if (w - n * n.dot(&w)).norm() > 1e-9 * (1.0 + w.norm()) {
+            return false;
+        }
+    }
     let n = checks.max(1);
     let v = DVector::from_row_slice(u);
     let settings = mncp::Settings::default();
@@ -193,16 +225,17 @@ impl<'a> Planner3<'a> {
     /// twist feasible at the step's start may not stay so) the pose the forward dynamics reach
     /// while the pusher moves with `u` and keeps contact, if the motion still heads towards the
     /// target (within 60°).
-    fn feasible_pusher(&self, q: &Isometry3<f64>, u: &Twist6, order: &[usize]) -> Option<(usize, Isometry3<f64>)> {
+    fn feasible_pusher(&self, q: &Isometry3<f64>, u: &Twist6, order: &[usize]) -> Option<(usize, Isometry3<f64>, Twist6)> {
         let l = self.l;
         let len = twist_length(l, u);
         // the first pusher in order that can (the later ones are not evaluated once it is known)
         order.par_iter().find_map_first(|&p| {
                 if step_feasible(self.scene, q, u, p, self.s.checks, Some(&self.solves)) {
-                    return Some((p, integrate(q, u, 1.0)));
+                    return Some((p, integrate(q, u, 1.0), *u));
                 }
                 self.solves.fetch_add(self.s.checks + 1, std::sync::atomic::Ordering::Relaxed);
-                let end = simulate_step(self.scene, q, u, p, self.s.checks)?;
+                let up = pusher_motion(self.scene, q, p, u);
+                let end = simulate_step(self.scene, q, &up, p, self.s.checks)?;
                 let v = se3_log(q, &end);
                 let vl = twist_length(l, &v);
                 if vl < 0.2 * len {
@@ -210,7 +243,7 @@ impl<'a> Planner3<'a> {
                 }
                 let m = |x: &Twist6| [x[0], x[1], x[2], l * x[3], l * x[4], l * x[5]];
                 let cos = m(&v).iter().zip(m(u).iter()).map(|(a, b)| a * b).sum::<f64>() / (vl * len);
-                (cos >= 0.5).then_some((p, end))
+                (cos >= 0.5).then_some((p, end, up))
         })
     }
 
@@ -251,8 +284,8 @@ impl<'a> Planner3<'a> {
         let scale = self.step.min(len) / len;
         let want: Twist6 = xi.map(|x| x * scale);
         let order = self.order(self.nodes[near].pusher);
-        if let Some((p, end)) = self.feasible_pusher(&q, &want, &order) {
-            return Some((end, p, want));
+        if let Some((p, end, up)) = self.feasible_pusher(&q, &want, &order) {
+            return Some((end, p, up));
         }
         // random directions around the desired one, in the metric's coordinates
         let wl = twist_length(self.l, &want);
@@ -273,8 +306,8 @@ impl<'a> Planner3<'a> {
         }
         cands.sort_by(|a, b| a.0.total_cmp(&b.0));
         for (_, u) in cands {
-            if let Some((p, end)) = self.feasible_pusher(&q, &u, &order) {
-                return Some((end, p, u));
+            if let Some((p, end, up)) = self.feasible_pusher(&q, &u, &order) {
+                return Some((end, p, up));
             }
         }
         None
@@ -341,6 +374,51 @@ impl<'a> Planner3<'a> {
         }
     }
 
+    /// Rolling to the goal from node `i` with a plane pusher (whose pushes are forward-dynamics
+    /// steps, never exact): unit steps re-aimed at the goal after each, at most `n + 4`, kept if
+    /// the goal is reached (within its tolerance) while each step closes in on it. A position
+    /// already within the tolerance is not chased (the aim is then the goal's orientation only:
+    /// rolling moves the object's centre as a side effect).
+    fn connect_goal_rolling(&mut self, i: usize, n: usize) -> Option<usize> {
+        let q0 = self.nodes[i].q;
+        let planes: Vec<usize> = self.order(self.nodes[i].pusher).into_iter().filter(|&p| self.scene.pushers[p].plane).collect();
+        let found = planes.par_iter().find_map_first(|&p| {
+            let (mut q, mut steps) = (q0, Vec::new());
+            for _ in 0..n + 4 {
+                let d = q.translation.vector - self.goal.translation.vector;
+                let t = self.scene.tolerance;
+                let aim = if d.x.abs() <= t[0] && d.y.abs() <= t[1] && d.z.abs() <= t[2] {
+                    Isometry3::from_parts(q.translation, self.goal.rotation)
+                } else {
+                    self.goal
+                };
+                let xi = se3_log(&q, &aim);
+                let len = twist_length(self.l, &xi);
+                let u: Twist6 = xi.map(|x| x * self.step.min(len) / len.max(1e-300));
+                let up = pusher_motion(self.scene, &q, p, &u);
+                self.solves.fetch_add(self.s.checks + 1, std::sync::atomic::Ordering::Relaxed);
+                let end = simulate_step(self.scene, &q, &up, p, self.s.checks)?;
+                if self.dist(&end, &self.goal) >= self.dist(&q, &self.goal) {
+                    return None;
+                }
+                steps.push((end, up));
+                q = end;
+                if self.at_goal(&q) {
+                    return Some((p, steps));
+                }
+            }
+            None
+        })?;
+        let (p, steps) = found;
+        let (mut last, mut prev) = (i, q0);
+        for (q, up) in steps {
+            let c = self.nodes[last].cost + self.edge_cost(self.nodes[last].pusher, p, self.dist(&prev, &q));
+            last = self.add(q, last, p, c, up);
+            prev = q;
+        }
+        Some(last)
+    }
+
     /// Straight push to the goal from node `i` (unit steps of one constant twist, one pusher).
     fn connect_goal(&mut self, i: usize) -> Option<usize> {
         let q = self.nodes[i].q;
@@ -368,7 +446,9 @@ impl<'a> Planner3<'a> {
                 true
             })
             .collect();
-        let p = *order.iter().zip(ok).find(|(_, o)| *o)?.0;
+        let Some(p) = order.iter().zip(ok).find(|(_, o)| *o).map(|(p, _)| *p) else {
+            return if n <= 20 { self.connect_goal_rolling(i, n) } else { None };
+        };
         let d = len / n as f64;
         let (mut last, mut qk) = (i, q);
         for k in 0..n {
@@ -410,7 +490,7 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
         tree: KdTree::new(),
         transition: Transition::new(settings, 0.0),
         solves: std::sync::atomic::AtomicUsize::new(0),
-        reach: scene.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max),
+        reach: scene.sphere.unwrap_or_else(|| scene.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max)),
     };
     pl.transition.c_max = settings.c_max * pl.cost_to_go(&start).max(1.0);
     pl.tree.add(&key(l, &start), 0);
@@ -433,7 +513,8 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
             .min_by(|&a, &b| pl.dist(&pl.nodes[a].q, &target).total_cmp(&pl.dist(&pl.nodes[b].q, &target)))
             .unwrap_or(0);
         let Some((q_new, pusher, u)) = pl.propagate(near, &target) else { continue };
-        let len = twist_length(l, &u);
+        // the object's motion (u is the pusher's, which differs for forward-dynamics steps)
+        let len = pl.dist(&pl.nodes[near].q, &q_new);
         if pl.tree.nearest_one::<SquaredEuclidean>(&key(l, &q_new)).distance <= (1e-9 * l).powi(2) {
             continue;
         }

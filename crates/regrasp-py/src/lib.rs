@@ -772,11 +772,28 @@ impl Scene3D {
     fn gravity(&self) -> [f64; 3] {
         [self.inner.gravity.x, self.inner.gravity.y, self.inner.gravity.z]
     }
-    /// Pusher `name`: (points (object frame), normal, friction).
-    fn pusher_spec(&self, name: &str) -> PyResult<(Vec<[f64; 3]>, [f64; 3], f64)> {
+    /// Pusher `name` brought against the object at `pose` (default: the task's start): (contact
+    /// points and normal in the object frame, friction). A rigid pusher's points do not depend
+    /// on the pose; a plane's are where the object is lowest along its normal.
+    #[pyo3(signature = (name, pose=None))]
+    fn pusher_spec(&self, name: &str, pose: Option<Vec<f64>>) -> PyResult<(Vec<[f64; 3]>, [f64; 3], f64)> {
         let i = self.inner.pusher_index(name).map_err(to_py)?;
-        let p = &self.inner.pushers[i];
-        Ok((p.points.iter().map(|v| [v.x, v.y, v.z]).collect(), [p.normal.x, p.normal.y, p.normal.z], p.friction))
+        let q = match pose {
+            Some(v) => pose7("pose", &v)?,
+            None => self.inner.start,
+        };
+        let (pts, n) = self.inner.pusher_contacts(i, &q);
+        Ok((pts.iter().map(|v| [v.x, v.y, v.z]).collect(), [n.x, n.y, n.z], self.inner.pushers[i].friction))
+    }
+    /// Whether pusher `name` is a plane (its normal fixed in the gripper frame).
+    fn is_plane(&self, name: &str) -> PyResult<bool> {
+        let i = self.inner.pusher_index(name).map_err(to_py)?;
+        Ok(self.inner.pushers[i].plane)
+    }
+    /// The sphere's radius, for a spherical object (else None).
+    #[getter]
+    fn sphere(&self) -> Option<f64> {
+        self.inner.sphere
     }
     /// T-RRT* over SE(3) with inverse-dynamics unit steps (`regrasp::trrt3d`). Returns a dict
     /// like the planar plan (poses as [x, y, z, qw, qx, qy, qz]) plus the number of solves.
@@ -871,10 +888,10 @@ impl Scene3D {
         regrasp::trrt3d::validate_path3(&self.inner, &path, tw.as_deref()).map_err(to_py)
     }
 
-    /// Contact points (object frame) of pusher `name`.
-    fn pusher_points(&self, name: &str) -> PyResult<Vec<[f64; 3]>> {
-        let i = self.inner.pusher_index(name).map_err(to_py)?;
-        Ok(self.inner.pushers[i].points.iter().map(|p| [p.x, p.y, p.z]).collect())
+    /// Contact points (object frame) of pusher `name` at `pose` (default: the task's start).
+    #[pyo3(signature = (name, pose=None))]
+    fn pusher_points(&self, name: &str, pose: Option<Vec<f64>>) -> PyResult<Vec<[f64; 3]>> {
+        Ok(self.pusher_spec(name, pose)?.0)
     }
 
     #[getter]
