@@ -22,4 +22,10 @@ if __name__ == "__main__":
         plot_plan(sc, p, OUT / f"plan-{name}.png")
         if name in ("t-shape", "block-xztheta"):
             animate_plan(sc, p, OUT / f"plan-{name}.gif")
+    # 3-D plans: GIFs (seed 0)
+    from regrasp.plotting import animate_plan3d
+
+    for name, fps in (("pivot-3d", 6), ("pivot-single-3d", 6), ("ball-roll-3d", 4)):
+        s3 = regrasp.Scene3D.load(ROOT / "examples" / f"{name}.toml")
+        animate_plan3d(s3, s3.plan(seed=0), OUT / f"plan-{name}.gif", frames_per_step=fps)
     print("wrote", *sorted(p.name for p in OUT.glob("*.png")), *sorted(p.name for p in OUT.glob("*.gif")))

@@ -52,7 +52,28 @@ def _exp(u, t) -> np.ndarray:
     return np.array(_core.se3_integrate([0, 0, 0, 1, 0, 0, 0], list(map(float, u)), float(t)))
 
 
+PLANE_HALF = 0.15  # m, half the side of a plane feature (a floor or a wall)
+
+
+def plane_frame(scene, name: str, pose) -> np.ndarray:
+    """For a plane pusher brought against the object at ``pose``: the pose, in the pusher's frame
+    (the object frame then), of the plane's own frame (origin at the contact, +Z its normal)."""
+    from scipy.spatial.transform import Rotation
+
+    pts, n, _ = scene._core.pusher_spec(name, list(map(float, pose)))
+    n = np.asarray(n, float) / np.linalg.norm(n)
+    a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+    t1 = np.cross(a, n)
+    t1 /= np.linalg.norm(t1)
+    q = Rotation.from_matrix(np.c_[t1, np.cross(n, t1), n]).as_quat()
+    return np.r_[np.asarray(pts, float).mean(axis=0), q[3], q[:3]]
+
+
 def feature_geoms(scene, name: str, friction: float) -> str:
+    if scene._core.is_plane(name):
+        # a thick slab whose top face is the plane z = 0 of the feature's frame (see plane_frame)
+        g = f'friction="{friction:.9g} 0 0" condim="3" {BITS_FEAT}'
+        return f'<geom type="box" size="{PLANE_HALF} {PLANE_HALF} 0.005" pos="0 0 -0.005" {g}/>'
     pts, n, _ = scene._core.pusher_spec(name)
     pts, n = np.asarray(pts, float), np.asarray(n, float) / np.linalg.norm(n)
     g = f'friction="{friction:.9g} 0 0" condim="3" {BITS_FEAT}'
@@ -99,7 +120,8 @@ def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, ma
     asset = f'<mesh name="obj" vertex="{_f(v)}" face="{_f(t)}"/>'
     obj = (f'<body name="object" pos="{_f(s0[:3])}" quat="{_f(s0[3:])}"><freejoint/>'
            f'<inertial pos="{_f(com)}" mass="{m:.9g}" fullinertia="{I[0,0]:.9g} {I[1,1]:.9g} {I[2,2]:.9g} {I[0,1]:.9g} {I[0,2]:.9g} {I[1,2]:.9g}"/>'
-           f'<geom type="mesh" mesh="obj" friction="0 0 0" condim="4" {BITS_OBJ}/></body>')
+           + (f'<geom type="sphere" size="{scene._core.sphere:.9g}" friction="0 0 0" condim="4" {BITS_OBJ}/></body>'
+              if scene._core.sphere else f'<geom type="mesh" mesh="obj" friction="0 0 0" condim="4" {BITS_OBJ}/></body>'))
     mu = scene._core.grip_friction * friction_scale
     k = 2.0 / 3.0 * scene._core.pad_radius
     # pads at the object's extreme points along ±Y at the start
@@ -175,7 +197,9 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
     gripper approaches until it touches), the gripper moves with the inverse of the virtual
     pusher's motion and backs off 2 mm before a switch-over. ``view="planner"``: the pads fixed,
     the feature (on a driven body) follows the virtual pusher's motion. Either way the feature's
-    pose in the grasp, ``P``, follows the plan's pusher twists; only what moves differs."""
+    pose in the grasp, ``P``, follows the plan's pusher twists (each a body twist in the object's
+    frame at the step's start, as the planner and the quasi-static replay apply it); only what
+    moves differs."""
     import mujoco
 
     from .scene3d import check_plan3d, quat_angle, twist_between
@@ -202,25 +226,29 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
     bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "object")
     G = lambda: grip.pose if world else identity  # noqa: E731 - the gripper in the world
     in_grasp = lambda: compose(inverse(G()), np.r_[data.xpos[bid], data.xquat[bid]])  # noqa: E731
-    state = {"pusher": None, "F": None}
+    # the feature body's pose in the pusher's frame: identity for rigid pushers (built in the
+    # object frame), the plane's frame for planes (set when the plane is brought)
+    state = {"pusher": None, "F": None, "T": identity}
 
     def place(P):
         """One time step with the active feature at pose ``P`` in the grasp (None: nothing moves)."""
         if world:
             grip.move(data, grip.pose if P is None else compose(state["F"], inverse(P)), dt)
         for p, d in drivers.items():
-            d.move(data, P if p == state["pusher"] and P is not None else d.pose, dt)
+            d.move(data, compose(P, state["T"]) if p == state["pusher"] and P is not None else d.pose, dt)
         mujoco.mj_step(model, data)
 
     def put(p, P):
         """Puts pusher ``p``'s feature at ``P`` in the grasp (where it stays, in the world's view)."""
         fid = model.body(f"feature_{p}").id
+        state["T"] = plane_frame(scene, p, in_grasp()) if scene._core.is_plane(p) else identity
         if world:
             state["F"] = compose(G(), P)
+            F = compose(state["F"], state["T"])
             fm = int(model.body_mocapid[fid])
-            data.mocap_pos[fm], data.mocap_quat[fm] = state["F"][:3], state["F"][3:]
+            data.mocap_pos[fm], data.mocap_quat[fm] = F[:3], F[3:]
         else:
-            drivers[p].set(data, P)
+            drivers[p].set(data, compose(P, state["T"]))
         state["pusher"] = p
         mujoco.mj_forward(model, data)
         return {i for i in range(model.ngeom) if model.geom_bodyid[i] == fid}
@@ -244,7 +272,7 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
                     P = compose(P0, np.r_[-n * creep * k, 1, 0, 0, 0])
                     place(P)
                 park(state["pusher"])
-            _, n, _ = scene._core.pusher_spec(p)
+            _, n, _ = scene._core.pusher_spec(p, list(map(float, in_grasp())))
             n = np.asarray(n, float) / np.linalg.norm(n)
             P = compose(in_grasp(), np.r_[-GAP * n, 1, 0, 0, 0])  # where it meets the object, backed off
             ids = put(p, P)
@@ -255,10 +283,14 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
                 place(P)
         u = b.get("pusher_twist")
         u = np.asarray(twist_between(a["pose"], b["pose"]) if u is None else u, float)
-        P0 = P.copy()
+        # the step's twist is the pusher's body twist in the object's frame at the step's start
+        # (where the planner and the quasi-static replay put the pusher); the feature, wherever
+        # it is now (offset D from that frame), makes the same rigid motion: P(t) = A exp(ut) D
+        A = in_grasp()
+        D = compose(inverse(A), P)
         nsteps = int(round(1.0 / dt))
         for k in range(1, nsteps + 1):
-            P = compose(P0, _exp(u, k / nsteps))
+            P = compose(A, compose(_exp(u, k / nsteps), D))
             place(P)
         poses.append(in_grasp())
     q = in_grasp()

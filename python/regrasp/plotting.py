@@ -433,6 +433,9 @@ def animate_plan3d(scene, plan: dict, path, fps: int = 12, frames_per_step: int 
         seq = [(poses[0][:3], Rotation.from_quat([poses[0][4], poses[0][5], poses[0][6], poses[0][3]]), None, 0)]
     size = float(np.linalg.norm(v, axis=1).max())
     pad_r = float(scene._core.pad_radius)
+    from .viewer import marks
+
+    face = np.where(marks(scene)[:, None] > 0, np.array([0.9, 0.6, 0.2]), np.array([0.56, 0.70, 0.85]))
     fig = plt.figure(figsize=(5.5, 5))
     ax = fig.add_subplot(projection="3d")
 
@@ -440,13 +443,27 @@ def animate_plan3d(scene, plan: dict, path, fps: int = 12, frames_per_step: int 
         ax.cla()
         p, R, name, step = seq[i]
         w = R.apply(v) + p
-        ax.add_collection3d(Poly3DCollection(w[t], facecolor="#8fb3d9", edgecolor="k", linewidth=0.3, alpha=0.9))
+        ax.add_collection3d(Poly3DCollection(w[t], facecolor=face, edgecolor="k", linewidth=0.3 if len(t) < 200 else 0.05,
+                                             alpha=0.9))
         a = np.linspace(0, 2 * np.pi, 30)
         for sgn in (1, -1):
             y = sgn * np.max(sgn * w[:, 1])
             disc = np.c_[pad_r * np.cos(a), np.full(30, y), pad_r * np.sin(a)]
             ax.add_collection3d(Poly3DCollection([disc], facecolor="0.3", alpha=0.6))
-        if name:
+        if name and scene._core.is_plane(name):
+            # a plane: where the object is lowest along its normal (gripper frame), and the plane
+            nrm = np.asarray(scene._core.pusher_normal(name), float)
+            low = (w @ nrm).min()
+            pts = w[w @ nrm < low + 1e-6 * size] if not scene._core.sphere else (p - scene._core.sphere * nrm)[None]
+            c = pts[0]
+            a = np.array([1.0, 0, 0]) if abs(nrm[0]) < 0.9 else np.array([0, 1.0, 0])
+            t1 = np.cross(nrm, a)
+            t1 /= np.linalg.norm(t1)
+            t2 = np.cross(nrm, t1)
+            sq = [c + 1.3 * size * (i * t1 + j * t2) for i, j in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+            ax.add_collection3d(Poly3DCollection([sq], facecolor="tab:red", alpha=0.12))
+            ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], color="tab:red", s=30)
+        elif name:
             pts = R.apply(np.asarray(scene._core.pusher_points(name), float)) + p
             ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], color="tab:red", s=30)
         for f, lim in ((ax.set_xlim, 0), (ax.set_ylim, 1), (ax.set_zlim, 2)):
@@ -456,6 +473,7 @@ def animate_plan3d(scene, plan: dict, path, fps: int = 12, frames_per_step: int 
         ax.set_zlabel("z")
         ax.set_title(f"{scene.name}: step {step}/{len(poses) - 1}" + (f", pusher {name}" if name else ""), fontsize=9)
         ax.view_init(elev=18, azim=-60)
+        ax.set_box_aspect((1, 1, 1))
 
     anim = FuncAnimation(fig, draw, frames=len(seq), interval=1000 / fps)
     path = Path(path)

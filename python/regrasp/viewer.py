@@ -56,7 +56,7 @@ function draw() {
   const world = D.vertices.map(v => { const r = qrot(rot, v); return [r[0]+pos[0], r[1]+pos[1], r[2]+pos[2]]; });
   const tris = [];
   const light = [0.3, -0.5, 0.8];
-  for (const t of D.triangles) {
+  for (const [i, t] of D.triangles.entries()) {
     const a = world[t[0]], b = world[t[1]], c = world[t[2]];
     const e1 = [b[0]-a[0], b[1]-a[1], b[2]-a[2]], e2 = [c[0]-a[0], c[1]-a[1], c[2]-a[2]];
     const n = [e1[1]*e2[2]-e1[2]*e2[1], e1[2]*e2[0]-e1[0]*e2[2], e1[0]*e2[1]-e1[1]*e2[0]];
@@ -65,7 +65,9 @@ function draw() {
     const cy = Math.cos(yaw), sy = Math.sin(yaw), ny = -sy*n[0] + cy*n[1];
     if (Math.cos(pitch)*ny - Math.sin(pitch)*n[2] > 0) continue;
     const P = [a, b, c].map(view);
-    tris.push([P, (P[0][2]+P[1][2]+P[2][2]) / 3, `rgb(${Math.round(90+120*sh)},${Math.round(110+110*sh)},${Math.round(140+100*sh)})`]);
+    const col = D.marks[i] ? `rgb(${Math.round(140+110*sh)},${Math.round(90+90*sh)},${Math.round(30+40*sh)})`
+                           : `rgb(${Math.round(90+120*sh)},${Math.round(110+110*sh)},${Math.round(140+100*sh)})`;
+    tris.push([P, (P[0][2]+P[1][2]+P[2][2]) / 3, col]);
   }
   // the pads: discs at the gripper's +-Y extremes of the object
   const pads = [];
@@ -88,12 +90,26 @@ function draw() {
   for (const [ring, facing] of pads) if (facing) poly(ring, "rgba(60,60,60,0.55)", "rgba(0,0,0,0.3)");
   // the pusher of the current step: its contact points, moving with the object
   const name = D.pushers_of_steps[Math.min(step, D.pushers_of_steps.length - 1)];
-  if (name && D.pusher_points[name]) {
-    ctx.fillStyle = "#d62728";
-    for (const pnt of D.pusher_points[name]) {
-      const r = qrot(rot, pnt), P = view([r[0]+pos[0], r[1]+pos[1], r[2]+pos[2]]);
-      ctx.beginPath(); ctx.arc(P[0], P[1], 5, 0, 2*Math.PI); ctx.fill();
-    }
+  // (a plane touches the object where it is lowest along its normal, given in the gripper frame)
+  let contacts = [];
+  if (name && D.planes[name]) {
+    const n = D.planes[name], dot = p => p[0]*n[0] + p[1]*n[1] + p[2]*n[2];
+    if (D.sphere) contacts = [[pos[0] - D.sphere*n[0], pos[1] - D.sphere*n[1], pos[2] - D.sphere*n[2]]];
+    else { const lo = Math.min(...world.map(dot)); contacts = world.filter(p => dot(p) < lo + 1e-6*D.size); }
+    // the plane itself: a square around the contact
+    const c = contacts[0], a = Math.abs(n[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0];
+    let t1 = [n[1]*a[2]-n[2]*a[1], n[2]*a[0]-n[0]*a[2], n[0]*a[1]-n[1]*a[0]];
+    const l = Math.hypot(...t1); t1 = t1.map(x => x / l);
+    const t2 = [n[1]*t1[2]-n[2]*t1[1], n[2]*t1[0]-n[0]*t1[2], n[0]*t1[1]-n[1]*t1[0]], h = 1.3 * D.size;
+    const sq = [[1, 1], [-1, 1], [-1, -1], [1, -1]].map(([i, j]) => view([0, 1, 2].map(k => c[k] + h*(i*t1[k] + j*t2[k]))));
+    poly(sq, "rgba(214,39,40,0.12)", "rgba(214,39,40,0.5)");
+  } else if (name && D.pusher_points[name]) {
+    contacts = D.pusher_points[name].map(pnt => { const r = qrot(rot, pnt); return [r[0]+pos[0], r[1]+pos[1], r[2]+pos[2]]; });
+  }
+  ctx.fillStyle = "#d62728";
+  for (const pnt of contacts) {
+    const P = view(pnt);
+    ctx.beginPath(); ctx.arc(P[0], P[1], 5, 0, 2*Math.PI); ctx.fill();
   }
   info.textContent = `${D.name}: step ${step} of ${D.poses.length - 1}` + (name ? `, pusher ${name}` : "") +
     ` — position [${pos.map(x => (1000*x).toFixed(1)).join(", ")}] mm`;
@@ -128,6 +144,16 @@ if (typeof location !== "undefined" && location.hash === "#selftest") {  // for 
 """
 
 
+def marks(scene) -> np.ndarray:
+    """Which of the object's triangles are painted (1) — a sphere's alternate octants, so its
+    turning shows (the thesis' paint marks on the ball, Fig 4-8); none for other objects."""
+    v, t = scene.mesh()
+    if not scene._core.sphere:
+        return np.zeros(len(t), int)
+    c = np.asarray(v, float)[np.asarray(t, int)].mean(axis=1)
+    return (np.prod(np.sign(c + 1e-12), axis=1) > 0).astype(int)
+
+
 def page(scene, plan: dict) -> str:
     """The HTML page of ``plan`` (a 3-D plan dict) for ``scene`` (a Scene3D)."""
     v, t = scene.mesh()
@@ -140,6 +166,11 @@ def page(scene, plan: dict) -> str:
         "poses": [list(map(float, k["pose"])) for k in plan["path"]],
         "pushers_of_steps": [k["pusher"] for k in plan["path"]],
         "pusher_points": {n: np.asarray(scene._core.pusher_points(n), float).tolist() for n in scene.pusher_names},
+        # plane pushers: their normals (gripper frame); the page finds where they touch
+        "planes": {n: np.asarray(scene._core.pusher_normal(n), float).tolist() for n in scene.pusher_names
+                   if scene._core.is_plane(n)},
+        "sphere": scene._core.sphere,
+        "marks": marks(scene).tolist(),
         "pad": float(scene._core.pad_radius),
         "size": size,
     }

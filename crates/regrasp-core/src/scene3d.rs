@@ -376,7 +376,7 @@ impl Scene3 {
                     .map_err(|e| Error::scene("object.mesh", format!("cannot read {}: {e}", path.display())))?;
                 ConvexMesh::from_obj(&text).map_err(|e| Error::scene("object.mesh", e))?
             }
-            Some("sphere") => ConvexMesh::icosphere(pos("object.radius", obj.radius)?, 3),
+            Some("sphere") => ConvexMesh::icosphere(pos("object.radius", obj.radius)?, 2),
             Some(other) => return Err(Error::scene("object.shape", format!("must be \"box\", \"mesh\" or \"sphere\" (got \"{other}\")"))),
             None => return Err(Error::scene("object.shape", "is required (\"box\", \"mesh\" or \"sphere\")")),
         };

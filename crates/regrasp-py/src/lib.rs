@@ -785,6 +785,12 @@ impl Scene3D {
         let (pts, n) = self.inner.pusher_contacts(i, &q);
         Ok((pts.iter().map(|v| [v.x, v.y, v.z]).collect(), [n.x, n.y, n.z], self.inner.pushers[i].friction))
     }
+    /// Pusher `name`'s normal as the scene gives it (object frame; a plane's: gripper frame).
+    fn pusher_normal(&self, name: &str) -> PyResult<[f64; 3]> {
+        let i = self.inner.pusher_index(name).map_err(to_py)?;
+        let n = self.inner.pushers[i].normal;
+        Ok([n.x, n.y, n.z])
+    }
     /// Whether pusher `name` is a plane (its normal fixed in the gripper frame).
     fn is_plane(&self, name: &str) -> PyResult<bool> {
         let i = self.inner.pusher_index(name).map_err(to_py)?;
