@@ -9,12 +9,13 @@ import sys
 import numpy as np
 import pytest
 
+from regrasp import _core
 from regrasp.scene3d import Scene3D, quat_angle, twist_between
 from regrasp.viewer import write_html
 
 from .conftest import EXAMPLES, ROOT
 
-THREE_D = ["offset-3d", "light-side-3d", "pivot-single-3d", "pivot-3d", "block-3d", "prism-3d"]
+THREE_D = ["offset-3d", "light-side-3d", "pivot-single-3d", "pivot-3d", "block-3d", "prism-3d", "ball-roll-3d"]
 
 
 @pytest.mark.parametrize("name", THREE_D)
@@ -95,6 +96,13 @@ def test_browser_view_draws_every_frame(tmp_path):
         assert fr["pusher_dots"] >= 2  # the active pusher's contacts
     assert "pusher corner" in out["frames"][0]["info"] and "pusher ground" in out["frames"][-1]["info"]
     assert np.allclose(out["frames"][-1]["pose"], p["path"][-1]["pose"], atol=1e-9)
+    # a ball on the floor: one contact dot (the lowest point), the floor drawn, painted faces
+    s = Scene3D.load(EXAMPLES / "ball-roll-3d.toml")
+    page = write_html(s, s.plan(seed=0), tmp_path / "ball.html")
+    out = json.loads(subprocess.run(["node", str(ROOT / "tests" / "js" / "run_viewer.js"), str(page)],
+                                    capture_output=True, text=True, check=True).stdout)
+    for fr in out["frames"]:
+        assert fr["finite"] and fr["pusher_dots"] == 1 and fr["drawn"] >= out["triangles"] // 3
 
 
 def test_3d_plans_execute_in_mujoco(tmp_path):
@@ -113,6 +121,53 @@ def test_3d_plans_execute_in_mujoco(tmp_path):
     r = subprocess.run([sys.executable, "-m", "regrasp.cli", "simulate", str(EXAMPLES / "light-side-3d.toml"), "--plan", str(f),
                         "--engine", "mujoco", "--json"], capture_output=True, text=True)
     assert r.returncode == 0 and json.loads(r.stdout)["engine"] == "mujoco", r.stderr
+
+
+def test_ball_rolls_on_the_floor_in_mujoco_and_feedback_closes_the_gap(tmp_path):
+    """The ball example rolled on the floor in MuJoCo: open loop it turns (it rolls: > 1.4 rad
+    of the 1.57) but MuJoCo's contacts roll it a little further per step than the quasi-static
+    model (measured 40 mrad at the goal, outside the 17.5 mrad tolerance); re-planning from the
+    measured pose (``regrasp control SCENE_3D``) ends within the tolerance."""
+    pytest.importorskip("mujoco")
+    from regrasp.mujoco3d import execute_plan3d
+
+    s = Scene3D.load(EXAMPLES / "ball-roll-3d.toml")
+    p = s.plan(seed=0)
+    ol = execute_plan3d(s, p)
+    assert quat_angle(ol["final_pose"][3:], [1, 0, 0, 0]) > 1.4
+    closed = execute_plan3d(s, p, feedback=True)
+    assert closed["success"] and closed["replans"] >= 1, closed["goal_error"]
+    f = tmp_path / "ball.json"
+    f.write_text(json.dumps(p))
+    cli = [sys.executable, "-m", "regrasp.cli", "control", str(EXAMPLES / "ball-roll-3d.toml"), "--plan", str(f), "--json"]
+    r = subprocess.run(cli + ["--engine", "mujoco"], capture_output=True, text=True)
+    out = json.loads(r.stdout)
+    assert r.returncode == 0 and out["success"] and out["policy"] == "replan", r.stderr
+    r = subprocess.run(cli + ["--poke", "1,0,0,0"], capture_output=True, text=True)
+    assert r.returncode == 2 and "--poke" in r.stderr
+
+
+def test_feedback_replans_after_a_disturbance():
+    """Closed loop by re-planning: a world that turns the ball 3 mrad further per step than the
+    quasi-static model (as MuJoCo does) ends outside the tolerance open loop, within it with
+    re-plans from the measured pose."""
+    s = Scene3D.load(EXAMPLES / "ball-roll-3d.toml")
+    p = s.plan(seed=0)
+    calls = []
+
+    def step(a, b):  # the quasi-static step, plus a 3 mrad extra turn about the grasp axis
+        q = np.asarray(s.simulate_push(a["pose"] if not calls else calls[-1], b["pusher"], b["pusher_twist"], 1.0, 0.25)["pose"][-1])
+        q = np.array(_core.se3_compose(list(q), [0, 0, 0, np.cos(0.0015), 0, np.sin(0.0015), 0]))
+        calls.append(q)
+        return q
+
+    from regrasp.scene3d import goal_report, run_plan3d
+
+    q, poses, n = run_plan3d(s, p["path"], step, p["path"][0]["pose"], feedback=False)
+    assert n == 0 and not goal_report(s, q)["success"], goal_report(s, q)  # open loop: 24 mrad off
+    calls.clear()
+    q, poses, n = run_plan3d(s, p["path"], step, p["path"][0]["pose"], feedback=True)
+    assert n >= 1 and goal_report(s, q)["success"], goal_report(s, q)
 
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")

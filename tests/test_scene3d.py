@@ -63,6 +63,30 @@ def test_bad_3d_scenes_name_the_field(tmp_path):
         assert e.value.field == field, str(e.value)
 
 
+def test_sphere_and_plane_fields_are_checked(tmp_path):
+    text = (EXAMPLES / "ball-roll-3d.toml").read_text()
+    cases = {
+        "object.radius": text.replace("radius = 0.035", "radius = -0.035"),
+        "pushers[0].points": text.replace("plane = true", "plane = true\npoints = [[0.0, 0.0, -0.035]]"),
+    }
+    box = (EXAMPLES / "block-3d.toml").read_text().replace('shape = "box"', 'shape = "box"\nradius = 0.02')
+    cases_box = {"object.radius": box}
+    for field, t in {**cases, **cases_box}.items():
+        with pytest.raises(regrasp.SceneError) as e:
+            regrasp.Scene3D.from_toml(t, tmp_path)
+        assert e.value.field == field, str(e.value)
+    s = regrasp.Scene3D.from_toml(text)
+    # a solid sphere: I = (2/5) m r^2; pads are rings of 8 points on the tangent planes
+    assert s.inertia[0, 0] == pytest.approx(0.4 * 0.058 * 0.035**2)
+    assert [len(x) for x in s.pad_contacts(IDENTITY)] == [8, 8]
+    # the floor touches the ball at its lowest point, wherever the ball has turned
+    q = [0, 0, 0, np.cos(0.3), 0, np.sin(0.3), 0]
+    pts, n, _ = s._core.pusher_spec("floor", q)
+    from scipy.spatial.transform import Rotation
+
+    assert np.allclose(Rotation.from_quat([0, np.sin(0.3), 0, np.cos(0.3)]).apply(pts[0]), [0, 0, -0.035], atol=1e-12)
+
+
 def test_push_cli_3d():
     r = subprocess.run([sys.executable, "-m", "regrasp.cli", "push", str(EXAMPLES / "prism-3d.toml"), "--pose",
                         "0,0,0,1,0,0,0", "--pusher", "ground", "--twist", "0,0,0.01,0,0,0", "--duration", "0.3",

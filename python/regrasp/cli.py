@@ -328,9 +328,13 @@ def cmd_control(a) -> int:
     from .mujoco_exec import Perturbation
     from .quasistatic import load_plan
 
+    from .scene3d import is_3d
+
+    _check_factors(a)
+    if is_3d(a.scene):
+        return _control3d(a)
     scene = _load_planar(a.scene, "control")
     plan = load_plan(a.plan)
-    _check_factors(a)
     if a.horizon < 1:
         raise ArgumentError(f"invalid `--horizon`: must be at least 1 step (got {a.horizon})", "--horizon")
     if not (np.isfinite(a.dt) and a.dt > 0):
@@ -356,6 +360,37 @@ def cmd_control(a) -> int:
               f"final pose {np.round(res.final_pose, 5).tolist()}, error {np.round(res.goal_error, 5).tolist()}"
               + (f" ({res.failure})" if res.failure else ""))
     return 0 if res.success else 1
+
+
+def _control3d(a) -> int:
+    """`regrasp control SCENE_3D`: the plan executed with feedback by re-planning (see
+    :func:`regrasp.scene3d.run_plan3d`), or open loop with --open-loop."""
+    from .scene3d import Scene3D
+
+    planar = [f for f in ("poke", "start_error", "robust", "uncertainty", "fixtureless", "plot") if getattr(a, f, None)]
+    if planar or a.noise:
+        raise ArgumentError("invalid flags for a 3-D scene: 3-D control re-plans from the measured pose "
+                            f"(no --{', --'.join(f.replace('_', '-') for f in planar or ['noise'])})", "scene")
+    s3 = Scene3D.load(a.scene)
+    try:
+        plan3 = json.loads(Path(a.plan).read_text())
+    except (OSError, ValueError) as e:
+        raise ArgumentError(f"invalid `--plan`: cannot read {a.plan}: {e}", "--plan") from e
+    fb = not a.open_loop
+    if a.engine == "mujoco":
+        from .mujoco3d import execute_plan3d
+
+        r = execute_plan3d(s3, plan3, a.scale_friction, a.scale_grip, a.scale_mass, feedback=fb, seed=a.seed)
+    else:
+        r = s3.replay(plan3, feedback=fb, seed=a.seed)
+    out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success", "replans")}
+    out["policy"] = "replan" if fb else "open_loop"
+    if a.json:
+        print(json.dumps(out))
+    else:
+        print(f"{s3.name}: {out['policy']} in {r['engine']}: {'success' if r['success'] else 'failure'}, "
+              f"{r['replans']} re-plans; error {np.round(r['goal_error'], 5).tolist()}")
+    return 0 if r["success"] else 1
 
 
 def _plan3d(a) -> int:
@@ -455,7 +490,8 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--html", metavar="HTML", help="3-D scenes: an interactive 3-D view of the plan (self-contained page)")
     pl.set_defaults(fn=cmd_plan)
 
-    k = sub.add_parser("control", help="track a plan with the MPC (closed loop) in a simulator")
+    k = sub.add_parser("control", help="track a plan with the MPC (closed loop) in a simulator "
+                                          "(3-D scenes: feedback by re-planning from the measured pose)")
     k.add_argument("scene")
     k.add_argument("--plan", required=True)
     k.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"])

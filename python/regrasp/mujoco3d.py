@@ -189,9 +189,15 @@ class Driver6:
 
 
 def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
-                   contact: Contact = Contact(), settle: float = 0.2, pad: str = "point", view: str = "world") -> dict:
+                   contact: Contact = Contact(), settle: float = 0.2, pad: str = "point", view: str = "world",
+                   feedback: bool = False, max_replans: int = 10, seed: int = 0) -> dict:
     """Executes a 3-D plan in MuJoCo; returns the final pose, the error to the goal (position,
-    angle), success and the object's pose in the grasp after each step.
+    angle), success, the object's pose in the grasp after each step and the re-plans made.
+
+    ``feedback``: closed loop by re-planning — after each step the object's pose is measured; when
+    it is off the plan by more than half the goal tolerance (position or angle), or the plan ends
+    outside the tolerance, the T-RRT* plans again from the measured pose (at most
+    ``max_replans`` times) and execution goes on with the new plan.
 
     ``view="world"``: each push's feature is fixed where the push needs it (2 mm back, then the
     gripper approaches until it touches), the gripper moves with the inverse of the virtual
@@ -202,7 +208,7 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
     moves differs."""
     import mujoco
 
-    from .scene3d import check_plan3d, quat_angle, twist_between
+    from .scene3d import check_plan3d, goal_report, run_plan3d, twist_between
 
     if pad not in ("point", "ring"):
         raise ArgumentError(f"invalid `pad`: 'point' or 'ring' (got {pad!r})", "pad")
@@ -261,10 +267,12 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
 
     for _ in range(int(settle / dt)):
         place(None)
-    poses, P, n = [in_grasp()], None, None
+    st = {"P": None, "n": None}
     creep = 0.005 * dt  # approach and back-off at 5 mm/s
-    for a, b in zip(path[:-1], path[1:]):
-        p = b["pusher"]
+
+    def step(a, b):
+        """One step of the plan: bring the step's pusher if it is a new one, then move it."""
+        P, n, p = st["P"], st["n"], b["pusher"]
         if state["pusher"] != p:
             if state["pusher"] is not None:  # back off, park the old feature (a switch-over)
                 P0 = P.copy()
@@ -277,7 +285,7 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
             P = compose(in_grasp(), np.r_[-GAP * n, 1, 0, 0, 0])  # where it meets the object, backed off
             ids = put(p, P)
             for _ in range(int(3 * GAP / creep)):  # approach until touching (at most 3 gaps)
-                if any(data.contact[i].geom1 in ids or data.contact[i].geom2 in ids for i in range(data.ncon)):
+                if any(data.contact[j].geom1 in ids or data.contact[j].geom2 in ids for j in range(data.ncon)):
                     break
                 P = compose(P, np.r_[n * creep, 1, 0, 0, 0])
                 place(P)
@@ -292,11 +300,8 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
         for k in range(1, nsteps + 1):
             P = compose(A, compose(_exp(u, k / nsteps), D))
             place(P)
-        poses.append(in_grasp())
-    q = in_grasp()
-    _, goal, tol = scene.task
-    dp = q[:3] - goal[:3]
-    ang = quat_angle(q[3:], goal[3:])
-    ok = bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])
-    return {"engine": "mujoco", "view": view, "final_pose": q.tolist(), "goal_error": dp.tolist() + [ang],
-            "success": ok, "poses": np.array(poses)}
+        st["P"], st["n"] = P, n
+        return in_grasp()
+
+    q, poses, replans = run_plan3d(scene, path, step, in_grasp(), feedback, max_replans, seed)
+    return {"engine": "mujoco", "view": view, **goal_report(scene, q), "poses": np.array(poses), "replans": replans}

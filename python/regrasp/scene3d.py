@@ -80,26 +80,72 @@ class Scene3D:
         tw = [k["pusher_twist"] if h else [0.0] * 6 for k, h in zip(path, has)] if any(has) else None
         return self._core.validate_path([list(map(float, k["pose"])) for k in path], [k["pusher"] for k in path], tw)
 
-    def replay(self, plan: dict, dt: float = 0.25) -> dict:
+    def replay(self, plan: dict, dt: float = 0.25, feedback: bool = False, max_replans: int = 10, seed: int = 0) -> dict:
         """Replays a 3-D plan in the quasi-static simulator: each step's pusher moves with the
         step's twist for unit time from wherever the object is. Returns the final pose, the
-        error to the goal (position [m] and angle [rad]), success (within the task's tolerance)
-        and the poses after each step."""
+        error to the goal (position [m] and angle [rad]), success (within the task's tolerance),
+        the poses after each step and the re-plans made (``feedback``: see :func:`run_plan3d`)."""
         path = check_plan3d(self, plan)
-        q = np.asarray(path[0]["pose"], float)
-        poses = [q]
-        for a, b in zip(path[:-1], path[1:]):
+
+        def step(a, b):
             u = b.get("pusher_twist")
             u = twist_between(a["pose"], b["pose"]) if u is None else u
-            tr = self.simulate_push(q, b["pusher"], u, 1.0, dt)
-            q = np.asarray(tr["pose"][-1], float)
-            poses.append(q)
-        _, goal, tol = self.task
-        dp = q[:3] - goal[:3]
-        ang = quat_angle(q[3:], goal[3:])
-        ok = bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])
-        return {"engine": "quasistatic", "final_pose": q.tolist(), "goal_error": dp.tolist() + [ang], "success": ok,
-                "poses": np.array(poses)}
+            return np.asarray(self.simulate_push(q[0], b["pusher"], u, 1.0, dt)["pose"][-1], float)
+
+        q = [np.asarray(path[0]["pose"], float)]
+
+        def tracked(a, b):
+            q[0] = step(a, b)
+            return q[0]
+
+        end, poses, replans = run_plan3d(self, path, tracked, q[0], feedback, max_replans, seed)
+        return {"engine": "quasistatic", **goal_report(self, end), "poses": np.array(poses), "replans": replans}
+
+
+def goal_report(scene: "Scene3D", q) -> dict:
+    """The final pose, its error to the task's goal (position [m], angle [rad]) and whether it
+    is within the task's tolerance."""
+    q = np.asarray(q, float)
+    _, goal, tol = scene.task
+    dp = q[:3] - goal[:3]
+    ang = quat_angle(q[3:], goal[3:])
+    return {"final_pose": q.tolist(), "goal_error": dp.tolist() + [ang],
+            "success": bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])}
+
+
+def run_plan3d(scene: "Scene3D", path: list, step, q0, feedback: bool = False, max_replans: int = 10, seed: int = 0):
+    """Executes a 3-D path with ``step(a, b) -> measured pose`` (one plan step from path entry
+    ``a`` to ``b``), from measured pose ``q0``. Closed loop by re-planning when ``feedback``: after
+    a step that leaves the object off the plan by more than half the goal tolerance (position or
+    angle), or when the plan ends outside the tolerance, the T-RRT* plans again from the measured
+    pose (at most ``max_replans`` times; seeds ``seed + 1, ...``). Returns the final pose, the poses
+    after each step and the number of re-plans."""
+    _, goal, tol = scene.task
+    if not (isinstance(max_replans, (int, np.integer)) and max_replans >= 0):
+        raise ArgumentError("invalid `max_replans`: a non-negative whole number", "max_replans")
+
+    def off(q, ref):
+        return bool(np.any(np.abs(q[:3] - np.asarray(ref[:3], float)) > tol[:3] / 2) or quat_angle(q[3:], ref[3:]) > tol[3] / 2)
+
+    q = np.asarray(q0, float)
+    poses, replans, i = [q], 0, 0
+    while True:
+        stray = i > 0 and i + 1 < len(path) and off(q, path[i]["pose"])
+        if i + 1 >= len(path) or stray:
+            if not feedback or replans >= max_replans or (not stray and goal_report(scene, q)["success"]):
+                if i + 1 >= len(path):
+                    break
+            else:
+                new = scene.plan(start=q, seed=seed + replans + 1)
+                replans += 1
+                if len(new["path"]) >= 2:
+                    path, i = new["path"], 0
+                elif i + 1 >= len(path):
+                    break
+        q = np.asarray(step(path[i], path[i + 1]), float)
+        poses.append(q)
+        i += 1
+    return q, poses, replans
 
 
 def check_plan3d(scene: "Scene3D", plan) -> list:

@@ -318,6 +318,81 @@ tolerance = [0.001, 0.001, 0.001, 0.0175]
         assert!(tr.pusher_sticking.iter().all(|n| *n == 2));
     }
 
+    const BALL3: &str = r#"
+dimension = 3
+name = "ball"
+[object]
+shape = "sphere"
+radius = 0.035
+mass = 0.058
+[grasp]
+force = 2.5
+friction = 0.5
+pad_radius = 0.006
+[[pushers]]
+name = "floor"
+friction = 0.9
+plane = true
+normal = [0.0, 0.0, 1.0]
+[task]
+start = [0, 0, 0, 1, 0, 0, 0]
+goal = [0, 0, 0, 1, 0, 0, 0]
+tolerance = [0.002, 0.002, 0.002, 0.0175]
+"#;
+
+    #[test]
+    fn icosphere_is_a_closed_convex_sphere() {
+        let m = crate::scene3d::ConvexMesh::icosphere(0.02, 2);
+        assert_eq!(m.triangles.len(), 320);
+        assert!(m.vertices.iter().all(|v| (v.norm() - 0.02).abs() < 1e-12));
+        let (vol, c, _) = m.mass_properties();
+        let ball = 4.0 / 3.0 * std::f64::consts::PI * 0.02f64.powi(3);
+        assert!(vol < ball && vol > 0.95 * ball && c.norm() < 1e-9, "{vol} vs {ball}");
+    }
+
+    /// A plane touches the object where it is lowest along its normal: a sphere's one point, a
+    /// box's face (4 vertices) or edge (2).
+    #[test]
+    fn planes_touch_the_lowest_points() {
+        let ball = Scene3::from_toml_str(BALL3, None).unwrap();
+        let q = Isometry3::from_parts(Translation3::new(0.001, 0.0, 0.002), UnitQuaternion::from_scaled_axis(V3::new(0.3, 0.7, -0.2)));
+        let (pts, n) = ball.pusher_contacts(0, &q);
+        assert_eq!(pts.len(), 1);
+        // in the gripper frame: straight below the centre, normal up
+        assert!(((q.rotation * pts[0]) - V3::new(0.0, 0.0, -0.035)).norm() < 1e-12 && ((q.rotation * n) - V3::z()).norm() < 1e-12);
+        let boxy = Scene3::from_toml_str(&BLOCK3.replace(
+            "[[pushers]]\nname = \"left\"",
+            "[[pushers]]\nname = \"floor\"\nfriction = 0.5\nplane = true\nnormal = [0.0, 0.0, 1.0]\n[[pushers]]\nname = \"left\"",
+        ), None).unwrap();
+        assert_eq!(boxy.pusher_contacts(0, &Isometry3::identity()).0.len(), 4);
+        let tilted = Isometry3::from_parts(Translation3::identity(), UnitQuaternion::from_scaled_axis(V3::new(0.0, 0.3, 0.0)));
+        assert_eq!(boxy.pusher_contacts(0, &tilted).0.len(), 2);
+    }
+
+    /// The floor moving under the held ball rolls it: the ball turns about the grasp axis by
+    /// the floor's travel over its radius (less the pads' yielding), every step meets the
+    /// complementarity conditions, the floor contact sticks, and the contact point moves over
+    /// the ball (it is always the lowest point).
+    #[test]
+    fn a_floor_rolls_the_ball() {
+        let ball = Scene3::from_toml_str(BALL3, None).unwrap();
+        let q0 = Isometry3::identity();
+        let w = 0.2;
+        let u = crate::trrt3d::pusher_motion(&ball, &q0, 0, &[0.0, 0.0, 0.0, 0.0, w, 0.0]);
+        // a level floor: no rotation; it slides at the contact point's speed and presses a little
+        assert!(u[3].abs() + u[4].abs() + u[5].abs() < 1e-15);
+        assert!((u[0] + w * 0.035).abs() < 1e-12 && (u[2] - crate::trrt3d::PLANE_PRESS * w * 0.035).abs() < 1e-12, "{u:?}");
+        let tr = simulate_push(&ball, &q0, 0, &u, 1.0, 0.1, &Settings::default()).unwrap();
+        assert!(tr.residual.iter().all(|r| *r < 1e-6), "{:?}", tr.residual);
+        assert!(tr.pusher_sticking.iter().all(|n| *n == 1), "{:?}", tr.pusher_sticking);
+        let end = crate::scene3d::pose_from_array("pose", tr.pose.last().unwrap()).unwrap();
+        let (axis, ang) = end.rotation.axis_angle().unwrap();
+        assert!((axis.y - 1.0).abs() < 1e-6 && ang > 0.9 * w && ang < 1.1 * w, "{axis:?} {ang}");
+        // the ball's contact point, in the ball's frame, has moved by the turn
+        let (c0, c1) = (ball.pusher_contacts(0, &q0).0[0], ball.pusher_contacts(0, &end).0[0]);
+        assert!((c0.angle(&c1) - ang).abs() < 1e-9);
+    }
+
     #[test]
     fn exp_map_composes() {
         let p = integrate(&Isometry3::identity(), &[0.0, 0.0, 1.0, 0.0, std::f64::consts::PI, 0.0], 1.0);

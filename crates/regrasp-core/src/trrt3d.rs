@@ -620,6 +620,24 @@ mod tests {
         }
     }
 
+    /// The rolling ball example: a plan of floor pushes (forward-dynamics steps with the floor
+    /// level), every step valid.
+    #[test]
+    fn the_ball_is_rolled_to_the_goal() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/ball-roll-3d.toml");
+        let s = Scene3::load(&path).unwrap();
+        let r = plan3(&s, None, None, &Settings { seed: 0, time_limit: 20.0, ..Settings::default() }).unwrap();
+        assert!(r.found, "{:?}", r.stop_reason);
+        let ok = validate_path3(&s, &r.path, Some(&r.twists)).unwrap();
+        assert!(ok.iter().all(|x| *x), "{ok:?}");
+        for (k, u) in r.twists.iter().enumerate().skip(1) {
+            // the floor never tilts: it turns about its normal (the gripper's Z) at most
+            let n = r.path[k - 1].0.rotation.inverse() * V3::z();
+            let w = V3::new(u[3], u[4], u[5]);
+            assert!((w - n * n.dot(&w)).norm() < 1e-12, "step {k}: {u:?}");
+        }
+    }
+
     #[test]
     fn key_distance_approximates_the_metric() {
         let l = 0.05;
