@@ -150,11 +150,13 @@ def test_control_arguments_are_checked(tmp_path):
         r = subprocess.run(cli + ["control", str(EXAMPLES / "block-high-friction.toml"), "--plan", str(f)] + extra,
                            capture_output=True, text=True)
         assert r.returncode == 2 and field in r.stderr, (extra, r.stderr)
-    # planar-only commands name the problem for a 3-D scene
-    for cmd in (["control", str(EXAMPLES / "pivot-3d.toml"), "--plan", str(f)], ["cone", str(EXAMPLES / "pivot-3d.toml"),
-                "--pose", "0,0,0", "--pusher", "ground"], ["validate", str(EXAMPLES / "pivot-3d.toml")]):
+    # planar-only commands name the problem for a 3-D scene; a planar plan for a 3-D scene too
+    for cmd in (["cone", str(EXAMPLES / "pivot-3d.toml"), "--pose", "0,0,0", "--pusher", "ground"],
+                ["validate", str(EXAMPLES / "pivot-3d.toml")]):
         r = subprocess.run(cli + cmd, capture_output=True, text=True)
         assert r.returncode == 2 and "3-D scene" in r.stderr, (cmd, r.stderr)
+    r = subprocess.run(cli + ["control", str(EXAMPLES / "pivot-3d.toml"), "--plan", str(f)], capture_output=True, text=True)
+    assert r.returncode == 2 and "plan.path[0].pose" in r.stderr, r.stderr
     # a poke after the time limit is an error, not silently dropped; a late poke extends the default
     with pytest.raises(ArgumentError, match="pokes"):
         control(s, p, pokes=[Poke(50.0, np.zeros(3))], max_time=10.0)
