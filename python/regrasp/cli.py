@@ -211,10 +211,7 @@ def cmd_simulate(a) -> int:
             raise ArgumentError("invalid flags for a 3-D scene: --perturb/--video/--plot are planar only "
                                 "(3-D: --scale-*, --dt, --json; `regrasp plan --html` for a view)", "scene")
         s3 = Scene3D.load(a.scene)
-        try:
-            plan3 = json.loads(Path(a.plan).read_text())
-        except (OSError, ValueError) as e:
-            raise ArgumentError(f"invalid `--plan`: cannot read {a.plan}: {e}", "--plan") from e
+        plan3 = _read_plan3d(a.plan)
         if a.engine == "mujoco":
             from .mujoco3d import execute_plan3d
 
@@ -362,6 +359,14 @@ def cmd_control(a) -> int:
     return 0 if res.success else 1
 
 
+def _read_plan3d(path) -> dict:
+    """A 3-D plan file (JSON), or an error naming --plan."""
+    try:
+        return json.loads(Path(path).read_text())
+    except (OSError, ValueError) as e:
+        raise ArgumentError(f"invalid `--plan`: cannot read {path}: {e}", "--plan") from e
+
+
 def _control3d(a) -> int:
     """`regrasp control SCENE_3D`: the plan executed with feedback by re-planning (see
     :func:`regrasp.scene3d.run_plan3d`), or open loop with --open-loop."""
@@ -372,10 +377,7 @@ def _control3d(a) -> int:
         raise ArgumentError("invalid flags for a 3-D scene: 3-D control re-plans from the measured pose "
                             f"(no --{', --'.join(f.replace('_', '-') for f in planar or ['noise'])})", "scene")
     s3 = Scene3D.load(a.scene)
-    try:
-        plan3 = json.loads(Path(a.plan).read_text())
-    except (OSError, ValueError) as e:
-        raise ArgumentError(f"invalid `--plan`: cannot read {a.plan}: {e}", "--plan") from e
+    plan3 = _read_plan3d(a.plan)
     fb = not a.open_loop
     if a.engine == "mujoco":
         from .mujoco3d import execute_plan3d
