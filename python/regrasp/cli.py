@@ -181,7 +181,7 @@ def _load_planar(path, cmd: str) -> Scene:
 
     if is_3d(path):
         raise ArgumentError(f"invalid `scene`: `regrasp {cmd}` works on planar scenes; {path} is a 3-D scene "
-                            "(3-D scenes: plan, simulate, push)", "scene")
+                            "(3-D scenes: plan, simulate, push, control)", "scene")
     return Scene.load(path)
 
 
@@ -379,6 +379,8 @@ def _control3d(a) -> int:
     s3 = Scene3D.load(a.scene)
     plan3 = _read_plan3d(a.plan)
     fb = not a.open_loop
+    if a.engine == "quasistatic" and (a.scale_friction, a.scale_grip, a.scale_mass) != (1.0, 1.0, 1.0):
+        raise ArgumentError("invalid `--scale-*`: the quasi-static 3-D world is the scene itself (MuJoCo only)", "--engine")
     if a.engine == "mujoco":
         from .mujoco3d import execute_plan3d
 

@@ -127,8 +127,9 @@ def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, ma
     # pads at the object's extreme points along ±Y at the start
     w = np.array([compose(s0, np.r_[x, 1, 0, 0, 0])[:3] for x in v])
     pads = []
+    R = scene._core.sphere
     for name, sign in (("pad_left", 1), ("pad_right", -1)):
-        y = np.max(sign * w[:, 1]) * sign
+        y = s0[1] + sign * R if R else np.max(sign * w[:, 1]) * sign
         if pad == "ring":
             # 8 point contacts on a ring at 2/3 of the pad's radius: the quasi-static model's pad
             geoms = "".join(
@@ -294,7 +295,9 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
         # the step's twist is the pusher's body twist in the object's frame at the step's start
         # (where the planner and the quasi-static replay put the pusher); the feature, wherever
         # it is now (offset D from that frame), makes the same rigid motion: P(t) = A exp(ut) D
-        A = in_grasp()
+        # (a plane: the planned frame, so it makes its planned motion in the gripper frame and
+        # stays level whatever the object's measured pose)
+        A = np.asarray(a["pose"], float) if scene._core.is_plane(p) else in_grasp()
         D = compose(inverse(A), P)
         nsteps = int(round(1.0 / dt))
         for k in range(1, nsteps + 1):

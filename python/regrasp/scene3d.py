@@ -90,6 +90,10 @@ class Scene3D:
         def step(a, b):
             u = b.get("pusher_twist")
             u = twist_between(a["pose"], b["pose"]) if u is None else u
+            if self._core.is_plane(b["pusher"]):
+                # a plane makes its planned motion in the gripper frame (it stays level), whatever
+                # the object's measured pose: the twist moved from the planned frame to this one
+                u = twist_in(_core.se3_compose(_core.se3_inverse(list(map(float, q[0]))), list(map(float, a["pose"]))), u)
             return np.asarray(self.simulate_push(q[0], b["pusher"], u, 1.0, dt)["pose"][-1], float)
 
         q = [np.asarray(path[0]["pose"], float)]
@@ -100,6 +104,17 @@ class Scene3D:
 
         end, poses, replans = run_plan3d(self, path, tracked, q[0], feedback, max_replans, seed)
         return {"engine": "quasistatic", **goal_report(self, end), "poses": np.array(poses), "replans": replans}
+
+
+def twist_in(rel, u) -> list:
+    """Body twist ``u`` of a frame B expressed in frame A, where ``rel`` = A⁻¹B (the adjoint):
+    ``[R v + p × (R ω), R ω]``."""
+    from scipy.spatial.transform import Rotation
+
+    rel, u = np.asarray(rel, float), np.asarray(u, float)
+    R = Rotation.from_quat([rel[4], rel[5], rel[6], rel[3]])
+    w = R.apply(u[3:])
+    return (R.apply(u[:3]) + np.cross(rel[:3], w)).tolist() + w.tolist()
 
 
 def goal_report(scene: "Scene3D", q) -> dict:
@@ -127,21 +142,25 @@ def run_plan3d(scene: "Scene3D", path: list, step, q0, feedback: bool = False, m
     def off(q, ref):
         return bool(np.any(np.abs(q[:3] - np.asarray(ref[:3], float)) > tol[:3] / 2) or quat_angle(q[3:], ref[3:]) > tol[3] / 2)
 
+    from .errors import RegraspError
+
     q = np.asarray(q0, float)
     poses, replans, i = [q], 0, 0
     while True:
+        if feedback and i > 0 and goal_report(scene, q)["success"]:
+            break  # at the goal (closed loop: going on with the plan could only move it away)
         stray = i > 0 and i + 1 < len(path) and off(q, path[i]["pose"])
         if i + 1 >= len(path) or stray:
-            if not feedback or replans >= max_replans or (not stray and goal_report(scene, q)["success"]):
-                if i + 1 >= len(path):
-                    break
-            else:
-                new = scene.plan(start=q, seed=seed + replans + 1)
+            if feedback and replans < max_replans:
                 replans += 1
+                try:
+                    new = scene.plan(start=q, seed=seed + replans)
+                except RegraspError:  # e.g. a pad off the object at the measured pose
+                    new = {"path": []}
                 if len(new["path"]) >= 2:
                     path, i = new["path"], 0
-                elif i + 1 >= len(path):
-                    break
+            if i + 1 >= len(path):
+                break
         q = np.asarray(step(path[i], path[i + 1]), float)
         poses.append(q)
         i += 1
@@ -166,6 +185,9 @@ def check_plan3d(scene: "Scene3D", plan) -> list:
         if i > 0 and k.get("pusher") not in scene.pusher_names:
             raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k.get('pusher')!r} in the scene",
                                 f"plan.path[{i}].pusher")
+        if i > 0 and k.get("pusher_twist") is None and scene._core.is_plane(k["pusher"]):
+            raise ArgumentError(f"invalid `plan.path[{i}].pusher_twist`: a step of plane {k['pusher']!r} needs its "
+                                "pusher twist (a plane only rolls the object)", f"plan.path[{i}].pusher_twist")
         if i > 0 and k.get("pusher_twist") is not None:
             try:
                 u = np.asarray(k["pusher_twist"], float)

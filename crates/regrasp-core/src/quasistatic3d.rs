@@ -193,7 +193,7 @@ pub fn simulate_push(
         let (mut pts, mut gaps) = (Vec::new(), Vec::new());
         if pz.plane {
             let on = (rel * nalgebra::Point3::from(points0[0])).coords;
-            for r in scene.lowest_points(&normal) {
+            for r in scene.plane_contacts(&normal, Some(&on), reach) {
                 let gap = normal.dot(&(r - on));
                 if gap < reach {
                     pts.push(r);
@@ -367,6 +367,14 @@ tolerance = [0.002, 0.002, 0.002, 0.0175]
         assert_eq!(boxy.pusher_contacts(0, &Isometry3::identity()).0.len(), 4);
         let tilted = Isometry3::from_parts(Translation3::identity(), UnitQuaternion::from_scaled_axis(V3::new(0.0, 0.3, 0.0)));
         assert_eq!(boxy.pusher_contacts(0, &tilted).0.len(), 2);
+        // a floor rising under the box lifts it on its whole face: 4 contacts, all sticking
+        let tr = simulate_push(&boxy, &Isometry3::identity(), 0, &[0.0, 0.0, 0.005, 0.0, 0.0, 0.0], 1.0, 0.1, &Settings::default()).unwrap();
+        assert!(tr.residual.iter().all(|r| *r < 1e-6) && tr.pusher_sticking.iter().all(|n| *n == 4), "{:?}", tr.pusher_sticking);
+        assert!((tr.pose.last().unwrap()[2] - 0.005).abs() < 1e-6);
+        // the ball off its pads: a pad touches only where the ball's extreme point is on it
+        let off = Isometry3::from_parts(Translation3::new(0.0, 0.0, 0.007), UnitQuaternion::identity());
+        assert!(ball.pad_contacts(&off).iter().all(|c| c.is_empty()));
+        assert!(!crate::trrt3d::pads_on(&ball, &off) && crate::trrt3d::pads_on(&ball, &q));
     }
 
     /// The floor moving under the held ball rolls it: the ball turns about the grasp axis by

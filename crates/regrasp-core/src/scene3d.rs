@@ -370,7 +370,7 @@ impl Scene3 {
                 ConvexMesh::cuboid(&s)
             }
             Some("mesh") => {
-                let file = req("object.mesh", obj.mesh)?;
+                let file = req("object.mesh", obj.mesh.clone())?;
                 let path = base.map(|b| b.join(&file)).unwrap_or_else(|| file.clone().into());
                 let text = std::fs::read_to_string(&path)
                     .map_err(|e| Error::scene("object.mesh", format!("cannot read {}: {e}", path.display())))?;
@@ -383,6 +383,11 @@ impl Scene3 {
         let sphere = if obj.shape.as_deref() == Some("sphere") { obj.radius } else { None };
         if sphere.is_none() && obj.radius.is_some() {
             return Err(Error::scene("object.radius", "is for shape = \"sphere\""));
+        }
+        if sphere.is_some() {
+            if let Some(f) = [("object.size", obj.size.is_some()), ("object.mesh", obj.mesh.is_some())].iter().find(|f| f.1) {
+                return Err(Error::scene(f.0, "is not for shape = \"sphere\" (give `radius`)"));
+            }
         }
         let mass = pos("object.mass", obj.mass)?;
         let (_, centroid, inertia_unit) = match sphere {
@@ -507,15 +512,31 @@ impl Scene3 {
     }
 
     /// The object's points lowest along `n` (object frame): where a plane with normal `n`
-    /// touches it — a sphere's one point, a mesh's vertex, edge or face (its vertices).
+    /// touches it — a sphere's one point, a mesh's vertex, edge or face (its vertices within
+    /// `1e-5` of the object's size of the lowest, so a face tilted by solver round-off stays a
+    /// face).
     pub fn lowest_points(&self, n: &V3) -> Vec<V3> {
+        self.plane_contacts(n, None, 1e-5 * self.size())
+    }
+
+    /// The object's points within `reach` of the plane with normal `n` through `on` (object
+    /// frame; default: the plane touching the object's lowest point), with a mesh's every vertex
+    /// considered (a vertex tipping towards the plane is found before it crosses it).
+    pub fn plane_contacts(&self, n: &V3, on: Option<&V3>, reach: f64) -> Vec<V3> {
         let n = n.normalize();
         if let Some(r) = self.sphere {
             return vec![-n * r];
         }
-        let size = self.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
-        let low = self.mesh.vertices.iter().map(|v| v.dot(&n)).fold(f64::INFINITY, f64::min);
-        self.mesh.vertices.iter().filter(|v| v.dot(&n) < low + 1e-6 * size).cloned().collect()
+        let low = match on {
+            Some(p) => n.dot(p),
+            None => self.mesh.vertices.iter().map(|v| v.dot(&n)).fold(f64::INFINITY, f64::min),
+        };
+        self.mesh.vertices.iter().filter(|v| v.dot(&n) < low + reach).cloned().collect()
+    }
+
+    /// The object's largest distance from its frame's origin.
+    pub fn size(&self) -> f64 {
+        self.sphere.unwrap_or_else(|| self.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max))
     }
 
     /// The contact points and normal (object frame) of pusher `p` brought against the object at
@@ -547,6 +568,12 @@ impl Scene3 {
             // a sphere pressed by a soft pad: the pad's ring of points on the tangent plane at
             // the sphere's extreme point (the pad radius is the contact patch's)
             for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
+                // the pad (centred on the gripper's Y axis) touches the ball only if the ball's
+                // extreme point lies on it
+                let c = pose.translation.vector + V3::new(0.0, sign * r, 0.0);
+                if c.x.hypot(c.z) > self.pad_radius {
+                    continue;
+                }
                 let tip = inv.rotation * V3::new(0.0, sign * r, 0.0);
                 let (t1, t2) = (inv.rotation * V3::x(), inv.rotation * V3::z());
                 for k in 0..8 {

@@ -142,17 +142,16 @@ pub fn pusher_motion(scene: &Scene3, q: &Isometry3<f64>, p: usize, u: &Twist6) -
 /// The least speed a plane pusher presses into the object, relative to its sliding speed.
 pub const PLANE_PRESS: f64 = 0.05;
 
+/// Time steps of a forward-dynamics step (the planner's and the path check's, so they agree).
+pub const FORWARD_STEPS: usize = 4;
+
 /// Whether pusher `p` can move the object with body twist `u` (unit time) from `q`: the inverse
 /// problem solves (pusher sticking) at the start and at `checks` poses along the step, both pads
-/// on the object all along. A plane sticks only to twists it can follow while staying parallel
-/// to itself (turning about its normal at most); others are forward-dynamics steps.
+/// on the object all along. Never for a plane: its steps are forward ones
+/// ([`pusher_motion`]; a plane sliding with the object leaves its contact force undetermined).
 pub fn step_feasible(scene: &Scene3, q: &Isometry3<f64>, u: &Twist6, p: usize, checks: usize, solves: Option<&std::sync::atomic::AtomicUsize>) -> bool {
     if scene.pushers[p].plane {
-        let n = scene.pusher_contacts(p, q).1;
-        let w = V3::new(u[3], u[4], u[5]);
-        if (w - n * n.dot(&w)).norm() > 1e-9 * (1.0 + w.norm()) {
-            return false;
-        }
+        return false;
     }
     let n = checks.max(1);
     let v = DVector::from_row_slice(u);
@@ -220,11 +219,12 @@ impl<'a> Planner3<'a> {
     }
 
     /// The first pusher (in `order`) that can take step `u` from `q`, pushers evaluated in
-    /// parallel, with the pose it reaches: `u` itself when the inverse problem accepts it along
-    /// the step; else (a point or edge contact does not fix the object's whole twist, and a
-    /// twist feasible at the step's start may not stay so) the pose the forward dynamics reach
-    /// while the pusher moves with `u` and keeps contact, if the motion still heads towards the
-    /// target (within 60°).
+    /// parallel, with the pose it reaches and the pusher's twist: `u` itself when the inverse
+    /// problem accepts it along the step; else (a point or edge contact does not fix the
+    /// object's whole twist, a twist feasible at the step's start may not stay so, a plane only
+    /// rolls) the pose the forward dynamics reach while the pusher moves with
+    /// [`pusher_motion`]`(u)` and keeps contact, if the motion still heads towards the target
+    /// (within 60°).
     fn feasible_pusher(&self, q: &Isometry3<f64>, u: &Twist6, order: &[usize]) -> Option<(usize, Isometry3<f64>, Twist6)> {
         let l = self.l;
         let len = twist_length(l, u);
@@ -233,9 +233,9 @@ impl<'a> Planner3<'a> {
                 if step_feasible(self.scene, q, u, p, self.s.checks, Some(&self.solves)) {
                     return Some((p, integrate(q, u, 1.0), *u));
                 }
-                self.solves.fetch_add(self.s.checks + 1, std::sync::atomic::Ordering::Relaxed);
+                self.solves.fetch_add(FORWARD_STEPS + 1, std::sync::atomic::Ordering::Relaxed);
                 let up = pusher_motion(self.scene, q, p, u);
-                let end = simulate_step(self.scene, q, &up, p, self.s.checks)?;
+                let end = simulate_step(self.scene, q, &up, p, FORWARD_STEPS)?;
                 let v = se3_log(q, &end);
                 let vl = twist_length(l, &v);
                 if vl < 0.2 * len {
@@ -396,8 +396,8 @@ impl<'a> Planner3<'a> {
                 let len = twist_length(self.l, &xi);
                 let u: Twist6 = xi.map(|x| x * self.step.min(len) / len.max(1e-300));
                 let up = pusher_motion(self.scene, &q, p, &u);
-                self.solves.fetch_add(self.s.checks + 1, std::sync::atomic::Ordering::Relaxed);
-                let end = simulate_step(self.scene, &q, &up, p, self.s.checks)?;
+                self.solves.fetch_add(FORWARD_STEPS + 1, std::sync::atomic::Ordering::Relaxed);
+                let end = simulate_step(self.scene, &q, &up, p, FORWARD_STEPS)?;
                 if self.dist(&end, &self.goal) >= self.dist(&q, &self.goal) {
                     return None;
                 }
@@ -419,7 +419,9 @@ impl<'a> Planner3<'a> {
         Some(last)
     }
 
-    /// Straight push to the goal from node `i` (unit steps of one constant twist, one pusher).
+    /// Straight push to the goal from node `i` (unit steps of one constant twist, one pusher);
+    /// when no pusher can take it (and it is at most 20 steps), rolling with a plane
+    /// ([`Self::connect_goal_rolling`]).
     fn connect_goal(&mut self, i: usize) -> Option<usize> {
         let q = self.nodes[i].q;
         let xi = se3_log(&q, &self.goal);
@@ -490,7 +492,7 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
         tree: KdTree::new(),
         transition: Transition::new(settings, 0.0),
         solves: std::sync::atomic::AtomicUsize::new(0),
-        reach: scene.sphere.unwrap_or_else(|| scene.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max)),
+        reach: scene.size(),
     };
     pl.transition.c_max = settings.c_max * pl.cost_to_go(&start).max(1.0);
     pl.tree.add(&key(l, &start), 0);
@@ -578,7 +580,7 @@ pub fn validate_path3(scene: &Scene3, path: &[(Isometry3<f64>, Option<usize>)], 
                 return Ok(true);
             }
             let Some(u) = twists.and_then(|t| t.get(i + 1)) else { return Ok(false) };
-            Ok(simulate_step(scene, &w[0].0, u, p, 4).is_some_and(|end| distance(scene.length, &end, &w[1].0) < 1e-6))
+            Ok(simulate_step(scene, &w[0].0, u, p, FORWARD_STEPS).is_some_and(|end| distance(scene.length, &end, &w[1].0) < 1e-6))
         })
         .collect()
 }
