@@ -146,7 +146,8 @@ def test_control_arguments_are_checked(tmp_path):
     p = regrasp.plan(s, seed=0)
     p.save(f)
     cli = [sys.executable, "-m", "regrasp.cli"]
-    for extra, field in ((["--horizon", "0"], "--horizon"), (["--dt", "-1"], "--dt"), (["--scale-mass", "0"], "scale-mass")):
+    for extra, field in ((["--horizon", "0"], "--horizon"), (["--dt", "-1"], "--dt"), (["--scale-mass", "0"], "scale-mass"),
+                         (["--seed", "-1"], "--seed")):
         r = subprocess.run(cli + ["control", str(EXAMPLES / "block-high-friction.toml"), "--plan", str(f)] + extra,
                            capture_output=True, text=True)
         assert r.returncode == 2 and field in r.stderr, (extra, r.stderr)
@@ -164,6 +165,11 @@ def test_control_arguments_are_checked(tmp_path):
     assert r.t[-1] >= 30.0 and r.success
     with pytest.raises(ArgumentError, match="horizon"):
         control(s, p, horizon=-1)
+    for bad in (-1, 2.5, True):
+        with pytest.raises(ArgumentError, match="seed"):
+            regrasp.plan(s, seed=bad)
+    with pytest.raises(ArgumentError, match="seed"):
+        regrasp.Scene3D.load(EXAMPLES / "ball-roll-3d.toml").plan(seed=-1)
 
 
 def test_simulate_cli_3d_rejects_planar_flags(tmp_path):

@@ -145,6 +145,8 @@ def test_ball_rolls_on_the_floor_in_mujoco_and_feedback_closes_the_gap(tmp_path)
     assert r.returncode == 0 and out["success"] and out["policy"] == "replan", r.stderr
     r = subprocess.run(cli + ["--poke", "1,0,0,0"], capture_output=True, text=True)
     assert r.returncode == 2 and "--poke" in r.stderr
+    r = subprocess.run(cli + ["--horizon", "7"], capture_output=True, text=True)
+    assert r.returncode == 2 and "--horizon" in r.stderr
 
 
 def test_feedback_replans_after_a_disturbance():

@@ -18,6 +18,17 @@ from .scene import Scene
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
+def _seed(text: str) -> int:
+    """argparse type of --seed: a whole number >= 0."""
+    try:
+        v = int(text)
+    except ValueError:
+        v = -1
+    if not 0 <= v < 2**64:
+        raise argparse.ArgumentTypeError(f"a whole number >= 0 (got {text!r})")
+    return v
+
+
 def _floats(text: str, n: int, name: str) -> np.ndarray:
     try:
         v = np.array([float(x) for x in text.split(",")])
@@ -373,6 +384,8 @@ def _control3d(a) -> int:
     from .scene3d import Scene3D
 
     planar = [f for f in ("poke", "start_error", "robust", "uncertainty", "fixtureless", "plot") if getattr(a, f, None)]
+    if a.dt != 0.1 or a.horizon != 5:  # the MPC's settings (their defaults): no meaning here
+        planar.append("dt" if a.dt != 0.1 else "horizon")
     if planar or a.noise:
         raise ArgumentError("invalid flags for a 3-D scene: 3-D control re-plans from the measured pose "
                             f"(no --{', --'.join(f.replace('_', '-') for f in planar or ['noise'])})", "scene")
@@ -477,7 +490,7 @@ def build_parser() -> argparse.ArgumentParser:
     pl = sub.add_parser("plan", help="plan a regrasp (T-RRT* with motion-cone propagation)")
     pl.add_argument("scene")
     pl.add_argument("--out", metavar="PLAN.json")
-    pl.add_argument("--seed", type=int, default=0)
+    pl.add_argument("--seed", type=_seed, default=0)
     pl.add_argument("--time-limit", type=float, default=10.0)
     pl.add_argument("--propagation", default="motion_cone", choices=["motion_cone", "stable_check", "mncp"])
     pl.add_argument("--start", help="x,z,theta (default: the scene's task)")
@@ -512,7 +525,7 @@ def build_parser() -> argparse.ArgumentParser:
     k.add_argument("--noise", type=float, default=0.0, help="pose measurement noise, standard deviation [m]")
     k.add_argument("--dt", type=float, default=0.1, help="control period [s]")
     k.add_argument("--horizon", type=int, default=5)
-    k.add_argument("--seed", type=int, default=0)
+    k.add_argument("--seed", type=_seed, default=0)
     k.add_argument("--plot", metavar="PNG", help="planned against executed poses, pokes marked")
     k.add_argument("--json", action="store_true")
     k.set_defaults(fn=cmd_control)
@@ -530,7 +543,7 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("scenes", nargs="*", help="scene files (default: every bundled example)")
     e.add_argument("--forces", default="5,20,80", help="grip forces per finger, N")
     e.add_argument("--samples", type=int, default=20000)
-    e.add_argument("--seed", type=int, default=0)
+    e.add_argument("--seed", type=_seed, default=0)
     e.add_argument("--json", action="store_true")
     e.set_defaults(fn=cmd_approx_error)
 
@@ -544,7 +557,7 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("scene")
     v.add_argument("--pushes", type=int, default=2000)
     v.add_argument("--engines", default="quasistatic", help="comma-separated: quasistatic,mujoco")
-    v.add_argument("--seed", type=int, default=0)
+    v.add_argument("--seed", type=_seed, default=0)
     v.add_argument("--workers", type=int, help="local processes for MuJoCo (default: all cores)")
     v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
     v.add_argument("--support", default="points", choices=["points", "limit_surface"],
@@ -562,7 +575,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--scale-mass", type=float, default=1.0, help="MuJoCo: factor on the object's mass")
     s.add_argument("--perturb", type=float, default=0.0,
                    help="MuJoCo: also draw each factor uniformly in [1-P, 1+P] from --seed")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=_seed, default=0)
     s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo: an animation of the execution")
     s.add_argument("--plot", metavar="PNG")
     s.add_argument("--json", action="store_true")
@@ -582,7 +595,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser("demo", help="the bundled example end to end, writing its figures")
     d.add_argument("--out", default="out/demo")
-    d.add_argument("--seed", type=int, default=0)
+    d.add_argument("--seed", type=_seed, default=0)
     d.set_defaults(fn=cmd_demo)
     return ap
 

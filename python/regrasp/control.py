@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _core
-from .errors import ArgumentError, RegraspError
+from .errors import ArgumentError, RegraspError, check_seed
 from .mujoco_exec import Perturbation
 from .quasistatic import body_twist, simulate_push
 from .scene import Scene
@@ -145,7 +145,7 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
     goal = np.asarray(task.goal if task is not None else poses[-1], float)
     tol = np.asarray(task.tolerance if task is not None else [1e-3, 1e-3, 0.0175], float)
     cscene = controller_scene or scene
-    ctrl = _core.Mpc(cscene._core, poses, names, goal.tolist(), dt=dt, horizon=horizon, speed=speed, seed=seed, **mpc)
+    ctrl = _core.Mpc(cscene._core, poses, names, goal.tolist(), dt=dt, horizon=horizon, speed=speed, seed=check_seed(seed), **mpc)
     knots = np.asarray(ctrl.knots)
     knot_pushers = ctrl.knot_pushers
     last_poke = max((pk.t for pk in pokes), default=0.0)

@@ -21,3 +21,12 @@ class ArgumentError(RegraspError, ValueError):
 
 class GraspError(RegraspError, RuntimeError):
     """The grasp cannot hold the object against gravity at the requested pose."""
+
+
+def check_seed(seed) -> int:
+    """A random seed: a whole number >= 0 (the core's generators take an unsigned 64-bit seed)."""
+    import numbers
+
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= int(seed) < 2**64:
+        raise ArgumentError(f"invalid `seed`: a whole number in [0, 2^64) (got {seed!r})", "seed")
+    return int(seed)

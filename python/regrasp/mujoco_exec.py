@@ -179,16 +179,10 @@ def animate_execution(scene: Scene, rep: Replay, path, fps: int = 20, every: int
     from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
     from matplotlib.patches import Circle, Polygon
 
-    from .plotting import _object_at
+    from .plotting import _object_at, animation_axes
 
     idx = list(range(0, len(rep.t), every))
-    pts = np.vstack([_object_at(scene, rep.poses[i]) for i in idx])
-    lo, hi = pts.min(axis=0) - 0.01, pts.max(axis=0) + 0.01
-    fig, ax = plt.subplots(figsize=(5, 5 * (hi[1] - lo[1]) / max(hi[0] - lo[0], 1e-9)))
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_aspect("equal")
-    ax.set_axis_off()
+    fig, ax = animation_axes(scene, [rep.poses[i] for i in idx])
     planned = Polygon(_object_at(scene, rep.planned[0]), closed=True, fill=False, ls="--", edgecolor="0.5")
     obj = Polygon(_object_at(scene, rep.poses[0]), closed=True, facecolor="tab:blue", alpha=0.5, edgecolor="k")
     ax.add_patch(planned)

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ArgumentError
+from .errors import ArgumentError, check_seed
 from .scene import Scene
 
 PROPAGATIONS = ("motion_cone", "stable_check", "mncp")
@@ -93,7 +93,7 @@ def plan(scene: Scene, start=None, goal=None, seed: int = 0, time_limit: float =
         raise ArgumentError("invalid `time_limit`: must be a non-negative number of seconds", "time_limit")
     s = list(map(float, start)) if start is not None else None
     g = list(map(float, goal)) if goal is not None else None
-    r = scene._core.plan(s, g, int(seed), float(time_limit), propagation, **settings)
+    r = scene._core.plan(s, g, check_seed(seed), float(time_limit), propagation, **settings)
     p = Plan(**{k: r[k] for k in ("scene", "found", "stop_reason", "planning_time_s", "nodes", "switch_overs", "path",
                                   "iterations", "cost", "goal_distance", "propagation", "seed")})
     p.step_margins = validate(scene, p.path) if len(p.path) > 1 else []

@@ -234,6 +234,20 @@ def _save(fig, path) -> Path:
 PUSHER_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive"]
 
 
+def animation_axes(scene, poses):
+    """A figure and bare, equal-aspect axes framing the object at every pose (1 cm margin)."""
+    import matplotlib.pyplot as plt
+
+    pts = np.vstack([_object_at(scene, q) for q in poses])
+    lo, hi = pts.min(axis=0) - 0.01, pts.max(axis=0) + 0.01
+    fig, ax = plt.subplots(figsize=(5, 5 * (hi[1] - lo[1]) / max(hi[0] - lo[0], 1e-9)))
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+    return fig, ax
+
+
 def _object_at(scene, q):
     c, s = np.cos(q[2]), np.sin(q[2])
     R = np.array([[c, -s], [s, c]])
@@ -322,13 +336,7 @@ def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> 
         for f in range(frames_per_step):
             frames.append((integrate_pose(a, xi, f / frames_per_step), plan.path[i]["pusher"]))
     frames.append((np.asarray(plan.path[-1]["pose"]), plan.path[-1]["pusher"]))
-    allpts = np.vstack([_object_at(scene, q) for q, _ in frames])
-    lo, hi = allpts.min(axis=0) - 0.01, allpts.max(axis=0) + 0.01
-    fig, ax = plt.subplots(figsize=(5, 5 * (hi[1] - lo[1]) / max(hi[0] - lo[0], 1e-9)))
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_aspect("equal")
-    ax.set_axis_off()
+    fig, ax = animation_axes(scene, [q for q, _ in frames])
     obj = Polygon(_object_at(scene, frames[0][0]), closed=True, facecolor="0.8", edgecolor="k")
     ax.add_patch(obj)
     if scene.task is not None:

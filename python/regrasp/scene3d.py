@@ -11,7 +11,7 @@ from typing import Optional
 import numpy as np
 
 from . import _core
-from .errors import ArgumentError
+from .errors import ArgumentError, check_seed
 
 
 class Scene3D:
@@ -68,7 +68,7 @@ class Scene3D:
             raise ArgumentError("invalid `time_limit`: must be a non-negative number of seconds", "time_limit")
         s = None if start is None else [float(x) for x in start]
         g = None if goal is None else [float(x) for x in goal]
-        r = self._core.plan(s, g, int(seed), float(time_limit), **settings)
+        r = self._core.plan(s, g, check_seed(seed), float(time_limit), **settings)
         r["valid"] = all(self.validate_path(r["path"])) if len(r["path"]) > 1 else True
         return r
 

@@ -98,6 +98,13 @@ impl<Q: Clone, E: Clone> Tree<Q, E> {
         out
     }
 
+    /// Keeps in `best` the cheaper of it and node `i` (a goal node the planner just reached).
+    pub fn keep_cheaper(&self, best: &mut Option<usize>, i: usize) {
+        if best.is_none_or(|b| self.nodes[i].cost < self.nodes[b].cost) {
+            *best = Some(i);
+        }
+    }
+
     /// The cheapest node for which `goal` holds (rewiring may have made a later goal node
     /// cheaper than the first one found).
     pub fn cheapest(&self, goal: impl Fn(&Q) -> bool) -> Option<usize> {

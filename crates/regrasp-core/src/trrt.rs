@@ -175,6 +175,19 @@ impl Default for Settings {
 /// A node of the planar tree (see [`crate::tree`]).
 pub type Node = TreeNode<[f64; 3], ()>;
 
+/// What every planner's answer reports besides its path (planar and 3-D).
+#[derive(Clone, Copy, Debug)]
+pub struct Summary {
+    pub found: bool,
+    pub stop_reason: StopReason,
+    pub planning_time_s: f64,
+    pub nodes: usize,
+    pub iterations: usize,
+    pub switch_overs: usize,
+    pub cost: f64,
+    pub goal_distance: f64,
+}
+
 /// Why the planner stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StopReason {
@@ -210,6 +223,29 @@ pub struct PlanResult {
     /// Distance (metric, m) from the path's end to the goal.
     pub goal_distance: f64,
 }
+
+/// `summary()` for a planner's result type (its fields named as in [`Summary`]).
+macro_rules! impl_summary {
+    ($t:ty) => {
+        impl $t {
+            /// What the result reports besides its path.
+            pub fn summary(&self) -> $crate::trrt::Summary {
+                $crate::trrt::Summary {
+                    found: self.found,
+                    stop_reason: self.stop_reason,
+                    planning_time_s: self.planning_time_s,
+                    nodes: self.nodes,
+                    iterations: self.iterations,
+                    switch_overs: self.switch_overs,
+                    cost: self.cost,
+                    goal_distance: self.goal_distance,
+                }
+            }
+        }
+    };
+}
+pub(crate) use impl_summary;
+impl_summary!(PlanResult);
 
 /// Planar log map: the constant body twist taking `a` to `b` in unit time.
 pub fn body_twist(a: &[f64; 3], b: &[f64; 3]) -> Vec3 {
@@ -726,14 +762,10 @@ pub fn plan_tree(
         if pl.cost_to_go(&q_new) < pl.cost_to_go(&pl.nodes[closest].q) {
             closest = i;
         }
-        if pl.at_goal(&q_new) && best_goal.is_none_or(|g| pl.nodes[i].cost < pl.nodes[g].cost) {
-            best_goal = Some(i);
-        } else if settings.connect && !settings.plain {
-            if let Some(g) = pl.connect_goal(i) {
-                if best_goal.is_none_or(|b| pl.nodes[g].cost < pl.nodes[b].cost) {
-                    best_goal = Some(g);
-                }
-            }
+        if pl.at_goal(&q_new) {
+            pl.nodes.keep_cheaper(&mut best_goal, i);
+        } else if let Some(g) = if settings.connect && !settings.plain { pl.connect_goal(i) } else { None } {
+            pl.nodes.keep_cheaper(&mut best_goal, g);
         }
     };
     // rewiring may have made another goal node the cheapest

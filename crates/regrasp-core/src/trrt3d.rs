@@ -90,6 +90,8 @@ pub struct PlanResult3 {
     pub solves: usize,
 }
 
+crate::trrt::impl_summary!(PlanResult3);
+
 struct Planner3<'a> {
     scene: &'a Scene3,
     s: &'a Settings,
@@ -530,14 +532,10 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
         if pl.cost_to_go(&q_new) < pl.cost_to_go(&pl.nodes[closest].q) {
             closest = i;
         }
-        if pl.at_goal(&q_new) && best.is_none_or(|g| pl.nodes[i].cost < pl.nodes[g].cost) {
-            best = Some(i);
-        } else if settings.connect {
-            if let Some(g) = pl.connect_goal(i) {
-                if best.is_none_or(|b| pl.nodes[g].cost < pl.nodes[b].cost) {
-                    best = Some(g);
-                }
-            }
+        if pl.at_goal(&q_new) {
+            pl.nodes.keep_cheaper(&mut best, i);
+        } else if let Some(g) = if settings.connect { pl.connect_goal(i) } else { None } {
+            pl.nodes.keep_cheaper(&mut best, g);
         }
     };
     // rewiring may have made another goal node the cheapest

@@ -36,6 +36,35 @@ fn to_py(err: Error) -> PyErr {
     })
 }
 
+/// The fields a plan dict shares between the planar and the 3-D planners.
+fn plan_summary<'py>(py: Python<'py>, scene: &str, r: &trrt::Summary, propagation: &str, seed: u64) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("scene", scene)?;
+    d.set_item("found", r.found)?;
+    d.set_item("stop_reason", r.stop_reason.label())?;
+    d.set_item("planning_time_s", r.planning_time_s)?;
+    d.set_item("nodes", r.nodes)?;
+    d.set_item("iterations", r.iterations)?;
+    d.set_item("switch_overs", r.switch_overs)?;
+    d.set_item("cost", r.cost)?;
+    d.set_item("goal_distance", r.goal_distance)?;
+    d.set_item("propagation", propagation)?;
+    d.set_item("seed", seed)?;
+    Ok(d)
+}
+
+/// Pusher indices of a path's pusher names (None for the start), errors naming the step.
+fn path_pushers(names: &[Option<String>], index: impl Fn(&str) -> regrasp::Result<usize>) -> PyResult<Vec<Option<usize>>> {
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, p)| match p {
+            None => Ok(None),
+            Some(n) => index(n).map(Some).map_err(|_| arg_err(&format!("path[{i}].pusher"), format!("no pusher {n:?}"))),
+        })
+        .collect()
+}
+
 fn arg_err(name: &str, msg: impl Into<String>) -> PyErr {
     to_py(Error::arg(name, msg))
 }
@@ -612,18 +641,7 @@ impl Scene {
             ..trrt::Settings::default()
         };
         let r = py.allow_threads(|| trrt::plan(&self.inner, start, goal, &settings)).map_err(to_py)?;
-        let d = PyDict::new(py);
-        d.set_item("scene", &self.inner.name)?;
-        d.set_item("found", r.found)?;
-        d.set_item("stop_reason", r.stop_reason.label())?;
-        d.set_item("planning_time_s", r.planning_time_s)?;
-        d.set_item("nodes", r.nodes)?;
-        d.set_item("iterations", r.iterations)?;
-        d.set_item("switch_overs", r.switch_overs)?;
-        d.set_item("cost", r.cost)?;
-        d.set_item("goal_distance", r.goal_distance)?;
-        d.set_item("propagation", settings.propagation.label())?;
-        d.set_item("seed", seed)?;
+        let d = plan_summary(py, &self.inner.name, &r.summary(), settings.propagation.label(), seed)?;
         let path = r
             .path
             .iter()
@@ -644,14 +662,10 @@ impl Scene {
         if poses.len() != pushers.len() {
             return Err(arg_err("path", "poses and pushers differ in length"));
         }
+        let idx = path_pushers(&pushers, |n| self.inner.pusher_index(n))?;
         let mut path = Vec::new();
-        for (i, (q, p)) in poses.iter().zip(&pushers).enumerate() {
-            let q = pose3(q).map_err(|_| arg_err(&format!("path[{i}].pose"), "must be 3 finite numbers"))?;
-            let p = match p {
-                None => None,
-                Some(n) => Some(self.inner.pusher_index(n).map_err(|_| arg_err(&format!("path[{i}].pusher"), format!("no pusher {n:?}")))?),
-            };
-            path.push((q, p));
+        for (i, (q, p)) in poses.iter().zip(idx).enumerate() {
+            path.push((pose3(q).map_err(|_| arg_err(&format!("path[{i}].pose"), "must be 3 finite numbers"))?, p));
         }
         trrt::validate_path(&self.inner, &path, checks).map_err(to_py)
     }
@@ -841,19 +855,8 @@ impl Scene3D {
             ..trrt::Settings::default()
         };
         let r = py.allow_threads(|| regrasp::trrt3d::plan3(&self.inner, start, goal, &settings)).map_err(to_py)?;
-        let d = PyDict::new(py);
-        d.set_item("scene", &self.inner.name)?;
-        d.set_item("found", r.found)?;
-        d.set_item("stop_reason", r.stop_reason.label())?;
-        d.set_item("planning_time_s", r.planning_time_s)?;
-        d.set_item("nodes", r.nodes)?;
-        d.set_item("iterations", r.iterations)?;
-        d.set_item("switch_overs", r.switch_overs)?;
-        d.set_item("cost", r.cost)?;
-        d.set_item("goal_distance", r.goal_distance)?;
+        let d = plan_summary(py, &self.inner.name, &r.summary(), "mncp_inverse", seed)?;
         d.set_item("solves", r.solves)?;
-        d.set_item("propagation", "mncp_inverse")?;
-        d.set_item("seed", seed)?;
         let path = r
             .path
             .iter()
@@ -882,14 +885,10 @@ impl Scene3D {
         if poses.len() != pushers.len() {
             return Err(arg_err("path", "poses and pushers differ in length"));
         }
+        let idx = path_pushers(&pushers, |n| self.inner.pusher_index(n))?;
         let mut path = Vec::new();
-        for (i, (q, p)) in poses.into_iter().zip(pushers).enumerate() {
-            let q = pose7(&format!("path[{i}].pose"), &q)?;
-            let p = match p {
-                None => None,
-                Some(n) => Some(self.inner.pusher_index(&n).map_err(to_py)?),
-            };
-            path.push((q, p));
+        for (i, (q, p)) in poses.iter().zip(idx).enumerate() {
+            path.push((pose7(&format!("path[{i}].pose"), q)?, p));
         }
         regrasp::trrt3d::validate_path3(&self.inner, &path, tw.as_deref()).map_err(to_py)
     }
