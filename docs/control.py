@@ -24,9 +24,9 @@ from pathlib import Path
 import numpy as np
 
 import regrasp
-from regrasp.control import Poke, control
-from regrasp.mujoco_exec import Perturbation
-from regrasp.plotting import plot_control
+from regrasp.control.loop import Poke, control
+from regrasp.mujoco.planar import Perturbation
+from regrasp.viz.plotting import plot_control
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ["block-low-friction", "block-high-friction", "block-xztheta", "t-shape", "block-tilted-gripper",

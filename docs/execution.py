@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 
 import regrasp
-from regrasp.mujoco_exec import Perturbation, execute_plan
-from regrasp.mujoco_model import SOFT, creep
-from regrasp.plotting import plot_replay
-from regrasp.quasistatic import replay_plan
+from regrasp.mujoco.planar import Perturbation, execute_plan
+from regrasp.mujoco.model import SOFT, creep
+from regrasp.viz.plotting import plot_replay
+from regrasp.sim.quasistatic import replay_plan
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ["block-low-friction", "block-high-friction", "block-xztheta", "t-shape", "block-tilted-gripper"]

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from regrasp.mujoco3d import execute_plan3d
-from regrasp.scene3d import Scene3D
+from regrasp.mujoco.spatial import execute_plan3d
+from regrasp.scene.spatial import Scene3D
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ["offset-3d", "light-side-3d", "pivot-single-3d", "pivot-3d", "block-3d", "prism-3d", "ball-roll-3d"]

@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 
 import regrasp
-from regrasp import mujoco_sim, quasistatic
+from regrasp.mujoco import push as mujoco_sim
+from regrasp.sim import quasistatic
 
 ROOT = Path(__file__).resolve().parents[1]
 

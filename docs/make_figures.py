@@ -3,7 +3,7 @@
 from pathlib import Path
 
 import regrasp
-from regrasp.plotting import plot_motion_cone
+from regrasp.viz.plotting import plot_motion_cone
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs"
@@ -14,7 +14,7 @@ if __name__ == "__main__":
     plot_motion_cone(block.motion_cone([0, 0, 0], "left"), OUT / "cone-left-20N.png")
     xzt = regrasp.Scene.load(ROOT / "examples" / "block-xztheta.toml")
     plot_motion_cone(xzt.with_grip_force(5.0).motion_cone([0, 0, 0], "corner"), OUT / "cone-corner-5N.png")
-    from regrasp.plotting import animate_plan, plot_plan
+    from regrasp.viz.plotting import animate_plan, plot_plan
 
     for name in ("t-shape", "block-xztheta", "block-low-friction", "block-high-friction"):
         sc = regrasp.Scene.load(ROOT / "examples" / f"{name}.toml")
@@ -23,7 +23,7 @@ if __name__ == "__main__":
         if name in ("t-shape", "block-xztheta"):
             animate_plan(sc, p, OUT / f"plan-{name}.gif")
     # 3-D plans: GIFs (seed 0)
-    from regrasp.plotting import animate_plan3d
+    from regrasp.viz.plotting import animate_plan3d
 
     for name, fps in (("pivot-3d", 6), ("pivot-single-3d", 6), ("ball-roll-3d", 4)):
         s3 = regrasp.Scene3D.load(ROOT / "examples" / f"{name}.toml")

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 import regrasp
-from regrasp.reference import RefParams, classify_numpy_batch, generators_numpy_batch
+from regrasp.reference.cones import RefParams, classify_numpy_batch, generators_numpy_batch
 
 
 def random_poses(scene, n, seed=0):

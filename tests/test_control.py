@@ -10,9 +10,9 @@ from hypothesis import given, settings, strategies as st
 
 import regrasp
 from regrasp import _core
-from regrasp.control import Poke, control
+from regrasp.control.loop import Poke, control
 from regrasp.errors import ArgumentError, SceneError
-from regrasp.plan import validate as plan_validate
+from regrasp.planning.plan import validate as plan_validate
 
 from .conftest import EXAMPLES
 

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from scipy.optimize import linprog
 
 import regrasp
-from regrasp.reference import RefParams, generators_numpy
+from regrasp.reference.cones import RefParams, generators_numpy
 
 from .conftest import block_scenes, twist_dirs
 

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import regrasp
-from regrasp.mujoco_exec import Perturbation, execute_plan
-from regrasp.mujoco_model import SOFT, convex_pieces, creep
-from regrasp.mujoco_sim import PushRig
-from regrasp.validation import validate
+from regrasp.mujoco.planar import Perturbation, execute_plan
+from regrasp.mujoco.model import SOFT, convex_pieces, creep
+from regrasp.mujoco.push import PushRig
+from regrasp.sim.validation import validate
 
 from .conftest import EXAMPLES
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import regrasp
-from regrasp.quasistatic import replay_plan
+from regrasp.sim.quasistatic import replay_plan
 
 from .conftest import EXAMPLES
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from regrasp import _core
-from regrasp.scene3d import Scene3D, quat_angle, twist_between
-from regrasp.viewer import write_html
+from regrasp.scene.spatial import Scene3D, quat_angle, twist_between
+from regrasp.viz.viewer import write_html
 
 from .conftest import EXAMPLES, ROOT
 
@@ -107,7 +107,7 @@ def test_browser_view_draws_every_frame(tmp_path):
 
 def test_3d_plans_execute_in_mujoco(tmp_path):
     pytest.importorskip("mujoco")
-    from regrasp.mujoco3d import execute_plan3d
+    from regrasp.mujoco.spatial import execute_plan3d
 
     for name in ("offset-3d", "pivot-single-3d", "pivot-3d", "prism-3d"):
         s = Scene3D.load(EXAMPLES / f"{name}.toml")
@@ -129,7 +129,7 @@ def test_ball_rolls_on_the_floor_in_mujoco_and_feedback_closes_the_gap(tmp_path)
     model (measured 38 mrad at the goal, outside the 17.5 mrad tolerance); re-planning from the
     measured pose (``regrasp control SCENE_3D``) ends within the tolerance."""
     pytest.importorskip("mujoco")
-    from regrasp.mujoco3d import execute_plan3d
+    from regrasp.mujoco.spatial import execute_plan3d
 
     s = Scene3D.load(EXAMPLES / "ball-roll-3d.toml")
     p = s.plan(seed=0)
@@ -163,7 +163,7 @@ def test_feedback_replans_after_a_disturbance():
         calls.append(q)
         return q
 
-    from regrasp.scene3d import goal_report, run_plan3d
+    from regrasp.scene.spatial import goal_report, run_plan3d
 
     q, poses, n = run_plan3d(s, p["path"], step, p["path"][0]["pose"], feedback=False)
     assert n == 0 and not goal_report(s, q)["success"], goal_report(s, q)  # open loop: 24 mrad off

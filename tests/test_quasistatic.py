@@ -11,7 +11,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import regrasp
-from regrasp import mncp_reference, quasistatic
+from regrasp.reference import mncp as mncp_reference
+from regrasp.sim import quasistatic
 
 from .conftest import EXAMPLES, block_scenes
 
@@ -160,7 +161,7 @@ def test_validate_json_and_agreement():
     assert out["pushes"] == 120 and sum(out["confusion_quasistatic"].values()) == out["solved"]
     assert out["agreement_quasistatic"] > 0.85
     # with the motion cones' own limit surface as the pads, prediction and simulation coincide
-    from regrasp.validation import validate
+    from regrasp.sim.validation import validate
 
     ls = validate(regrasp.Scene.load(EXAMPLES / "block-high-friction.toml"), 90, 1, support="limit_surface")
     assert ls["agreement_quasistatic"] > 0.99
@@ -178,7 +179,7 @@ def test_push_cli_plot(tmp_path):
 
 def test_mujoco_agrees_with_the_quasistatic_pivot():
     pytest.importorskip("mujoco")
-    from regrasp import mujoco_sim
+    from regrasp.mujoco import push as mujoco_sim
 
     sc = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
     w = np.radians(10.0)

@@ -109,7 +109,7 @@ def test_cli_exit_codes(tmp_path):
 
 
 def test_approximation_report_shows_the_polyhedral_error():
-    from regrasp.report import approximation_report
+    from regrasp.reference.approx_error import approximation_report
 
     sc = regrasp.Scene.load(EXAMPLES / "block-xztheta.toml")
     rows = approximation_report([sc], (5.0, 80.0), samples=4000)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import regrasp
-from regrasp import mncp_reference
+from regrasp.reference import mncp as mncp_reference
 
 from .conftest import EXAMPLES
 

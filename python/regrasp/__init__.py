@@ -10,9 +10,9 @@ Quick use::
 
 from ._core import __version__
 from .errors import ArgumentError, GraspError, RegraspError, SceneError
-from .scene import Classification, GravityFreeCone, MotionCone, MotionConeBatch, Pusher, Scene, Task
-from .scene3d import Scene3D
-from .plan import Plan, plan
+from .scene.planar import Classification, GravityFreeCone, MotionCone, MotionConeBatch, Pusher, Scene, Task
+from .scene.spatial import Scene3D
+from .planning.plan import Plan, plan
 
 __all__ = [
     "__version__",

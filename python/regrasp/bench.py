@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import reference
-from .scene import Scene
+from .reference import cones as reference
+from .scene.planar import Scene
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
@@ -125,8 +125,8 @@ def run_mujoco(steps: int = 4000) -> dict:
     simulator's time for the same push (10 mm at 10 mm/s)."""
     import mujoco
 
-    from .mujoco_sim import PushRig
-    from .quasistatic import simulate_push
+    from .mujoco.push import PushRig
+    from .sim.quasistatic import simulate_push
 
     scene = Scene.load(EXAMPLES / "block-low-friction.toml")
     rig = PushRig(scene, "left")
@@ -193,7 +193,7 @@ def run_mpc(reps: int = 200) -> dict:
     """One MPC step called from Python (Rust: closest knot, cones of the horizon, the QP with
     clarabel, the exact check; wall time of the call) against the same QP solved by scipy's SLSQP (the QP alone, generators given)."""
     from . import _core
-    from .plan import plan
+    from .planning.plan import plan
 
     out = {}
     for name in ("block-high-friction", "t-shape"):
@@ -228,8 +228,8 @@ def run_plan3d(seeds: int = 10, examples=PLANNED_3D) -> dict:
     ``seeds`` seeds per example, against the same search with each of its solves made by the
     IPOPT reference (the thesis' approach; estimated as solves x the median IPOPT time of the
     plan's first step solved forward, measured in the same run)."""
-    from . import mncp_reference
-    from .scene3d import Scene3D
+    from .reference import mncp as mncp_reference
+    from .scene.spatial import Scene3D
 
     out = {}
     for name in examples:
@@ -263,7 +263,7 @@ PLANNED = ("block-low-friction", "block-high-friction", "block-xztheta", "t-shap
 def run_planner(seeds: int = 10, time_limit: float = 30.0, examples=PLANNED) -> dict:
     """The planner table (thesis Table 4.2): median planning time over ``seeds`` seeds for each
     example and each propagation, measured in the same run, with the baselines' ratios."""
-    from .plan import plan
+    from .planning.plan import plan
 
     out = {}
     for name in examples:
@@ -298,7 +298,7 @@ def run_mncp(reps: int = 11, ref_reps: int = 3) -> dict:
     """One instantaneous quasi-static solve (two finger patches of 4 points, a line pusher):
     the Rust solver against the IPOPT reference on the same problem, for a push that sticks, one
     that slides and one that separates."""
-    from . import mncp_reference
+    from .reference import mncp as mncp_reference
 
     scene = Scene.load(EXAMPLES / "block-low-friction.toml")
     p = scene._core.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, 4, False)

@@ -9,8 +9,8 @@ use std::path::Path;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use regrasp::batch::{generators_into, Status};
-use regrasp::geometry::Vec3;
+use regrasp::cones::batch::{generators_into, Status};
+use regrasp::mechanics::geometry::Vec3;
 use regrasp::Scene;
 
 const POSE: [f64; 3] = [0.003, 0.004, 0.1];

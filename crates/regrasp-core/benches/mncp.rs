@@ -3,8 +3,8 @@
 //! separates; and the inverse problem.
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::DVector;
-use regrasp::mncp::{solve_forward, solve_inverse, Settings};
-use regrasp::quasistatic::{push_problem, Options, SupportModel};
+use regrasp::dynamics::mncp::{solve_forward, solve_inverse, Settings};
+use regrasp::dynamics::planar::{push_problem, Options, SupportModel};
 use regrasp::Scene;
 use std::hint::black_box;
 use std::path::Path;

@@ -2,9 +2,9 @@
 //! check of the executed twist): horizon 5 on the block and the T-shape, nominal and robust
 //! cones. Target: median under 1 ms (a 125 Hz pushing MPC is the published reference).
 use criterion::{criterion_group, criterion_main, Criterion};
-use regrasp::mpc::{Mpc, MpcSettings};
-use regrasp::robust::{worst_case, Uncertainty};
-use regrasp::trrt::{plan, Settings};
+use regrasp::control::mpc::{Mpc, MpcSettings};
+use regrasp::cones::robust::{worst_case, Uncertainty};
+use regrasp::planning::planar::{plan, PlanarSettings};
 use regrasp::Scene;
 use std::hint::black_box;
 use std::path::Path;
@@ -18,14 +18,14 @@ fn bench(c: &mut Criterion) {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../examples/{name}.toml"));
         let scene = Scene::load(&path).unwrap();
         for (label, s) in [("nominal", scene.clone()), ("robust", worst_case(&scene, &u).unwrap())] {
-            let r = plan(&s, None, None, &Settings::default()).unwrap();
+            let r = plan(&s, None, None, &PlanarSettings::default()).unwrap();
             // a missing plan is a regression, never a silently shorter benchmark
             assert!(r.found, "no {label} plan for {name}: {}", r.stop_reason.label());
             let q0 = r.path[0].0;
             let q = [q0[0] + 0.0005, q0[1] - 0.0005, q0[2] + 0.01];
             g.bench_function(format!("step/{name}/{label}"), |b| {
                 b.iter_batched(
-                    || Mpc::new(&s, &r.path, None, MpcSettings::default()).unwrap(),
+                    || Mpc::new(&s, &r.poses(), None, MpcSettings::default()).unwrap(),
                     |mut m| black_box(m.step(black_box(&q)).unwrap()),
                     criterion::BatchSize::SmallInput,
                 )

@@ -7,8 +7,8 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use common::*;
 use proptest::prelude::*;
-use regrasp::geometry::{perp, rot, Vec2, Vec3};
-use regrasp::scene::{RawGravity, RawScene};
+use regrasp::mechanics::geometry::{perp, rot, Vec2, Vec3};
+use regrasp::scene::planar::{RawGravity, RawScene};
 use regrasp::Scene;
 
 fn twist_from_angles(a: f64, b: f64, l: f64) -> Vec3 {
@@ -346,7 +346,7 @@ fn exact_test_matches_brute_force_lp() {
                 }
             } else {
                 // a point pusher: the twist its contact point's motion produces
-                let u = regrasp::geometry::Vec2::new(a1.cos(), a1.sin());
+                let u = regrasp::mechanics::geometry::Vec2::new(a1.cos(), a1.sin());
                 if let Some(t) = push.point_pusher_twist(&u, push.spec().friction_scale) {
                     v = t;
                 }

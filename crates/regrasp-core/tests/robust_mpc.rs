@@ -3,9 +3,9 @@
 mod common;
 
 use proptest::prelude::*;
-use regrasp::geometry::Vec3;
-use regrasp::mpc::{Mpc, MpcSettings, Status};
-use regrasp::robust::{self, ConeMode, Uncertainty};
+use regrasp::mechanics::geometry::Vec3;
+use regrasp::control::mpc::{Mpc, MpcSettings, Status};
+use regrasp::cones::robust::{self, ConeMode, Uncertainty};
 use regrasp::Scene;
 
 fn example(name: &str) -> Scene {
@@ -118,9 +118,9 @@ fn robust_cone_shrinks_the_nominal_one() {
 #[test]
 fn mpc_qp_respects_its_cone_constraints_and_tracks() {
     let s = example("block-low-friction");
-    let r = regrasp::trrt::plan(&s, None, None, &regrasp::trrt::Settings::default()).unwrap();
+    let r = regrasp::planning::planar::plan(&s, None, None, &regrasp::planning::planar::PlanarSettings::default()).unwrap();
     assert!(r.found);
-    let mut mpc = Mpc::new(&s, &r.path, None, MpcSettings::default()).unwrap();
+    let mut mpc = Mpc::new(&s, &r.poses(), None, MpcSettings::default()).unwrap();
     let q = [0.0005, -0.0003, 0.01];
     let sol = mpc.solve_qp(&q, 0).unwrap();
     assert!(sol.status_ok);
@@ -142,7 +142,7 @@ fn mpc_qp_respects_its_cone_constraints_and_tracks() {
     // just inside the tolerance it keeps pushing while it makes progress
     let tol = s.task.unwrap().tolerance;
     let edge = [g[0] - 0.9 * tol[0], g[1], g[2]];
-    let mut fresh = Mpc::new(&s, &r.path, None, MpcSettings::default()).unwrap();
+    let mut fresh = Mpc::new(&s, &r.poses(), None, MpcSettings::default()).unwrap();
     assert_ne!(fresh.step(&edge).unwrap().status, Status::AtGoal);
 }
 
@@ -151,8 +151,8 @@ fn mpc_closed_loop_on_the_cone_model_reaches_the_goal_after_a_poke() {
     // the plant moves exactly as commanded (the motion-cone model): the loop must converge
     for name in ["block-low-friction", "t-shape", "block-xztheta"] {
         let s = example(name);
-        let r = regrasp::trrt::plan(&s, None, None, &regrasp::trrt::Settings::default()).unwrap();
-        let mut mpc = Mpc::new(&s, &r.path, None, MpcSettings::default()).unwrap();
+        let r = regrasp::planning::planar::plan(&s, None, None, &regrasp::planning::planar::PlanarSettings::default()).unwrap();
+        let mut mpc = Mpc::new(&s, &r.poses(), None, MpcSettings::default()).unwrap();
         let mut q = s.task.unwrap().start;
         let mut done = false;
         for k in 0..400 {
@@ -167,7 +167,7 @@ fn mpc_closed_loop_on_the_cone_model_reaches_the_goal_after_a_poke() {
             if c.status == Status::Stuck {
                 continue;
             }
-            q = regrasp::quasistatic::integrate(&q, &c.twist, 0.1);
+            q = regrasp::dynamics::planar::integrate(&q, &c.twist, 0.1);
         }
         assert!(done, "{name}: did not reach the goal ({q:?}, {} replans)", mpc.replans);
     }

@@ -88,7 +88,7 @@ fn every_bundled_example_loads() {
             continue;
         }
         if std::fs::read_to_string(&path).unwrap().contains("dimension = 3") {
-            let s3 = regrasp::scene3d::Scene3::load(&path).unwrap_or_else(|e| panic!("{} does not load: {e}", path.display()));
+            let s3 = regrasp::scene::spatial::Scene3::load(&path).unwrap_or_else(|e| panic!("{} does not load: {e}", path.display()));
             assert!(!s3.pushers.is_empty());
             continue;
         }

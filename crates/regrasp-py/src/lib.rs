@@ -5,20 +5,23 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use regrasp::friction_cone::{ConeShape, ContactLimit};
-use regrasp::geometry::{Vec2, Vec3};
-use regrasp::motion_cone::{project_onto_generators, Classification, PlanarPush};
-use regrasp::mncp::{self, FrictionLaw, NormalLaw, Side};
-use regrasp::quasistatic::{self, Options, SupportModel};
-use regrasp::quasistatic3d;
-use regrasp::scene3d::{self, Scene3};
-use regrasp::trrt;
-use regrasp::{batch, Error};
+use regrasp::mechanics::friction_cone::{ConeShape, ContactLimit};
+use regrasp::mechanics::geometry::{Vec2, Vec3};
+use regrasp::cones::motion_cone::{project_onto_generators, Classification, PlanarPush};
+use regrasp::dynamics::mncp::{self, FrictionLaw, NormalLaw, Side};
+use regrasp::dynamics::planar::{self as quasistatic, Options, SupportModel};
+use regrasp::dynamics::spatial as quasistatic3d;
+use regrasp::scene::spatial::{self as scene3d, Scene3};
+use regrasp::planning::planar as trrt;
+use regrasp::cones::batch;
+use regrasp::Error;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
+mod settings;
+
 /// Raise the Python exception (defined in `regrasp.errors`) matching a core error.
-fn to_py(err: Error) -> PyErr {
+pub(crate) fn to_py(err: Error) -> PyErr {
     Python::with_gil(|py| {
         let module = match py.import("regrasp.errors") {
             Ok(m) => m,
@@ -37,7 +40,7 @@ fn to_py(err: Error) -> PyErr {
 }
 
 /// The fields a plan dict shares between the planar and the 3-D planners.
-fn plan_summary<'py>(py: Python<'py>, scene: &str, r: &trrt::Summary, propagation: &str, seed: u64) -> PyResult<Bound<'py, PyDict>> {
+fn plan_summary<'py, Q, E>(py: Python<'py>, scene: &str, r: &regrasp::planning::trrt::Plan<Q, E>, propagation: &str, seed: u64) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("scene", scene)?;
     d.set_item("found", r.found)?;
@@ -65,7 +68,7 @@ fn path_pushers(names: &[Option<String>], index: impl Fn(&str) -> regrasp::Resul
         .collect()
 }
 
-fn arg_err(name: &str, msg: impl Into<String>) -> PyErr {
+pub(crate) fn arg_err(name: &str, msg: impl Into<String>) -> PyErr {
     to_py(Error::arg(name, msg))
 }
 
@@ -292,8 +295,8 @@ impl Scene {
     #[getter]
     fn kind(&self) -> &'static str {
         match self.inner.support {
-            regrasp::scene::Support::Grasp(_) => "grasp",
-            regrasp::scene::Support::Surface(_) => "surface",
+            regrasp::scene::planar::Support::Grasp(_) => "grasp",
+            regrasp::scene::planar::Support::Surface(_) => "surface",
         }
     }
     #[getter]
@@ -338,8 +341,8 @@ impl Scene {
     #[getter]
     fn pad_limit_surface_k(&self) -> f64 {
         match &self.inner.support {
-            regrasp::scene::Support::Grasp(g) => g.limit_surface.k(),
-            regrasp::scene::Support::Surface(s) => s.limit_surface.k(),
+            regrasp::scene::planar::Support::Grasp(g) => g.limit_surface.k(),
+            regrasp::scene::planar::Support::Surface(s) => s.limit_surface.k(),
         }
     }
 
@@ -347,9 +350,9 @@ impl Scene {
     #[getter]
     fn pad(&self) -> Option<(String, f64, f64)> {
         match &self.inner.support {
-            regrasp::scene::Support::Grasp(g) => Some(match g.pad {
-                regrasp::scene::PadShape::Circle { radius } => ("circle".into(), radius, radius),
-                regrasp::scene::PadShape::Rectangle { width, height } => ("rectangle".into(), width, height),
+            regrasp::scene::planar::Support::Grasp(g) => Some(match g.pad {
+                regrasp::scene::planar::PadShape::Circle { radius } => ("circle".into(), radius, radius),
+                regrasp::scene::planar::PadShape::Rectangle { width, height } => ("rectangle".into(), width, height),
             }),
             _ => None,
         }
@@ -598,54 +601,19 @@ impl Scene {
         Ok(d)
     }
 
-    /// T-RRT* regrasp plan (see `regrasp.plan`). Returns a dict.
-    #[pyo3(signature = (start=None, goal=None, seed=0, time_limit=10.0, propagation="motion_cone", max_nodes=20000,
-                        step=None, goal_bias=0.2, margin=0.01, neighbour_steps=2.0, cost_threshold=f64::INFINITY,
-                        checks=16, random_tries=8, connect=true, plain=false))]
-    #[allow(clippy::too_many_arguments)]
-    fn plan<'py>(
-        &self,
-        py: Python<'py>,
-        start: Option<Vec<f64>>,
-        goal: Option<Vec<f64>>,
-        seed: u64,
-        time_limit: f64,
-        propagation: &str,
-        max_nodes: usize,
-        step: Option<f64>,
-        goal_bias: f64,
-        margin: f64,
-        neighbour_steps: f64,
-        cost_threshold: f64,
-        checks: usize,
-        random_tries: usize,
-        connect: bool,
-        plain: bool,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    /// T-RRT* regrasp plan (see `regrasp.plan`): `settings` overrides the defaults of
+    /// `planner_defaults(2)`. Returns a dict.
+    #[pyo3(signature = (start=None, goal=None, settings=None))]
+    fn plan<'py>(&self, py: Python<'py>, start: Option<Vec<f64>>, goal: Option<Vec<f64>>, settings: Option<&Bound<'py, PyDict>>) -> PyResult<Bound<'py, PyDict>> {
         let start = start.map(|v| pose3(&v)).transpose().map_err(|_| arg_err("start", "must be 3 finite numbers"))?;
         let goal = goal.map(|v| pose3(&v)).transpose().map_err(|_| arg_err("goal", "must be 3 finite numbers"))?;
-        let settings = trrt::Settings {
-            seed,
-            time_limit,
-            max_nodes,
-            step,
-            goal_bias,
-            margin,
-            neighbour_steps,
-            cost_threshold,
-            checks,
-            random_tries,
-            connect,
-            plain,
-            propagation: trrt::Propagation::parse(propagation).map_err(to_py)?,
-            ..trrt::Settings::default()
-        };
+        let settings = settings::planar(settings)?;
         let r = py.allow_threads(|| trrt::plan(&self.inner, start, goal, &settings)).map_err(to_py)?;
-        let d = plan_summary(py, &self.inner.name, &r.summary(), settings.propagation.label(), seed)?;
+        let d = plan_summary(py, &self.inner.name, &r, settings.propagation.label(), settings.search.seed)?;
         let path = r
             .path
             .iter()
-            .map(|(q, p)| -> PyResult<Bound<'py, PyDict>> {
+            .map(|(q, p, _)| -> PyResult<Bound<'py, PyDict>> {
                 let k = PyDict::new(py);
                 k.set_item("pose", q.to_vec())?;
                 k.set_item("pusher", p.map(|i| self.inner.pushers[i].name.clone()))?;
@@ -689,14 +657,14 @@ impl Scene {
     /// `ρ = μ_s N / (m g)` (grasp scenes).
     #[getter]
     fn rho(&self) -> Option<f64> {
-        regrasp::robust::rho(&self.inner)
+        regrasp::cones::robust::rho(&self.inner)
     }
 
     /// A copy with scaled parameters and a cone mode (see `regrasp.robust`).
     #[pyo3(signature = (finger_friction=1.0, grip=1.0, mass=1.0, pusher_friction=1.0, mode="nominal"))]
     fn scaled(&self, finger_friction: f64, grip: f64, mass: f64, pusher_friction: f64, mode: &str) -> PyResult<Self> {
-        let mode = regrasp::robust::ConeMode::parse(mode).map_err(to_py)?;
-        regrasp::robust::scaled(&self.inner, finger_friction, grip, mass, pusher_friction, mode).map(|inner| Self { inner }).map_err(to_py)
+        let mode = regrasp::cones::robust::ConeMode::parse(mode).map_err(to_py)?;
+        regrasp::cones::robust::scaled(&self.inner, finger_friction, grip, mass, pusher_friction, mode).map(|inner| Self { inner }).map_err(to_py)
     }
 
     /// Whether pusher `pusher` alone can carry the object's weight at pose `q` (the invariant case).
@@ -704,7 +672,7 @@ impl Scene {
         let q = pose3(&q)?;
         let p = self.inner.pusher_index(pusher).map_err(to_py)?;
         self.inner.check_pose(&q).map_err(to_py)?;
-        Ok(regrasp::robust::carries_weight(&self.inner.frame(&q), &self.inner.pushers[p].model))
+        Ok(regrasp::cones::robust::carries_weight(&self.inner.frame(&q), &self.inner.pushers[p].model))
     }
 
     /// Messages of the batch status codes.
@@ -815,53 +783,22 @@ impl Scene3D {
     fn sphere(&self) -> Option<f64> {
         self.inner.sphere
     }
-    /// T-RRT* over SE(3) with inverse-dynamics unit steps (`regrasp::trrt3d`). Returns a dict
-    /// like the planar plan (poses as [x, y, z, qw, qx, qy, qz]) plus the number of solves.
-    #[pyo3(signature = (start=None, goal=None, seed=0, time_limit=10.0, max_nodes=5000, step=None, goal_bias=0.3,
-                        neighbour_steps=1.5, random_tries=6, theta_margin=0.5, connect=true, cost_threshold=f64::INFINITY))]
-    #[allow(clippy::too_many_arguments)]
-    fn plan<'py>(
-        &self,
-        py: Python<'py>,
-        start: Option<Vec<f64>>,
-        goal: Option<Vec<f64>>,
-        seed: u64,
-        time_limit: f64,
-        max_nodes: usize,
-        step: Option<f64>,
-        goal_bias: f64,
-        neighbour_steps: f64,
-        random_tries: usize,
-        theta_margin: f64,
-        connect: bool,
-        cost_threshold: f64,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    /// T-RRT* over SE(3) with inverse-dynamics unit steps (`regrasp::planning::spatial`):
+    /// `settings` overrides the defaults of `planner_defaults(3)`. Returns a dict like the
+    /// planar plan (poses as [x, y, z, qw, qx, qy, qz]) plus the number of solves.
+    #[pyo3(signature = (start=None, goal=None, settings=None))]
+    fn plan<'py>(&self, py: Python<'py>, start: Option<Vec<f64>>, goal: Option<Vec<f64>>, settings: Option<&Bound<'py, PyDict>>) -> PyResult<Bound<'py, PyDict>> {
         let start = start.map(|v| pose7("start", &v)).transpose()?;
         let goal = goal.map(|v| pose7("goal", &v)).transpose()?;
-        if !(goal_bias >= 0.0 && goal_bias <= 1.0) {
-            return Err(arg_err("goal_bias", "must be in [0, 1]"));
-        }
-        let settings = trrt::Settings {
-            seed,
-            time_limit,
-            max_nodes,
-            step,
-            goal_bias,
-            neighbour_steps,
-            random_tries,
-            theta_margin,
-            connect,
-            cost_threshold,
-            ..trrt::Settings::default()
-        };
-        let r = py.allow_threads(|| regrasp::trrt3d::plan3(&self.inner, start, goal, &settings)).map_err(to_py)?;
-        let d = plan_summary(py, &self.inner.name, &r.summary(), "mncp_inverse", seed)?;
+        let settings = settings::spatial(settings)?;
+        let r = py.allow_threads(|| regrasp::planning::spatial::plan3(&self.inner, start, goal, &settings)).map_err(to_py)?;
+        let d = plan_summary(py, &self.inner.name, &r.plan, "mncp_inverse", settings.search.seed)?;
         d.set_item("solves", r.solves)?;
         let path = r
+            .plan
             .path
             .iter()
-            .zip(&r.twists)
-            .map(|((q, p), u)| -> PyResult<Bound<'py, PyDict>> {
+            .map(|(q, p, u)| -> PyResult<Bound<'py, PyDict>> {
                 let k = PyDict::new(py);
                 k.set_item("pose", scene3d::pose_to_array(q).to_vec())?;
                 k.set_item("pusher", p.map(|i| self.inner.pushers[i].name.clone()))?;
@@ -890,7 +827,7 @@ impl Scene3D {
         for (i, (q, p)) in poses.iter().zip(idx).enumerate() {
             path.push((pose7(&format!("path[{i}].pose"), q)?, p));
         }
-        regrasp::trrt3d::validate_path3(&self.inner, &path, tw.as_deref()).map_err(to_py)
+        regrasp::planning::spatial::validate_path3(&self.inner, &path, tw.as_deref()).map_err(to_py)
     }
 
     /// Contact points (object frame) of pusher `name` at `pose` (default: the task's start).
@@ -1022,7 +959,7 @@ impl MotionCone {
     fn support_matrices<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>) {
         let s = self.push.spec();
         let a = s.limit_surface.matrix(s.friction_scale);
-        let to = |m: &regrasp::geometry::Mat3| {
+        let to = |m: &regrasp::mechanics::geometry::Mat3| {
             let mut o = Array2::zeros((3, 3));
             for i in 0..3 {
                 for j in 0..3 {
@@ -1070,7 +1007,7 @@ impl MotionCone {
         let cone = self.push.polyhedral_cone().map_err(to_py)?;
         let mt = self.push.metric();
         let m: Vec<bool> =
-            ts.iter().map(|v| cone.contains(&mt.twist(v), regrasp::motion_cone::MEMBERSHIP_TOL)).collect();
+            ts.iter().map(|v| cone.contains(&mt.twist(v), regrasp::cones::motion_cone::MEMBERSHIP_TOL)).collect();
         Ok(if many {
             Array1::from(m).into_pyarray(py).into_any().unbind()
         } else {
@@ -1139,10 +1076,10 @@ impl MotionCone {
     }
 }
 
-/// The MPC controller (Rust `regrasp::mpc`): a plan's reference, the scene's cones.
+/// The MPC controller (Rust `regrasp::control::mpc`): a plan's reference, the scene's cones.
 #[pyclass(module = "regrasp._core", unsendable)]
 struct Mpc {
-    inner: regrasp::mpc::Mpc,
+    inner: regrasp::control::mpc::Mpc,
     names: Vec<String>,
 }
 
@@ -1188,7 +1125,7 @@ impl Mpc {
     ) -> PyResult<Self> {
         let path = path_from(&scene.inner, &poses, &pushers)?;
         let goal = goal.map(|g| pose3(&g)).transpose().map_err(|_| arg_err("goal", "must be 3 finite numbers"))?;
-        let settings = regrasp::mpc::MpcSettings {
+        let settings = regrasp::control::mpc::MpcSettings {
             dt,
             horizon,
             speed,
@@ -1198,10 +1135,15 @@ impl Mpc {
             margin,
             stall_steps,
             max_replans,
-            planner: trrt::Settings { time_limit: replan_time_limit, seed, ..trrt::Settings::default() },
-            ..regrasp::mpc::MpcSettings::default()
+            planner: {
+                let mut p = trrt::PlanarSettings::default();
+                p.search.time_limit = replan_time_limit;
+                p.search.seed = seed;
+                p
+            },
+            ..regrasp::control::mpc::MpcSettings::default()
         };
-        let inner = regrasp::mpc::Mpc::new(&scene.inner, &path, goal, settings).map_err(to_py)?;
+        let inner = regrasp::control::mpc::Mpc::new(&scene.inner, &path, goal, settings).map_err(to_py)?;
         Ok(Self { inner, names: scene.inner.pushers.iter().map(|p| p.name.clone()).collect() })
     }
 
@@ -1287,7 +1229,7 @@ fn twist6(name: &str, v: &[f64]) -> PyResult<[f64; 6]> {
 /// The constant body twist taking pose `a` to pose `b` in unit time (SE(3) log).
 #[pyfunction]
 fn se3_log(a: Vec<f64>, b: Vec<f64>) -> PyResult<[f64; 6]> {
-    Ok(regrasp::trrt3d::se3_log(&pose7("a", &a)?, &pose7("b", &b)?))
+    Ok(regrasp::pose::spatial::log(&pose7("a", &a)?, &pose7("b", &b)?))
 }
 
 /// `pose ∘ exp(t · twist)` (body twist; SE(3) exp).
@@ -1296,7 +1238,7 @@ fn se3_integrate(pose: Vec<f64>, twist: Vec<f64>, t: f64) -> PyResult<[f64; 7]> 
     if !t.is_finite() {
         return Err(arg_err("t", "must be finite"));
     }
-    Ok(scene3d::pose_to_array(&quasistatic3d::integrate(&pose7("pose", &pose)?, &twist6("twist", &twist)?, t)))
+    Ok(scene3d::pose_to_array(&regrasp::pose::spatial::integrate(&pose7("pose", &pose)?, &twist6("twist", &twist)?, t)))
 }
 
 /// `a ∘ b` of two poses.
@@ -1318,6 +1260,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<MncpProblem>()?;
     m.add_class::<Scene3D>()?;
     m.add_class::<Mpc>()?;
+    m.add_function(wrap_pyfunction!(settings::planner_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(se3_log, m)?)?;
     m.add_function(wrap_pyfunction!(se3_integrate, m)?)?;
     m.add_function(wrap_pyfunction!(se3_compose, m)?)?;

@@ -1,0 +1,511 @@
+//! The planar space of the T-RRT* ([`crate::planning::trrt`]): object poses `q = [x, z, θ]` in
+//! the grasp where the finger pad lies on the object and the grasp holds it (thesis §4.1, §4.3).
+//!
+//! * **Metric**: `d(q, q')² = Δx² + Δz² + (L Δθ)²` (L: the object's radius of gyration), the
+//!   same weighting of rotation against translation as the motion cones.
+//! * **Unit-step propagation** (Fig 4-9), by [`Propagation`]: the motion cones (the desired step
+//!   is taken when some pusher's exact cone contains it, else projected on each cone and the
+//!   closest kept, preferring the parent's pusher); or the baselines — random steps kept when a
+//!   force-balance feasibility LP passes (ICRA 2018 "stable check"), or the inverse quasi-static
+//!   complementarity dynamics (thesis §4.2.1).
+//! * Every accepted step is checked along its length by the exact motion-cone test (`checks`
+//!   poses), so that a plan's steps are feasible, not only at their start.
+
+use crate::cones::motion_cone::{project_with_margin, SupportFrame};
+use crate::dynamics::mncp;
+use crate::dynamics::planar::{push_problem, Options as QsOptions, SupportModel};
+use crate::error::{Error, Result};
+use crate::mechanics::geometry::{rot, Vec2, Vec3};
+use crate::planning::tree::pusher_order;
+use crate::planning::trrt::{self, gauss, SearchSettings, Space, Step};
+use crate::pose::planar::{body_twist, distance, integrate};
+use crate::scene::Scene;
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+pub use crate::planning::trrt::StopReason;
+
+/// How a unit step is propagated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Propagation {
+    /// Projection on the exact motion cones (this library).
+    MotionCone,
+    /// Random steps kept when a force-balance LP with a sticking pusher is feasible.
+    StableCheck,
+    /// The inverse quasi-static complementarity dynamics (point-set pads).
+    Mncp,
+}
+
+impl Propagation {
+    pub fn parse(s: &str) -> Result<Self> {
+        match s {
+            "motion_cone" | "motion-cone" => Ok(Self::MotionCone),
+            "stable_check" | "stable-check" => Ok(Self::StableCheck),
+            "mncp" => Ok(Self::Mncp),
+            _ => Err(Error::arg("propagation", format!("must be motion_cone, stable_check or mncp (got {s:?})"))),
+        }
+    }
+    pub fn label(&self) -> &'static str {
+        match self {
+            Self::MotionCone => "motion_cone",
+            Self::StableCheck => "stable_check",
+            Self::Mncp => "mncp",
+        }
+    }
+}
+
+/// Settings of the planar planner (defaults in [`PlanarSettings::default`]; the unit step
+/// defaults to a tenth of L).
+#[derive(Clone, Debug)]
+pub struct PlanarSettings {
+    pub search: SearchSettings,
+    /// Smallest margin of the exact test at the start of an accepted step.
+    pub margin: f64,
+    pub propagation: Propagation,
+    /// A plain goal-biased RRT (no transition test, no RRT*, no preference for the parent's
+    /// pusher, no straight-push connection): the reference for the switch-over count.
+    pub plain: bool,
+}
+
+impl Default for PlanarSettings {
+    fn default() -> Self {
+        Self { search: SearchSettings::default(), margin: 0.01, propagation: Propagation::MotionCone, plain: false }
+    }
+}
+
+impl PlanarSettings {
+    /// Checks every setting (errors name the setting).
+    pub fn check(&self) -> Result<()> {
+        self.search.check()?;
+        if !(self.margin.is_finite() && self.margin >= 0.0) {
+            return Err(Error::arg("margin", format!("must be a finite, non-negative number (got {})", self.margin)));
+        }
+        Ok(())
+    }
+}
+
+/// A planar plan: poses and the pusher reaching each (None for the start).
+pub type PlanarPlan = trrt::Plan<[f64; 3], ()>;
+
+/// The planar space: a scene, a goal with its tolerance, and the planner's settings.
+pub struct PlanarSpace<'a> {
+    scene: &'a Scene,
+    s: &'a PlanarSettings,
+    step: f64,
+    goal: [f64; 3],
+    tol: [f64; 3],
+    bounds: ([f64; 2], [f64; 2], [f64; 2]),
+    qs_opts: QsOptions,
+}
+
+impl<'a> PlanarSpace<'a> {
+    /// The space between `start` and `goal` (checked: finite, pad on the object, grasp holding).
+    pub fn new(scene: &'a Scene, start: [f64; 3], goal: [f64; 3], tol: [f64; 3], s: &'a PlanarSettings) -> Result<Self> {
+        for (name, q) in [("start", &start), ("goal", &goal)] {
+            if !q.iter().all(|x| x.is_finite()) {
+                return Err(Error::arg(name, "has a non-finite component"));
+            }
+            if !scene.admissible(q) {
+                return Err(Error::arg(name, format!("{q:?} is not admissible: the finger pad is not entirely on the object")));
+            }
+            if !(scene.hold_ratio(q) < 1.0) {
+                return Err(Error::arg(name, format!("{q:?}: the grasp cannot hold the object against gravity there")));
+            }
+        }
+        s.check()?;
+        // the region of poses where the pad can be on the object: t = −R c for c on the object
+        let reach = scene.outline.vertices().iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let m = s.search.theta_margin;
+        let (tlo, thi) = (start[2].min(goal[2]) - m, start[2].max(goal[2]) + m);
+        Ok(Self {
+            scene,
+            s,
+            step: s.search.step.unwrap_or(0.1 * scene.length),
+            goal,
+            tol,
+            bounds: ([-reach, reach], [-reach, reach], [tlo, thi]),
+            qs_opts: QsOptions { support: SupportModel::Points { rings: 2, points: 0, merge_fingers: true }, ..QsOptions::default() },
+        })
+    }
+
+    /// The frame at `q` when the pad is on the object and the grasp holds.
+    fn frame(&self, q: &[f64; 3]) -> Option<SupportFrame> {
+        if !self.scene.admissible(q) {
+            return None;
+        }
+        let f = self.scene.frame(q);
+        (f.hold_ratio < 1.0).then_some(f)
+    }
+
+    /// Whether pusher `p` can move the object with body twist `tw` (unit time) from `q`: the
+    /// exact test at `checks` poses along the step (margin ≥ `margin` at the start, ≥ half
+    /// of it further on), and the pad on the object all along: at each interior pose its
+    /// clearance exceeds how far it moves to the neighbouring poses, so it cannot leave the
+    /// object between them.
+    fn step_feasible(&self, q: &[f64; 3], tw: &Vec3, p: usize) -> bool {
+        let model = &self.scene.pushers[p].model;
+        let n = self.s.search.checks.max(1);
+        let poses: Vec<[f64; 3]> = (0..=n).map(|k| if k == 0 { *q } else { integrate(q, tw, k as f64 / n as f64) }).collect();
+        let pad = |x: &[f64; 3]| rot(-x[2]) * Vec2::new(-x[0], -x[1]);
+        let pads: Vec<Vec2> = poses.iter().map(pad).collect();
+        for k in 0..=n {
+            let Some(f) = self.frame(&poses[k]) else { return false };
+            if k > 0 && k < n {
+                let reach = (pads[k] - pads[k - 1]).norm().max((pads[k + 1] - pads[k]).norm());
+                if self.scene.pad_clearance(&poses[k]) < 1.1 * reach {
+                    return false;
+                }
+            }
+            if k == n {
+                break; // the end pose: on the object and held; its twist is the next step's
+            }
+            let m = f.classify(model, tw).margin;
+            if m < if k == 0 { self.s.margin } else { 0.5 * self.s.margin } {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Whether the inverse quasi-static dynamics find pusher forces for step `tw` with pusher `p`.
+    fn mncp_feasible(&self, q: &[f64; 3], tw: &Vec3, p: usize) -> bool {
+        let Ok(prob) = push_problem(self.scene, q, p, &self.qs_opts) else { return false };
+        let v = nalgebra::DVector::from_row_slice(tw.as_slice());
+        mncp::solve_inverse(&prob, &v, &mncp::Settings::default()).is_ok()
+    }
+
+    /// The propagation's own feasibility test of a step (exact cone along the step, the
+    /// stable-check LP, or the inverse complementarity dynamics).
+    fn feasible(&self, q: &[f64; 3], tw: &Vec3, p: usize) -> bool {
+        match self.s.propagation {
+            Propagation::MotionCone => self.step_feasible(q, tw, p),
+            Propagation::StableCheck => stable_push_lp(self.scene, q, p, tw) && self.frame(&integrate(q, tw, 1.0)).is_some(),
+            Propagation::Mncp => self.mncp_feasible(q, tw, p) && self.frame(&integrate(q, tw, 1.0)).is_some(),
+        }
+    }
+
+    fn step_to(&self, q: &[f64; 3], p: usize, tw: Vec3) -> Step<[f64; 3], ()> {
+        Step { q: integrate(q, &tw, 1.0), pusher: p, edge: (), length: self.scene.metric().twist_norm(&tw) }
+    }
+
+    /// The desired unit step towards `target` (its body twist) and the whole twist's length.
+    fn desired(&self, q: &[f64; 3], target: &[f64; 3]) -> Option<(Vec3, f64)> {
+        let xi = body_twist(q, target);
+        let len = self.scene.metric().twist_norm(&xi);
+        (len >= 1e-12).then(|| (xi * (self.step.min(len) / len), len))
+    }
+
+    /// Propagation by motion cones: the desired step if some cone contains it (parent's pusher
+    /// first), else its projections, the closest in angle kept (parent's pusher preferred).
+    fn propagate_cones(&self, q: &[f64; 3], parent_pusher: Option<usize>, target: &[f64; 3]) -> Option<Step<[f64; 3], ()>> {
+        let (want, len) = self.desired(q, target)?;
+        let m = self.scene.metric();
+        let frame = self.frame(q)?;
+        let order = pusher_order(self.scene.pushers.len(), if self.s.plain { None } else { parent_pusher });
+        // 1. the desired step itself
+        for &p in &order {
+            if frame.classify(&self.scene.pushers[p].model, &want).margin >= self.s.margin && self.step_feasible(q, &want, p) {
+                return Some(self.step_to(q, p, want));
+            }
+        }
+        // 2. projections on each cone
+        let wn = m.twist_norm(&want);
+        let mut best: Option<(f64, usize, Vec3)> = None;
+        for &p in &order {
+            let Some(v) = project_with_margin(&frame, &self.scene.pushers[p].model, &want, self.s.margin) else { continue };
+            let vn = m.twist_norm(&v);
+            if vn < 1e-12 {
+                continue;
+            }
+            let cos = m.twist(&v).dot(&m.twist(&want)) / (vn * wn);
+            let bonus = if Some(p) == parent_pusher && !self.s.plain { 0.05 } else { 0.0 };
+            if cos > 0.2 && best.as_ref().is_none_or(|b| cos + bonus > b.0) {
+                best = Some((cos + bonus, p, v));
+            }
+        }
+        let (_, p, v) = best?;
+        // a step of the unit length along the projection, halved until feasible along it
+        let mut tw = v * (self.step.min(len) / m.twist_norm(&v));
+        for _ in 0..4 {
+            if self.step_feasible(q, &tw, p) {
+                return Some(self.step_to(q, p, tw));
+            }
+            tw *= 0.5;
+        }
+        None
+    }
+
+    /// Random unit steps for the baselines: the stable check (directions in the target's
+    /// half-space, ICRA 2018) or the MNCP (the desired direction first, then within about 30°).
+    fn propagate_random(&self, rng: &mut ChaCha8Rng, q: &[f64; 3], pusher: Option<usize>, target: &[f64; 3]) -> Option<Step<[f64; 3], ()>> {
+        let (want, _) = self.desired(q, target)?;
+        let m = self.scene.metric();
+        let wl = m.twist_norm(&want);
+        let dir = m.twist(&want) / wl;
+        self.frame(q)?;
+        let order = pusher_order(self.scene.pushers.len(), pusher);
+        for k in 0..self.s.search.random_tries {
+            let r = Vec3::new(gauss(rng), gauss(rng), gauss(rng));
+            let d = match self.s.propagation {
+                Propagation::Mncp if k == 0 => dir,
+                Propagation::Mncp => (dir + (r - dir * r.dot(&dir)) * 0.3).normalize(),
+                _ => {
+                    let r = r.normalize();
+                    if r.dot(&dir) < 0.0 { -r } else { r }
+                }
+            };
+            let tw = m.twist_inv(&(d * wl));
+            for &p in &order {
+                if self.feasible(q, &tw, p) {
+                    return Some(self.step_to(q, p, tw));
+                }
+            }
+        }
+        None
+    }
+}
+
+impl Space<3> for PlanarSpace<'_> {
+    type Q = [f64; 3];
+    type Edge = ();
+    type Motion = Vec3;
+
+    fn search(&self) -> &SearchSettings {
+        &self.s.search
+    }
+    fn length(&self) -> f64 {
+        self.scene.length
+    }
+    fn step(&self) -> f64 {
+        self.step
+    }
+    fn pushers(&self) -> usize {
+        self.scene.pushers.len()
+    }
+    fn goal(&self) -> &[f64; 3] {
+        &self.goal
+    }
+    fn root_edge(&self) {}
+    fn key(&self, q: &[f64; 3]) -> [f64; 3] {
+        [q[0], q[1], self.scene.length * q[2]]
+    }
+    fn dist(&self, a: &[f64; 3], b: &[f64; 3]) -> f64 {
+        distance(self.scene.length, a, b)
+    }
+    fn at_goal(&self, q: &[f64; 3]) -> bool {
+        (0..3).all(|k| (q[k] - self.goal[k]).abs() <= self.tol[k])
+    }
+    fn sample(&self, rng: &mut ChaCha8Rng, _start: &[f64; 3]) -> [f64; 3] {
+        let (bx, bz, bt) = self.bounds;
+        for _ in 0..100 {
+            let q = [rng.random_range(bx[0]..=bx[1]), rng.random_range(bz[0]..=bz[1]), rng.random_range(bt[0]..=bt[1])];
+            if self.scene.admissible(&q) {
+                return q;
+            }
+        }
+        self.goal
+    }
+    fn propagate(&self, rng: &mut ChaCha8Rng, q: &[f64; 3], pusher: Option<usize>, target: &[f64; 3]) -> Option<Step<[f64; 3], ()>> {
+        match self.s.propagation {
+            Propagation::MotionCone => self.propagate_cones(q, pusher, target),
+            Propagation::StableCheck | Propagation::Mncp => self.propagate_random(rng, q, pusher, target),
+        }
+    }
+    fn interpolate(&self, a: &[f64; 3], b: &[f64; 3]) -> (Vec3, f64) {
+        let tw = body_twist(a, b);
+        (tw, self.scene.metric().twist_norm(&tw))
+    }
+    fn take(&self, a: &[f64; 3], tw: &Vec3, p: usize) -> Option<()> {
+        self.step_feasible(a, tw, p).then_some(())
+    }
+    /// Straight push to the goal: unit steps of one constant body twist, all feasible for one
+    /// pusher (the node's first), at most 200 of them.
+    fn connect_goal(&self, q: &[f64; 3], pusher: Option<usize>) -> Option<(usize, Vec<([f64; 3], (), f64)>)> {
+        let xi = body_twist(q, &self.goal);
+        let len = self.scene.metric().twist_norm(&xi);
+        if len < 1e-12 {
+            return None;
+        }
+        let n = (len / self.step).ceil().max(1.0) as usize;
+        if n > 200 {
+            return None;
+        }
+        let tw = xi / n as f64;
+        let poses: Vec<[f64; 3]> = (1..=n).scan(*q, |qk, _| {
+            *qk = integrate(qk, &tw, 1.0);
+            Some(*qk)
+        }).collect();
+        let starts = std::iter::once(*q).chain(poses.iter().copied().take(n - 1)).collect::<Vec<_>>();
+        let p = pusher_order(self.scene.pushers.len(), pusher).into_iter().find(|&p| starts.iter().all(|qk| self.feasible(qk, &tw, p)))?;
+        Some((p, poses.into_iter().map(|qk| (qk, (), len / n as f64)).collect()))
+    }
+    fn rewires(&self) -> bool {
+        self.s.propagation == Propagation::MotionCone
+    }
+    fn plain(&self) -> bool {
+        self.s.plain
+    }
+}
+
+/// Plans a regrasp from `start` to `goal` (defaults: the scene's task; tolerance the task's,
+/// else 1 mm, 1 mm, 1°).
+pub fn plan(scene: &Scene, start: Option<[f64; 3]>, goal: Option<[f64; 3]>, settings: &PlanarSettings) -> Result<PlanarPlan> {
+    plan_tree(scene, start, goal, settings).map(|(r, _)| r)
+}
+
+/// [`plan`], also returning the search tree.
+pub fn plan_tree(
+    scene: &Scene,
+    start: Option<[f64; 3]>,
+    goal: Option<[f64; 3]>,
+    settings: &PlanarSettings,
+) -> Result<(PlanarPlan, Vec<crate::planning::tree::TreeNode<[f64; 3], ()>>)> {
+    let task = scene.task;
+    let start = start.or(task.map(|t| t.start)).ok_or_else(|| Error::arg("start", "the scene has no task: give a start"))?;
+    let goal = goal.or(task.map(|t| t.goal)).ok_or_else(|| Error::arg("goal", "the scene has no task: give a goal"))?;
+    let tol = task.map(|t| t.tolerance).unwrap_or([1e-3, 1e-3, 0.0175]);
+    let space = PlanarSpace::new(scene, start, goal, tol, settings)?;
+    Ok(trrt::plan_tree(&space, start))
+}
+
+/// ICRA 2018 "stable check": is there a pusher force in its friction cone that, with the
+/// fingers sliding as the ellipsoidal limit surface says and gravity, balances the object for
+/// twist `tw`? Solved as a small LP (clarabel) over the pusher's edge-force weights.
+pub fn stable_push_lp(scene: &Scene, q: &[f64; 3], pusher: usize, tw: &Vec3) -> bool {
+    use clarabel::algebra::CscMatrix;
+    use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+    let f = scene.frame(q);
+    if !(f.hold_ratio < 1.0) || tw.amax() == 0.0 {
+        return false;
+    }
+    let required = f.support_load(tw) - f.gravity;
+    let edges = &scene.pushers[pusher].model.edges;
+    let k = edges.len();
+    let scale = required.amax().max(1e-12);
+    // Σ α_i e_i = required, α ≥ 0
+    let mut rows = vec![vec![0.0; k]; 3 + k];
+    for (j, e) in edges.iter().enumerate() {
+        for r in 0..3 {
+            rows[r][j] = e.wrench[r];
+        }
+        rows[3 + j][j] = -1.0;
+    }
+    // scale the moment row by the length to balance the units
+    let l = scene.length;
+    for v in rows[2].iter_mut() {
+        *v /= l;
+    }
+    let mut b = vec![required.x / scale, required.y / scale, required.z / l / scale];
+    b.extend(std::iter::repeat_n(0.0, k));
+    let a = CscMatrix::from(&rows);
+    let p = CscMatrix::zeros((k, k));
+    let c = vec![0.0; k];
+    let cones = [SupportedConeT::ZeroConeT(3), SupportedConeT::NonnegativeConeT(k)];
+    let settings = DefaultSettings { verbose: false, ..DefaultSettings::default() };
+    let Ok(mut solver) = DefaultSolver::new(&p, &c, &a, &b, &cones, settings) else { return false };
+    solver.solve();
+    matches!(solver.solution.status, SolverStatus::Solved | SolverStatus::AlmostSolved)
+}
+
+/// Checks a path with the exact motion-cone test at `checks` poses along each step; returns
+/// the smallest margin of each step (negative: the pusher would slip somewhere along it; −1:
+/// the finger pad leaves the object or the grasp cannot hold it somewhere along the step). An
+/// error names a step whose pusher is missing or unknown.
+pub fn validate_path(scene: &Scene, path: &[([f64; 3], Option<usize>)], checks: usize) -> Result<Vec<f64>> {
+    let mut out = Vec::new();
+    for (i, w) in path.windows(2).enumerate() {
+        let (a, b) = (w[0].0, w[1].0);
+        let p = w[1].1.ok_or_else(|| Error::arg(format!("path[{}].pusher", i + 1), "is missing"))?;
+        if p >= scene.pushers.len() {
+            return Err(Error::arg(format!("path[{}].pusher", i + 1), "is not a pusher of the scene"));
+        }
+        let tw = body_twist(&a, &b);
+        let mut worst = f64::INFINITY;
+        let n = checks.max(1);
+        for k in 0..=n {
+            let qk = integrate(&a, &tw, k as f64 / n as f64);
+            if !scene.admissible(&qk) || !(scene.frame(&qk).hold_ratio < 1.0) {
+                worst = -1.0;
+                break;
+            }
+            if k < n && tw.amax() > 0.0 {
+                worst = worst.min(scene.frame(&qk).classify(&scene.pushers[p].model, &tw).margin);
+            }
+        }
+        out.push(if worst.is_finite() { worst } else { 0.0 });
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(name: &str) -> Scene {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name);
+        Scene::load(&path).unwrap()
+    }
+
+    fn with(search: SearchSettings) -> PlanarSettings {
+        PlanarSettings { search, ..PlanarSettings::default() }
+    }
+
+
+    /// After choose-parent and rewiring, every node's cost is its parent's plus the edge cost.
+    #[test]
+    fn rewiring_keeps_costs_consistent() {
+        let s = scene("t-shape.toml");
+        let mut settings = PlanarSettings::default();
+        settings.search = SearchSettings { seed: 5, cost_threshold: 0.0, max_iterations: 3000, connect: false, ..SearchSettings::default() };
+        let (_, nodes) = plan_tree(&s, None, None, &settings).unwrap();
+        assert!(nodes.len() > 100);
+        let m = s.metric();
+        let sd = &settings.search;
+        let mut rewired = 0;
+        for (i, n) in nodes.iter().enumerate().skip(1) {
+            let p = n.parent.unwrap();
+            let len = m.twist_norm(&body_twist(&nodes[p].q, &n.q));
+            let switch = if nodes[p].pusher == n.pusher { sd.same_pusher_cost } else { sd.switch_cost };
+            let expect = nodes[p].cost + switch + sd.length_weight * len / s.length;
+            assert!((n.cost - expect).abs() < 1e-9, "node {i}: {} vs {expect}", n.cost);
+            assert!(nodes[p].children.contains(&i));
+            rewired += (p != i - 1) as usize;
+        }
+        assert!(rewired > 0, "no node was rewired or re-parented");
+    }
+
+    #[test]
+    fn bad_requests_are_errors_or_reported_failures() {
+        let s = scene("block-low-friction.toml");
+        // inadmissible start: the pad is off the object
+        assert!(plan(&s, Some([0.03, 0.0, 0.0]), None, &PlanarSettings::default()).is_err());
+        // NaN goal
+        assert!(plan(&s, None, Some([f64::NAN, 0.0, 0.0]), &PlanarSettings::default()).is_err());
+        // zero budget: not found, says why, returns the start as the partial path
+        let r = plan(&s, None, None, &with(SearchSettings { time_limit: 0.0, connect: false, ..SearchSettings::default() })).unwrap();
+        assert!(!r.found && r.stop_reason == StopReason::TimeLimit && r.path.len() == 1);
+        // unreachable: only the top pusher (pushes down) for a goal above the start
+        let text = include_str!("../../../../examples/block-low-friction.toml");
+        let top_only = text.split("[[pushers]]").enumerate().filter(|(i, p)| *i == 0 || p.contains("name = \"top\"")).map(|(i, p)| if i == 0 { p.to_string() } else { format!("[[pushers]]{p}") }).collect::<String>();
+        let s2 = Scene::from_toml_str(&top_only).unwrap();
+        assert_eq!(s2.pushers.len(), 1);
+        let r = plan(&s2, None, Some([0.0, 0.01, 0.0]), &with(SearchSettings { time_limit: 0.3, ..SearchSettings::default() })).unwrap();
+        assert!(!r.found && r.stop_reason == StopReason::TimeLimit);
+        assert!(r.goal_distance > 0.0);
+    }
+
+    #[test]
+    fn plans_are_deterministic_and_feasible_along_every_step() {
+        let s = scene("block-low-friction.toml");
+        let settings = with(SearchSettings { seed: 3, ..SearchSettings::default() });
+        let a = plan(&s, None, None, &settings).unwrap();
+        let b = plan(&s, None, None, &settings).unwrap();
+        assert!(a.found, "{a:?}");
+        assert_eq!(a.path, b.path);
+        let margins = validate_path(&s, &a.poses(), 16).unwrap();
+        assert!(margins.iter().all(|m| *m >= -1e-9), "{margins:?}");
+        let end = a.path.last().unwrap().0;
+        let goal = s.task.unwrap().goal;
+        assert!((0..3).all(|k| (end[k] - goal[k]).abs() <= s.task.unwrap().tolerance[k]));
+    }
+}

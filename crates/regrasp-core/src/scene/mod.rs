@@ -1,0 +1,8 @@
+//! Scenes: the object, the grasp and the pushers read from the TOML contract
+//! (`docs/scene-file.md`), planar ([`planar::Scene`]) and spatial ([`spatial::Scene3`]).
+
+pub mod planar;
+pub mod spatial;
+
+pub use planar::Scene;
+pub use spatial::Scene3;

@@ -1,0 +1,595 @@
+//! Spatial scenes (TOML, `dimension = 3`): an object that is a box, a convex mesh or a sphere,
+//! a parallel-jaw grasp with circular pads, gravity, pushers and fixed features as rigid point
+//! sets (point, line or patch contacts) or as planes (the ground, a wall: a rolling contact,
+//! wherever the object touches the plane), and the task as 3-D poses.
+//!
+//! ```toml
+//! dimension = 3
+//! name = "block-pivot-3d"
+//!
+//! [object]
+//! shape = "box"                    # or "mesh" with mesh = "part.obj" (convex, object frame),
+//!                                  # or "sphere" with radius = 0.03 (centred on the frame)
+//! size = [0.05, 0.012, 0.08]       # box: full size along the object's x, y, z [m]
+//! mass = 0.13
+//! # com = [0, 0, 0]                # default: the volume centroid
+//!
+//! [grasp]                          # fingers close along the gripper's Y axis
+//! force = 20.0
+//! friction = 0.6
+//! pad_radius = 0.007
+//!
+//! [gravity]
+//! direction = [0.0, 0.0, -1.0]     # gripper frame
+//! g = 9.81
+//!
+//! [[pushers]]
+//! name = "ground"
+//! friction = 0.5
+//! points = [[-0.025, -0.006, -0.04], [0.025, -0.006, -0.04], [0.025, 0.006, -0.04]]  # object frame
+//! normal = [0.0, 0.0, 1.0]         # object frame, the direction the pusher pushes
+//!
+//! [[pushers]]                      # a plane: touches the object wherever it is lowest along
+//! name = "floor"                   # `normal`, so the contact point moves over the object as it
+//! friction = 0.8                   # rolls (a sphere on the ground); no `points`
+//! plane = true
+//! normal = [0.0, 0.0, 1.0]         # gripper frame (a floor: opposite to gravity)
+//!
+//! [task]
+//! start = [0, 0, 0, 1, 0, 0, 0]    # [x, y, z, qw, qx, qy, qz]: object frame in the gripper frame
+//! goal = [0, 0, 0, 1, 0, 0, 0]
+//! tolerance = [0.001, 0.001, 0.001, 0.0175]   # position components, then the rotation angle
+//! ```
+
+use crate::error::{Error, Result};
+pub use crate::pose::spatial::{from_array as pose_from_array, to_array as pose_to_array};
+use nalgebra::{Isometry3, Matrix3, Vector3};
+use serde::Deserialize;
+use std::path::Path;
+
+pub type V3 = Vector3<f64>;
+
+/// A closed convex triangle mesh (object frame).
+#[derive(Clone, Debug)]
+pub struct ConvexMesh {
+    pub vertices: Vec<V3>,
+    pub triangles: Vec<[usize; 3]>,
+    /// Outward unit normal and offset of each face plane: `n·x ≤ d` inside.
+    pub planes: Vec<(V3, f64)>,
+}
+
+impl ConvexMesh {
+    /// An icosphere of radius `r`: an icosahedron subdivided `levels` times, vertices on the
+    /// sphere (a drawing of a sphere; 20·4^levels triangles).
+    pub fn icosphere(r: f64, levels: usize) -> Self {
+        let t = (1.0 + 5f64.sqrt()) / 2.0;
+        let mut v: Vec<V3> = [
+            [-1.0, t, 0.0], [1.0, t, 0.0], [-1.0, -t, 0.0], [1.0, -t, 0.0], [0.0, -1.0, t], [0.0, 1.0, t],
+            [0.0, -1.0, -t], [0.0, 1.0, -t], [t, 0.0, -1.0], [t, 0.0, 1.0], [-t, 0.0, -1.0], [-t, 0.0, 1.0],
+        ]
+        .iter()
+        .map(|a| V3::new(a[0], a[1], a[2]).normalize())
+        .collect();
+        let mut f: Vec<[usize; 3]> = vec![
+            [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2], [10, 7, 6], [7, 1, 8],
+            [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
+        ];
+        for _ in 0..levels {
+            let mut mid = std::collections::HashMap::new();
+            let mut m = |a: usize, b: usize, v: &mut Vec<V3>| -> usize {
+                *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    v.push(((v[a] + v[b]) / 2.0).normalize());
+                    v.len() - 1
+                })
+            };
+            f = f
+                .iter()
+                .flat_map(|&[a, b, c]| {
+                    let (ab, bc, ca) = (m(a, b, &mut v), m(b, c, &mut v), m(c, a, &mut v));
+                    [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
+                })
+                .collect();
+        }
+        Self::new(v.into_iter().map(|x| x * r).collect(), f).expect("an icosphere is a convex mesh")
+    }
+
+    /// A box of full sizes `s`, centred at the origin.
+    pub fn cuboid(s: &V3) -> Self {
+        let h = s / 2.0;
+        let v: Vec<V3> = (0..8)
+            .map(|i| V3::new(if i & 1 == 0 { -h.x } else { h.x }, if i & 2 == 0 { -h.y } else { h.y }, if i & 4 == 0 { -h.z } else { h.z }))
+            .collect();
+        // faces as outward-oriented triangles
+        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let mut t = Vec::new();
+        for q in quads {
+            t.push([q[0], q[1], q[2]]);
+            t.push([q[0], q[2], q[3]]);
+        }
+        Self::new(v, t).expect("a box is a convex mesh")
+    }
+
+    /// Validates a closed convex mesh with outward-oriented triangles.
+    pub fn new(vertices: Vec<V3>, triangles: Vec<[usize; 3]>) -> std::result::Result<Self, String> {
+        if vertices.len() < 4 || triangles.len() < 4 {
+            return Err("a closed mesh needs at least 4 vertices and 4 triangles".into());
+        }
+        if vertices.iter().any(|v| !v.iter().all(|x| x.is_finite())) {
+            return Err("a vertex has a non-finite coordinate".into());
+        }
+        let scale = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max).max(1e-12);
+        let mut planes = Vec::with_capacity(triangles.len());
+        for (k, t) in triangles.iter().enumerate() {
+            if t.iter().any(|&i| i >= vertices.len()) {
+                return Err(format!("triangle {k} refers to a missing vertex"));
+            }
+            let (a, b, c) = (vertices[t[0]], vertices[t[1]], vertices[t[2]]);
+            let n = (b - a).cross(&(c - a));
+            if n.norm() <= 1e-14 * scale * scale {
+                return Err(format!("triangle {k} is degenerate"));
+            }
+            let n = n.normalize();
+            planes.push((n, n.dot(&a)));
+        }
+        let m = Self { vertices, triangles, planes };
+        let vol = m.mass_properties().0;
+        if !(vol > 0.0) {
+            return Err("the triangles are not oriented outwards (negative volume)".into());
+        }
+        for (k, (n, d)) in m.planes.iter().enumerate() {
+            if m.vertices.iter().any(|v| n.dot(v) - d > 1e-9 * scale) {
+                return Err(format!("the mesh is not convex (a vertex lies outside the plane of triangle {k})"));
+            }
+        }
+        Ok(m)
+    }
+
+    /// Reads a Wavefront OBJ file (`v` and `f` lines; polygons are fanned into triangles).
+    pub fn from_obj(text: &str) -> std::result::Result<Self, String> {
+        let mut v = Vec::new();
+        let mut t = Vec::new();
+        for (ln, line) in text.lines().enumerate() {
+            let mut it = line.split_whitespace();
+            match it.next() {
+                Some("v") => {
+                    let c: Vec<f64> = it.take(3).map(|x| x.parse::<f64>()).collect::<std::result::Result<_, _>>()
+                        .map_err(|e| format!("line {}: {e}", ln + 1))?;
+                    if c.len() != 3 {
+                        return Err(format!("line {}: a vertex needs 3 coordinates", ln + 1));
+                    }
+                    v.push(V3::new(c[0], c[1], c[2]));
+                }
+                Some("f") => {
+                    let idx: Vec<usize> = it
+                        .map(|x| x.split('/').next().unwrap_or("").parse::<isize>())
+                        .collect::<std::result::Result<Vec<_>, _>>()
+                        .map_err(|e| format!("line {}: {e}", ln + 1))?
+                        .into_iter()
+                        .map(|i| if i < 0 { (v.len() as isize + i) as usize } else { (i - 1) as usize })
+                        .collect();
+                    if idx.len() < 3 {
+                        return Err(format!("line {}: a face needs 3 vertices", ln + 1));
+                    }
+                    for k in 1..idx.len() - 1 {
+                        t.push([idx[0], idx[k], idx[k + 1]]);
+                    }
+                }
+                _ => {}
+            }
+        }
+        Self::new(v, t)
+    }
+
+    /// Volume, centroid and inertia about the centroid per unit density (divergence theorem
+    /// over the tetrahedra from the origin).
+    pub fn mass_properties(&self) -> (f64, V3, Matrix3<f64>) {
+        let mut vol = 0.0;
+        let mut c = V3::zeros();
+        let mut cov = Matrix3::zeros();
+        // canonical tetrahedron covariance
+        let canon = Matrix3::new(2.0, 1.0, 1.0, 1.0, 2.0, 1.0, 1.0, 1.0, 2.0) / 120.0;
+        for t in &self.triangles {
+            let (a, b, d) = (self.vertices[t[0]], self.vertices[t[1]], self.vertices[t[2]]);
+            let m = Matrix3::from_columns(&[a, b, d]);
+            let det = m.determinant();
+            vol += det / 6.0;
+            c += (a + b + d) * det / 24.0;
+            cov += m * canon * m.transpose() * det;
+        }
+        let com = c / vol;
+        // covariance about the centroid, then inertia = tr(C) I − C
+        let cov_c = cov - com * com.transpose() * vol;
+        let inertia = Matrix3::identity() * cov_c.trace() - cov_c;
+        (vol, com, inertia / vol)
+    }
+
+    /// Signed distance of `p` to the surface (positive outside; exact where a face is closest).
+    pub fn signed_distance(&self, p: &V3) -> f64 {
+        self.planes.iter().map(|(n, d)| n.dot(p) - d).fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// A pusher or fixed feature: a rigid set of points with a common normal (object frame), or a
+/// plane (`plane`: `normal` in the gripper frame, `points` empty) that touches the object where
+/// it is lowest along the normal.
+#[derive(Clone, Debug)]
+pub struct Pusher3 {
+    pub name: String,
+    pub friction: f64,
+    pub points: Vec<V3>,
+    pub normal: V3,
+    pub plane: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct Scene3 {
+    pub name: String,
+    /// The object's surface: exact for a box or a mesh, a drawing (an icosphere) for a sphere.
+    pub mesh: ConvexMesh,
+    /// A sphere's radius (centred on the object frame's origin): its exact surface.
+    pub sphere: Option<f64>,
+    pub mass: f64,
+    pub com: V3,
+    /// Inertia about the centre of mass [kg m²].
+    pub inertia: Matrix3<f64>,
+    pub grip_force: f64,
+    pub grip_friction: f64,
+    pub pad_radius: f64,
+    pub gravity: V3,
+    pub pushers: Vec<Pusher3>,
+    pub start: Isometry3<f64>,
+    pub goal: Isometry3<f64>,
+    pub tolerance: [f64; 4],
+    /// Characteristic length [m] (radius of gyration).
+    pub length: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Raw {
+    dimension: Option<u32>,
+    name: Option<String>,
+    description: Option<String>,
+    object: Option<RawObject>,
+    grasp: Option<RawGrasp>,
+    gravity: Option<RawGravity>,
+    pushers: Option<Vec<RawPusher>>,
+    task: Option<RawTask>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawObject {
+    shape: Option<String>,
+    size: Option<[f64; 3]>,
+    mesh: Option<String>,
+    radius: Option<f64>,
+    mass: Option<f64>,
+    com: Option<[f64; 3]>,
+    material: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawGrasp {
+    force: Option<f64>,
+    friction: Option<f64>,
+    pad_radius: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawGravity {
+    direction: Option<[f64; 3]>,
+    g: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPusher {
+    name: Option<String>,
+    friction: Option<f64>,
+    points: Option<Vec<[f64; 3]>>,
+    normal: Option<[f64; 3]>,
+    plane: Option<bool>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTask {
+    start: Option<[f64; 7]>,
+    goal: Option<[f64; 7]>,
+    tolerance: Option<[f64; 4]>,
+}
+
+/// Signed distance to the object's surface: the sphere's exactly, else the mesh's.
+fn surface_distance(mesh: &ConvexMesh, sphere: Option<f64>, p: &V3) -> f64 {
+    match sphere {
+        Some(r) => p.norm() - r,
+        None => mesh.signed_distance(p),
+    }
+}
+
+fn req<T>(field: &str, v: Option<T>) -> Result<T> {
+    v.ok_or_else(|| Error::scene(field, "is required"))
+}
+
+fn pos(field: &str, v: Option<f64>) -> Result<f64> {
+    let v = req(field, v)?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(Error::scene(field, format!("must be a positive number (got {v})")));
+    }
+    Ok(v)
+}
+
+fn vec3(field: &str, v: [f64; 3]) -> Result<V3> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(V3::new(v[0], v[1], v[2]))
+    } else {
+        Err(Error::scene(field, "has a non-finite component"))
+    }
+}
+
+impl Scene3 {
+    /// Parses and validates a 3-D scene; `base` resolves a relative mesh path.
+    pub fn from_toml_str(text: &str, base: Option<&Path>) -> Result<Self> {
+        let de = toml::Deserializer::new(text);
+        let raw: Raw = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            Error::scene(if path.is_empty() || path == "." { "(toml)".to_string() } else { path }, e.into_inner().message().to_string())
+        })?;
+        if raw.dimension != Some(3) {
+            return Err(Error::scene("dimension", "a 3-D scene says `dimension = 3`"));
+        }
+        let _ = &raw.description;
+        let name = req("name", raw.name)?;
+        let obj = req("object", raw.object)?;
+        let _ = &obj.material;
+        let mesh = match obj.shape.as_deref() {
+            Some("box") => {
+                let s = vec3("object.size", req("object.size", obj.size)?)?;
+                if s.iter().any(|x| !(*x > 0.0)) {
+                    return Err(Error::scene("object.size", "every size must be positive"));
+                }
+                ConvexMesh::cuboid(&s)
+            }
+            Some("mesh") => {
+                let file = req("object.mesh", obj.mesh.clone())?;
+                let path = base.map(|b| b.join(&file)).unwrap_or_else(|| file.clone().into());
+                let text = std::fs::read_to_string(&path)
+                    .map_err(|e| Error::scene("object.mesh", format!("cannot read {}: {e}", path.display())))?;
+                ConvexMesh::from_obj(&text).map_err(|e| Error::scene("object.mesh", e))?
+            }
+            Some("sphere") => ConvexMesh::icosphere(pos("object.radius", obj.radius)?, 2),
+            Some(other) => return Err(Error::scene("object.shape", format!("must be \"box\", \"mesh\" or \"sphere\" (got \"{other}\")"))),
+            None => return Err(Error::scene("object.shape", "is required (\"box\", \"mesh\" or \"sphere\")")),
+        };
+        let sphere = if obj.shape.as_deref() == Some("sphere") { obj.radius } else { None };
+        if sphere.is_none() && obj.radius.is_some() {
+            return Err(Error::scene("object.radius", "is for shape = \"sphere\""));
+        }
+        if sphere.is_some() {
+            if let Some(f) = [("object.size", obj.size.is_some()), ("object.mesh", obj.mesh.is_some())].iter().find(|f| f.1) {
+                return Err(Error::scene(f.0, "is not for shape = \"sphere\" (give `radius`)"));
+            }
+        }
+        let mass = pos("object.mass", obj.mass)?;
+        let (_, centroid, inertia_unit) = match sphere {
+            // a solid sphere: I = (2/5) r² per unit mass
+            Some(r) => (4.0 / 3.0 * std::f64::consts::PI * r.powi(3), V3::zeros(), Matrix3::identity() * 0.4 * r * r),
+            None => mesh.mass_properties(),
+        };
+        let com = match obj.com {
+            Some(c) => vec3("object.com", c)?,
+            None => centroid,
+        };
+        if surface_distance(&mesh, sphere, &com) > 0.0 {
+            return Err(Error::scene("object.com", "must lie inside the object"));
+        }
+        // uniform density; a moved centre of mass shifts the inertia by the parallel-axis rule
+        let d = com - centroid;
+        let inertia = inertia_unit * mass - (Matrix3::identity() * d.norm_squared() - d * d.transpose()) * mass;
+        let gr = req("grasp", raw.grasp)?;
+        let grip_force = pos("grasp.force", gr.force)?;
+        let grip_friction = pos("grasp.friction", gr.friction)?;
+        let pad_radius = pos("grasp.pad_radius", gr.pad_radius)?;
+        let (dir, g) = match raw.gravity {
+            None => (V3::new(0.0, 0.0, -1.0), 9.81),
+            Some(gv) => {
+                let d = vec3("gravity.direction", gv.direction.unwrap_or([0.0, 0.0, -1.0]))?;
+                if (d.norm() - 1.0).abs() > 1e-3 {
+                    return Err(Error::scene("gravity.direction", "must be a unit vector"));
+                }
+                let g = gv.g.unwrap_or(9.81);
+                if !(g >= 0.0 && g.is_finite()) {
+                    return Err(Error::scene("gravity.g", "must be a non-negative number"));
+                }
+                (d.normalize(), g)
+            }
+        };
+        let size = mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let mut pushers = Vec::new();
+        for (i, p) in req("pushers", raw.pushers)?.into_iter().enumerate() {
+            let f = format!("pushers[{i}]");
+            let name = req(&format!("{f}.name"), p.name)?;
+            if pushers.iter().any(|q: &Pusher3| q.name == name) {
+                return Err(Error::scene(format!("{f}.name"), format!("`{name}` is used twice")));
+            }
+            let friction = req(&format!("{f}.friction"), p.friction)?;
+            if !(friction >= 0.0 && friction.is_finite()) {
+                return Err(Error::scene(format!("{f}.friction"), "must be a non-negative number"));
+            }
+            let normal = vec3(&format!("{f}.normal"), req(&format!("{f}.normal"), p.normal)?)?;
+            if normal.norm() == 0.0 {
+                return Err(Error::scene(format!("{f}.normal"), "must be non-zero"));
+            }
+            let normal = normal.normalize();
+            if p.plane == Some(true) {
+                if p.points.is_some() {
+                    return Err(Error::scene(format!("{f}.points"), "a plane has no points (it touches the object where it is lowest)"));
+                }
+                pushers.push(Pusher3 { name, friction, points: Vec::new(), normal, plane: true });
+                continue;
+            }
+            let pts = req(&format!("{f}.points"), p.points)?;
+            if pts.is_empty() {
+                return Err(Error::scene(format!("{f}.points"), "needs at least one point"));
+            }
+            let mut points = Vec::new();
+            for (k, q) in pts.iter().enumerate() {
+                let q = vec3(&format!("{f}.points[{k}]"), *q)?;
+                let dist = surface_distance(&mesh, sphere, &q);
+                if dist.abs() > 1e-4 * size {
+                    return Err(Error::scene(format!("{f}.points[{k}]"), format!("is not on the object's surface ({dist:.2e} m off)")));
+                }
+                if surface_distance(&mesh, sphere, &(q + normal * 1e-3 * size)) > 0.0 {
+                    return Err(Error::scene(format!("{f}.normal"), "must point into the object"));
+                }
+                points.push(q);
+            }
+            pushers.push(Pusher3 { name, friction, points, normal, plane: false });
+        }
+        if pushers.is_empty() {
+            return Err(Error::scene("pushers", "at least one [[pushers]] is required"));
+        }
+        let task = req("task", raw.task)?;
+        let start = pose_from_array("task.start", &req("task.start", task.start)?)?;
+        let goal = pose_from_array("task.goal", &req("task.goal", task.goal)?)?;
+        let tolerance = req("task.tolerance", task.tolerance)?;
+        if tolerance.iter().any(|t| !(*t > 0.0)) {
+            return Err(Error::scene("task.tolerance", "every component must be positive"));
+        }
+        let length = (inertia.trace() / (2.0 * mass)).sqrt();
+        let s = Scene3 {
+            name,
+            mesh,
+            sphere,
+            mass,
+            com,
+            inertia,
+            grip_force,
+            grip_friction,
+            pad_radius,
+            gravity: dir * g,
+            pushers,
+            start,
+            goal,
+            tolerance,
+            length,
+        };
+        for (field, p) in [("task.start", &s.start), ("task.goal", &s.goal)] {
+            if s.pad_contacts(p).iter().any(|c| c.is_empty()) {
+                return Err(Error::scene(field, "a finger pad does not touch the object at this pose"));
+            }
+        }
+        Ok(s)
+    }
+
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::arg("path", format!("cannot read {}: {e}", path.display())))?;
+        Self::from_toml_str(&text, path.parent())
+    }
+
+    /// Signed distance of object-frame point `p` to the object's surface (positive outside).
+    pub fn signed_distance(&self, p: &V3) -> f64 {
+        surface_distance(&self.mesh, self.sphere, p)
+    }
+
+    /// The object's points lowest along `n` (object frame): where a plane with normal `n`
+    /// touches it — a sphere's one point, a mesh's vertex, edge or face (its vertices within
+    /// `1e-5` of the object's size of the lowest, so a face tilted by solver round-off stays a
+    /// face).
+    pub fn lowest_points(&self, n: &V3) -> Vec<V3> {
+        self.plane_contacts(n, None, 1e-5 * self.size())
+    }
+
+    /// The object's points within `reach` of the plane with normal `n` through `on` (object
+    /// frame; default: the plane touching the object's lowest point), with a mesh's every vertex
+    /// considered (a vertex tipping towards the plane is found before it crosses it).
+    pub fn plane_contacts(&self, n: &V3, on: Option<&V3>, reach: f64) -> Vec<V3> {
+        let n = n.normalize();
+        if let Some(r) = self.sphere {
+            return vec![-n * r];
+        }
+        let low = match on {
+            Some(p) => n.dot(p),
+            None => self.mesh.vertices.iter().map(|v| v.dot(&n)).fold(f64::INFINITY, f64::min),
+        };
+        self.mesh.vertices.iter().filter(|v| v.dot(&n) < low + reach).cloned().collect()
+    }
+
+    /// The object's largest distance from its frame's origin.
+    pub fn size(&self) -> f64 {
+        self.sphere.unwrap_or_else(|| self.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max))
+    }
+
+    /// The contact points and normal (object frame) of pusher `p` brought against the object at
+    /// pose `pose`: a rigid pusher's own points, a plane's lowest points of the object.
+    pub fn pusher_contacts(&self, p: usize, pose: &Isometry3<f64>) -> (Vec<V3>, V3) {
+        let pz = &self.pushers[p];
+        if pz.plane {
+            let n = pose.rotation.inverse() * pz.normal;
+            (self.lowest_points(&n), n)
+        } else {
+            (pz.points.clone(), pz.normal)
+        }
+    }
+
+    pub fn pusher_index(&self, name: &str) -> Result<usize> {
+        self.pushers.iter().position(|p| p.name == name).ok_or_else(|| {
+            let names: Vec<&str> = self.pushers.iter().map(|p| p.name.as_str()).collect();
+            Error::arg("pusher", format!("no pusher named `{name}` (the scene has {names:?})"))
+        })
+    }
+
+    /// Contact points (object frame) of the two pads (left: +Y, right: −Y) at pose `pose`: the
+    /// object's extreme points along ±Y of the gripper; a face parallel to the pad gives the
+    /// pad's ring of points that lie on the face (a patch), an edge or a vertex gives itself.
+    pub fn pad_contacts(&self, pose: &Isometry3<f64>) -> [Vec<V3>; 2] {
+        let inv = pose.inverse();
+        let mut out: [Vec<V3>; 2] = [Vec::new(), Vec::new()];
+        if let Some(r) = self.sphere {
+            // a sphere pressed by a soft pad: the pad's ring of points on the tangent plane at
+            // the sphere's extreme point (the pad radius is the contact patch's)
+            for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
+                // the pad (centred on the gripper's Y axis) touches the ball only if the ball's
+                // extreme point lies on it
+                let c = pose.translation.vector + V3::new(0.0, sign * r, 0.0);
+                if c.x.hypot(c.z) > self.pad_radius {
+                    continue;
+                }
+                let tip = inv.rotation * V3::new(0.0, sign * r, 0.0);
+                let (t1, t2) = (inv.rotation * V3::x(), inv.rotation * V3::z());
+                for k in 0..8 {
+                    let a = std::f64::consts::PI * 2.0 * (k as f64 + 0.5) / 8.0;
+                    let rho = 2.0 / 3.0 * self.pad_radius;
+                    out[side].push(tip + t1 * (rho * a.cos()) + t2 * (rho * a.sin()));
+                }
+            }
+            return out;
+        }
+        let size = self.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
+            // pad normal (pointing into the object) is −sign·Y; the object's extreme along sign·Y
+            let dir = inv.rotation * V3::new(0.0, sign, 0.0);
+            let top = self.mesh.vertices.iter().map(|v| v.dot(&dir)).fold(f64::NEG_INFINITY, f64::max);
+            let extreme: Vec<V3> = self.mesh.vertices.iter().filter(|v| v.dot(&dir) > top - 1e-6 * size).cloned().collect();
+            if extreme.len() >= 3 {
+                // a face: pad ring points projected on the face plane, kept if on the face
+                for k in 0..8 {
+                    let a = std::f64::consts::PI * 2.0 * (k as f64 + 0.5) / 8.0;
+                    let rho = 2.0 / 3.0 * self.pad_radius;
+                    let pg = nalgebra::Point3::new(rho * a.cos(), 0.0, rho * a.sin());
+                    let po = inv * pg;
+                    let on_face = po.coords + dir * (top - po.coords.dot(&dir));
+                    if self.mesh.signed_distance(&on_face) <= 1e-6 * size {
+                        out[side].push(on_face);
+                    }
+                }
+            } else {
+                out[side] = extreme;
+            }
+        }
+        out
+    }
+}

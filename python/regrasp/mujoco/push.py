@@ -1,0 +1,148 @@
+"""Pushes in MuJoCo in the planner's view (gripper fixed, the virtual pusher moving): for the
+thesis' experiments and the validation of motion cones against an independent engine.
+
+The model (``regrasp.mujoco.model``): the object extruded from its outline, force-driven pads
+fixed in the world, and the pusher's feature on a driven body (its velocity is seen by the
+contacts, so its friction drags the object as a real pusher would).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .model import (FEATURE_RADIUS, Contact, Driver, compose, driven_body_xml, feature_xml, header, inverse, object_xml,
+                           pads_xml, planar_pose)
+from ..sim.quasistatic import integrate_pose
+from ..scene.planar import Scene
+
+Settings = Contact  # kept for callers of the first version
+
+
+def _model(scene: Scene, pusher: str, contact: Contact):
+    import mujoco
+
+    assets, obj = object_xml(scene, np.zeros(3))
+    pads, acts = pads_xml(scene)
+    # the feature's geometry inside a driven body whose frame is the pusher frame
+    feat = feature_xml(scene, pusher, "feature")
+    inner = feat[feat.index(">") + 1: feat.rindex("</body>")]
+    xml = (f'<mujoco>{header(scene, contact)}<asset>{assets}</asset><worldbody>{obj}{pads}'
+           f'{driven_body_xml("pusher", inner)}</worldbody><actuator>{acts}</actuator></mujoco>')
+    return mujoco.MjModel.from_xml_string(xml)
+
+
+class PushRig:
+    """A reusable MuJoCo model of one pusher of a scene (reset for each push)."""
+
+    def __init__(self, scene: Scene, pusher: str, contact: Contact = Contact()):
+        import mujoco
+
+        self.scene, self.pusher, self.contact = scene, pusher, contact
+        self.model = _model(scene, pusher, contact)
+        self.data = mujoco.MjData(self.model)
+        self.driver = Driver(self.model, "pusher")
+        # the object's free joint is the model's first joint
+        self.obj_qadr = int(self.model.jnt_qposadr[0])
+
+    def reset(self, pose):
+        import mujoco
+
+        mujoco.mj_resetData(self.model, self.data)
+        q = np.asarray(pose, float)
+        a = self.obj_qadr
+        self.data.qpos[a:a + 3] = [q[0], 0.0, q[1]]
+        self.data.qpos[a + 3:a + 7] = [np.cos(-q[2] / 2), 0.0, np.sin(-q[2] / 2), 0.0]
+        self.data.ctrl[:] = self.scene.grip_force
+        self.driver.set(self.data, q)
+        mujoco.mj_forward(self.model, self.data)
+
+    def push(self, pose, twist, duration: float, settle: float = 0.1, record_dt: float = 0.02) -> dict:
+        """The pusher starts in contact at the object's pose and moves with constant body
+        ``twist``; returns times, object poses (gripper frame) and pusher poses."""
+        import mujoco
+
+        self.reset(pose)
+        dt = self.contact.timestep
+        m, d = self.model, self.data
+        q0 = np.asarray(pose, float)
+        for _ in range(int(round(settle / dt))):
+            self.driver.move(d, q0, dt)
+            mujoco.mj_step(m, d)
+        every = max(1, int(round(record_dt / dt)))
+        t, poses, pushers = [0.0], [planar_pose(m, d, "object")], [q0]
+        n = int(round(duration / dt))
+        for k in range(1, n + 1):
+            qp = integrate_pose(q0, twist, k * dt)
+            self.driver.move(d, qp, dt)
+            mujoco.mj_step(m, d)
+            if k % every == 0 or k == n:
+                t.append(k * dt)
+                poses.append(planar_pose(m, d, "object"))
+                pushers.append(qp)
+        return {"t": np.array(t), "pose": np.array(poses), "pusher_pose": np.array(pushers)}
+
+    def slip_fraction(self, pose, twist, distance: float = 0.003, speed: float = 0.01) -> float:
+        """How far the pusher and the object move apart at the contact over a short push, as a
+        share of the push: for a line pusher, the largest motion of the object relative to the
+        pusher at either end of the line — its slide along the contact and its lift-off (a roll
+        about the other end), pressing in by the soft contact's compliance left out; for a point
+        pusher, the slide of its contact on the object (the object may turn about it)."""
+        tw = np.asarray(twist, float)
+        norm = float(np.linalg.norm(self.scene.metric_twist(tw)))
+        tw = tw / norm * speed
+        pts = self.scene.pusher(self.pusher).points
+        if len(pts) == 1:
+            return self._point_slip(pose, tw, distance, speed, pts[0])
+        r = self.push(pose, tw, distance / speed, record_dt=distance / speed)
+        rel0 = compose(inverse(r["pusher_pose"][0]), r["pose"][0])
+        rel1 = compose(inverse(r["pusher_pose"][-1]), r["pose"][-1])
+        n = self.scene.pusher(self.pusher).normal
+        n = n / np.linalg.norm(n)
+        t = np.array([-n[1], n[0]])
+        worst = 0.0
+        for c in pts:
+            # the object's material point at contact point c, seen from the pusher, before and
+            # after: its slide along the contact, and how far it lifted off the pusher (pressing
+            # further in is the soft contact's compliance, not a slip)
+            d = compose(rel1, np.r_[c, 0.0])[:2] - compose(rel0, np.r_[c, 0.0])[:2]
+            worst = max(worst, float(np.hypot(d @ t, max(0.0, d @ n))))
+        return worst / distance
+
+    def _point_slip(self, pose, twist, distance, speed, c) -> float:
+        """A point pusher sticks when its contact does not slide on the object (the object may
+        turn about it, rolling on the feature's small cylinder): the tangential slide at the
+        contact, integrated over the push (every 2.5 ms)."""
+        n = self.scene.pusher(self.pusher).normal
+        n = n / np.linalg.norm(n)
+        r = self.push(pose, twist, distance / speed, record_dt=0.0025)
+        centre = np.r_[c - FEATURE_RADIUS * n, 0.0]
+        slide = 0.0
+        for k in range(len(r["t"]) - 1):
+            q0, q1 = r["pose"][k], r["pose"][k + 1]
+            p0, p1 = r["pusher_pose"][k], r["pusher_pose"][k + 1]
+            cw, sw = np.cos(q0[2]), np.sin(q0[2])
+            nw = np.array([cw * n[0] - sw * n[1], sw * n[0] + cw * n[1]])
+            x = compose(p0, centre)[:2] + FEATURE_RADIUS * nw  # the contact point (world)
+            mo = compose(inverse(q0), np.r_[x, 0.0])  # material points there
+            mp = compose(inverse(p0), np.r_[x, 0.0])
+            d = (compose(q1, mo)[:2] - x) - (compose(p1, mp)[:2] - x)
+            slide += abs(d[0] * nw[1] - d[1] * nw[0])
+        return float(slide / distance)
+
+    def sticks(self, pose, twist, distance: float = 0.003, speed: float = 0.01, ratio: float = 0.02) -> bool:
+        """Whether the pusher and the object move together over a short push: they move apart at
+        the contact by less than ``ratio`` of the push (:meth:`slip_fraction`; soft contacts creep
+        by about 1% of a push when the pusher sticks)."""
+        f = self.slip_fraction(pose, twist, distance, speed)
+        if not np.isfinite(f):
+            raise FloatingPointError("the MuJoCo push diverged (non-finite poses)")
+        return f < ratio
+
+
+def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, record_dt: float = 0.02,
+                  settings: Contact = Contact()) -> dict:
+    """A push in MuJoCo: the pads squeeze for 0.3 s, then the pusher moves with constant body
+    ``twist`` (object frame at the start). Returns times and object poses (gripper frame)."""
+    rig = PushRig(scene, pusher, settings)
+    r = rig.push(pose, twist, duration, settle=0.3, record_dt=record_dt)
+    return {"t": r["t"], "pose": r["pose"], "settled_pose": r["pose"][0]}

@@ -1,0 +1,499 @@
+"""Scenes and motion cones: the Python face of the Rust core.
+
+Units are SI, angles radians. Poses are ``[x, z, theta]`` of the object frame in the gripper
+frame; twists ``[vx, vz, omega]`` in the object frame; wrenches ``[fx, fz, tau]`` (tau
+counter-clockwise in the X-Z drawing). See ``interface.md`` for the scene file contract.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Optional, Sequence
+
+import numpy as np
+
+from .. import _core
+from ..errors import ArgumentError, SceneError
+
+ArrayLike = Sequence[float] | np.ndarray
+
+
+def _vec(x, n: int, name: str) -> np.ndarray:
+    a = np.asarray(x, dtype=float)
+    if a.shape != (n,):
+        raise ArgumentError(f"invalid `{name}`: expected {n} numbers, got shape {a.shape}", name)
+    if not np.all(np.isfinite(a)):
+        raise ArgumentError(f"invalid `{name}`: has a non-finite component", name)
+    return a
+
+
+def _rows(x, name: str) -> np.ndarray:
+    a = np.ascontiguousarray(np.asarray(x, dtype=float))
+    if a.ndim == 1 and a.shape == (3,):
+        a = a[None, :]
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ArgumentError(f"invalid `{name}`: expected an (n, 3) array, got shape {a.shape}", name)
+    return a
+
+
+@dataclass(frozen=True)
+class Pusher:
+    name: str
+    points: np.ndarray  # (1, 2) point pusher or (2, 2) line pusher, object frame [m]
+    normal: np.ndarray  # (2,) unit, the direction the pusher pushes the object
+    friction: float
+
+
+@dataclass(frozen=True)
+class Task:
+    start: np.ndarray
+    goal: np.ndarray
+    tolerance: np.ndarray
+
+
+@dataclass(frozen=True)
+class Classification:
+    """Result of the exact motion-cone test of one twist."""
+
+    feasible: bool
+    margin: float  # >= 0 inside; sine of the angle to the nearest limit, scaled wrench space
+    active_limit: str  # "slide+t", "slide-t", "roll_about_point_i", "torque", "off_ray"
+    pusher_wrench: np.ndarray  # wrench the pusher must apply, object frame
+    support_wrench: np.ndarray  # load on the support (finger pads), object frame
+
+
+class GravityFreeCone:
+    """The gravity-free motion cone V_gf = J_s^-1 A J_s^-T W_p (exactly polyhedral)."""
+
+    def __init__(self, cone: "MotionCone"):
+        self._cone = cone
+
+    @property
+    def generators(self) -> np.ndarray:
+        return self._cone._core.gravity_free_generators
+
+    def margin(self, twist: ArrayLike) -> float:
+        return self._cone._core.gravity_free_margin(list(_vec(twist, 3, "twist")))
+
+    def contains(self, twist: ArrayLike, tol: float = 1e-9) -> bool:
+        return self.margin(twist) >= -tol
+
+    def project(self, twist: ArrayLike) -> np.ndarray:
+        return self._cone._core.project_polyhedral(list(_vec(twist, 3, "twist")), "gravity_free")
+
+
+class MotionCone:
+    """Motion cone of one pusher at one pose (RSS 2018; thesis §3.3).
+
+    ``generators``: polyhedral approximation, one unit twist a row (one per edge of the
+    pusher's friction cone; unit in the metric of :meth:`Scene.metric_twist`).
+    ``contains``/``margin``/``classify``: the exact test (is the twist producible with a
+    sticking pusher?). ``project``: closest feasible twist in that metric. ``gravity_free``:
+    the gravity-free cone.
+    """
+
+    def __init__(self, core: "_core.MotionCone", scene: "Scene"):
+        self._core = core
+        self.scene = scene
+
+    def __repr__(self) -> str:
+        return f"MotionCone(pusher={self.pusher!r}, pose={list(self.pose)}, shape={self._core.pusher_cone_shape})"
+
+    @property
+    def pusher(self) -> str:
+        return self._core.pusher
+
+    @property
+    def pose(self) -> np.ndarray:
+        return np.array(self._core.pose)
+
+    @property
+    def generators(self) -> np.ndarray:
+        return self._core.generators
+
+    @property
+    def gravity_free_generators(self) -> np.ndarray:
+        return self._core.gravity_free_generators
+
+    @property
+    def gravity_free(self) -> GravityFreeCone:
+        return GravityFreeCone(self)
+
+    @property
+    def hold_ratio(self) -> float:
+        """Share of the pads' friction that gravity alone uses (< 1 holds)."""
+        return self._core.hold_ratio
+
+    @property
+    def is_line_pusher(self) -> bool:
+        """A line pusher (two rigidly connected points) rather than a point pusher."""
+        return self._core.line
+
+    def contains(self, twist):
+        """Exact test for one twist (bool) or an (n, 3) array (bool array)."""
+        t = np.asarray(twist, dtype=float)
+        return self._core.contains(np.ascontiguousarray(t) if t.ndim == 2 else list(_vec(t, 3, "twist")))
+
+    def margin(self, twist):
+        t = np.asarray(twist, dtype=float)
+        return self._core.margin(np.ascontiguousarray(t) if t.ndim == 2 else list(_vec(t, 3, "twist")))
+
+    def classify(self, twist: ArrayLike) -> Classification:
+        d = self._core.classify(list(_vec(twist, 3, "twist")))
+        return Classification(
+            feasible=d["feasible"],
+            margin=d["margin"],
+            active_limit=d["active_limit"],
+            pusher_wrench=np.array(d["pusher_wrench"]),
+            support_wrench=np.array(d["support_wrench"]),
+        )
+
+    def project(self, twist):
+        """Closest feasible twist (exact cone) to one twist or to each row of an (n, 3) array,
+        in the metric of :meth:`Scene.metric_twist`."""
+        t = np.asarray(twist, dtype=float)
+        return self._core.project(np.ascontiguousarray(t) if t.ndim == 2 else list(_vec(t, 3, "twist")))
+
+    def project_polyhedral(self, twist: ArrayLike) -> np.ndarray:
+        """Closest twist in the polyhedral approximation (non-negative least squares)."""
+        return self._core.project_polyhedral(list(_vec(twist, 3, "twist")), "approx")
+
+    def contains_polyhedral(self, twist):
+        """Membership in the polyhedral approximation (one twist, or an (n, 3) array)."""
+        t = np.asarray(twist, dtype=float)
+        return self._core.contains_polyhedral(np.ascontiguousarray(t) if t.ndim == 2 else list(_vec(t, 3, "twist")))
+
+    def grip_force_range(self, twist: ArrayLike) -> Optional[tuple[float, float]]:
+        """Per-finger grip forces [min, max] (max may be inf) for which the pusher motion of
+        ``twist`` sticks (RSS 2018 Theorem 1), or None if no grip force does. A line pusher's
+        motion is the whole twist; a point pusher's is only its contact point's velocity (the
+        object's rotation rate then depends on the grip force, see ``point_pusher_twist``)."""
+        return self._core.grip_force_range(list(_vec(twist, 3, "twist")))
+
+    def min_grip_force(self, twist: ArrayLike) -> Optional[float]:
+        r = self.grip_force_range(twist)
+        return None if r is None else r[0]
+
+    def central_twist(self) -> np.ndarray:
+        """A twist well inside the gravity-free cone: the normalized sum of its generators."""
+        s = self.scene.metric_twist(self.gravity_free_generators).sum(axis=0)
+        return self.scene.metric_twist_inv(s / np.linalg.norm(s))
+
+    def ray(self, wrench: ArrayLike) -> Optional[np.ndarray]:
+        """Unit twist of the exact cone produced by pusher wrench ``wrench`` (or None)."""
+        return self._core.ray(list(_vec(wrench, 3, "wrench")))
+
+    def point_pusher_twist(self, u: ArrayLike) -> Optional[np.ndarray]:
+        """Point pusher: object twist when its contact point moves with velocity ``u``."""
+        return self._core.point_pusher_twist(list(_vec(u, 2, "u")))
+
+
+_STATUS = dict(_core.Scene.status_messages())
+_LIMITS = np.array(_core.Scene.limit_labels())
+
+
+def _errors(status: np.ndarray) -> list:
+    return [None if c == 0 else _STATUS[int(c)] for c in status]
+
+
+@dataclass
+class MotionConeBatch:
+    """Motion cones of one pusher at many poses (vectorized in Rust, no Python loop)."""
+
+    scene: "Scene"
+    pusher: str
+    poses: np.ndarray  # (n, 3)
+    generators: np.ndarray  # (n, k, 3), zeros where not valid
+    status: np.ndarray  # (n,) uint8, 0 where valid
+
+    @property
+    def valid(self) -> np.ndarray:
+        return self.status == 0
+
+    @property
+    def errors(self) -> list:
+        """Reason per pose (None where valid)."""
+        return _errors(self.status)
+
+    def gravity_free_generators(self) -> np.ndarray:
+        g, _ = self.scene._core.generators_many(self.poses, self.pusher, True)
+        return g
+
+    def classify(self, twists) -> dict:
+        """Exact test of twist i at pose i: dict of arrays feasible, margin, active_limit, valid."""
+        t = _rows(twists, "twists")
+        feas, margin, codes, status = self.scene._core.classify_many(self.poses, t, self.pusher)
+        return {"feasible": feas, "margin": margin, "active_limit": _LIMITS[codes], "valid": status == 0,
+                "errors": _errors(status)}
+
+    def contains(self, twists) -> np.ndarray:
+        t = _rows(twists, "twists")
+        return self.scene._core.classify_many(self.poses, t, self.pusher)[0]
+
+    def margin(self, twists) -> np.ndarray:
+        t = _rows(twists, "twists")
+        return self.scene._core.classify_many(self.poses, t, self.pusher)[1]
+
+    def project(self, twists) -> np.ndarray:
+        t = _rows(twists, "twists")
+        out, _ = self.scene._core.project_many(self.poses, t, self.pusher)
+        return out
+
+
+def _rebuild_scene(kind: str, text: str, path, ops=()):
+    """The scene rebuilt from its source text and the views taken of it, in order (pickling)."""
+    s = Scene.from_toml(text) if kind == "toml" else Scene(_core.Scene.from_json(text), None, ("json", text))
+    s.path = None if path is None else Path(path)
+    for name, kw in ops:
+        s = getattr(s, name)(**kw)
+    return s
+
+
+def _non_finite(x, path: str):
+    """Dotted path of the first non-finite number in a nested dict/list, or None."""
+    if isinstance(x, dict):
+        for k, v in x.items():
+            r = _non_finite(v, f"{path}.{k}" if path else str(k))
+            if r is not None:
+                return r
+    elif isinstance(x, (list, tuple, np.ndarray)):
+        for i, v in enumerate(x):
+            r = _non_finite(v, f"{path}[{i}]")
+            if r is not None:
+                return r
+    elif isinstance(x, (float, np.floating)) and not np.isfinite(x):
+        return path
+    return None
+
+
+def _jsonable(x):
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    raise TypeError(f"{type(x).__name__} is not a scene value")
+
+
+class Scene:
+    """A validated planar scene. Load with :meth:`Scene.load` (TOML) or :meth:`Scene.from_dict`."""
+
+    def __init__(self, core: "_core.Scene", path: Optional[Path] = None, source: Optional[tuple] = None):
+        self._core = core
+        self.path = path
+        #: ("toml" | "json", text) the scene was built from (to rebuild it in other processes)
+        self.source = source
+
+    def __reduce__(self):
+        if self.source is None:
+            raise TypeError("this scene has no source text to be pickled from")
+        kind, text = self.source
+        return (_rebuild_scene, (kind, text, None if self.path is None else str(self.path),
+                                 getattr(self, "_ops", ())))
+
+    @classmethod
+    def load(cls, path) -> "Scene":
+        p = Path(path)
+        try:
+            text = p.read_text()
+        except OSError as e:
+            raise ArgumentError(f"invalid `path`: cannot read {p}: {e}", "path") from e
+        return cls(_core.Scene.from_toml(text), p, ("toml", text))
+
+    @classmethod
+    def from_toml(cls, text: str) -> "Scene":
+        return cls(_core.Scene.from_toml(text), None, ("toml", text))
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Scene":
+        """A scene from a dict with the layout of the TOML file (numbers may be numpy scalars)."""
+        bad = _non_finite(d, "")
+        if bad is not None:
+            raise SceneError(f"scene field `{bad}`: must be a finite number", bad)
+        try:
+            text = json.dumps(d, allow_nan=False, default=_jsonable)
+        except (TypeError, ValueError) as e:
+            raise SceneError(f"scene is not serializable: {e}", None) from e
+        return cls(_core.Scene.from_json(text), None, ("json", text))
+
+    def __repr__(self) -> str:
+        return f"Scene({self.name!r}, kind={self.kind}, pushers={self.pusher_names})"
+
+    @property
+    def name(self) -> str:
+        return self._core.name
+
+    @property
+    def kind(self) -> str:
+        """"grasp" (object between finger pads) or "surface" (object on a plane)."""
+        return self._core.kind
+
+    @property
+    def pusher_names(self) -> list[str]:
+        return self._core.pusher_names
+
+    @property
+    def pushers(self) -> list[Pusher]:
+        out = []
+        for n in self.pusher_names:
+            pts, normal, mu = self._core.pusher(n)
+            out.append(Pusher(n, np.asarray(pts), np.asarray(normal), mu))
+        return out
+
+    def pusher(self, name: str) -> Pusher:
+        pts, normal, mu = self._core.pusher(name)
+        return Pusher(name, np.asarray(pts), np.asarray(normal), mu)
+
+    @property
+    def length(self) -> float:
+        """Characteristic length L [m] weighing rotation against translation."""
+        return self._core.length
+
+    def metric_twist(self, twist) -> np.ndarray:
+        """Twists (rows) in the frame-invariant metric: [velocity of the COM, L omega]. Norms,
+        distances and projections of regrasp are Euclidean in these coordinates."""
+        v = np.asarray(twist, dtype=float)
+        c, L = self.com, self.length
+        w = v[..., 2]
+        return np.stack([v[..., 0] - w * c[1], v[..., 1] + w * c[0], L * w], axis=-1)
+
+    def metric_twist_inv(self, scaled) -> np.ndarray:
+        """Inverse of :meth:`metric_twist`."""
+        s = np.asarray(scaled, dtype=float)
+        c, L = self.com, self.length
+        w = s[..., 2] / L
+        return np.stack([s[..., 0] + w * c[1], s[..., 1] - w * c[0], w], axis=-1)
+
+    @property
+    def mass(self) -> float:
+        return self._core.mass
+
+    @property
+    def com(self) -> np.ndarray:
+        return np.array(self._core.com)
+
+    @property
+    def outline(self) -> np.ndarray:
+        return self._core.outline
+
+    @property
+    def gravity(self) -> tuple[np.ndarray, float]:
+        dx, dz, g = self._core.gravity
+        return np.array([dx, dz]), g
+
+    @property
+    def grip_force(self) -> Optional[float]:
+        return self._core.grip_force
+
+    @property
+    def pad(self):
+        return self._core.pad
+
+    @property
+    def task(self) -> Optional[Task]:
+        t = self._core.task
+        return None if t is None else Task(*(np.array(x) for x in t))
+
+    def with_grip_force(self, force: float) -> "Scene":
+        """The same scene with another grip force per finger (not re-validated: the task's
+        poses may not be held at that force)."""
+        return self._view(self._core.with_grip_force(float(force)), "with_grip_force", force=float(force))
+
+    def _view(self, core, op: str, **kw) -> "Scene":
+        """A view of this scene (a new core) that remembers how it was taken, so it pickles."""
+        s = Scene(core, self.path, self.source)
+        s._ops = tuple(getattr(self, "_ops", ())) + ((op, kw),)
+        return s
+
+    @property
+    def mode(self) -> str:
+        """Which motion cones this scene answers with: "nominal", "robust" or "fixtureless"."""
+        return self._core.mode
+
+    @property
+    def uncertainty(self) -> Optional[dict]:
+        """The ``[uncertainty]`` table (relative spreads), or None."""
+        return self._core.uncertainty
+
+    @property
+    def rho(self) -> Optional[float]:
+        """ρ = μ_s N / (m g), the one number mass, grip force and finger friction enter the
+        planar motion cone through (grasp scenes)."""
+        return self._core.rho
+
+    def scaled(self, finger_friction: float = 1.0, grip: float = 1.0, mass: float = 1.0,
+               pusher_friction: float = 1.0, mode: str = "nominal") -> "Scene":
+        """A copy with the finger friction, grip force, mass and every pusher's friction
+        multiplied by the given factors, answering with the cones of ``mode``."""
+        core = self._core.scaled(float(finger_friction), float(grip), float(mass), float(pusher_friction), mode)
+        return self._view(core, "scaled", finger_friction=finger_friction, grip=grip, mass=mass,
+                          pusher_friction=pusher_friction, mode=mode)
+
+    def robust(self, uncertainty: Optional[dict] = None) -> "Scene":
+        """The robust view (thesis §5.1): the worst case of the ranges (ρ_min = μ_s,min N_min /
+        (m_max g), lowest pusher friction) whose cones are V(ρ_min) ∩ V_gf — the pushes that
+        stick for every value in the ranges. ``uncertainty``: relative spreads
+        ``{"pusher_friction", "finger_friction", "grip_force", "mass"}`` (default: the scene's
+        ``[uncertainty]`` table)."""
+        u = dict(self.uncertainty or {}) if uncertainty is None else dict(uncertainty)
+        if uncertainty is None and self.uncertainty is None:
+            raise ArgumentError("invalid `uncertainty`: the scene has no [uncertainty] table; give the spreads", "uncertainty")
+        keys = ("pusher_friction", "finger_friction", "grip_force", "mass")
+        for k, v in u.items():
+            if k not in keys:
+                raise ArgumentError(f"invalid `uncertainty.{k}`: unknown (expected {', '.join(keys)})", f"uncertainty.{k}")
+            if not (isinstance(v, (int, float)) and np.isfinite(v) and 0 <= v < 1):
+                raise ArgumentError(f"invalid `uncertainty.{k}`: must be a relative spread in [0, 1) (got {v!r})",
+                                    f"uncertainty.{k}")
+        f = {k: float(u.get(k, 0.0)) for k in keys}
+        s = self.scaled(1 - f["finger_friction"], 1 - f["grip_force"], 1 + f["mass"], 1 - f["pusher_friction"], "robust")
+        return s
+
+    def fixtureless(self) -> "Scene":
+        """Fixtureless fixturing (CASE 2018): only pushes by pushers that carry the object's
+        weight, inside their gravity-free cones — invariant to mass, grip force and finger
+        friction; the object stays put against the feature while the fingers slide over it."""
+        return self._view(self._core.scaled(1.0, 1.0, 1.0, 1.0, "fixtureless"), "fixtureless")
+
+    def carries_weight(self, pose, pusher: str) -> bool:
+        """Whether ``pusher`` alone can carry the object's weight at ``pose`` (the invariant case
+        of §5.1: its gravity-free pushes stick for any mass, grip force and finger friction)."""
+        return self._core.carries_weight(list(_vec(pose, 3, "pose")), pusher)
+
+    def admissible(self, pose) -> bool | np.ndarray:
+        """Whether the whole finger pad lies on the object at ``pose`` (or each row of an array)."""
+        a = np.asarray(pose, dtype=float)
+        if a.ndim == 2:
+            return self._core.admissible_many(_rows(a, "poses"))
+        return self._core.admissible(list(_vec(a, 3, "pose")))
+
+    def hold_ratio(self, pose) -> float:
+        """Share of the support's friction that gravity alone uses at ``pose`` (< 1 holds)."""
+        q = _vec(pose, 3, "pose")
+        if not self.admissible(q):
+            raise ArgumentError(f"invalid `pose`: {q.tolist()} is not admissible: the finger pad is not entirely on the object", "pose")
+        return self._core.hold_ratio(list(q))
+
+    def hold_grip_force(self, pose) -> Optional[float]:
+        """Smallest per-finger grip force that holds the object against gravity at ``pose``."""
+        if self.grip_force is None:
+            return None
+        return self.grip_force * self.hold_ratio(pose)
+
+    def motion_cone(self, pose, pusher: str, check_hold: bool = True) -> MotionCone:
+        """The motion cone of ``pusher`` at ``pose``. Raises GraspError when the grasp cannot
+        hold the object there (pass ``check_hold=False`` for gravity-free and grip-force queries)."""
+        return MotionCone(self._core.motion_cone(list(_vec(pose, 3, "pose")), pusher, check_hold), self)
+
+    def gravity_free_cone(self, pose, pusher: str) -> GravityFreeCone:
+        return self.motion_cone(pose, pusher, check_hold=False).gravity_free
+
+    def motion_cones(self, poses, pusher: str, strict: bool = False) -> MotionConeBatch:
+        """Motion cones at many poses. With ``strict`` the first invalid pose raises."""
+        q = _rows(poses, "poses")
+        g, status = self._core.generators_many(q, pusher, False)
+        if strict and status.any():
+            i = int(np.flatnonzero(status)[0])
+            raise ArgumentError(f"invalid `poses[{i}]`: {_STATUS[int(status[i])]}", f"poses[{i}]")
+        return MotionConeBatch(self, pusher, q, g, status)

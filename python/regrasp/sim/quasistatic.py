@@ -1,0 +1,154 @@
+"""The quasi-static complementarity simulator through Python: single pushes, long pushes and
+plan replay (thesis §3.2; the validation of motion cones against it is in ``validation``).
+
+A *push* is the pusher's motion: a twist ``[vx, vz, omega]`` in the object frame (the pusher
+frame coincides with the object frame when the push starts). A line pusher that sticks moves the
+object with exactly that twist; a point pusher only imposes its contact point's velocity.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ArgumentError
+from ..scene.planar import Scene, _vec
+
+SPEED = 0.01  # m/s, the thesis' pushing speed
+
+
+def support_kwargs(support: str = "points", rings: int = 3, points: int = 0, merge_fingers: bool = True) -> dict:
+    if support not in ("points", "limit_surface"):
+        raise ArgumentError(f"invalid `support`: must be 'points' or 'limit_surface', got {support!r}", "support")
+    return dict(support=support, rings=rings, points=points, merge_fingers=merge_fingers)
+
+
+def problem(scene: Scene, pose, pusher: str | None = None, h: float = 1.0, **support):
+    """The instantaneous complementarity problem (``regrasp._core.MncpProblem``)."""
+    kw = support_kwargs(**support)
+    return scene._core.quasistatic_problem(list(_vec(pose, 3, "pose")), pusher, kw["support"], kw["rings"],
+                                           kw["points"], kw["merge_fingers"], h, SPEED)
+
+
+def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: float = 0.05, **support) -> dict:
+    """Explicit time stepping of one push: the pusher moves with constant body ``twist``."""
+    kw = support_kwargs(**support)
+    if not (duration > 0 and dt > 0 and np.isfinite(duration) and np.isfinite(dt)):
+        raise ArgumentError("invalid `duration`/`dt`: must be positive and finite", "duration")
+    return scene._core.simulate_push(list(_vec(pose, 3, "pose")), pusher, list(_vec(twist, 3, "twist")),
+                                     float(duration), float(dt), kw["support"], kw["rings"], kw["points"],
+                                     kw["merge_fingers"])
+
+
+# --- plans -------------------------------------------------------------------------------------
+
+def body_twist(a, b) -> np.ndarray:
+    """Constant body twist taking pose ``a`` to pose ``b`` in unit time (planar log map)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    c, s = np.cos(a[2]), np.sin(a[2])
+    d = np.array([c * (b[0] - a[0]) + s * (b[1] - a[1]), -s * (b[0] - a[0]) + c * (b[1] - a[1])])
+    w = b[2] - a[2]
+    if abs(w) < 1e-9:
+        return np.array([d[0], d[1], w])
+    # inverse of V(w) = [[sin w / w, −(1−cos w)/w], [(1−cos w)/w, sin w / w]]
+    A, B = np.sin(w) / w, (1 - np.cos(w)) / w
+    det = A * A + B * B
+    lin = np.array([A * d[0] + B * d[1], -B * d[0] + A * d[1]]) / det
+    return np.array([lin[0], lin[1], w])
+
+
+def load_plan(path) -> dict:
+    p = Path(path)
+    try:
+        plan = json.loads(p.read_text())
+    except (OSError, ValueError) as e:
+        raise ArgumentError(f"invalid `plan`: cannot read {p}: {e}", "plan") from e
+    path_ = plan.get("path")
+    if not isinstance(path_, list) or len(path_) < 1:
+        raise ArgumentError("invalid `plan`: it needs a non-empty `path`", "plan.path")
+    for i, k in enumerate(path_):
+        q = k.get("pose") if isinstance(k, dict) else None
+        if not (isinstance(q, list) and len(q) == 3 and all(isinstance(x, (int, float)) and np.isfinite(x) for x in q)):
+            raise ArgumentError(f"invalid `plan.path[{i}].pose`: expected 3 finite numbers", f"plan.path[{i}].pose")
+        if i > 0 and not isinstance(k.get("pusher"), str):
+            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: expected a pusher name", f"plan.path[{i}].pusher")
+    return plan
+
+
+@dataclass
+class Replay:
+    """Result of replaying a plan in a simulator."""
+
+    engine: str
+    final_pose: np.ndarray
+    goal_error: np.ndarray
+    success: bool
+    max_pusher_slip: float  # largest slip distance of the pusher over one step [m]
+    t: np.ndarray = field(repr=False, default=None)
+    poses: np.ndarray = field(repr=False, default=None)
+    planned: np.ndarray = field(repr=False, default=None)
+    steps: list = field(repr=False, default_factory=list)
+
+    def to_json(self) -> dict:
+        return {
+            "engine": self.engine,
+            "final_pose": self.final_pose.tolist(),
+            "goal_error": self.goal_error.tolist(),
+            "success": bool(self.success),
+            "max_pusher_slip": float(self.max_pusher_slip),
+        }
+
+
+def replay_plan(scene: Scene, plan: dict, speed: float = SPEED, dt: float = 0.05, **support) -> Replay:
+    """Replays a plan in the quasi-static simulator: for each step the pusher is put in contact
+    with the object where it is now, then follows the planned object motion of that step (its
+    body twist, at ``speed``)."""
+    path = plan["path"]
+    for i, k in enumerate(path[1:], 1):
+        if k["pusher"] not in scene.pusher_names:
+            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r} in the scene",
+                                f"plan.path[{i}].pusher")
+    q = np.asarray(path[0]["pose"], float)
+    ts, qs, planned = [0.0], [q.copy()], [q.copy()]
+    t_now, max_slip, steps = 0.0, 0.0, []
+    for k0, k1 in zip(path[:-1], path[1:]):
+        xi = body_twist(k0["pose"], k1["pose"])
+        length = np.linalg.norm(scene.metric_twist(xi))
+        if length == 0:
+            continue
+        T = length / speed
+        n = max(1, int(np.ceil(T / dt)))
+        tr = simulate_push(scene, q, k1["pusher"], xi / T, T, T / n, **support)
+        slip = float(np.sum(tr["pusher_slip"][:-1]) * T / n)
+        max_slip = max(max_slip, slip)
+        steps.append({"pusher": k1["pusher"], "duration": T, "slip": slip,
+                      "end_pose": tr["pose"][-1].tolist(), "planned_end": list(k1["pose"])})
+        ts.extend((t_now + tr["t"][1:]).tolist())
+        qs.extend(tr["pose"][1:])
+        planned.extend([np.asarray(k0["pose"]) + (np.asarray(k1["pose"]) - np.asarray(k0["pose"])) * s
+                        for s in tr["t"][1:] / T])
+        t_now += T
+        q = tr["pose"][-1]
+    task = scene.task
+    goal = task.goal if task is not None else np.asarray(path[-1]["pose"], float)
+    tol = task.tolerance if task is not None else np.array([1e-3, 1e-3, 0.0175])
+    err = q - goal
+    return Replay("quasistatic", q, err, bool(np.all(np.abs(err) <= tol)), max_slip, np.array(ts),
+                  np.array(qs), np.array(planned), steps)
+
+
+def integrate_pose(q, u, t: float) -> np.ndarray:
+    """Pose reached from ``q`` after moving for ``t`` s with constant body twist ``u``."""
+    q, u = np.asarray(q, float), np.asarray(u, float)
+    w = u[2] * t
+    lin = u[:2] * t
+    if abs(w) < 1e-9:
+        a, b = 1 - w * w / 6, w / 2
+    else:
+        a, b = np.sin(w) / w, (1 - np.cos(w)) / w
+    d = np.array([a * lin[0] - b * lin[1], b * lin[0] + a * lin[1]])
+    c, s = np.cos(q[2]), np.sin(q[2])
+    return np.array([q[0] + c * d[0] - s * d[1], q[1] + s * d[0] + c * d[1], q[2] + w])

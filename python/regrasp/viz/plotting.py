@@ -1,0 +1,491 @@
+"""Figures: the motion cone in wrench and twist space (thesis Fig 3-10)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..scene.planar import MotionCone
+
+
+def _lambda(A, Js, wg, p):
+    """Positive root of (l u + ug)^T A (l u + ug) = 1, u = Js^-T p (see motion_cone.rs)."""
+    JinvT = np.linalg.inv(Js).T
+    u, ug = JinvT @ p, JinvT @ wg
+    a, b, c = u @ A @ u, 2 * u @ A @ ug, ug @ A @ ug - 1
+    return (-b + np.sqrt(b * b - 4 * a * c)) / (2 * a)
+
+
+def boundary_samples(cone: MotionCone, n: int = 40):
+    """Points on the boundary of the exact cone: for each boundary fan of the pusher's friction
+    cone, pusher wrench directions p(t), the balancing wrench w_g + lambda p (object frame) and
+    the twist ray. Returns a list of (wrenches (n, 3), twists (n, 3)) per fan."""
+    A, Js, wg = cone._core.support_matrices
+    E = cone._core.pusher_edges
+    L = cone.scene.length
+    S = np.array([1.0, 1.0, 1.0 / L])
+    out = []
+    for i, j in cone._core.boundary_segments:
+        ei, ej = E[i] * S / np.linalg.norm(E[i] * S), E[j] * S / np.linalg.norm(E[j] * S)
+        ws, ts = [], []
+        for t in np.linspace(0, 1, n if i != j else 1):
+            p = ((1 - t) * ei + t * ej) / S
+            lam = _lambda(A, Js, wg, p)
+            ws.append(wg + lam * p)
+            ts.append(cone.ray(p))
+        out.append((np.array(ws), np.array(ts)))
+    return out
+
+
+def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
+    """Two 3-D panels: (left) wrench space: the limit surface, the pusher's friction cone shifted
+    by gravity and their intersection (the wrench set); (right) twist space: the exact, curved
+    motion cone, its polyhedral approximation and the gravity-free cone."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    sc = cone.scene
+    L, com = sc.length, sc.com
+
+    def Wm(w):  # wrench metric: [f, moment about the COM / L]
+        w = np.asarray(w, float)
+        return np.stack([w[..., 0], w[..., 1], (w[..., 2] - (com[0] * w[..., 1] - com[1] * w[..., 0])) / L], axis=-1)
+
+    Tm = sc.metric_twist  # twist metric: [COM velocity, L omega]
+    A, Js, wg = cone._core.support_matrices
+    fig = plt.figure(figsize=(18, 6))
+
+    # --- wrench space -------------------------------------------------------------------------
+    ax = fig.add_subplot(1, 3, 1, projection="3d")
+    # limit surface {Js^T w : w^T A w = 1}: w = A^{-1/2} s for s on the unit sphere
+    evals, evecs = np.linalg.eigh(A)
+    Ainvh = evecs @ np.diag(evals**-0.5) @ evecs.T
+    uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
+    sph = np.stack([np.cos(uu) * np.sin(vv), np.sin(uu) * np.sin(vv), np.cos(vv)], axis=-1)
+    ell = Wm(np.einsum("ij,jk,...k->...i", Js.T, Ainvh, sph))
+    ax.plot_wireframe(ell[..., 0], ell[..., 1], ell[..., 2], color="0.6", linewidth=0.3, alpha=0.5)
+    # pusher cone shifted by gravity: apex at w_g
+    E = cone._core.pusher_edges
+    reach = 1.3 * np.max(np.linalg.norm(ell.reshape(-1, 3), axis=1))
+    apex = Wm(wg)
+    segs = cone._core.boundary_segments
+    for i, j in segs:
+        ei, ej = Wm(E[i]), Wm(E[j])
+        ei, ej = ei / np.linalg.norm(ei) * reach, ej / np.linalg.norm(ej) * reach
+        ax.add_collection3d(Poly3DCollection([[apex, apex + ei, apex + ej]], alpha=0.15, color="tab:blue"))
+    for e in E:
+        es = Wm(e)
+        ax.plot(*np.stack([apex, apex + es / np.linalg.norm(es) * reach]).T, color="tab:blue", lw=1)
+    ax.scatter(*apex, color="k", s=20)
+    ax.text(*apex, "  w_g", fontsize=8)
+    samples = boundary_samples(cone)
+    for k, (ws, _) in enumerate(samples):
+        ax.plot(*Wm(ws).T, color="tab:red", lw=2.5, label="wrench set boundary" if k == 0 else None)
+    ax.set_xlabel("f_x [N]")
+    ax.set_ylabel("f_z [N]")
+    ax.set_zlabel("tau_com / L [N]")
+    ax.set_title("wrench space: limit surface, pusher cone + gravity")
+    ax.legend(loc="upper left", fontsize=8)
+
+    # --- twist space --------------------------------------------------------------------------
+    ax = fig.add_subplot(1, 3, 2, projection="3d")
+    o = np.zeros(3)
+    for k, (_, ts) in enumerate(samples):
+        ts = Tm(ts)
+        tris = [[o, ts[m], ts[m + 1]] for m in range(len(ts) - 1)]
+        ax.add_collection3d(Poly3DCollection(tris, alpha=0.12, color="tab:red"))
+        ax.plot(*ts.T, color="tab:red", lw=2, label="exact cone (curved)" if k == 0 else None)
+    G = Tm(cone.generators)
+    GF = Tm(cone.gravity_free_generators)
+    for k, g in enumerate(G):
+        ax.plot(*np.stack([o, g]).T, color="tab:green", lw=2, label="polyhedral approximation" if k == 0 else None)
+    for i, j in segs:
+        if i != j:
+            ax.add_collection3d(Poly3DCollection([[o, G[i], G[j]]], alpha=0.12, color="tab:green"))
+    for k, g in enumerate(GF):
+        ax.plot(*np.stack([o, g]).T, color="k", ls="--", lw=1, label="gravity-free cone" if k == 0 else None)
+    ax.set_xlim(-1, 1)
+    ax.set_ylim(-1, 1)
+    ax.set_zlim(-1, 1)
+    ax.set_xlabel("v_com,x [m/s]")
+    ax.set_ylabel("v_com,z [m/s]")
+    ax.set_zlabel("L omega [m/s]")
+    ax.set_title("twist space: motion cone (unit twists)")
+    ax.legend(loc="upper left", fontsize=8)
+
+    # --- chart of ray directions: angles about the cone's axis --------------------------------
+    ax = fig.add_subplot(1, 3, 3)
+    axis = GF.sum(axis=0)
+    axis /= np.linalg.norm(axis)
+    # e2: the direction along which the cone spreads most; e1 = axis × e2 (its thin direction)
+    off = GF - np.outer(GF @ axis, axis)
+    evals, evecs = np.linalg.eigh(off.T @ off)
+    e2 = evecs[:, -1]
+    e1 = np.cross(axis, e2)
+
+    def proj(r):
+        # longitude along the cone (about e1, from the axis) and latitude across it
+        r = np.atleast_2d(r)
+        r = r / np.linalg.norm(r, axis=1)[:, None]
+        return np.degrees(np.column_stack([np.arctan2(r @ e2, r @ axis), np.arcsin(np.clip(r @ e1, -1, 1))]))
+
+    for k, (_, ts) in enumerate(samples):
+        p = proj(Tm(ts))
+        ax.plot(p[:, 0], p[:, 1], color="tab:red", lw=2.5, label="exact cone" if k == 0 else None)
+    for name, Gs, style in (("polyhedral approximation", G, dict(color="tab:green", lw=1.5)),
+                            ("gravity-free cone", GF, dict(color="k", ls="--", lw=1))):
+        for k, (i, j) in enumerate(segs):
+            if i == j:
+                continue
+            p = proj(np.stack([Gs[i], Gs[j]]))
+            ax.plot(p[:, 0], p[:, 1], label=name if k == 0 else None, **style)
+        p = proj(Gs)
+        ax.scatter(p[:, 0], p[:, 1], s=12, color=style["color"])
+    ax.set_title("chart of ray directions (twist space)")
+    ax.set_xlabel("longitude along the cone's widest spread [deg]")
+    ax.set_ylabel("latitude across it [deg]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    q = cone.pose
+    fig.suptitle(
+        title
+        or f"{cone.scene.name}: pusher '{cone.pusher}' at pose [{q[0]:.4f}, {q[1]:.4f}, {q[2]:.3f}]"
+        f" — grip {cone.scene.grip_force} N, gravity uses {100 * cone.hold_ratio:.1f}% of the pad friction"
+    )
+    return _save(fig, path)
+
+
+def _axes_pose(ax, t, q, label_prefix="", style=None):
+    style = style or {}
+    ax[0].plot(t, 1e3 * q[:, 0], label=f"{label_prefix}x", **style)
+    ax[0].plot(t, 1e3 * q[:, 1], label=f"{label_prefix}z", **style)
+    ax[1].plot(t, np.degrees(q[:, 2]), label=f"{label_prefix}theta", **style)
+
+
+def plot_push(scene, tr: dict, pusher: str, twist, path) -> Path:
+    """Object pose in the grasp and contact forces over time for one simulated push."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    t = tr["t"]
+    _axes_pose(ax, t, tr["pose"])
+    ax[0].set_ylabel("object position in the grasp [mm]")
+    ax[1].set_ylabel("object angle in the grasp [deg]")
+    wp, ws = tr["pusher_wrench"], tr["support_wrench"]
+    ax[2].plot(t, wp[:, 0], label="pusher f_x")
+    ax[2].plot(t, wp[:, 1], label="pusher f_z")
+    ax[2].plot(t, ws[:, 0], "--", label="fingers f_x")
+    ax[2].plot(t, ws[:, 1], "--", label="fingers f_z")
+    ax[2].set_ylabel("force on the object (object frame) [N]")
+    slip = tr["pusher_slip"] > 1e-6
+    for a in ax:
+        a.set_xlabel("t [s]")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+        if slip.any():
+            a.fill_between(t, 0, 1, where=slip, color="tab:red", alpha=0.08, transform=a.get_xaxis_transform())
+    fig.suptitle(f"{scene.name}: pusher '{pusher}', body twist {np.round(twist, 4).tolist()} "
+                 f"(shaded: the pusher slips)")
+    return _save(fig, path)
+
+
+def plot_replay(scene, rep, path, extra=None) -> Path:
+    """Planned against executed object pose in the grasp over a replayed plan."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    _axes_pose(ax, rep.t, rep.planned, "planned ", dict(ls="--", color="0.5"))
+    _axes_pose(ax, rep.t, rep.poses, f"{rep.engine} ")
+    for name, r in (extra or {}).items():
+        _axes_pose(ax, r.t, r.poses, f"{name} ", dict(ls=":"))
+    ax[0].set_ylabel("object position in the grasp [mm]")
+    ax[1].set_ylabel("object angle in the grasp [deg]")
+    for a in ax:
+        a.set_xlabel("t [s]")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7)
+    fig.suptitle(f"{scene.name}: plan replayed ({'success' if rep.success else 'outside tolerance'}, "
+                 f"largest pusher slip {1e3 * rep.max_pusher_slip:.2f} mm)")
+    return _save(fig, path)
+
+
+def _save(fig, path) -> Path:
+    """Lays out, writes (creating the folder) and closes a figure."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+PUSHER_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive"]
+
+
+def animation_axes(scene, poses):
+    """A figure and bare, equal-aspect axes framing the object at every pose (1 cm margin)."""
+    import matplotlib.pyplot as plt
+
+    pts = np.vstack([_object_at(scene, q) for q in poses])
+    lo, hi = pts.min(axis=0) - 0.01, pts.max(axis=0) + 0.01
+    fig, ax = plt.subplots(figsize=(5, 5 * (hi[1] - lo[1]) / max(hi[0] - lo[0], 1e-9)))
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+    return fig, ax
+
+
+def _object_at(scene, q):
+    c, s = np.cos(q[2]), np.sin(q[2])
+    R = np.array([[c, -s], [s, c]])
+    return scene.outline @ R.T + q[:2]
+
+
+def _pusher_at(scene, q, name):
+    p = scene.pusher(name)
+    c, s = np.cos(q[2]), np.sin(q[2])
+    R = np.array([[c, -s], [s, c]])
+    return p.points @ R.T + q[:2], R @ p.normal
+
+
+def plot_plan(scene, plan, path) -> Path:
+    """The object in the grasp (gripper frame) at the plan's knots, the finger pad, and each
+    push coloured by its pusher (thesis Figs 4-11..4-14); beside it the pose over the steps."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, Polygon
+
+    names = scene.pusher_names
+    color = {n: PUSHER_COLORS[i % len(PUSHER_COLORS)] for i, n in enumerate(names)}
+    poses = plan.poses
+    fig, ax = plt.subplots(1, 2, figsize=(13, 5.5), gridspec_kw={"width_ratios": [1.2, 1]})
+    a = ax[0]
+    n = len(poses)
+    for i, q in enumerate(poses):
+        last = i in (0, n - 1)
+        pusher = plan.path[i]["pusher"]
+        col = "k" if i == 0 else color[pusher]
+        a.add_patch(Polygon(_object_at(scene, q), closed=True, fill=last, alpha=0.15 if last else 0.5,
+                            edgecolor=col, facecolor=col, lw=1.5 if last else 0.6))
+        if pusher is not None:
+            pts, nrm = _pusher_at(scene, q, pusher)
+            a.plot(*pts.T, "-o", color=color[pusher], ms=3, lw=3)
+    if scene.task is not None:
+        a.add_patch(Polygon(_object_at(scene, scene.task.goal), closed=True, fill=False, ls="--", edgecolor="0.3", lw=1.2))
+    pad = scene.pad
+    if pad is not None:
+        a.add_patch(Circle((0, 0), pad[1], color="0.2", alpha=0.6, zorder=5))
+    for nm in names:
+        a.plot([], [], color=color[nm], lw=3, label=f"pusher {nm}")
+    a.plot([], [], "k", label="start (filled)")
+    a.plot([], [], "--", color="0.3", label="goal")
+    a.set_aspect("equal")
+    a.autoscale_view()
+    a.set_xlabel("x in the gripper frame [m]")
+    a.set_ylabel("z in the gripper frame [m]")
+    a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    a.set_title("object in the grasp at the plan's knots (pad in grey)")
+    b = ax[1]
+    k = np.arange(n)
+    b.plot(k, 1e3 * poses[:, 0], "-o", ms=3, label="x [mm]")
+    b.plot(k, 1e3 * poses[:, 1], "-o", ms=3, label="z [mm]")
+    b.plot(k, np.degrees(poses[:, 2]), "-o", ms=3, label="theta [deg]")
+    for i in range(1, n):
+        b.axvspan(i - 1, i, color=color[plan.path[i]["pusher"]], alpha=0.12, lw=0)
+    b.set_xlabel("knot")
+    b.legend(fontsize=8)
+    b.grid(alpha=0.3)
+    b.set_title("pose in the grasp (bands: pusher of each step)")
+    fig.suptitle(f"{scene.name}: {'plan' if plan.found else 'best partial plan'} with {n - 1} steps, "
+                 f"{plan.switch_overs} switch-overs, found in {1e3 * plan.planning_time_s:.1f} ms ({plan.propagation})")
+    return _save(fig, path)
+
+
+def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> Path:
+    """A GIF of the plan: the object moving in the grasp, the active pusher drawn in colour."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    from matplotlib.patches import Circle, Polygon
+
+    from ..sim.quasistatic import body_twist, integrate_pose
+
+    names = scene.pusher_names
+    color = {n: PUSHER_COLORS[i % len(PUSHER_COLORS)] for i, n in enumerate(names)}
+    frames = []
+    for i in range(1, len(plan.path)):
+        a, b = plan.path[i - 1]["pose"], plan.path[i]["pose"]
+        xi = body_twist(a, b)
+        for f in range(frames_per_step):
+            frames.append((integrate_pose(a, xi, f / frames_per_step), plan.path[i]["pusher"]))
+    frames.append((np.asarray(plan.path[-1]["pose"]), plan.path[-1]["pusher"]))
+    fig, ax = animation_axes(scene, [q for q, _ in frames])
+    obj = Polygon(_object_at(scene, frames[0][0]), closed=True, facecolor="0.8", edgecolor="k")
+    ax.add_patch(obj)
+    if scene.task is not None:
+        ax.add_patch(Polygon(_object_at(scene, scene.task.goal), closed=True, fill=False, ls="--", edgecolor="0.4"))
+    pad = scene.pad
+    if pad is not None:
+        ax.add_patch(Circle((0, 0), pad[1], color="0.2", zorder=5))
+    (line,) = ax.plot([], [], "-", lw=5)
+    title = ax.set_title("")
+
+    def draw(k):
+        q, pusher = frames[k]
+        obj.set_xy(_object_at(scene, q))
+        if pusher is None:
+            line.set_data([], [])
+        else:
+            pts, nrm = _pusher_at(scene, q, pusher)
+            if len(pts) == 1:
+                pts = np.vstack([pts[0] - 0.004 * np.array([-nrm[1], nrm[0]]), pts[0] + 0.004 * np.array([-nrm[1], nrm[0]])])
+            pts = pts - 0.0015 * nrm
+            line.set_data(*pts.T)
+            line.set_color(color[pusher])
+        title.set_text(f"{scene.name}: pusher {pusher or '-'}")
+        return obj, line, title
+
+    anim = FuncAnimation(fig, draw, frames=len(frames), blit=False)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    anim.save(path, writer=PillowWriter(fps=fps))
+    plt.close(fig)
+    return path
+
+
+def plot_control(scene, res, path, extra=None) -> Path:
+    """Planned (reference) against executed poses of a controlled run, pokes and re-plans marked
+    (like the thesis' Figs 5-8..5-11): x, z and θ over time, and the path in the X–Z plane."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    _axes_pose(ax[:2], res.t, res.reference, "reference ", dict(ls="--", color="0.5"))
+    _axes_pose(ax[:2], res.t, res.poses, f"{res.policy} ({res.engine}) ")
+    for name, r in (extra or {}).items():
+        _axes_pose(ax[:2], r.t, r.poses, f"{name} ", dict(ls=":"))
+    for t, d in res.pokes:
+        for a in ax[:2]:
+            a.axvline(t, color="tab:red", lw=0.8, alpha=0.6)
+        ax[0].annotate("poke", (t, ax[0].get_ylim()[1]), color="tab:red", fontsize=7, va="top")
+    rp = [res.t[i] for i, s in enumerate(res.statuses) if s == "replanned"]
+    for t in rp:
+        for a in ax[:2]:
+            a.axvline(t, color="tab:purple", lw=0.8, ls="-.", alpha=0.7)
+    ax[0].set_ylabel("object position in the grasp [mm]")
+    ax[1].set_ylabel("object angle in the grasp [deg]")
+    for a in ax[:2]:
+        a.set_xlabel("t [s]")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7)
+    # the path in the X–Z plane
+    a = ax[2]
+    a.plot(1e3 * res.reference[:, 0], 1e3 * res.reference[:, 1], "--", color="0.5", label="reference")
+    a.plot(1e3 * res.poses[:, 0], 1e3 * res.poses[:, 1], "-", color="tab:blue", label="executed")
+    a.plot(1e3 * res.poses[0, 0], 1e3 * res.poses[0, 1], "o", color="tab:blue")
+    if scene.task is not None:
+        g, tol = scene.task.goal, scene.task.tolerance
+        a.add_patch(plt.Rectangle((1e3 * (g[0] - tol[0]), 1e3 * (g[1] - tol[1])), 2e3 * tol[0], 2e3 * tol[1],
+                                  color="tab:green", alpha=0.3, label="goal tolerance"))
+    a.set_xlabel("x [mm]")
+    a.set_ylabel("z [mm]")
+    a.set_aspect("equal", adjustable="datalim")
+    a.grid(alpha=0.3)
+    a.legend(fontsize=7)
+    fig.suptitle(f"{scene.name}: {res.policy} in {res.engine} — {'success' if res.success else 'failure'}, "
+                 f"{res.replans} re-plans, {len(res.pokes)} pokes" + (f" ({res.failure})" if res.failure else ""))
+    return _save(fig, path)
+
+
+def animate_plan3d(scene, plan: dict, path, fps: int = 12, frames_per_step: int = 6) -> Path:
+    """A GIF of a 3-D plan: the object moving in the grasp (pads grey, the active pusher's
+    contact points red), poses interpolated along each step's twist."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from scipy.spatial.transform import Rotation, Slerp
+
+    v, t = scene.mesh()
+    v, t = np.asarray(v, float), np.asarray(t, int)
+    poses = np.array([k["pose"] for k in plan["path"]], float)
+    names = [k["pusher"] for k in plan["path"]]
+    seq = []
+    for k in range(len(poses) - 1):
+        a, b = poses[k], poses[k + 1]
+        sl = Slerp([0, 1], Rotation.from_quat([[a[4], a[5], a[6], a[3]], [b[4], b[5], b[6], b[3]]]))
+        for s in np.linspace(0, 1, frames_per_step, endpoint=k == len(poses) - 2):
+            seq.append((a[:3] + s * (b[:3] - a[:3]), sl(s), names[k + 1], k + 1))
+    if not seq:
+        seq = [(poses[0][:3], Rotation.from_quat([poses[0][4], poses[0][5], poses[0][6], poses[0][3]]), None, 0)]
+    size = float(np.linalg.norm(v, axis=1).max())
+    pad_r = float(scene._core.pad_radius)
+    from .viewer import marks
+
+    face = np.where(marks(scene)[:, None] > 0, np.array([0.9, 0.6, 0.2]), np.array([0.56, 0.70, 0.85]))
+    fig = plt.figure(figsize=(5.5, 5))
+    ax = fig.add_subplot(projection="3d")
+
+    def draw(i):
+        ax.cla()
+        p, R, name, step = seq[i]
+        w = R.apply(v) + p
+        ax.add_collection3d(Poly3DCollection(w[t], facecolor=face, edgecolor="k", linewidth=0.3 if len(t) < 200 else 0.05,
+                                             alpha=0.9))
+        a = np.linspace(0, 2 * np.pi, 30)
+        for sgn in (1, -1):
+            y = sgn * np.max(sgn * w[:, 1])
+            disc = np.c_[pad_r * np.cos(a), np.full(30, y), pad_r * np.sin(a)]
+            ax.add_collection3d(Poly3DCollection([disc], facecolor="0.3", alpha=0.6))
+        if name and scene._core.is_plane(name):
+            # a plane: where the object is lowest along its normal (gripper frame), and the plane
+            nrm = np.asarray(scene._core.pusher_normal(name), float)
+            low = (w @ nrm).min()
+            pts = w[w @ nrm < low + 1e-6 * size] if not scene._core.sphere else (p - scene._core.sphere * nrm)[None]
+            c = pts[0]
+            a = np.array([1.0, 0, 0]) if abs(nrm[0]) < 0.9 else np.array([0, 1.0, 0])
+            t1 = np.cross(nrm, a)
+            t1 /= np.linalg.norm(t1)
+            t2 = np.cross(nrm, t1)
+            sq = [c + 1.3 * size * (i * t1 + j * t2) for i, j in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+            ax.add_collection3d(Poly3DCollection([sq], facecolor="tab:red", alpha=0.12))
+            ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], color="tab:red", s=30)
+        elif name:
+            pts = R.apply(np.asarray(scene._core.pusher_points(name), float)) + p
+            ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], color="tab:red", s=30)
+        for f, lim in ((ax.set_xlim, 0), (ax.set_ylim, 1), (ax.set_zlim, 2)):
+            f(-1.1 * size, 1.1 * size)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y (grasp axis)")
+        ax.set_zlabel("z")
+        ax.set_title(f"{scene.name}: step {step}/{len(poses) - 1}" + (f", pusher {name}" if name else ""), fontsize=9)
+        ax.view_init(elev=18, azim=-60)
+        ax.set_box_aspect((1, 1, 1))
+
+    anim = FuncAnimation(fig, draw, frames=len(seq), interval=1000 / fps)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    anim.save(path, writer=PillowWriter(fps=fps))
+    plt.close(fig)
+    return path
