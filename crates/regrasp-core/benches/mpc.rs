@@ -3,7 +3,8 @@
 //! cones. Target: median under 1 ms (a 125 Hz pushing MPC is the published reference).
 use criterion::{criterion_group, criterion_main, Criterion};
 use regrasp::control::mpc::{Mpc, MpcSettings};
-use regrasp::cones::robust::{worst_case, Uncertainty};
+use regrasp::cones::robust::Uncertainty;
+use regrasp::scene::perturb::worst_case;
 use regrasp::planning::planar::{plan, PlanarSettings};
 use regrasp::Scene;
 use std::hint::black_box;

@@ -6,6 +6,7 @@ use proptest::prelude::*;
 use regrasp::mechanics::geometry::Vec3;
 use regrasp::control::mpc::{Mpc, MpcSettings, Status};
 use regrasp::cones::robust::{self, ConeMode, Uncertainty};
+use regrasp::scene::perturb;
 use regrasp::Scene;
 
 fn example(name: &str) -> Scene {
@@ -29,14 +30,14 @@ proptest! {
         let scene = common::scene(&case);
         prop_assume!(scene.is_some());
         let scene = scene.unwrap();
-        let worst = robust::worst_case(&scene, &SPREAD).unwrap();
+        let worst = perturb::worst_case(&scene, &SPREAD).unwrap();
         let q = case.pose;
         let fw = worst.frame(&q);
         prop_assume!(fw.hold_ratio < 0.95);
         let gens = robust::generators(&fw, &worst.pushers[0].model);
         prop_assume!(!gens.is_empty());
         for (a, b, c, d) in draws {
-            let s = robust::scaled(&scene, 0.8 + 0.4 * a, 0.8 + 0.4 * b, 0.8 + 0.4 * c, 0.8 + 0.4 * d, ConeMode::Nominal).unwrap();
+            let s = perturb::scaled(&scene, 0.8 + 0.4 * a, 0.8 + 0.4 * b, 0.8 + 0.4 * c, 0.8 + 0.4 * d, ConeMode::Nominal).unwrap();
             let f = s.frame(&q);
             for g in &gens {
                 let m = f.classify(&s.pushers[0].model, g).margin;
@@ -57,7 +58,7 @@ fn invariant_case_is_detected_for_a_pusher_below() {
     assert!(!robust::carries_weight(&f, &s.pushers[idx("top")].model));
     // the robust cone of the bottom pusher is its gravity-free cone; fixtureless pushes exist
     // only for it
-    let fx = robust::fixtureless(&s);
+    let fx = perturb::fixtureless(&s);
     let ff = fx.frame(&q);
     assert!(robust::generators(&ff, &fx.pushers[idx("left")].model).is_empty());
     let gb = robust::generators(&ff, &fx.pushers[idx("bottom")].model);
@@ -65,7 +66,7 @@ fn invariant_case_is_detected_for_a_pusher_below() {
     // a fixtureless push sticks for any grip force, finger friction and mass
     for g in &gb {
         for (fr, grip, mass) in [(0.3, 0.3, 3.0), (1.0, 1.0, 1.0), (3.0, 5.0, 0.2)] {
-            let w = robust::scaled(&s, fr, grip, mass, 1.0, ConeMode::Nominal).unwrap();
+            let w = perturb::scaled(&s, fr, grip, mass, 1.0, ConeMode::Nominal).unwrap();
             let m = w.frame(&q).classify(&w.pushers[idx("bottom")].model, g).margin;
             assert!(m >= -1e-7, "fixtureless generator slips at {fr} {grip} {mass}: {m}");
         }
@@ -79,7 +80,7 @@ fn robust_cone_found_where_the_two_cones_cross() {
     // the two cones cross (pivoting pushes); the robust cone is found on the chords between
     // outside rays, and its generators stick in every sampled world
     let s = example("block-low-friction");
-    let w = robust::worst_case(&s, &SPREAD).unwrap();
+    let w = perturb::worst_case(&s, &SPREAD).unwrap();
     let q = [0.002, -0.004, 0.05];
     let f = w.frame(&q);
     let p = s.pusher_index("left").unwrap();
@@ -91,7 +92,7 @@ fn robust_cone_found_where_the_two_cones_cross() {
     let gens = robust::generators(&f, model);
     assert!(gens.len() >= 2);
     for (a, b, c, d) in [(0.8, 0.8, 1.2, 0.8), (1.2, 1.2, 0.8, 1.2), (0.8, 1.2, 1.0, 1.0), (1.0, 1.0, 1.0, 1.0)] {
-        let sc = robust::scaled(&s, a, b, c, d, ConeMode::Nominal).unwrap();
+        let sc = perturb::scaled(&s, a, b, c, d, ConeMode::Nominal).unwrap();
         for g in &gens {
             assert!(sc.frame(&q).classify(&sc.pushers[p].model, g).margin >= -1e-7);
         }
@@ -101,7 +102,7 @@ fn robust_cone_found_where_the_two_cones_cross() {
 #[test]
 fn robust_cone_shrinks_the_nominal_one() {
     let s = example("block-high-friction");
-    let w = robust::worst_case(&s, &SPREAD).unwrap();
+    let w = perturb::worst_case(&s, &SPREAD).unwrap();
     let q = [0.002, -0.004, 0.05];
     let p = s.pusher_index("left").unwrap();
     let (fs, fw) = (s.frame(&q), w.frame(&q));

@@ -657,14 +657,14 @@ impl Scene {
     /// `ρ = μ_s N / (m g)` (grasp scenes).
     #[getter]
     fn rho(&self) -> Option<f64> {
-        regrasp::cones::robust::rho(&self.inner)
+        regrasp::scene::perturb::rho(&self.inner)
     }
 
     /// A copy with scaled parameters and a cone mode (see `regrasp.robust`).
     #[pyo3(signature = (finger_friction=1.0, grip=1.0, mass=1.0, pusher_friction=1.0, mode="nominal"))]
     fn scaled(&self, finger_friction: f64, grip: f64, mass: f64, pusher_friction: f64, mode: &str) -> PyResult<Self> {
         let mode = regrasp::cones::robust::ConeMode::parse(mode).map_err(to_py)?;
-        regrasp::cones::robust::scaled(&self.inner, finger_friction, grip, mass, pusher_friction, mode).map(|inner| Self { inner }).map_err(to_py)
+        regrasp::scene::perturb::scaled(&self.inner, finger_friction, grip, mass, pusher_friction, mode).map(|inner| Self { inner }).map_err(to_py)
     }
 
     /// Whether pusher `pusher` alone can carry the object's weight at pose `q` (the invariant case).

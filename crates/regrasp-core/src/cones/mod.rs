@@ -2,5 +2,7 @@
 //! their exact test and projection, robust and fixtureless variants (§5.1), and batches.
 
 pub mod batch;
+pub mod frame;
 pub mod motion_cone;
+pub mod projection;
 pub mod robust;

@@ -17,40 +17,9 @@
 //!   only on the pusher's friction.
 
 use crate::error::{Error, Result};
-use crate::mechanics::friction_cone::PusherContact;
-use crate::cones::motion_cone::{PusherModel, SupportFrame, MEMBERSHIP_TOL};
+use crate::cones::frame::{PusherModel, SupportFrame};
+pub use crate::cones::frame::{carries_weight, mode_margin, ConeMode, MEMBERSHIP_TOL};
 use crate::mechanics::geometry::Vec3;
-use crate::scene::planar::{Scene, Support};
-
-/// Which cone the exact test, the rays and the planner use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum ConeMode {
-    /// The motion cone at the scene's values.
-    #[default]
-    Nominal,
-    /// `V(ρ_min) ∩ V_gf` (the scene is already the worst case, see [`worst_case`]).
-    Robust,
-    /// Fixtureless fixturing: `V_gf` of a pusher that carries the weight, else empty.
-    Fixtureless,
-}
-
-impl ConeMode {
-    pub fn parse(s: &str) -> Result<Self> {
-        match s {
-            "nominal" => Ok(Self::Nominal),
-            "robust" => Ok(Self::Robust),
-            "fixtureless" => Ok(Self::Fixtureless),
-            _ => Err(Error::arg("mode", format!("must be nominal, robust or fixtureless (got {s:?})"))),
-        }
-    }
-    pub fn label(&self) -> &'static str {
-        match self {
-            Self::Nominal => "nominal",
-            Self::Robust => "robust",
-            Self::Fixtureless => "fixtureless",
-        }
-    }
-}
 
 /// Relative spreads of the uncertain parameters (each value lies in `[x(1 − e), x(1 + e)]`),
 /// the scene's optional `[uncertainty]` table.
@@ -81,75 +50,6 @@ impl Uncertainty {
     /// `ρ_min / ρ`: the worst ratio of support friction to weight in the range.
     pub fn rho_factor(&self) -> f64 {
         (1.0 - self.finger_friction) * (1.0 - self.grip_force) / (1.0 + self.mass)
-    }
-}
-
-/// `ρ = μ_s N / (m g)` of a grasp scene (`N` per finger); `None` for an object on a surface.
-pub fn rho(scene: &Scene) -> Option<f64> {
-    match &scene.support {
-        Support::Grasp(g) => Some(g.friction * g.force / (scene.mass * scene.g)),
-        Support::Surface(_) => None,
-    }
-}
-
-/// A copy of `scene` with parameters scaled (finger friction, grip force, mass, every pusher's
-/// friction) and the given cone mode.
-pub fn scaled(scene: &Scene, finger_friction: f64, grip: f64, mass: f64, pusher_friction: f64, mode: ConeMode) -> Result<Scene> {
-    for (name, v) in [("finger_friction", finger_friction), ("grip", grip), ("mass", mass), ("pusher_friction", pusher_friction)] {
-        if !(v > 0.0) || !v.is_finite() {
-            return Err(Error::arg(name, format!("scale must be positive and finite (got {v})")));
-        }
-    }
-    let mut s = scene.clone();
-    match &mut s.support {
-        Support::Grasp(g) => {
-            g.friction *= finger_friction;
-            g.force *= grip;
-        }
-        Support::Surface(sf) => sf.friction *= finger_friction,
-    }
-    s.mass *= mass;
-    let metric = s.metric();
-    for p in s.pushers.iter_mut() {
-        p.contact = PusherContact { friction: p.contact.friction * pusher_friction, ..p.contact.clone() };
-        p.model = PusherModel::new(p.contact.clone(), metric)?;
-    }
-    s.mode = mode;
-    Ok(s)
-}
-
-/// The worst case of a range (`ρ_min`, lowest pusher friction) with the robust cone mode.
-pub fn worst_case(scene: &Scene, u: &Uncertainty) -> Result<Scene> {
-    let u = u.checked()?;
-    scaled(scene, 1.0 - u.finger_friction, 1.0 - u.grip_force, 1.0 + u.mass, 1.0 - u.pusher_friction, ConeMode::Robust)
-}
-
-/// The same scene planning only with fixtureless-fixturing pushes.
-pub fn fixtureless(scene: &Scene) -> Scene {
-    let mut s = scene.clone();
-    s.mode = ConeMode::Fixtureless;
-    s
-}
-
-/// Whether the pusher alone can carry the object's weight (`−w_g ∈ W_p`): its pushes inside
-/// the gravity-free cone are then invariant to mass, grip force and finger friction.
-pub fn carries_weight(frame: &SupportFrame, model: &PusherModel) -> bool {
-    frame.gravity.amax() == 0.0 || model.membership(&(-frame.gravity)).0 >= -MEMBERSHIP_TOL
-}
-
-/// The margin of the exact test in `mode`, from the nominal margin and the support load.
-#[inline]
-pub fn mode_margin(mode: ConeMode, frame: &SupportFrame, model: &PusherModel, nominal: f64, support: &Vec3) -> f64 {
-    match mode {
-        ConeMode::Nominal => nominal,
-        ConeMode::Robust => nominal.min(model.membership(support).0),
-        ConeMode::Fixtureless => {
-            if carries_weight(frame, model) {
-                model.membership(support).0
-            } else {
-                -1.0
-            }
-        }
     }
 }
 

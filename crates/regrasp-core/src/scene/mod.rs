@@ -1,6 +1,7 @@
 //! Scenes: the object, the grasp and the pushers read from the TOML contract
 //! (`docs/scene-file.md`), planar ([`planar::Scene`]) and spatial ([`spatial::Scene3`]).
 
+pub mod perturb;
 pub mod planar;
 pub mod spatial;
 

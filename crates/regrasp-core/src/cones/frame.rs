@@ -1,0 +1,187 @@
+//! The pose-dependent frame of a planar push and the pusher's pose-independent model (split as in
+//! MuJoCo's model/data), the exact membership test (thesis §3.3, RSS 2018) and the cone modes
+//! (nominal, robust, fixtureless; §5.1, CASE 2018).
+//!
+//! Exact test: for a twist `v`, `v_s = J_s v`, `ŵ = A⁻¹v_s/√(v_sᵀA⁻¹v_s)` (eq 3.10); the
+//! required pusher wrench is `w_p = J_sᵀŵ − w_g`; `v` is feasible iff `w_p ∈ W_p`.
+
+use crate::error::{Error, Result};
+use crate::mechanics::friction_cone::{ContactLimit, EdgeWrench, PolyhedralCone, PusherContact};
+use crate::mechanics::geometry::{Mat3, Vec3};
+use crate::mechanics::metric::Metric;
+
+/// Tolerance of the exact membership test on the (dimensionless) margin.
+pub const MEMBERSHIP_TOL: f64 = 1e-9;
+
+/// A pusher's generalized friction cone in the object frame (pose-independent).
+#[derive(Clone, Debug)]
+pub struct PusherModel {
+    pub contact: PusherContact,
+    /// Edge wrenches, physical units, unit normal force (eq 3.6).
+    pub edges: Vec<EdgeWrench>,
+    /// `W_p` in the scaled wrench space of `metric`.
+    pub cone: PolyhedralCone,
+    pub metric: Metric,
+}
+
+impl PusherModel {
+    pub fn new(contact: PusherContact, metric: Metric) -> Result<Self> {
+        if !(metric.length > 0.0) {
+            return Err(Error::arg("length", "must be positive"));
+        }
+        let edges = contact.edge_wrenches();
+        let scaled: Vec<Vec3> = edges.iter().map(|e| metric.wrench(&e.wrench)).collect();
+        let cone = PolyhedralCone::from_edges(&scaled)
+            .map_err(|e| Error::arg("pusher", format!("its friction cone is degenerate ({e:?})")))?;
+        Ok(Self { contact, edges, cone, metric })
+    }
+
+    /// Signed margin of pusher wrench `w` and the contact limit nearest to it.
+    pub fn membership(&self, w: &Vec3) -> (f64, ContactLimit) {
+        let m = self.cone.membership(&self.metric.wrench(w));
+        (m.margin, self.contact.limit_of(&self.edges, m.active, w))
+    }
+}
+
+/// Pose-dependent quantities of a push: limit surface, support Jacobian, gravity.
+#[derive(Clone, Copy, Debug)]
+pub struct SupportFrame {
+    /// `A` (eq 3.7), support frame.
+    pub a: Mat3,
+    pub a_inv: Mat3,
+    /// `J_s`: object twist → support twist.
+    pub js: Mat3,
+    pub js_inv: Mat3,
+    /// Gravity wrench, object frame.
+    pub gravity: Vec3,
+    /// `J_s⁻ᵀ w_g`.
+    pub ug: Vec3,
+    /// `√(u_gᵀ A u_g)`: < 1 when the support holds the object against gravity.
+    pub hold_ratio: f64,
+    /// Which cone the exact test answers for (nominal, robust, fixtureless; [`crate::cones::robust`]).
+    pub mode: ConeMode,
+}
+
+impl SupportFrame {
+    pub fn new(a: Mat3, a_inv: Mat3, js: Mat3, js_inv: Mat3, gravity: Vec3) -> Self {
+        let ug = js_inv.tr_mul(&gravity);
+        let hold_ratio = ug.dot(&(a * ug)).sqrt();
+        Self { a, a_inv, js, js_inv, gravity, ug, hold_ratio, mode: ConeMode::Nominal }
+    }
+
+    /// The motion-cone ray (unit twist in `metric`) of pusher wrench direction `p`;
+    /// `None` if the support cannot hold the object (no positive root).
+    #[inline]
+    pub fn ray(&self, p: &Vec3, metric: &Metric) -> Option<Vec3> {
+        let scale = p.amax();
+        if !(scale > 0.0) || !scale.is_finite() {
+            return None;
+        }
+        let u = self.js_inv.tr_mul(&(p / scale));
+        let au = self.a * u;
+        let qa = u.dot(&au);
+        let qb = 2.0 * self.ug.dot(&au);
+        let qc = self.hold_ratio * self.hold_ratio - 1.0;
+        if !(qc < 0.0) || !(qa > 0.0) {
+            return None;
+        }
+        let disc = (qb * qb - 4.0 * qa * qc).sqrt();
+        // positive root, in the cancellation-free form
+        let lambda = if qb >= 0.0 { 2.0 * qc / (-qb - disc) } else { (-qb + disc) / (2.0 * qa) };
+        let v = self.js_inv * (au * lambda + self.a * self.ug);
+        Some(v / metric.twist_norm(&v))
+    }
+
+    /// Ray of the gravity-free cone for pusher wrench `p`: `J_s⁻¹ A J_s⁻ᵀ p`, unit.
+    #[inline]
+    pub fn gravity_free_ray(&self, p: &Vec3, metric: &Metric) -> Vec3 {
+        let v = self.js_inv * (self.a * self.js_inv.tr_mul(&(p / p.amax())));
+        v / metric.twist_norm(&v)
+    }
+
+    /// Load wrench on the support for twist `v`, mapped to the object frame: `J_sᵀ ŵ` (eq 3.10).
+    #[inline]
+    pub fn support_load(&self, v: &Vec3) -> Vec3 {
+        // only the direction matters: normalize first so that huge or tiny twists are safe
+        let vs = self.js * (v / v.amax());
+        let w = self.a_inv * vs;
+        self.js.tr_mul(&(w / vs.dot(&w).sqrt()))
+    }
+
+    /// The exact test (twist assumed finite and non-zero, support assumed to hold).
+    #[inline]
+    pub fn classify(&self, model: &PusherModel, v: &Vec3) -> Classification {
+        let support = self.support_load(v);
+        let wp = support - self.gravity;
+        let (margin, limit) = model.membership(&wp);
+        let margin = mode_margin(self.mode, self, model, margin, &support);
+        Classification { feasible: margin >= -MEMBERSHIP_TOL, margin, limit, pusher_wrench: wp, support_wrench: support }
+    }
+}
+
+/// Result of the exact membership test.
+#[derive(Clone, Copy, Debug)]
+pub struct Classification {
+    pub feasible: bool,
+    /// Signed margin (≥ 0 inside): the sine of the angle from the required pusher wrench to the
+    /// nearest boundary of `W_p`, in the scaled wrench metric.
+    pub margin: f64,
+    /// The contact limit nearest to being violated (active when `margin ≈ 0`).
+    pub limit: ContactLimit,
+    /// Wrench the pusher must apply [N, N, N·m], object frame.
+    pub pusher_wrench: Vec3,
+    /// Load wrench of the object on the support, mapped to the object frame (`J_sᵀŵ`).
+    pub support_wrench: Vec3,
+}
+
+/// Which cone the exact test, the rays and the planner use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ConeMode {
+    /// The motion cone at the scene's values.
+    #[default]
+    Nominal,
+    /// `V(ρ_min) ∩ V_gf` (the scene is already the worst case, see [`crate::scene::perturb::worst_case`]).
+    Robust,
+    /// Fixtureless fixturing: `V_gf` of a pusher that carries the weight, else empty.
+    Fixtureless,
+}
+
+impl ConeMode {
+    pub fn parse(s: &str) -> Result<Self> {
+        match s {
+            "nominal" => Ok(Self::Nominal),
+            "robust" => Ok(Self::Robust),
+            "fixtureless" => Ok(Self::Fixtureless),
+            _ => Err(Error::arg("mode", format!("must be nominal, robust or fixtureless (got {s:?})"))),
+        }
+    }
+    pub fn label(&self) -> &'static str {
+        match self {
+            Self::Nominal => "nominal",
+            Self::Robust => "robust",
+            Self::Fixtureless => "fixtureless",
+        }
+    }
+}
+
+/// Whether the pusher alone can carry the object's weight (`−w_g ∈ W_p`): its pushes inside
+/// the gravity-free cone are then invariant to mass, grip force and finger friction.
+pub fn carries_weight(frame: &SupportFrame, model: &PusherModel) -> bool {
+    frame.gravity.amax() == 0.0 || model.membership(&(-frame.gravity)).0 >= -MEMBERSHIP_TOL
+}
+
+/// The margin of the exact test in `mode`, from the nominal margin and the support load.
+#[inline]
+pub fn mode_margin(mode: ConeMode, frame: &SupportFrame, model: &PusherModel, nominal: f64, support: &Vec3) -> f64 {
+    match mode {
+        ConeMode::Nominal => nominal,
+        ConeMode::Robust => nominal.min(model.membership(support).0),
+        ConeMode::Fixtureless => {
+            if carries_weight(frame, model) {
+                model.membership(support).0
+            } else {
+                -1.0
+            }
+        }
+    }
+}

@@ -1,0 +1,222 @@
+//! Projections onto motion cones: the closest feasible twist to a desired one, on the exact
+//! cone (the image of the boundary of the pusher's cone searched by grid and golden section) or
+//! on a polyhedral cone spanned by generators (non-negative least squares).
+
+use crate::cones::frame::{ConeMode, PusherModel, SupportFrame};
+use crate::cones::robust::generators;
+use crate::mechanics::geometry::Vec3;
+
+
+/// Closest feasible twist (see [`PlanarPush::project`]); the support must hold.
+pub fn project_exact(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> Vec3 {
+    let scale = d.amax();
+    if scale == 0.0 {
+        return Vec3::zeros();
+    }
+    let dd = d / scale;
+    if frame.classify(model, &dd).feasible {
+        return *d;
+    }
+    let dn = model.metric.twist_norm(&dd);
+    let (cos, u) = nearest_boundary_ray(frame, model, &dd);
+    if cos > 0.0 {
+        u * (cos * dn * scale)
+    } else {
+        Vec3::zeros()
+    }
+}
+
+/// Closest twist to `want` in the cone (of the frame's mode) with at least margin `margin`: the
+/// projection on the polyhedral cone of its generators when the exact test accepts it, else the
+/// exact projection, then moved towards the mean of the generators until the margin holds.
+/// `None` when the cone is empty or the support cannot hold the object.
+pub fn project_with_margin(frame: &SupportFrame, model: &PusherModel, want: &Vec3, margin_min: f64) -> Option<Vec3> {
+    project_with_margin_on(frame, model, &generators(frame, model), want, margin_min)
+}
+
+/// [`project_with_margin`] with the cone's generators already computed (`gens`, unit twists).
+pub fn project_with_margin_on(frame: &SupportFrame, model: &PusherModel, gens: &[Vec3], want: &Vec3, margin_min: f64) -> Option<Vec3> {
+    let m = &model.metric;
+    // (a nominal cone with fewer rays than W_p has edges: the support cannot hold the object)
+    if gens.is_empty() || (frame.mode == ConeMode::Nominal && gens.len() < model.edges.len()) {
+        return None;
+    }
+    let gs: Vec<Vec3> = gens.iter().map(|g| m.twist(g)).collect();
+    let (pp, _) = project_onto_generators(&gs, &m.twist(want));
+    let mut v = m.twist_inv(&pp);
+    if v.amax() == 0.0 || frame.classify(model, &v).margin < 0.0 {
+        v = project_exact(frame, model, want);
+        if v.amax() == 0.0 {
+            return None;
+        }
+    }
+    let margin = |x: &Vec3| frame.classify(model, x).margin;
+    if margin(&v) >= margin_min {
+        return Some(v);
+    }
+    // towards the mean of the cone's rays
+    let centre = gens.iter().fold(Vec3::zeros(), |a, g| a + g);
+    if centre.amax() == 0.0 || margin(&centre) < margin_min {
+        return (margin(&v) >= 0.0).then_some(v);
+    }
+    let (vn, cn) = (m.twist_norm(&v), m.twist_norm(&centre));
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        let x = v / vn * (1.0 - mid) + centre / cn * mid;
+        if margin(&x) >= margin_min {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    // the blend of two unit directions is shorter than either: back to the projection's speed
+    let x = v / vn * (1.0 - hi) + centre / cn * hi;
+    Some(x * (vn / m.twist_norm(&x)))
+}
+
+/// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images of
+/// the boundary fans of `W_p`). Each fan is sampled until consecutive rays are less than 4°
+/// apart (the boundary can turn quickly where gravity matters most), then the best two local
+/// maxima are refined by golden-section search. Returns the cosine and the unit ray.
+fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> (f64, Vec3) {
+    const MAX_STEP: f64 = 0.07; // rad between consecutive samples
+    const MAX_SAMPLES: usize = 4096;
+    let m = &model.metric;
+    let ds = m.twist(d).normalize();
+    // (t, cosine, unit ray in the metric, ray)
+    type Sample = (f64, f64, Vec3, Vec3);
+    let sample = |p: &Vec3, t: f64| -> Sample {
+        match frame.ray(&m.wrench_inv(p), m) {
+            Some(v) => {
+                let s = m.twist(&v);
+                (t, s.dot(&ds), s, v)
+            }
+            None => (t, f64::NEG_INFINITY, Vec3::zeros(), Vec3::zeros()),
+        }
+    };
+    let mut best = (f64::NEG_INFINITY, Vec3::zeros());
+    // sample every boundary fan finely enough, keeping (segment, samples)
+    let segments = model.cone.boundary_segments();
+    let mut sampled: Vec<Vec<Sample>> = Vec::with_capacity(segments.len());
+    for &(i, j) in &segments {
+        let (ea, eb) = (model.cone.edges[i], model.cone.edges[j]);
+        let at = |t: f64| ea * (1.0 - t) + eb * t;
+        if i == j {
+            sampled.push(vec![sample(&ea, 0.0)]);
+            continue;
+        }
+        // depth-first subdivision of each interval until its end rays are close
+        let cos_step = MAX_STEP.cos();
+        let mut pts: Vec<Sample> = Vec::with_capacity(64);
+        let mut stack: Vec<Sample> = Vec::with_capacity(32);
+        let first = sample(&at(0.0), 0.0);
+        pts.push(first);
+        for k in (1..=8).rev() {
+            stack.push(sample(&at(k as f64 / 8.0), k as f64 / 8.0));
+        }
+        while let Some(right) = stack.pop() {
+            let left = *pts.last().expect("samples");
+            if left.2.dot(&right.2) < cos_step && right.0 - left.0 > 1e-9 && pts.len() + stack.len() < MAX_SAMPLES {
+                let t = 0.5 * (left.0 + right.0);
+                stack.push(right);
+                stack.push(sample(&at(t), t));
+            } else {
+                pts.push(right);
+            }
+        }
+        sampled.push(pts);
+    }
+    let top = sampled.iter().flatten().map(|s| s.1).fold(f64::NEG_INFINITY, f64::max);
+    // between samples at most MAX_STEP apart the cosine can rise by about MAX_STEP²/2 above
+    // the better sample: refine every local maximum within that of the best one
+    let slack = MAX_STEP * MAX_STEP;
+    for (seg, pts) in sampled.iter().enumerate() {
+        let (i, j) = segments[seg];
+        let (ea, eb) = (model.cone.edges[i], model.cone.edges[j]);
+        let at = |t: f64| ea * (1.0 - t) + eb * t;
+        for k in 0..pts.len() {
+            let is_peak = (k == 0 || pts[k].1 >= pts[k - 1].1) && (k + 1 == pts.len() || pts[k].1 >= pts[k + 1].1);
+            if !is_peak || pts[k].1 < top - slack {
+                continue;
+            }
+            if pts[k].1 > best.0 {
+                best = (pts[k].1, pts[k].3);
+            }
+            if pts.len() < 2 {
+                continue;
+            }
+            let (mut lo, mut hi) = (pts[k.saturating_sub(1)].0, pts[(k + 1).min(pts.len() - 1)].0);
+            let g = 0.5 * (5f64.sqrt() - 1.0);
+            let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+            let (mut f1, mut f2) = (sample(&at(x1), x1), sample(&at(x2), x2));
+            let stop = 1e-7 * (hi - lo);
+            while hi - lo > stop {
+                if f1.1 >= f2.1 {
+                    hi = x2;
+                    x2 = x1;
+                    f2 = f1;
+                    x1 = hi - g * (hi - lo);
+                    f1 = sample(&at(x1), x1);
+                } else {
+                    lo = x1;
+                    x1 = x2;
+                    f1 = f2;
+                    x2 = lo + g * (hi - lo);
+                    f2 = sample(&at(x2), x2);
+                }
+            }
+            for f in [f1, f2] {
+                if f.1 > best.0 {
+                    best = (f.1, f.3);
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Euclidean projection of `d` onto the cone generated by `gens` (non-negative least squares,
+/// exact by enumerating the faces: a projection lies in the relative interior of a face spanned
+/// by at most 3 independent generators). Returns the projection and the weights.
+pub fn project_onto_generators(gens: &[Vec3], d: &Vec3) -> (Vec3, Vec<f64>) {
+    let k = gens.len();
+    let mut best = (d.norm_squared(), Vec3::zeros(), vec![0.0; k]);
+    // every face spanned by 1, 2 or 3 generators: O(k³) small fixed-size solves
+    let mut consider = |idx: &[usize]| {
+        let n = idx.len();
+        let mut g = nalgebra::Matrix3::<f64>::zeros();
+        for (j, &i) in idx.iter().enumerate() {
+            g.set_column(j, &gens[i]);
+        }
+        let g = g.columns(0, n);
+        let gtg = g.transpose() * g;
+        if gtg.determinant().abs() < 1e-14 * gtg.norm().powi(n as i32) {
+            return;
+        }
+        let Some(inv) = gtg.try_inverse() else { return };
+        let alpha = inv * (g.transpose() * d);
+        if alpha.iter().any(|&a| a < 0.0) {
+            return;
+        }
+        let p: Vec3 = g * &alpha;
+        let res = (d - p).norm_squared();
+        if res < best.0 {
+            let mut w = vec![0.0; k];
+            for (j, &i) in idx.iter().enumerate() {
+                w[i] = alpha[j];
+            }
+            best = (res, p, w);
+        }
+    };
+    for a in 0..k {
+        consider(&[a]);
+        for b in a + 1..k {
+            consider(&[a, b]);
+            for c in b + 1..k {
+                consider(&[a, b, c]);
+            }
+        }
+    }
+    (best.1, best.2)
+}
