@@ -23,6 +23,12 @@ def load(d):
         raise
 
 
+def start_cone(d):
+    """The scene of ``d`` and the motion cone of its pusher at the task's start."""
+    sc = load(d)
+    return sc, sc.motion_cone(d["task"]["start"], "p")
+
+
 def required_pusher_wrench(d, twist):
     """Pusher wrench needed for `twist`, from the raw scene dict (eq 3.10 at a circular pad)."""
     q = np.array(d["task"]["start"])
@@ -72,8 +78,7 @@ def lp_sticks(d, twist) -> bool:
 @SETTINGS
 @given(block_scenes(), st.integers(0, 2**31))
 def test_exact_test_agrees_with_lp_over_contact_forces(d, seed):
-    sc = load(d)
-    cone = sc.motion_cone(d["task"]["start"], "p")
+    sc, cone = start_cone(d)
     rng = np.random.default_rng(seed)
     tw = twist_dirs(20, sc.length, rng)
     # and twists near the cone: generator mixes plus noise
@@ -89,8 +94,7 @@ def test_exact_test_agrees_with_lp_over_contact_forces(d, seed):
 @SETTINGS
 @given(block_scenes())
 def test_generators_balance_forces_on_the_friction_cone_edges(d):
-    sc = load(d)
-    cone = sc.motion_cone(d["task"]["start"], "p")
+    sc, cone = start_cone(d)
     edges = cone._core.pusher_edges
     for g, e in zip(cone.generators, edges):
         c = cone.classify(g)
@@ -113,8 +117,7 @@ def test_rust_generators_match_the_numpy_reference(d):
 @SETTINGS
 @given(block_scenes(g=0.0), st.integers(0, 2**31))
 def test_without_gravity_exact_equals_polyhedral(d, seed):
-    sc = load(d)
-    cone = sc.motion_cone(d["task"]["start"], "p")
+    sc, cone = start_cone(d)
     assert np.allclose(cone.generators, cone.gravity_free_generators, atol=1e-12)
     if cone.is_line_pusher:
         tw = twist_dirs(200, sc.length, np.random.default_rng(seed))
@@ -127,8 +130,7 @@ def test_without_gravity_exact_equals_polyhedral(d, seed):
 @given(block_scenes(line=True))
 def test_zero_pusher_friction_collapses_the_cone(d):
     d["pushers"][0]["friction"] = 0.0
-    sc = load(d)
-    cone = sc.motion_cone(d["task"]["start"], "p")
+    sc, cone = start_cone(d)
     g = cone.generators
     assert np.allclose(g[0], g[1]) and np.allclose(g[2], g[3])
     tw = twist_dirs(500, sc.length, np.random.default_rng(0))
@@ -187,8 +189,7 @@ def test_invariant_under_a_rigid_change_of_object_frame(d, tx, tz, phi, seed):
 @SETTINGS
 @given(block_scenes(), st.integers(0, 2**31))
 def test_projection_is_feasible_and_closest(d, seed):
-    sc = load(d)
-    cone = sc.motion_cone(d["task"]["start"], "p")
+    sc, cone = start_cone(d)
     rng = np.random.default_rng(seed)
     M = sc.metric_twist
     for t in twist_dirs(5, sc.length, rng):

@@ -23,18 +23,18 @@ def test_every_3d_example_plans_and_replays(name):
     s = Scene3D.load(EXAMPLES / f"{name}.toml")
     for seed in (0, 1):
         p = s.plan(seed=seed, time_limit=20)
-        assert p["found"] and p["valid"], (name, seed, p["stop_reason"])
+        assert p.found and p.valid, (name, seed, p.stop_reason)
         r = s.replay(p)
         assert r["success"], (name, seed, r["goal_error"])
 
 
 def test_pivoting_with_a_switch_over_and_with_one_pusher():
     p = Scene3D.load(EXAMPLES / "pivot-3d.toml").plan(seed=0)
-    assert p["switch_overs"] >= 1 and {"corner", "ground"} <= {k["pusher"] for k in p["path"][1:]}
+    assert p.switch_overs >= 1 and {"corner", "ground"} <= set(p.pushers[1:])
     p1 = Scene3D.load(EXAMPLES / "pivot-single-3d.toml").plan(seed=0)
-    assert {k["pusher"] for k in p1["path"][1:]} == {"corner"}
+    assert set(p1.pushers[1:]) == {"corner"}
     # the block turned about the grasp axis (Y)
-    q = np.array(p1["path"][-1]["pose"])
+    q = p1.poses[-1]
     assert quat_angle(q[3:], [1, 0, 0, 0]) > 0.38 and abs(q[4]) < 1e-6 and abs(q[6]) < 1e-6
 
 
@@ -54,7 +54,7 @@ def test_inverse_dynamics_step_acceptance():
 def test_se3_twist_between_inverts_the_plan_steps():
     s = Scene3D.load(EXAMPLES / "pivot-3d.toml")
     p = s.plan(seed=0)
-    for a, b in zip(p["path"][:-1], p["path"][1:]):
+    for a, b in zip(p.path[:-1], p.path[1:]):
         # the stored pusher twist reproduces the step exactly; the SE(3) log between the poses
         # (pusher sticking: the object's twist) reaches it to the simulator's step error
         # (measured 26 um / 0.8 mrad on the corner pivot, 0 elsewhere)
@@ -95,7 +95,7 @@ def test_browser_view_draws_every_frame(tmp_path):
         assert fr["finite"] and 4 + 2 <= fr["drawn"] <= out["triangles"] + 2
         assert fr["pusher_dots"] >= 2  # the active pusher's contacts
     assert "pusher corner" in out["frames"][0]["info"] and "pusher ground" in out["frames"][-1]["info"]
-    assert np.allclose(out["frames"][-1]["pose"], p["path"][-1]["pose"], atol=1e-9)
+    assert np.allclose(out["frames"][-1]["pose"], p.poses[-1], atol=1e-9)
     # a ball on the floor: one contact dot (the lowest point), the floor drawn, painted faces
     s = Scene3D.load(EXAMPLES / "ball-roll-3d.toml")
     page = write_html(s, s.plan(seed=0), tmp_path / "ball.html")
@@ -117,7 +117,7 @@ def test_3d_plans_execute_in_mujoco(tmp_path):
             assert r["success"], (name, view, r["goal_error"])
     f = tmp_path / "plan.json"
     s = Scene3D.load(EXAMPLES / "light-side-3d.toml")
-    f.write_text(json.dumps(s.plan(seed=0)))
+    s.plan(seed=0).save(f)
     r = subprocess.run([sys.executable, "-m", "regrasp.cli", "simulate", str(EXAMPLES / "light-side-3d.toml"), "--plan", str(f),
                         "--engine", "mujoco", "--json"], capture_output=True, text=True)
     assert r.returncode == 0 and json.loads(r.stdout)["engine"] == "mujoco", r.stderr
@@ -138,7 +138,7 @@ def test_ball_rolls_on_the_floor_in_mujoco_and_feedback_closes_the_gap(tmp_path)
     closed = execute_plan3d(s, p, feedback=True)
     assert closed["success"] and closed["replans"] >= 1, closed["goal_error"]
     f = tmp_path / "ball.json"
-    f.write_text(json.dumps(p))
+    p.save(f)
     cli = [sys.executable, "-m", "regrasp.cli", "control", str(EXAMPLES / "ball-roll-3d.toml"), "--plan", str(f), "--json"]
     r = subprocess.run(cli + ["--engine", "mujoco"], capture_output=True, text=True)
     out = json.loads(r.stdout)
@@ -165,10 +165,10 @@ def test_feedback_replans_after_a_disturbance():
 
     from regrasp.scene.spatial import goal_report, run_plan3d
 
-    q, poses, n = run_plan3d(s, p["path"], step, p["path"][0]["pose"], feedback=False)
+    q, poses, n = run_plan3d(s, p.path, step, p.poses[0], feedback=False)
     assert n == 0 and not goal_report(s, q)["success"], goal_report(s, q)  # open loop: 24 mrad off
     calls.clear()
-    q, poses, n = run_plan3d(s, p["path"], step, p["path"][0]["pose"], feedback=True)
+    q, poses, n = run_plan3d(s, p.path, step, p.poses[0], feedback=True)
     assert n >= 1 and goal_report(s, q)["success"], goal_report(s, q)
 
 
@@ -195,7 +195,7 @@ def test_browser_view_in_headless_chromium(tmp_path):
         assert 6 <= fr["drawn"] <= out["triangles"] + 2
         assert 0.01 * area < fr["ink"] < 0.6 * area  # the object is drawn, and fits the canvas
     assert "pusher corner" in out["frames"][0]["info"] and "pusher ground" in out["frames"][-1]["info"]
-    assert np.allclose(out["frames"][-1]["pose"], p["path"][-1]["pose"], atol=1e-9)
+    assert np.allclose(out["frames"][-1]["pose"], p.poses[-1], atol=1e-9)
     shot = tmp_path / "view.png"
     subprocess.run([CHROMIUM, *[f for f in flags if not f.startswith("--user-data-dir")],
                     f"--user-data-dir={tmp_path / 'profile2'}", f"--screenshot={shot}", f"file://{page}"],

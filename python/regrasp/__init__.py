@@ -6,13 +6,18 @@ Quick use::
     scene = regrasp.Scene.load("examples/block-low-friction.toml")
     cone = scene.motion_cone([0, 0, 0], "bottom")
     cone.generators, cone.contains([0, 0.01, 0]), cone.project([0.01, 0.0, 0.0])
+
+    scene = regrasp.load_scene("examples/pivot-3d.toml")   # a Scene or a Scene3D, by the file
+    plan = regrasp.plan(scene, seed=0)                      # a Plan, for either
+    plan.found, plan.poses, plan.pushers, plan.to_json()
 """
 
 from ._core import __version__
 from .errors import ArgumentError, GraspError, RegraspError, SceneError
+from .planning.plan import Plan, plan, planner_defaults
+from .scene import load_scene
 from .scene.planar import Classification, GravityFreeCone, MotionCone, MotionConeBatch, Pusher, Scene, Task
 from .scene.spatial import Scene3D
-from .planning.plan import Plan, plan
 
 __all__ = [
     "__version__",
@@ -28,6 +33,8 @@ __all__ = [
     "Scene",
     "Scene3D",
     "Plan",
+    "load_scene",
     "plan",
+    "planner_defaults",
     "Task",
 ]

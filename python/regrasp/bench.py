@@ -38,86 +38,102 @@ def _random_poses(scene: Scene, n: int, rng) -> np.ndarray:
 
 
 def run(n: int = 100_000, reps: int = 11, baseline_reps: int = 3, scene_path=None, pusher: str = "left") -> dict:
+    """Every measurement (see the module notes): the cone batches on ``n`` random poses of the
+    scene (default: the low-friction block), then the solver, planner, MuJoCo and MPC probes."""
     scene = Scene.load(scene_path or EXAMPLES / "block-low-friction.toml")
     rng = np.random.default_rng(0)
     poses = _random_poses(scene, n, rng)
     params = reference.RefParams.from_scene(scene, pusher)
-    L = scene.length
-    twists = rng.normal(size=(n, 3)) * np.array([1.0, 1.0, 1.0 / L])
+    twists = rng.normal(size=(n, 3)) * np.array([1.0, 1.0, 1.0 / scene.length])
+    batch = scene.motion_cones(poses, pusher)
     results = {}
-
-    # one batch of n cones: Rust (threads) vs a per-cone numpy loop and vectorized numpy
-    rust = scene.motion_cones(poses, pusher)
-    loop = np.array([reference.generators_numpy(params, q) for q in poses[: min(n, 2000)]])
-    vec = reference.generators_numpy_batch(params, poses)
-    diff = max(np.abs(rust.generators[: len(loop)] - loop).max(), np.abs(rust.generators - vec).max())
-    t_rust = _median_time(lambda: scene.motion_cones(poses, pusher), reps)
-    t_loop = _median_time(lambda: [reference.generators_numpy(params, q) for q in poses], baseline_reps)
-    t_vec = _median_time(lambda: reference.generators_numpy_batch(params, poses), reps)
-    results[f"cone_batch_{n}"] = {
-        "median_s": t_rust,
-        "baseline_median_s": t_loop,
-        "ratio": t_loop / t_rust,
-        "baseline": "numpy, one cone per call (thesis equations)",
-        "n": n,
-        "max_abs_diff": float(diff),
-    }
-    results[f"cone_batch_{n}_vs_vectorized_numpy"] = {
-        "median_s": t_rust,
-        "baseline_median_s": t_vec,
-        "ratio": t_vec / t_rust,
-        "baseline": "numpy, vectorized over poses (einsum)",
-        "n": n,
-        "max_abs_diff": float(np.abs(rust.generators - vec).max()),
-    }
-
-    # exact membership of n twists (one per pose)
-    got = rust.contains(twists)
-    ref = reference.classify_numpy_batch(params, poses, twists)
-    t_rust = _median_time(lambda: rust.contains(twists), reps)
-    t_vec = _median_time(lambda: reference.classify_numpy_batch(params, poses, twists), reps)
-    results[f"membership_batch_{n}"] = {
-        "median_s": t_rust,
-        "baseline_median_s": t_vec,
-        "ratio": t_vec / t_rust,
-        "baseline": "numpy, vectorized over poses",
-        "n": n,
-        "disagreements": int((got != ref).sum()),
-    }
-
-    # one cone from Python, call by call
-    q0 = poses[0]
-    m = 2000
-    t_one = _median_time(lambda: [scene.motion_cone(q0, pusher).generators for _ in range(m)], reps) / m
-    t_np = _median_time(lambda: [reference.generators_numpy(params, q0) for _ in range(m)], reps) / m
-    results["cone_single_call"] = {
-        "median_s": t_one,
-        "baseline_median_s": t_np,
-        "ratio": t_np / t_one,
-        "baseline": "numpy, one cone per call",
-        "n": 1,
-    }
-
-    # projection onto the exact cone (no numpy baseline: reported as throughput)
-    k = min(n, 20_000)
-    sub = scene.motion_cones(poses[:k], pusher)
-    t_proj = _median_time(lambda: sub.project(twists[:k]), reps)
-    t_poly = _median_time(
-        lambda: [scene.motion_cone(q, pusher).project_polyhedral(t) for q, t in zip(poses[:500], twists[:500])], 1
-    ) * (k / 500)
-    results[f"project_exact_batch_{k}"] = {
-        "median_s": t_proj,
-        "baseline_median_s": t_poly,
-        "ratio": t_poly / t_proj,
-        "baseline": "polyhedral projection (NNLS) called one by one from Python",
-        "n": k,
-    }
+    results.update(_cone_batch(scene, pusher, params, poses, batch, reps, baseline_reps))
+    results.update(_membership(params, poses, twists, batch, reps))
+    results.update(_single_cone(scene, pusher, params, poses[0], reps))
+    results.update(_projection(scene, pusher, poses, twists, reps))
     results.update(run_mncp(reps=reps))
     results.update(run_planner())
     results.update(run_mujoco())
     results.update(run_mpc())
     results.update(run_plan3d())
     return results
+
+
+def _cone_batch(scene: Scene, pusher: str, params, poses, batch, reps: int, baseline_reps: int) -> dict:
+    """One batch of n cones: Rust (threads) against a per-cone numpy loop and vectorized numpy."""
+    n = len(poses)
+    loop = np.array([reference.generators_numpy(params, q) for q in poses[: min(n, 2000)]])
+    vec = reference.generators_numpy_batch(params, poses)
+    diff = max(np.abs(batch.generators[: len(loop)] - loop).max(), np.abs(batch.generators - vec).max())
+    t_rust = _median_time(lambda: scene.motion_cones(poses, pusher), reps)
+    t_loop = _median_time(lambda: [reference.generators_numpy(params, q) for q in poses], baseline_reps)
+    t_vec = _median_time(lambda: reference.generators_numpy_batch(params, poses), reps)
+    return {
+        f"cone_batch_{n}": {
+            "median_s": t_rust,
+            "baseline_median_s": t_loop,
+            "ratio": t_loop / t_rust,
+            "baseline": "numpy, one cone per call (thesis equations)",
+            "n": n,
+            "max_abs_diff": float(diff),
+        },
+        f"cone_batch_{n}_vs_vectorized_numpy": {
+            "median_s": t_rust,
+            "baseline_median_s": t_vec,
+            "ratio": t_vec / t_rust,
+            "baseline": "numpy, vectorized over poses (einsum)",
+            "n": n,
+            "max_abs_diff": float(np.abs(batch.generators - vec).max()),
+        },
+    }
+
+
+def _membership(params, poses, twists, batch, reps: int) -> dict:
+    """Exact membership of n twists (one per pose)."""
+    n = len(poses)
+    got = batch.contains(twists)
+    ref = reference.classify_numpy_batch(params, poses, twists)
+    t_rust = _median_time(lambda: batch.contains(twists), reps)
+    t_vec = _median_time(lambda: reference.classify_numpy_batch(params, poses, twists), reps)
+    return {f"membership_batch_{n}": {
+        "median_s": t_rust,
+        "baseline_median_s": t_vec,
+        "ratio": t_vec / t_rust,
+        "baseline": "numpy, vectorized over poses",
+        "n": n,
+        "disagreements": int((got != ref).sum()),
+    }}
+
+
+def _single_cone(scene: Scene, pusher: str, params, q0, reps: int, m: int = 2000) -> dict:
+    """One cone from Python, call by call."""
+    t_one = _median_time(lambda: [scene.motion_cone(q0, pusher).generators for _ in range(m)], reps) / m
+    t_np = _median_time(lambda: [reference.generators_numpy(params, q0) for _ in range(m)], reps) / m
+    return {"cone_single_call": {
+        "median_s": t_one,
+        "baseline_median_s": t_np,
+        "ratio": t_np / t_one,
+        "baseline": "numpy, one cone per call",
+        "n": 1,
+    }}
+
+
+def _projection(scene: Scene, pusher: str, poses, twists, reps: int) -> dict:
+    """Projection onto the exact cone (no numpy baseline: against the polyhedral projection
+    called one by one)."""
+    k = min(len(poses), 20_000)
+    sub = scene.motion_cones(poses[:k], pusher)
+    t_proj = _median_time(lambda: sub.project(twists[:k]), reps)
+    t_poly = _median_time(
+        lambda: [scene.motion_cone(q, pusher).project_polyhedral(t) for q, t in zip(poses[:500], twists[:500])], 1
+    ) * (k / 500)
+    return {f"project_exact_batch_{k}": {
+        "median_s": t_proj,
+        "baseline_median_s": t_poly,
+        "ratio": t_poly / t_proj,
+        "baseline": "polyhedral projection (NNLS) called one by one from Python",
+        "n": k,
+    }}
 
 
 def run_mujoco(steps: int = 4000) -> dict:
@@ -199,7 +215,7 @@ def run_mpc(reps: int = 200) -> dict:
     for name in ("block-high-friction", "t-shape"):
         scene = Scene.load(EXAMPLES / f"{name}.toml")
         p = plan(scene, seed=0)
-        poses = [k["pose"] for k in p.path]
+        poses = p.poses.tolist()
         q = (np.asarray(poses[0]) + [0.0005, -0.0005, 0.01]).tolist()
         times = []
         for _ in range(reps):
@@ -235,12 +251,12 @@ def run_plan3d(seeds: int = 10, examples=PLANNED_3D) -> dict:
     for name in examples:
         s = Scene3D.load(EXAMPLES / f"{name}.toml")
         runs = [s.plan(seed=k, time_limit=60.0) for k in range(seeds)]
-        t = float(np.median([r["planning_time_s"] for r in runs]))
-        solves = float(np.median([r["solves"] for r in runs]))
+        t = float(np.median([r.planning_time_s for r in runs]))
+        solves = float(np.median([r.solves for r in runs]))
         # the first step of the first plan, solved forward by IPOPT (the pusher moving with it)
-        first = runs[0]["path"][:2]
-        p = s.quasistatic_problem(first[0]["pose"], first[1]["pusher"], 1.0)
-        u = np.asarray(first[1]["pusher_twist"], float)
+        first = runs[0]
+        p = s.quasistatic_problem(first.poses[0], first.pushers[1], 1.0)
+        u = first.pusher_twists[1]
         times = []
         for _ in range(3):
             try:
@@ -251,8 +267,8 @@ def run_plan3d(seeds: int = 10, examples=PLANNED_3D) -> dict:
         out[f"plan3d_{name}"] = {
             "median_s": t, "baseline_median_s": solves * t_ipopt, "ratio": solves * t_ipopt / max(t, 1e-9),
             "baseline": f"the same search with IPOPT solves ({solves:.0f} solves x {1e3 * t_ipopt:.1f} ms)",
-            "found": sum(r["found"] for r in runs), "n": seeds, "median_solves": solves,
-            "switch_overs": float(np.median([r["switch_overs"] for r in runs])),
+            "found": sum(r.found for r in runs), "n": seeds, "median_solves": solves,
+            "switch_overs": float(np.median([r.switch_overs for r in runs])),
         }
     return out
 

@@ -48,6 +48,123 @@ class ReferenceSolution:
     solve_time_s: float
 
 
+class _Program:
+    """The nonlinear program as it is built: unknowns (scaled) with bounds and start values,
+    constraints with bounds, the objective and the complementarity products each relaxed by ε."""
+
+    def __init__(self):
+        self.xs, self.lbx, self.ubx, self.x_init = [], [], [], []
+        self.g, self.lbg, self.ubg = [], [], []
+        self.objective = 0
+        self.relaxed = []
+
+    def unknown(self, x, n: int, lb: float, ub: float, init) -> object:
+        self.xs.append(x)
+        self.lbx.extend([lb] * n)
+        self.ubx.extend([ub] * n)
+        self.x_init.extend(list(np.broadcast_to(init, (n,))))
+        return x
+
+    def var(self, name: str, n: int, lb: float, ub: float, init):
+        import casadi as ca
+
+        return self.unknown(ca.SX.sym(name, n), n, lb, ub, init)
+
+    def constrain(self, expr, lb: float, ub: float, n: int = 1) -> None:
+        self.g.append(expr)
+        self.lbg.extend([lb] * n)
+        self.ubg.extend([ub] * n)
+
+    def complementarity(self, a, b) -> None:
+        """The product ``a b``, ≥ 0 at feasible points: minimized, and bounded by ε."""
+        self.objective += a * b
+        self.relaxed.append(a * b)
+
+
+def _twists(prog: _Program, dim: int, vs: float, pusher_twist, twist, x0):
+    """The object's twist V and the pusher's U (scaled): the given one a constant, the other an
+    unknown started at the given one (or at ``x0["twist"]``)."""
+    import casadi as ca
+
+    if twist is None:
+        init = np.asarray(pusher_twist) / vs if x0 is None else np.asarray(x0["twist"]) / vs
+        V = prog.unknown(ca.SX.sym("V", dim), dim, -np.inf, np.inf, init)
+    else:
+        V = ca.DM(np.asarray(twist) / vs)
+    if pusher_twist is None:
+        U = prog.unknown(ca.SX.sym("U", dim), dim, -np.inf, np.inf, np.asarray(twist) / vs)
+    else:
+        U = ca.DM(np.asarray(pusher_twist) / vs)
+    return V, U
+
+
+def _friction(prog: _Program, c: dict, fn, ft, s, ut, k: int, fs: float) -> None:
+    """The friction law of one contact: Coulomb's cone with maximum dissipation, or a
+    limit-surface patch."""
+    import casadi as ca
+
+    if c["friction"] == "coulomb":
+        mu = c["mu"]
+        cone = (mu * fn) ** 2 - ca.sumsqr(ft)
+        prog.constrain(cone, 0.0, np.inf)
+        # maximum dissipation: mu f_n u_t + f_t s = 0, s = |u_t|
+        prog.constrain(mu * fn * ut + ft * s, 0.0, 0.0, k)
+        prog.constrain(s**2 - ca.sumsqr(ut), 0.0, 0.0)
+    else:
+        A = np.asarray(c["A"]) * fs**2
+        Ainv = np.linalg.inv(A)
+        cone = 1 - ca.mtimes([ft.T, ca.DM(A), ft])
+        prog.constrain(cone, 0.0, np.inf)
+        prog.constrain(ft * s + ca.mtimes(ca.DM(Ainv), ut), 0.0, 0.0, k)
+        prog.constrain(s**2 - ca.mtimes([ut.T, ca.DM(Ainv), ut]), 0.0, 0.0)
+    prog.complementarity(cone, s)
+
+
+def _contact(prog: _Program, i: int, c: dict, V, U, h: float, vs: float, fs: float):
+    """One contact's unknowns and constraints; returns its normal force, friction force and its
+    term of the Newton–Euler equations."""
+    import casadi as ca
+
+    jn, jt = np.asarray(c["jn"]), np.asarray(c["jt"])
+    jno, jto = np.asarray(c["jn_other"]), np.asarray(c["jt_other"])
+    k = jt.shape[0]
+    un = ca.mtimes(ca.DM(jn[None, :]), V) - ca.mtimes(ca.DM(jno[None, :]), U) + c["gap"] / h / vs
+    ut = ca.mtimes(ca.DM(jt), V) - ca.mtimes(ca.DM(jto), U)
+    if c["normal"] == "unilateral":
+        fn = prog.var(f"fn{i}", 1, 0.0, np.inf, 0.1)
+        prog.constrain(un, 0.0, np.inf)
+        prog.complementarity(fn, un)
+    else:
+        fn = ca.DM(c["normal_force"] / fs)
+    ft = prog.var(f"ft{i}", k, -np.inf, np.inf, 0.0)
+    s = prog.var(f"s{i}", 1, 0.0, np.inf, 1.0)
+    _friction(prog, c, fn, ft, s, ut, k, fs)
+    return fn, ft, ca.DM(jn[:, None]) * fn + ca.mtimes(ca.DM(jt.T), ft)
+
+
+def _solve_relaxed(prog: _Program, newton_euler, dim: int, tol: float, max_iter: int):
+    """IPOPT on the program, the relaxation ε driven from 1 to 1e-10, each solve warm-starting
+    the next. Returns (x, the last solution, solver stats, iterations, seconds)."""
+    import casadi as ca
+
+    eps = ca.SX.sym("eps")
+    g = [newton_euler] + prog.g + [r - eps for r in prog.relaxed]
+    lbg = [0.0] * dim + prog.lbg + [-np.inf] * len(prog.relaxed)
+    ubg = [0.0] * dim + prog.ubg + [0.0] * len(prog.relaxed)
+    x = ca.vertcat(*prog.xs)
+    nlp = {"x": x, "f": prog.objective, "g": ca.vertcat(*g), "p": eps}
+    opts = {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": tol, "ipopt.max_iter": max_iter,
+            "ipopt.sb": "yes", "ipopt.mu_strategy": "adaptive"}
+    solver = ca.nlpsol("mncp", "ipopt", nlp, opts)
+    t0 = time.perf_counter()
+    xv, iters, sol = ca.DM(prog.x_init), 0, None
+    for e in (1.0, 1e-2, 1e-4, 1e-6, 1e-8, 1e-10):
+        sol = solver(x0=xv, p=e, lbx=ca.DM(prog.lbx), ubx=ca.DM(prog.ubx), lbg=ca.DM(lbg), ubg=ca.DM(ubg))
+        xv = sol["x"]
+        iters += int(solver.stats()["iter_count"])
+    return x, sol, solver.stats(), iters, time.perf_counter() - t0
+
+
 def solve(problem, pusher_twist=None, twist=None, tol: float = 1e-10, accept: float = 1e-6,
           x0: dict | None = None, max_iter: int = 500) -> ReferenceSolution:
     """Forward problem (give ``pusher_twist``) or inverse problem (give ``twist``) with IPOPT.
@@ -66,110 +183,18 @@ def solve(problem, pusher_twist=None, twist=None, tol: float = 1e-10, accept: fl
     contacts = d["contacts"]
 
     # unknowns, scaled: V/vs, U/vs, f/fs, s/vs
-    V = ca.SX.sym("V", dim) if twist is None else ca.DM(np.asarray(twist) / vs)
-    U = ca.SX.sym("U", dim) if pusher_twist is None else ca.DM(np.asarray(pusher_twist) / vs)
-    xs, lbx, ubx, x_init = [], [], [], []
-
-    def var(name, n, lb, ub, init):
-        x = ca.SX.sym(name, n)
-        xs.append(x)
-        lbx.extend([lb] * n)
-        ubx.extend([ub] * n)
-        x_init.extend(list(np.broadcast_to(init, (n,))))
-        return x
-
-    if twist is None:
-        xs.append(V)
-        lbx.extend([-np.inf] * dim)
-        ubx.extend([np.inf] * dim)
-        x_init.extend(list(np.asarray(pusher_twist) / vs if x0 is None else np.asarray(x0["twist"]) / vs))
-    if pusher_twist is None:
-        xs.append(U)
-        lbx.extend([-np.inf] * dim)
-        ubx.extend([np.inf] * dim)
-        x_init.extend(list(np.asarray(twist) / vs))
-
-    g, lbg, ubg = [], [], []
-    objective = 0
-    eps = ca.SX.sym("eps")
-    relaxed = []  # complementarity products, each ≤ eps
+    prog = _Program()
+    V, U = _twists(prog, dim, vs, pusher_twist, twist, x0)
     ne = ca.DM(w / fs) - ca.mtimes(ca.DM(M * vs / fs), V)
-    f_n_expr, f_t_expr, s_vars = [], [], []
+    f_n_expr, f_t_expr = [], []
     for i, c in enumerate(contacts):
-        jn, jt = np.asarray(c["jn"]), np.asarray(c["jt"])
-        jno, jto = np.asarray(c["jn_other"]), np.asarray(c["jt_other"])
-        k = jt.shape[0]
-        un = ca.mtimes(ca.DM(jn[None, :]), V) - ca.mtimes(ca.DM(jno[None, :]), U) + c["gap"] / h / vs
-        ut = ca.mtimes(ca.DM(jt), V) - ca.mtimes(ca.DM(jto), U)
-        if c["normal"] == "unilateral":
-            fn = var(f"fn{i}", 1, 0.0, np.inf, 0.1)
-            g.append(un)
-            lbg.append(0.0)
-            ubg.append(np.inf)
-            objective += fn * un
-            relaxed.append(fn * un)
-        else:
-            fn = ca.DM(c["normal_force"] / fs)
-        ft = var(f"ft{i}", k, -np.inf, np.inf, 0.0)
-        s = var(f"s{i}", 1, 0.0, np.inf, 1.0)
-        ne += ca.DM(jn[:, None]) * fn + ca.mtimes(ca.DM(jt.T), ft)
-        if c["friction"] == "coulomb":
-            mu = c["mu"]
-            cone = (mu * fn) ** 2 - ca.sumsqr(ft)
-            g.append(cone)
-            lbg.append(0.0)
-            ubg.append(np.inf)
-            # maximum dissipation: mu f_n u_t + f_t s = 0, s = |u_t|
-            g.append(mu * fn * ut + ft * s)
-            lbg.extend([0.0] * k)
-            ubg.extend([0.0] * k)
-            g.append(s**2 - ca.sumsqr(ut))
-            lbg.append(0.0)
-            ubg.append(0.0)
-            objective += cone * s
-            relaxed.append(cone * s)
-        else:
-            A = np.asarray(c["A"]) * fs**2
-            Ainv = np.linalg.inv(A)
-            cone = 1 - ca.mtimes([ft.T, ca.DM(A), ft])
-            g.append(cone)
-            lbg.append(0.0)
-            ubg.append(np.inf)
-            g.append(ft * s + ca.mtimes(ca.DM(Ainv), ut))
-            lbg.extend([0.0] * k)
-            ubg.extend([0.0] * k)
-            g.append(s**2 - ca.mtimes([ut.T, ca.DM(Ainv), ut]))
-            lbg.append(0.0)
-            ubg.append(0.0)
-            objective += cone * s
-            relaxed.append(cone * s)
+        fn, ft, term = _contact(prog, i, c, V, U, h, vs, fs)
+        ne += term
         f_n_expr.append(fn)
         f_t_expr.append(ft)
-        s_vars.append(s)
-    g.insert(0, ne)
-    lbg = [0.0] * dim + lbg
-    ubg = [0.0] * dim + ubg
-    for r in relaxed:
-        g.append(r - eps)
-        lbg.append(-np.inf)
-        ubg.append(0.0)
-
-    x = ca.vertcat(*xs)
-    nlp = {"x": x, "f": objective, "g": ca.vertcat(*g), "p": eps}
-    opts = {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": tol, "ipopt.max_iter": max_iter,
-            "ipopt.sb": "yes", "ipopt.mu_strategy": "adaptive"}
-    solver = ca.nlpsol("mncp", "ipopt", nlp, opts)
-    t0 = time.perf_counter()
-    xv, iters = ca.DM(x_init), 0
-    for e in (1.0, 1e-2, 1e-4, 1e-6, 1e-8, 1e-10):
-        sol = solver(x0=xv, p=e, lbx=ca.DM(lbx), ubx=ca.DM(ubx), lbg=ca.DM(lbg), ubg=ca.DM(ubg))
-        xv = sol["x"]
-        iters += int(solver.stats()["iter_count"])
-    elapsed = time.perf_counter() - t0
-    stats = solver.stats()
-    f = ca.Function("unpack", [x], [V, U, ca.vertcat(*[ca.DM(fn) if isinstance(fn, ca.DM) else fn for fn in f_n_expr]),
-                                    ca.vertcat(*f_t_expr)])
-    Vv, Uv, fnv, ftv = (np.asarray(a).ravel() for a in f(xv))
+    x, sol, stats, iters, elapsed = _solve_relaxed(prog, ne, dim, tol, max_iter)
+    f = ca.Function("unpack", [x], [V, U, ca.vertcat(*f_n_expr), ca.vertcat(*f_t_expr)])
+    Vv, Uv, fnv, ftv = (np.asarray(a).ravel() for a in f(sol["x"]))
     Vv, Uv, fnv, ftv = Vv * vs, Uv * vs, fnv * fs, ftv * fs
     fts, k0 = [], 0
     for c in contacts:

@@ -16,6 +16,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import ArgumentError, SceneError
+from .common import core_property, read_scene_file
 
 ArrayLike = Sequence[float] | np.ndarray
 
@@ -101,35 +102,17 @@ class MotionCone:
     def __repr__(self) -> str:
         return f"MotionCone(pusher={self.pusher!r}, pose={list(self.pose)}, shape={self._core.pusher_cone_shape})"
 
-    @property
-    def pusher(self) -> str:
-        return self._core.pusher
-
-    @property
-    def pose(self) -> np.ndarray:
-        return np.array(self._core.pose)
-
-    @property
-    def generators(self) -> np.ndarray:
-        return self._core.generators
-
-    @property
-    def gravity_free_generators(self) -> np.ndarray:
-        return self._core.gravity_free_generators
+    pusher = core_property("pusher")
+    pose = core_property("pose", wrap=np.array)
+    generators = core_property("generators")
+    gravity_free_generators = core_property("gravity_free_generators")
 
     @property
     def gravity_free(self) -> GravityFreeCone:
         return GravityFreeCone(self)
 
-    @property
-    def hold_ratio(self) -> float:
-        """Share of the pads' friction that gravity alone uses (< 1 holds)."""
-        return self._core.hold_ratio
-
-    @property
-    def is_line_pusher(self) -> bool:
-        """A line pusher (two rigidly connected points) rather than a point pusher."""
-        return self._core.line
+    hold_ratio = core_property("hold_ratio", "Share of the pads' friction that gravity alone uses (< 1 holds).")
+    is_line_pusher = core_property("line", "A line pusher (two rigidly connected points) rather than a point pusher.")
 
     def contains(self, twist):
         """Exact test for one twist (bool) or an (n, 3) array (bool array)."""
@@ -279,6 +262,9 @@ def _jsonable(x):
 class Scene:
     """A validated planar scene. Load with :meth:`Scene.load` (TOML) or :meth:`Scene.from_dict`."""
 
+    #: poses [x, z, theta]
+    dimension = 2
+
     def __init__(self, core: "_core.Scene", path: Optional[Path] = None, source: Optional[tuple] = None):
         self._core = core
         self.path = path
@@ -294,11 +280,7 @@ class Scene:
 
     @classmethod
     def load(cls, path) -> "Scene":
-        p = Path(path)
-        try:
-            text = p.read_text()
-        except OSError as e:
-            raise ArgumentError(f"invalid `path`: cannot read {p}: {e}", "path") from e
+        p, text = read_scene_file(path)
         return cls(_core.Scene.from_toml(text), p, ("toml", text))
 
     @classmethod
@@ -320,18 +302,9 @@ class Scene:
     def __repr__(self) -> str:
         return f"Scene({self.name!r}, kind={self.kind}, pushers={self.pusher_names})"
 
-    @property
-    def name(self) -> str:
-        return self._core.name
-
-    @property
-    def kind(self) -> str:
-        """"grasp" (object between finger pads) or "surface" (object on a plane)."""
-        return self._core.kind
-
-    @property
-    def pusher_names(self) -> list[str]:
-        return self._core.pusher_names
+    name = core_property("name")
+    kind = core_property("kind", '"grasp" (object between finger pads) or "surface" (object on a plane).')
+    pusher_names = core_property("pusher_names")
 
     @property
     def pushers(self) -> list[Pusher]:
@@ -345,10 +318,7 @@ class Scene:
         pts, normal, mu = self._core.pusher(name)
         return Pusher(name, np.asarray(pts), np.asarray(normal), mu)
 
-    @property
-    def length(self) -> float:
-        """Characteristic length L [m] weighing rotation against translation."""
-        return self._core.length
+    length = core_property("length", "Characteristic length L [m] weighing rotation against translation.")
 
     def metric_twist(self, twist) -> np.ndarray:
         """Twists (rows) in the frame-invariant metric: [velocity of the COM, L omega]. Norms,
@@ -365,30 +335,17 @@ class Scene:
         w = s[..., 2] / L
         return np.stack([s[..., 0] + w * c[1], s[..., 1] - w * c[0], w], axis=-1)
 
-    @property
-    def mass(self) -> float:
-        return self._core.mass
-
-    @property
-    def com(self) -> np.ndarray:
-        return np.array(self._core.com)
-
-    @property
-    def outline(self) -> np.ndarray:
-        return self._core.outline
+    mass = core_property("mass")
+    com = core_property("com", wrap=np.array)
+    outline = core_property("outline")
 
     @property
     def gravity(self) -> tuple[np.ndarray, float]:
         dx, dz, g = self._core.gravity
         return np.array([dx, dz]), g
 
-    @property
-    def grip_force(self) -> Optional[float]:
-        return self._core.grip_force
-
-    @property
-    def pad(self):
-        return self._core.pad
+    grip_force = core_property("grip_force")
+    pad = core_property("pad")
 
     @property
     def task(self) -> Optional[Task]:
@@ -406,21 +363,10 @@ class Scene:
         s._ops = tuple(getattr(self, "_ops", ())) + ((op, kw),)
         return s
 
-    @property
-    def mode(self) -> str:
-        """Which motion cones this scene answers with: "nominal", "robust" or "fixtureless"."""
-        return self._core.mode
-
-    @property
-    def uncertainty(self) -> Optional[dict]:
-        """The ``[uncertainty]`` table (relative spreads), or None."""
-        return self._core.uncertainty
-
-    @property
-    def rho(self) -> Optional[float]:
-        """ρ = μ_s N / (m g), the one number mass, grip force and finger friction enter the
-        planar motion cone through (grasp scenes)."""
-        return self._core.rho
+    mode = core_property("mode", 'Which motion cones this scene answers with: "nominal", "robust" or "fixtureless".')
+    uncertainty = core_property("uncertainty", "The ``[uncertainty]`` table (relative spreads), or None.")
+    rho = core_property("rho", "ρ = μ_s N / (m g), the one number mass, grip force and finger friction enter the "
+                               "planar motion cone through (grasp scenes).")
 
     def scaled(self, finger_friction: float = 1.0, grip: float = 1.0, mass: float = 1.0,
                pusher_friction: float = 1.0, mode: str = "nominal") -> "Scene":

@@ -11,21 +11,24 @@ from typing import Optional
 import numpy as np
 
 from .. import _core
-from ..errors import ArgumentError, check_seed
+from ..errors import ArgumentError, RegraspError
+from ..planning.plan import Plan, as_plan
+from .common import core_property, read_scene_file
 
 
 class Scene3D:
+    """A validated 3-D scene. Load with :meth:`Scene3D.load` (or :func:`regrasp.load_scene`)."""
+
+    #: poses [x, y, z, qw, qx, qy, qz]
+    dimension = 3
+
     def __init__(self, core: "_core.Scene3D", path: Optional[Path] = None):
         self._core = core
         self.path = path
 
     @classmethod
     def load(cls, path) -> "Scene3D":
-        p = Path(path)
-        try:
-            text = p.read_text()
-        except OSError as e:
-            raise ArgumentError(f"invalid `path`: cannot read {p}: {e}", "path") from e
+        p, text = read_scene_file(path)
         return cls(_core.Scene3D.from_toml(text, str(p.parent)), p)
 
     @classmethod
@@ -35,11 +38,11 @@ class Scene3D:
     def __repr__(self) -> str:
         return f"Scene3D({self.name!r}, pushers={self.pusher_names})"
 
-    name = property(lambda self: self._core.name)
-    pusher_names = property(lambda self: self._core.pusher_names)
-    length = property(lambda self: self._core.length)
-    mass = property(lambda self: self._core.mass)
-    inertia = property(lambda self: self._core.inertia)
+    name = core_property("name")
+    pusher_names = core_property("pusher_names")
+    length = core_property("length", "Characteristic length L [m] weighing rotation against translation.")
+    mass = core_property("mass")
+    inertia = core_property("inertia")
 
     @property
     def task(self):
@@ -59,34 +62,30 @@ class Scene3D:
         return self._core.simulate_push(list(np.asarray(pose, float)), pusher, list(np.asarray(twist, float)),
                                         float(duration), float(dt))
 
+    def plan(self, start=None, goal=None, **settings) -> Plan:
+        """T-RRT* over SE(3) with inverse-dynamics and rolling unit steps (thesis §4.2): the same
+        as ``regrasp.plan(self, ...)``, a :class:`~regrasp.Plan` of ``dimension`` 3 (each step
+        also carries the pusher's body twist over unit time, ``pusher_twists``; ``solves``;
+        ``valid``). ``settings`` override the defaults of ``regrasp.planner_defaults(3)``."""
+        from ..planning.plan import plan
 
-    def plan(self, start=None, goal=None, **settings) -> dict:
-        """T-RRT* over SE(3) with inverse-dynamics unit steps (thesis §4.2): a plan dict like the
-        planar plan file (poses [x, y, z, qw, qx, qy, qz]; each step also carries the pusher's
-        body twist ``pusher_twist`` over unit time) plus ``solves`` and ``valid``. ``settings``
-        override the defaults of ``regrasp._core.planner_defaults(3)``."""
-        if "seed" in settings:
-            settings["seed"] = check_seed(settings["seed"])
-        s = None if start is None else [float(x) for x in start]
-        g = None if goal is None else [float(x) for x in goal]
-        r = self._core.plan(s, g, settings)
-        r["valid"] = all(self.validate_path(r["path"])) if len(r["path"]) > 1 else True
-        return r
+        return plan(self, start, goal, **settings)
 
-    def validate_path(self, path: list) -> list:
-        """Whether each step of a 3-D plan's path can be taken by its pusher (see
-        ``regrasp::trrt3d::validate_path3``)."""
-        path = check_plan3d(self, {"path": path})
-        has = [k.get("pusher_twist") is not None for k in path]
-        tw = [k["pusher_twist"] if h else [0.0] * 6 for k, h in zip(path, has)] if any(has) else None
-        return self._core.validate_path([list(map(float, k["pose"])) for k in path], [k["pusher"] for k in path], tw)
+    def validate_path(self, path) -> list:
+        """Whether each step of a 3-D plan (a :class:`~regrasp.Plan`, a plan dict or its
+        ``path`` list) can be taken by its pusher (see ``regrasp::trrt3d::validate_path3``)."""
+        p = as_plan({"path": path} if isinstance(path, list) else path, self)
+        tw = p.pusher_twists
+        tw = None if all(u is None for u in tw) else [[0.0] * 6 if u is None else u.tolist() for u in tw]
+        return self._core.validate_path(p.poses.tolist(), p.pushers, tw)
 
-    def replay(self, plan: dict, dt: float = 0.25, feedback: bool = False, max_replans: int = 10, seed: int = 0) -> dict:
-        """Replays a 3-D plan in the quasi-static simulator: each step's pusher moves with the
-        step's twist for unit time from wherever the object is. Returns the final pose, the
-        error to the goal (position [m] and angle [rad]), success (within the task's tolerance),
-        the poses after each step and the re-plans made (``feedback``: see :func:`run_plan3d`)."""
-        path = check_plan3d(self, plan)
+    def replay(self, plan, dt: float = 0.25, feedback: bool = False, max_replans: int = 10, seed: int = 0) -> dict:
+        """Replays a 3-D plan (a :class:`~regrasp.Plan` or a plan dict) in the quasi-static
+        simulator: each step's pusher moves with the step's twist for unit time from wherever
+        the object is. Returns the final pose, the error to the goal (position [m] and angle
+        [rad]), success (within the task's tolerance), the poses after each step and the
+        re-plans made (``feedback``: see :func:`run_plan3d`)."""
+        path = as_plan(plan, self).path
 
         def step(a, b):
             u = b.get("pusher_twist")
@@ -143,8 +142,6 @@ def run_plan3d(scene: "Scene3D", path: list, step, q0, feedback: bool = False, m
     def off(q, ref):
         return bool(np.any(np.abs(q[:3] - np.asarray(ref[:3], float)) > tol[:3] / 2) or quat_angle(q[3:], ref[3:]) > tol[3] / 2)
 
-    from ..errors import RegraspError
-
     q = np.asarray(q0, float)
     poses, replans, i = [q], 0, 0
     while True:
@@ -155,11 +152,11 @@ def run_plan3d(scene: "Scene3D", path: list, step, q0, feedback: bool = False, m
             if feedback and replans < max_replans:
                 replans += 1
                 try:
-                    new = scene.plan(start=q, seed=seed + replans)
+                    new = scene.plan(start=q, seed=seed + replans).path
                 except RegraspError:  # e.g. a pad off the object at the measured pose
-                    new = {"path": []}
-                if len(new["path"]) >= 2:
-                    path, i = new["path"], 0
+                    new = []
+                if len(new) >= 2:
+                    path, i = new, 0
             if i + 1 >= len(path):
                 break
         q = np.asarray(step(path[i], path[i + 1]), float)
@@ -169,35 +166,9 @@ def run_plan3d(scene: "Scene3D", path: list, step, q0, feedback: bool = False, m
 
 
 def check_plan3d(scene: "Scene3D", plan) -> list:
-    """The path of a 3-D plan, checked: poses of 7 numbers, known pushers, twists of 6 numbers.
-    Errors name the field."""
-    if not isinstance(plan, dict) or not isinstance(plan.get("path"), list) or len(plan["path"]) < 1:
-        raise ArgumentError("invalid `plan`: a dict with a non-empty `path` list", "plan.path")
-    for i, k in enumerate(plan["path"]):
-        if not isinstance(k, dict) or "pose" not in k:
-            raise ArgumentError(f"invalid `plan.path[{i}]`: needs a `pose`", f"plan.path[{i}].pose")
-        try:
-            q = np.asarray(k["pose"], float)
-        except (TypeError, ValueError):
-            q = np.full(1, np.nan)
-        if q.shape != (7,) or not np.all(np.isfinite(q)) or np.linalg.norm(q[3:]) < 1e-9:
-            raise ArgumentError(f"invalid `plan.path[{i}].pose`: 7 finite numbers [x, y, z, qw, qx, qy, qz]",
-                                f"plan.path[{i}].pose")
-        if i > 0 and k.get("pusher") not in scene.pusher_names:
-            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k.get('pusher')!r} in the scene",
-                                f"plan.path[{i}].pusher")
-        if i > 0 and k.get("pusher_twist") is None and scene._core.is_plane(k["pusher"]):
-            raise ArgumentError(f"invalid `plan.path[{i}].pusher_twist`: a step of plane {k['pusher']!r} needs its "
-                                "pusher twist (a plane only rolls the object)", f"plan.path[{i}].pusher_twist")
-        if i > 0 and k.get("pusher_twist") is not None:
-            try:
-                u = np.asarray(k["pusher_twist"], float)
-            except (TypeError, ValueError):
-                u = np.full(1, np.nan)
-            if u.shape != (6,) or not np.all(np.isfinite(u)):
-                raise ArgumentError(f"invalid `plan.path[{i}].pusher_twist`: 6 finite numbers",
-                                    f"plan.path[{i}].pusher_twist")
-    return plan["path"]
+    """The path (a list of entries) of a 3-D plan (a :class:`~regrasp.Plan` or a plan dict),
+    checked against ``scene``; errors name the field (``plan.path[2].pusher_twist``)."""
+    return as_plan(plan, scene).path
 
 
 def quat_angle(a, b) -> float:
@@ -210,13 +181,3 @@ def quat_angle(a, b) -> float:
 def twist_between(a, b) -> list:
     """The constant body twist taking pose a to pose b in unit time (SE(3) log, the core's)."""
     return list(_core.se3_log([float(x) for x in a], [float(x) for x in b]))
-
-
-def is_3d(path) -> bool:
-    """Whether a scene file is a 3-D scene (``dimension = 3``)."""
-    import tomllib
-
-    try:
-        return tomllib.loads(Path(path).read_text()).get("dimension") == 3
-    except (OSError, tomllib.TOMLDecodeError):
-        return False

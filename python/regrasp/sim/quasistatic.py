@@ -8,13 +8,12 @@ object with exactly that twist; a point pusher only imposes its contact point's 
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import ArgumentError
+from ..planning.plan import as_plan
 from ..scene.planar import Scene, _vec
 
 SPEED = 0.01  # m/s, the thesis' pushing speed
@@ -60,24 +59,6 @@ def body_twist(a, b) -> np.ndarray:
     return np.array([lin[0], lin[1], w])
 
 
-def load_plan(path) -> dict:
-    p = Path(path)
-    try:
-        plan = json.loads(p.read_text())
-    except (OSError, ValueError) as e:
-        raise ArgumentError(f"invalid `plan`: cannot read {p}: {e}", "plan") from e
-    path_ = plan.get("path")
-    if not isinstance(path_, list) or len(path_) < 1:
-        raise ArgumentError("invalid `plan`: it needs a non-empty `path`", "plan.path")
-    for i, k in enumerate(path_):
-        q = k.get("pose") if isinstance(k, dict) else None
-        if not (isinstance(q, list) and len(q) == 3 and all(isinstance(x, (int, float)) and np.isfinite(x) for x in q)):
-            raise ArgumentError(f"invalid `plan.path[{i}].pose`: expected 3 finite numbers", f"plan.path[{i}].pose")
-        if i > 0 and not isinstance(k.get("pusher"), str):
-            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: expected a pusher name", f"plan.path[{i}].pusher")
-    return plan
-
-
 @dataclass
 class Replay:
     """Result of replaying a plan in a simulator."""
@@ -102,15 +83,11 @@ class Replay:
         }
 
 
-def replay_plan(scene: Scene, plan: dict, speed: float = SPEED, dt: float = 0.05, **support) -> Replay:
-    """Replays a plan in the quasi-static simulator: for each step the pusher is put in contact
-    with the object where it is now, then follows the planned object motion of that step (its
-    body twist, at ``speed``)."""
-    path = plan["path"]
-    for i, k in enumerate(path[1:], 1):
-        if k["pusher"] not in scene.pusher_names:
-            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r} in the scene",
-                                f"plan.path[{i}].pusher")
+def replay_plan(scene: Scene, plan, speed: float = SPEED, dt: float = 0.05, **support) -> Replay:
+    """Replays a plan (a :class:`~regrasp.Plan` or a plan dict) in the quasi-static simulator:
+    for each step the pusher is put in contact with the object where it is now, then follows the
+    planned object motion of that step (its body twist, at ``speed``)."""
+    path = as_plan(plan, scene).path
     q = np.asarray(path[0]["pose"], float)
     ts, qs, planned = [0.0], [q.copy()], [q.copy()]
     t_now, max_slip, steps = 0.0, 0.0, []

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..planning.plan import as_plan
 from ..scene.planar import MotionCone
 
 
@@ -41,26 +42,53 @@ def boundary_samples(cone: MotionCone, n: int = 40):
 def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
     """Two 3-D panels: (left) wrench space: the limit surface, the pusher's friction cone shifted
     by gravity and their intersection (the wrench set); (right) twist space: the exact, curved
-    motion cone, its polyhedral approximation and the gravity-free cone."""
+    motion cone, its polyhedral approximation and the gravity-free cone; beside them a chart of
+    ray directions where the difference shows."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    sc = cone.scene
-    L, com = sc.length, sc.com
+    fig = plt.figure(figsize=(18, 6))
+    samples = boundary_samples(cone)
+    _wrench_panel(fig.add_subplot(1, 3, 1, projection="3d"), cone, samples)
+    _twist_panel(fig.add_subplot(1, 3, 2, projection="3d"), cone, samples)
+    _ray_chart(fig.add_subplot(1, 3, 3), cone, samples)
+    q = cone.pose
+    fig.suptitle(
+        title
+        or f"{cone.scene.name}: pusher '{cone.pusher}' at pose [{q[0]:.4f}, {q[1]:.4f}, {q[2]:.3f}]"
+        f" — grip {cone.scene.grip_force} N, gravity uses {100 * cone.hold_ratio:.1f}% of the pad friction"
+    )
+    return _save(fig, path)
 
-    def Wm(w):  # wrench metric: [f, moment about the COM / L]
+
+def _wrench_metric(scene):
+    """Wrenches (rows) in the plotted metric: [f, moment about the COM / L]."""
+    L, com = scene.length, scene.com
+
+    def Wm(w):
         w = np.asarray(w, float)
         return np.stack([w[..., 0], w[..., 1], (w[..., 2] - (com[0] * w[..., 1] - com[1] * w[..., 0])) / L], axis=-1)
 
-    Tm = sc.metric_twist  # twist metric: [COM velocity, L omega]
-    A, Js, wg = cone._core.support_matrices
-    fig = plt.figure(figsize=(18, 6))
+    return Wm
 
-    # --- wrench space -------------------------------------------------------------------------
-    ax = fig.add_subplot(1, 3, 1, projection="3d")
+
+def _label3d(ax, labels, title: str) -> None:
+    """Axis labels, title and legend of a 3-D panel."""
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+    ax.set_zlabel(labels[2])
+    ax.set_title(title)
+    ax.legend(loc="upper left", fontsize=8)
+
+
+def _wrench_panel(ax, cone: MotionCone, samples) -> None:
+    """Wrench space: the limit surface, the pusher's cone shifted by gravity, the wrench set."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    Wm = _wrench_metric(cone.scene)
+    A, Js, wg = cone._core.support_matrices
     # limit surface {Js^T w : w^T A w = 1}: w = A^{-1/2} s for s on the unit sphere
     evals, evecs = np.linalg.eigh(A)
     Ainvh = evecs @ np.diag(evals**-0.5) @ evecs.T
@@ -72,8 +100,7 @@ def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
     E = cone._core.pusher_edges
     reach = 1.3 * np.max(np.linalg.norm(ell.reshape(-1, 3), axis=1))
     apex = Wm(wg)
-    segs = cone._core.boundary_segments
-    for i, j in segs:
+    for i, j in cone._core.boundary_segments:
         ei, ej = Wm(E[i]), Wm(E[j])
         ei, ej = ei / np.linalg.norm(ei) * reach, ej / np.linalg.norm(ej) * reach
         ax.add_collection3d(Poly3DCollection([[apex, apex + ei, apex + ej]], alpha=0.15, color="tab:blue"))
@@ -82,17 +109,17 @@ def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
         ax.plot(*np.stack([apex, apex + es / np.linalg.norm(es) * reach]).T, color="tab:blue", lw=1)
     ax.scatter(*apex, color="k", s=20)
     ax.text(*apex, "  w_g", fontsize=8)
-    samples = boundary_samples(cone)
     for k, (ws, _) in enumerate(samples):
         ax.plot(*Wm(ws).T, color="tab:red", lw=2.5, label="wrench set boundary" if k == 0 else None)
-    ax.set_xlabel("f_x [N]")
-    ax.set_ylabel("f_z [N]")
-    ax.set_zlabel("tau_com / L [N]")
-    ax.set_title("wrench space: limit surface, pusher cone + gravity")
-    ax.legend(loc="upper left", fontsize=8)
+    _label3d(ax, ("f_x [N]", "f_z [N]", "tau_com / L [N]"), "wrench space: limit surface, pusher cone + gravity")
 
-    # --- twist space --------------------------------------------------------------------------
-    ax = fig.add_subplot(1, 3, 2, projection="3d")
+
+def _twist_panel(ax, cone: MotionCone, samples) -> None:
+    """Twist space (metric [COM velocity, L omega]): the exact cone, its polyhedral
+    approximation and the gravity-free cone."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    Tm = cone.scene.metric_twist
     o = np.zeros(3)
     for k, (_, ts) in enumerate(samples):
         ts = Tm(ts)
@@ -100,25 +127,23 @@ def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
         ax.add_collection3d(Poly3DCollection(tris, alpha=0.12, color="tab:red"))
         ax.plot(*ts.T, color="tab:red", lw=2, label="exact cone (curved)" if k == 0 else None)
     G = Tm(cone.generators)
-    GF = Tm(cone.gravity_free_generators)
     for k, g in enumerate(G):
         ax.plot(*np.stack([o, g]).T, color="tab:green", lw=2, label="polyhedral approximation" if k == 0 else None)
-    for i, j in segs:
+    for i, j in cone._core.boundary_segments:
         if i != j:
             ax.add_collection3d(Poly3DCollection([[o, G[i], G[j]]], alpha=0.12, color="tab:green"))
-    for k, g in enumerate(GF):
+    for k, g in enumerate(Tm(cone.gravity_free_generators)):
         ax.plot(*np.stack([o, g]).T, color="k", ls="--", lw=1, label="gravity-free cone" if k == 0 else None)
     ax.set_xlim(-1, 1)
     ax.set_ylim(-1, 1)
     ax.set_zlim(-1, 1)
-    ax.set_xlabel("v_com,x [m/s]")
-    ax.set_ylabel("v_com,z [m/s]")
-    ax.set_zlabel("L omega [m/s]")
-    ax.set_title("twist space: motion cone (unit twists)")
-    ax.legend(loc="upper left", fontsize=8)
+    _label3d(ax, ("v_com,x [m/s]", "v_com,z [m/s]", "L omega [m/s]"), "twist space: motion cone (unit twists)")
 
-    # --- chart of ray directions: angles about the cone's axis --------------------------------
-    ax = fig.add_subplot(1, 3, 3)
+
+def _ray_chart(ax, cone: MotionCone, samples) -> None:
+    """A chart of ray directions: angles about the cone's axis (twist space)."""
+    Tm = cone.scene.metric_twist
+    G, GF = Tm(cone.generators), Tm(cone.gravity_free_generators)
     axis = GF.sum(axis=0)
     axis /= np.linalg.norm(axis)
     # e2: the direction along which the cone spreads most; e1 = axis × e2 (its thin direction)
@@ -138,7 +163,7 @@ def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
         ax.plot(p[:, 0], p[:, 1], color="tab:red", lw=2.5, label="exact cone" if k == 0 else None)
     for name, Gs, style in (("polyhedral approximation", G, dict(color="tab:green", lw=1.5)),
                             ("gravity-free cone", GF, dict(color="k", ls="--", lw=1))):
-        for k, (i, j) in enumerate(segs):
+        for k, (i, j) in enumerate(cone._core.boundary_segments):
             if i == j:
                 continue
             p = proj(np.stack([Gs[i], Gs[j]]))
@@ -150,13 +175,6 @@ def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
     ax.set_ylabel("latitude across it [deg]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    q = cone.pose
-    fig.suptitle(
-        title
-        or f"{cone.scene.name}: pusher '{cone.pusher}' at pose [{q[0]:.4f}, {q[1]:.4f}, {q[2]:.3f}]"
-        f" — grip {cone.scene.grip_force} N, gravity uses {100 * cone.hold_ratio:.1f}% of the pad friction"
-    )
-    return _save(fig, path)
 
 
 def _axes_pose(ax, t, q, label_prefix="", style=None):
@@ -270,6 +288,7 @@ def plot_plan(scene, plan, path) -> Path:
     import matplotlib.pyplot as plt
     from matplotlib.patches import Circle, Polygon
 
+    plan = as_plan(plan, scene)
     names = scene.pusher_names
     color = {n: PUSHER_COLORS[i % len(PUSHER_COLORS)] for i, n in enumerate(names)}
     poses = plan.poses
@@ -278,7 +297,7 @@ def plot_plan(scene, plan, path) -> Path:
     n = len(poses)
     for i, q in enumerate(poses):
         last = i in (0, n - 1)
-        pusher = plan.path[i]["pusher"]
+        pusher = plan.pushers[i]
         col = "k" if i == 0 else color[pusher]
         a.add_patch(Polygon(_object_at(scene, q), closed=True, fill=last, alpha=0.15 if last else 0.5,
                             edgecolor=col, facecolor=col, lw=1.5 if last else 0.6))
@@ -306,7 +325,7 @@ def plot_plan(scene, plan, path) -> Path:
     b.plot(k, 1e3 * poses[:, 1], "-o", ms=3, label="z [mm]")
     b.plot(k, np.degrees(poses[:, 2]), "-o", ms=3, label="theta [deg]")
     for i in range(1, n):
-        b.axvspan(i - 1, i, color=color[plan.path[i]["pusher"]], alpha=0.12, lw=0)
+        b.axvspan(i - 1, i, color=color[plan.pushers[i]], alpha=0.12, lw=0)
     b.set_xlabel("knot")
     b.legend(fontsize=8)
     b.grid(alpha=0.3)
@@ -329,13 +348,14 @@ def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> 
 
     names = scene.pusher_names
     color = {n: PUSHER_COLORS[i % len(PUSHER_COLORS)] for i, n in enumerate(names)}
+    plan = as_plan(plan, scene)
+    poses, pushers = plan.poses, plan.pushers
     frames = []
-    for i in range(1, len(plan.path)):
-        a, b = plan.path[i - 1]["pose"], plan.path[i]["pose"]
-        xi = body_twist(a, b)
+    for i in range(1, len(poses)):
+        xi = body_twist(poses[i - 1], poses[i])
         for f in range(frames_per_step):
-            frames.append((integrate_pose(a, xi, f / frames_per_step), plan.path[i]["pusher"]))
-    frames.append((np.asarray(plan.path[-1]["pose"]), plan.path[-1]["pusher"]))
+            frames.append((integrate_pose(poses[i - 1], xi, f / frames_per_step), pushers[i]))
+    frames.append((poses[-1], pushers[-1]))
     fig, ax = animation_axes(scene, [q for q, _ in frames])
     obj = Polygon(_object_at(scene, frames[0][0]), closed=True, facecolor="0.8", edgecolor="k")
     ax.add_patch(obj)
@@ -416,7 +436,7 @@ def plot_control(scene, res, path, extra=None) -> Path:
     return _save(fig, path)
 
 
-def animate_plan3d(scene, plan: dict, path, fps: int = 12, frames_per_step: int = 6) -> Path:
+def animate_plan3d(scene, plan, path, fps: int = 12, frames_per_step: int = 6) -> Path:
     """A GIF of a 3-D plan: the object moving in the grasp (pads grey, the active pusher's
     contact points red), poses interpolated along each step's twist."""
     import matplotlib
@@ -429,8 +449,8 @@ def animate_plan3d(scene, plan: dict, path, fps: int = 12, frames_per_step: int 
 
     v, t = scene.mesh()
     v, t = np.asarray(v, float), np.asarray(t, int)
-    poses = np.array([k["pose"] for k in plan["path"]], float)
-    names = [k["pusher"] for k in plan["path"]]
+    plan = as_plan(plan, scene)
+    poses, names = plan.poses, plan.pushers
     seq = []
     for k in range(len(poses) - 1):
         a, b = poses[k], poses[k + 1]

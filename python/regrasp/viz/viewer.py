@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..planning.plan import as_plan
+
 PAGE = r"""<!doctype html>
 <html><head><meta charset="utf-8"><title>regrasp: __TITLE__</title>
 <style>
@@ -154,8 +156,9 @@ def marks(scene) -> np.ndarray:
     return (np.prod(np.sign(c + 1e-12), axis=1) > 0).astype(int)
 
 
-def page(scene, plan: dict) -> str:
-    """The HTML page of ``plan`` (a 3-D plan dict) for ``scene`` (a Scene3D)."""
+def page(scene, plan) -> str:
+    """The HTML page of ``plan`` (a 3-D :class:`~regrasp.Plan` or plan dict) for ``scene`` (a Scene3D)."""
+    plan = as_plan(plan, scene)
     v, t = scene.mesh()
     v = np.asarray(v, float)
     size = float(np.linalg.norm(v, axis=1).max())
@@ -163,8 +166,8 @@ def page(scene, plan: dict) -> str:
         "name": scene.name,
         "vertices": v.tolist(),
         "triangles": np.asarray(t, int).tolist(),
-        "poses": [list(map(float, k["pose"])) for k in plan["path"]],
-        "pushers_of_steps": [k["pusher"] for k in plan["path"]],
+        "poses": plan.poses.tolist(),
+        "pushers_of_steps": plan.pushers,
         "pusher_points": {n: np.asarray(scene._core.pusher_points(n), float).tolist() for n in scene.pusher_names},
         # plane pushers: their normals (gripper frame); the page finds where they touch
         "planes": {n: np.asarray(scene._core.pusher_normal(n), float).tolist() for n in scene.pusher_names
@@ -180,7 +183,7 @@ def page(scene, plan: dict) -> str:
     return PAGE.replace("__TITLE__", html.escape(scene.name)).replace("__DATA__", text)
 
 
-def write_html(scene, plan: dict, path) -> Path:
+def write_html(scene, plan, path) -> Path:
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     p.write_text(page(scene, plan))

@@ -1,0 +1,135 @@
+"""`regrasp cone` and `regrasp approx-error`: motion cones of planar scenes."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+
+from ..errors import ArgumentError, GraspError
+from ..scene.common import is_3d_text, read_scene_file
+from ..scene.planar import Scene
+from . import CANNOT, EXAMPLES, OK, floats, load_planar, seed_arg
+
+
+def _json_float(x):
+    return None if x is None or not np.isfinite(x) else float(x)
+
+
+def _report_twist(scene: Scene, probe, cone, pusher: str, twist):
+    """The twist `regrasp cone` reports the grip forces of: the given one, else the central
+    gravity-free twist (a point pusher: the twist its contact-point motion produces)."""
+    if twist is not None:
+        return np.asarray(twist, float)
+    twist = probe.central_twist()
+    if not cone.is_line_pusher:
+        # a point pusher imposes its contact point's velocity: report the twist it produces
+        r = scene.pusher(pusher).points[0]
+        u = twist[:2] + twist[2] * np.array([-r[1], r[0]])
+        t = cone.point_pusher_twist(u)
+        twist = twist if t is None else t
+    return np.asarray(twist, float)
+
+
+def cone_report(scene: Scene, pose, pusher: str, twist=None) -> dict:
+    """Everything `regrasp cone --json` prints."""
+    hold = scene.hold_grip_force(pose)
+    probe = scene.motion_cone(pose, pusher, check_hold=False)
+    cone = scene.motion_cone(pose, pusher)  # raises GraspError when it cannot hold
+    twist = _report_twist(scene, probe, cone, pusher, twist)
+    rng = probe.grip_force_range(twist) if scene.grip_force is not None else None
+    return {
+        "scene": scene.name,
+        "pusher": pusher,
+        "pose": [float(x) for x in pose],
+        "generators": cone.generators.tolist(),
+        "gravity_free_generators": cone.gravity_free_generators.tolist(),
+        "min_grip_force": None if rng is None else _json_float(rng[0]),
+        "max_grip_force": None if rng is None else _json_float(rng[1]),
+        "min_grip_force_twist": twist.tolist(),
+        "grip_force": scene.grip_force,
+        "hold_grip_force": hold,
+        "hold_ratio": cone.hold_ratio,
+        "pusher_kind": "line" if cone.is_line_pusher else "point",
+        "twist_metric_length": scene.length,
+    }
+
+
+def _print_cone(scene: Scene, rep: dict, plot) -> None:
+    print(f"motion cone of pusher '{rep['pusher']}' in scene '{scene.name}' at pose {rep['pose']}")
+    print(f"  ({rep['pusher_kind']} pusher; twists [vx, vz, omega] in the object frame, unit in diag(1,1,L^2), "
+          f"L = {scene.length:.4f} m)")
+    print("  generators (polyhedral approximation):")
+    for g in rep["generators"]:
+        print("    [{:+.5f}, {:+.5f}, {:+.4f}]".format(*g))
+    print("  gravity-free cone generators:")
+    for g in rep["gravity_free_generators"]:
+        print("    [{:+.5f}, {:+.5f}, {:+.4f}]".format(*g))
+    mn, mx = rep["min_grip_force"], rep["max_grip_force"]
+    rng = "none" if mn is None else f"[{mn:.3f}, {'inf' if mx is None else f'{mx:.3f}'}] N"
+    print(f"  grip force {scene.grip_force} N per finger; holding needs {rep['hold_grip_force']:.3f} N")
+    print(f"  grip forces at which the central gravity-free twist sticks: {rng}")
+    if plot:
+        print(f"  figure: {plot}")
+
+
+def cmd_cone(a) -> int:
+    scene = load_planar(a.scene, "cone")
+    pose = floats(a.pose, 3, "--pose")
+    twist = None if a.twist is None else floats(a.twist, 3, "--twist")
+    try:
+        rep = cone_report(scene, pose, a.pusher, twist)
+    except GraspError as e:
+        hold = scene.hold_grip_force(pose)
+        print(f"regrasp: {e} (holding needs at least {hold:.3f} N per finger)", file=sys.stderr)
+        return CANNOT
+    if a.plot:
+        from ..viz.plotting import plot_motion_cone
+
+        plot_motion_cone(scene.motion_cone(pose, a.pusher), a.plot)
+    if a.json:
+        print(json.dumps(rep))
+    else:
+        _print_cone(scene, rep, a.plot)
+    return OK
+
+
+def _bundled_planar_examples() -> list:
+    return [p for p in sorted(EXAMPLES.glob("*.toml")) if not is_3d_text(read_scene_file(p)[1])]
+
+
+def cmd_approx_error(a) -> int:
+    from ..reference.approx_error import approximation_report, format_report
+
+    scenes = [load_planar(p, "approx-error") for p in a.scenes or _bundled_planar_examples()]
+    forces = floats(a.forces, len(a.forces.split(",")), "--forces")
+    if a.samples < 1:
+        raise ArgumentError(f"invalid `--samples`: must be at least 1 (got {a.samples})", "--samples")
+    if (forces <= 0).any():
+        raise ArgumentError("invalid `--forces`: grip forces must be positive", "--forces")
+    skipped = [s.name for s in scenes if s.kind != "grasp"]
+    if skipped and not a.json:
+        print(f"(skipped {', '.join(skipped)}: no grasp, so no grip force to vary)", file=sys.stderr)
+    rows = approximation_report(scenes, tuple(forces), a.samples, a.seed)
+    print(json.dumps(rows) if a.json else format_report(rows))
+    return OK
+
+
+def add_parsers(sub) -> None:
+    c = sub.add_parser("cone", help="motion cone of a pusher at a pose")
+    c.add_argument("scene")
+    c.add_argument("--pose", required=True, help="x,z,theta (m, m, rad)")
+    c.add_argument("--pusher", required=True)
+    c.add_argument("--twist", help="vx,vz,omega for min_grip_force (default: the central gravity-free twist)")
+    c.add_argument("--json", action="store_true")
+    c.add_argument("--plot", metavar="PNG")
+    c.set_defaults(fn=cmd_cone)
+
+    e = sub.add_parser("approx-error", help="polyhedral approximation vs exact cone, per scene and grip force")
+    e.add_argument("scenes", nargs="*", help="scene files (default: every bundled example)")
+    e.add_argument("--forces", default="5,20,80", help="grip forces per finger, N")
+    e.add_argument("--samples", type=int, default=20000)
+    e.add_argument("--seed", type=seed_arg, default=0)
+    e.add_argument("--json", action="store_true")
+    e.set_defaults(fn=cmd_approx_error)

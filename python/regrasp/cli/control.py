@@ -1,0 +1,94 @@
+"""`regrasp control`: a plan executed with feedback (planar: the MPC; 3-D: re-planning)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ..errors import ArgumentError
+from ..planning.plan import Plan
+from ..scene import load_scene
+from . import (CANNOT, OK, SCALES, add_scale_options, check_positive, execute3d, floats, given, mode_scene,
+               reject_flags, scales, seed_arg)
+
+#: options of the planar MPC, without meaning for 3-D control
+PLANAR_ONLY = ("poke", "start_error", "robust", "uncertainty", "fixtureless", "plot", "dt", "horizon", "noise")
+
+
+def _control3d(scene, plan: Plan, a) -> int:
+    """3-D: the plan executed with feedback by re-planning (see
+    :func:`regrasp.scene.spatial.run_plan3d`), or open loop with --open-loop."""
+    reject_flags(a, PLANAR_ONLY, "3-D control re-plans from the measured pose")
+    if a.engine == "quasistatic" and any(getattr(a, f) is not None for f in SCALES):
+        raise ArgumentError("invalid `--scale-*`: the quasi-static 3-D world is the scene itself (MuJoCo only)", "--engine")
+    fb = not a.open_loop
+    r = execute3d(scene, plan, a, feedback=fb, seed=a.seed)
+    out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success", "replans")}
+    out["policy"] = "replan" if fb else "open_loop"
+    if a.json:
+        print(json.dumps(out))
+    else:
+        print(f"{scene.name}: {out['policy']} in {r['engine']}: {'success' if r['success'] else 'failure'}, "
+              f"{r['replans']} re-plans; error {np.round(r['goal_error'], 5).tolist()}")
+    return OK if r["success"] else CANNOT
+
+
+def _check_mpc_options(a) -> None:
+    if a.horizon is not None and a.horizon < 1:
+        raise ArgumentError(f"invalid `--horizon`: must be at least 1 step (got {a.horizon})", "--horizon")
+    check_positive(a, "dt", "control period [s]")
+    if a.noise is not None and not (a.noise >= 0 and np.isfinite(a.noise)):
+        raise ArgumentError("invalid `--noise`: must be a non-negative standard deviation", "--noise")
+
+
+def cmd_control(a) -> int:
+    from ..control.loop import Poke, control
+    from ..mujoco.planar import Perturbation
+
+    scales(a)
+    scene = load_scene(a.scene)
+    plan = Plan.load(a.plan, scene)
+    if scene.dimension == 3:
+        return _control3d(scene, plan, a)
+    _check_mpc_options(a)
+    pokes = [Poke.parse(t) for t in a.poke or []]
+    start_error = np.zeros(3) if a.start_error is None else floats(a.start_error, 3, "--start-error")
+    res = control(scene, plan, engine=a.engine, policy="open_loop" if a.open_loop else "mpc", pokes=pokes,
+                  start_error=start_error, perturb=Perturbation(*scales(a)), controller_scene=mode_scene(scene, a),
+                  seed=a.seed, **given(a, "noise", "dt", "horizon"))
+    if a.plot:
+        from ..viz.plotting import plot_control
+
+        plot_control(scene, res, a.plot)
+    if a.json:
+        print(json.dumps(res.to_json()))
+    else:
+        print(f"{scene.name}: {res.policy} in {res.engine}: {'success' if res.success else 'failure'} "
+              f"after {res.t[-1]:.1f} s, {res.replans} re-plans, median MPC step {1e3 * res.mpc_step_median_s:.3f} ms; "
+              f"final pose {np.round(res.final_pose, 5).tolist()}, error {np.round(res.goal_error, 5).tolist()}"
+              + (f" ({res.failure})" if res.failure else ""))
+    return OK if res.success else CANNOT
+
+
+def add_parsers(sub) -> None:
+    k = sub.add_parser("control", help="track a plan with the MPC (closed loop) in a simulator "
+                                       "(3-D scenes: feedback by re-planning from the measured pose)")
+    k.add_argument("scene")
+    k.add_argument("--plan", required=True)
+    k.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"])
+    k.add_argument("--poke", action="append", metavar="T,dx,dz,dtheta",
+                   help="displace the object in the grasp at time T [s] (repeatable)")
+    k.add_argument("--start-error", metavar="dx,dz,dtheta", help="the object starts this far from the plan's start")
+    add_scale_options(k)
+    k.add_argument("--robust", action="store_true", help="constrain the MPC with robust cones (scene's [uncertainty])")
+    k.add_argument("--uncertainty", metavar="P,F,N,M", help="spreads for the robust cones (implies --robust)")
+    k.add_argument("--fixtureless", action="store_true", help="constrain the MPC with fixtureless-fixturing cones")
+    k.add_argument("--open-loop", action="store_true", help="execute the plan open loop instead (for comparison)")
+    k.add_argument("--noise", type=float, help="planar: pose measurement noise, standard deviation [m] (default 0)")
+    k.add_argument("--dt", type=float, help="planar: control period [s] (default: the controller's, 0.1)")
+    k.add_argument("--horizon", type=int, help="planar: MPC horizon in steps (default: the controller's, 5)")
+    k.add_argument("--seed", type=seed_arg, default=0)
+    k.add_argument("--plot", metavar="PNG", help="planned against executed poses, pokes marked")
+    k.add_argument("--json", action="store_true")
+    k.set_defaults(fn=cmd_control)

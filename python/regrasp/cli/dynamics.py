@@ -1,0 +1,165 @@
+"""`regrasp validate`, `regrasp simulate` and `regrasp push`: the simulators."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ..errors import ArgumentError
+from ..planning.plan import POSE_SIZE, Plan
+from ..scene import load_scene
+from . import CANNOT, OK, add_scale_options, check_positive, execute3d, floats, given, load_planar, reject_flags, scales, seed_arg
+
+
+def cmd_validate(a) -> int:
+    from ..sim.validation import format_validation, validate
+
+    scene = load_planar(a.scene, "validate")
+    engines = tuple(e.strip() for e in a.engines.split(",") if e.strip())
+    if a.workers is not None and a.workers < 1:
+        raise ArgumentError("invalid `--workers`: must be at least 1", "--workers")
+    res = validate(scene, a.pushes, a.seed, engines=engines, support=a.support, workers=a.workers,
+                   ray_address=a.ray, progress=not a.json and a.pushes >= 500)
+    print(json.dumps(res) if a.json else format_validation(res))
+    return OK
+
+
+# --- simulate ----------------------------------------------------------------------------------
+
+def _simulate3d(scene, plan: Plan, a) -> int:
+    reject_flags(a, ("perturb", "video", "plot"), "--perturb/--video/--plot are planar only "
+                 "(3-D: --scale-*, --dt, --json; `regrasp plan --html` for a view)")
+    r = execute3d(scene, plan, a, **(given(a, "dt") if a.engine == "quasistatic" else {}))
+    out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success")}
+    out["max_pusher_slip"] = None
+    print(json.dumps(out) if a.json else f"{scene.name}: {r['engine']}: "
+          f"{'success' if r['success'] else 'outside the tolerance'}, error {np.round(r['goal_error'], 5).tolist()}")
+    return OK if r["success"] else CANNOT
+
+
+def _replay_planar(scene, plan: Plan, a):
+    """The planar plan replayed in the engine of --engine."""
+    if a.engine == "quasistatic":
+        from ..sim.quasistatic import replay_plan
+
+        return replay_plan(scene, plan, **given(a, "dt"))
+    from ..mujoco.planar import Perturbation, execute_plan
+
+    if a.perturb is not None and not (0 <= a.perturb < 1):
+        raise ArgumentError("invalid `--perturb`: a spread in [0, 1)", "--perturb")
+    base = Perturbation(*scales(a))
+    pert = Perturbation.draw(a.perturb, np.random.default_rng(a.seed), base) if a.perturb else base
+    rep = execute_plan(scene, plan, pert)
+    if a.video:
+        from ..mujoco.planar import animate_execution
+
+        animate_execution(scene, rep, a.video)
+    return rep
+
+
+def _print_replay(scene, rep) -> None:
+    print(f"{scene.name}: replayed {len(rep.steps)} pushes in the {rep.engine} simulator")
+    for k, st in enumerate(rep.steps, 1):
+        print(f"  {k:2d} {st['pusher']:12s} slip {1e3 * st['slip']:.3f} mm")
+    print(f"  final pose {np.round(rep.final_pose, 5).tolist()}, error to goal {np.round(rep.goal_error, 5).tolist()}: "
+          f"{'success' if rep.success else 'outside the tolerance'}; largest pusher slip {1e3 * rep.max_pusher_slip:.3f} mm")
+
+
+def cmd_simulate(a) -> int:
+    scales(a)
+    check_positive(a, "dt", "time step [s]")
+    scene = load_scene(a.scene)
+    plan = Plan.load(a.plan, scene)
+    if scene.dimension == 3:
+        return _simulate3d(scene, plan, a)
+    rep = _replay_planar(scene, plan, a)
+    if a.plot:
+        from ..viz.plotting import plot_replay
+
+        plot_replay(scene, rep, a.plot)
+    if a.json:
+        print(json.dumps(rep.to_json()))
+    else:
+        _print_replay(scene, rep)
+    return OK if rep.success else CANNOT
+
+
+# --- push --------------------------------------------------------------------------------------
+
+def _push_report(scene, a, twist, tr: dict) -> int:
+    """What `regrasp push` prints for a simulated push (planar or 3-D)."""
+    out = {
+        "scene": scene.name, "pusher": a.pusher, "twist": twist.tolist(), "final_pose": tr["pose"][-1].tolist(),
+        "max_pusher_slip_speed": float(tr["pusher_slip"].max()),
+        "pusher_sticking_share": float(np.mean(tr["pusher_sticking"] == np.maximum(tr["pusher_contacts"], 1))),
+        "max_residual": float(tr["residual"].max()),
+    }
+    if a.json:
+        out["t"] = tr["t"].tolist()
+        out["pose"] = tr["pose"].tolist()
+        if "pusher_wrench" in tr:
+            out["pusher_wrench"] = tr["pusher_wrench"].tolist()
+        print(json.dumps(out))
+    else:
+        print(f"{scene.name}: pusher '{a.pusher}' with body twist {twist.tolist()} for {a.duration} s")
+        print(f"  final pose {np.round(out['final_pose'], 5).tolist()}; pusher sticks in "
+              f"{100 * out['pusher_sticking_share']:.0f}% of the steps; largest constraint residual {out['max_residual']:.1e}")
+    return OK
+
+
+def cmd_push(a) -> int:
+    scene = load_scene(a.scene)
+    pose = floats(a.pose, POSE_SIZE[scene.dimension], "--pose")
+    twist = floats(a.twist, 6 if scene.dimension == 3 else 3, "--twist")
+    if scene.dimension == 3:
+        tr = scene.simulate_push(pose, a.pusher, twist, a.duration, a.dt)
+    else:
+        from ..sim.quasistatic import simulate_push
+
+        tr = simulate_push(scene, pose, a.pusher, twist, a.duration, a.dt)
+        if a.plot:
+            from ..viz.plotting import plot_push
+
+            plot_push(scene, tr, a.pusher, twist, a.plot)
+    return _push_report(scene, a, twist, tr)
+
+
+def add_parsers(sub) -> None:
+    v = sub.add_parser("validate", help="motion-cone predictions against the simulators")
+    v.add_argument("scene")
+    v.add_argument("--pushes", type=int, default=2000)
+    v.add_argument("--engines", default="quasistatic", help="comma-separated: quasistatic,mujoco")
+    v.add_argument("--seed", type=seed_arg, default=0)
+    v.add_argument("--workers", type=int, help="local processes for MuJoCo (default: all cores)")
+    v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
+    v.add_argument("--support", default="points", choices=["points", "limit_surface"],
+                   help="quasi-static pads as point sets (default) or as the motion cones' limit surface")
+    v.add_argument("--json", action="store_true")
+    v.set_defaults(fn=cmd_validate)
+
+    s = sub.add_parser("simulate", help="replay a plan in a simulator")
+    s.add_argument("scene")
+    s.add_argument("--plan", required=True)
+    s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"])
+    s.add_argument("--dt", type=float, help="quasi-static time step [s] (default 0.05 planar, 0.25 3-D)")
+    add_scale_options(s, "MuJoCo: ")
+    s.add_argument("--perturb", type=float,
+                   help="MuJoCo: also draw each factor uniformly in [1-P, 1+P] from --seed (default 0: none)")
+    s.add_argument("--seed", type=seed_arg, default=0)
+    s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo: an animation of the execution")
+    s.add_argument("--plot", metavar="PNG")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(fn=cmd_simulate)
+
+    p = sub.add_parser("push", help="simulate one push and plot object motion and contact forces")
+    p.add_argument("scene")
+    p.add_argument("--pose", required=True, help="x,z,theta (3-D scenes: x,y,z,qw,qx,qy,qz)")
+    p.add_argument("--pusher", required=True)
+    p.add_argument("--twist", required=True,
+                   help="pusher body twist vx,vz,omega, object frame at the start (3-D: vx,vy,vz,wx,wy,wz)")
+    p.add_argument("--duration", type=float, default=1.0)
+    p.add_argument("--dt", type=float, default=0.02)
+    p.add_argument("--plot", metavar="PNG")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(fn=cmd_push)

@@ -1,0 +1,39 @@
+"""What planar and 3-D scenes share: reading a scene file, telling the two kinds apart, and the
+read-only properties that hand a value of the Rust core through."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from ..errors import ArgumentError
+
+
+def read_scene_file(path) -> tuple[Path, str]:
+    """The path and text of a scene file; an :class:`ArgumentError` naming ``path`` when it
+    cannot be read."""
+    p = Path(path)
+    try:
+        return p, p.read_text()
+    except (OSError, UnicodeDecodeError) as e:
+        raise ArgumentError(f"invalid `path`: cannot read {p}: {e}", "path") from e
+
+
+def is_3d_text(text: str) -> bool:
+    """Whether scene text is a 3-D scene: it has a ``dimension`` key (a planar scene has none; the
+    3-D loader checks that it is 3). Text that is not TOML counts as planar, whose loader then
+    names the error."""
+    try:
+        return "dimension" in tomllib.loads(text)
+    except tomllib.TOMLDecodeError:
+        return False
+
+
+def core_property(name: str, doc: str | None = None, wrap=None) -> property:
+    """A read-only property that returns ``self._core.<name>`` (passed through ``wrap``)."""
+
+    def get(self):
+        v = getattr(self._core, name)
+        return v if wrap is None else wrap(v)
+
+    return property(get, doc=doc)
