@@ -8,7 +8,7 @@ use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, S
 use common::*;
 use proptest::prelude::*;
 use regrasp::mechanics::geometry::{perp, rot, Vec2, Vec3};
-use regrasp::scene::planar::{RawGravity, RawScene};
+use regrasp::scene::planar_file::{RawGravity, RawScene};
 use regrasp::Scene;
 
 fn twist_from_angles(a: f64, b: f64, l: f64) -> Vec3 {

@@ -3,6 +3,7 @@
 
 pub mod perturb;
 pub mod planar;
+pub mod planar_file;
 pub mod spatial;
 
 pub use planar::Scene;

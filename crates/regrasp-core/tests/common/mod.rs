@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use proptest::prelude::*;
-use regrasp::scene::planar::{RawGrasp, RawGravity, RawObject, RawPusher, RawScene, RawTask};
+use regrasp::scene::planar_file::{RawGrasp, RawGravity, RawObject, RawPusher, RawScene, RawTask};
 use regrasp::Scene;
 
 /// Parameters of a random block scene with one pusher.
