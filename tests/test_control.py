@@ -175,7 +175,8 @@ def test_control_arguments_are_checked(tmp_path):
 def test_simulate_cli_3d_rejects_planar_flags(tmp_path):
     f = tmp_path / "plan.json"
     s3 = regrasp.Scene3D.load(EXAMPLES / "offset-3d.toml")
-    f.write_text(json.dumps(s3.plan(seed=0)))
+    p3 = s3.plan(seed=0)  # a regrasp.Plan (or, before it, the plan dict)
+    f.write_text(json.dumps(p3.to_json() if hasattr(p3, "to_json") else p3))
     cli = [sys.executable, "-m", "regrasp.cli", "simulate", str(EXAMPLES / "offset-3d.toml"), "--plan", str(f)]
     r = subprocess.run(cli + ["--video", str(tmp_path / "v.gif")], capture_output=True, text=True)
     assert r.returncode == 2 and "planar only" in r.stderr

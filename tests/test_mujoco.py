@@ -99,3 +99,55 @@ def test_point_pusher_sticks_while_the_object_turns_about_it():
     assert rig.slip_fraction([0, 0, 0], u) < 0.05
     # pulled along the face, it slides
     assert rig.slip_fraction([0, 0, 0], [0.01, 0.0, 0.0]) > 0.2
+
+
+def test_models_carry_the_contact_settings_and_physics():
+    # the MjSpec builders: elliptic cones, impratio, no-slip, the geoms' solref/solimp, collision
+    # bits (pads and features touch only the object), masses, the pads' limit-surface friction
+    from regrasp.mujoco import planar, spatial
+    from regrasp.mujoco.model import Contact
+
+    s = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    plan = {"path": [{"pose": [0, 0, 0], "pusher": None}, {"pose": [0.002, 0, 0], "pusher": "left"}]}
+    m = planar.build(s, plan, Perturbation(friction=1.1, mass=0.9)).compile()
+    c = Contact()
+    assert m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC and m.opt.impratio == c.impratio
+    assert m.opt.noslip_iterations == c.noslip_iterations and m.opt.timestep == c.timestep
+    g = {m.geom(i).name or f"{m.body(m.geom_bodyid[i]).name}{i}": i for i in range(m.ngeom)}
+    obj = g["object"]
+    assert np.allclose(m.geom_solref[obj], c.solref) and np.allclose(m.geom_solimp[obj][:3], c.solimp)
+    assert (m.geom_contype[obj], m.geom_conaffinity[obj]) == (1, 3) and m.geom_condim[obj] == 4
+    assert m.body("object").mass[0] == pytest.approx(0.9 * s.mass)
+    assert m.body("gripper").mass[0] == 1000.0 and m.nmocap == 1  # one parked feature: the plan's pusher
+    pads = [i for i in range(m.ngeom) if m.geom_contype[i] == 2]
+    mu = s._core.friction_scale / (2 * s.grip_force) * 1.1
+    assert len(pads) == 2 and all(np.allclose(m.geom_friction[i][:2], [mu, s._core.pad_limit_surface_k * mu])
+                                  for i in pads)
+    feat = [i for i in range(m.ngeom) if m.geom_contype[i] == 4]
+    assert len(feat) == 1 and m.geom_conaffinity[feat[0]] == 1
+    assert list(m.actuator_gear[:, 0]) == [-1.0, 1.0] and m.nu == 2
+    s3 = regrasp.Scene3D.load(EXAMPLES / "pivot-3d.toml")
+    for world in (True, False):
+        m3 = spatial.build(s3, [0, 0, 0, 1, 0, 0, 0], world=world).compile()
+        assert m3.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC and m3.nu == 2
+        assert m3.nmocap == (len(s3.pusher_names) if world else 0)
+        assert m3.body("object").mass[0] == pytest.approx(s3.mass)
+
+
+def test_execution_takes_a_plan_or_its_dict():
+    s = regrasp.Scene.load(EXAMPLES / "block-high-friction.toml")
+    p = regrasp.plan(s, seed=0)
+    a, b = execute_plan(s, p), execute_plan(s, p.to_json())
+    assert np.array_equal(a.final_pose, b.final_pose) and a.success
+    from regrasp.mujoco.spatial import execute_plan3d
+
+    s3 = regrasp.Scene3D.load(EXAMPLES / "offset-3d.toml")
+    d = s3.plan(seed=0)
+    d = d.to_json() if hasattr(d, "to_json") else d
+
+    class PlanLike:  # what a regrasp.Plan offers: the plan file's dict
+        def to_json(self):
+            return d
+
+    r, r_dict = execute_plan3d(s3, PlanLike(), view="planner"), execute_plan3d(s3, d, view="planner")
+    assert r["success"] and r["final_pose"] == r_dict["final_pose"]

@@ -17,6 +17,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import ArgumentError, RegraspError, check_seed
+from ..mujoco.model import plan_dict
 from ..mujoco.planar import Perturbation
 from ..sim.quasistatic import body_twist, simulate_push
 from ..scene.planar import Scene
@@ -106,24 +107,13 @@ def _plant(engine: str, scene: Scene, q0, perturb: Perturbation):
 
 
 def _plan_dict(plan) -> dict:
-    d = plan if isinstance(plan, dict) else plan.to_json()
-    if "path" not in d or len(d["path"]) < 1:
+    d = plan_dict(plan)
+    if not isinstance(d, dict) or "path" not in d or len(d["path"]) < 1:
         raise ArgumentError("invalid `plan`: no path", "plan")
     return d
 
 
-def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc", pokes=(), start_error=(0.0, 0.0, 0.0),
-            perturb: Perturbation = Perturbation(), controller_scene: Scene | None = None, noise: float = 0.0,
-            seed: int = 0, dt: float = 0.1, speed: float = 0.01, horizon: int = 5, max_time: float | None = None,
-            **mpc) -> ControlResult:
-    """Runs ``plan`` closed loop (``policy="mpc"``) or open loop in ``engine``.
-
-    ``controller_scene``: the scene whose cones constrain the MPC and its re-planning (e.g.
-    ``scene.robust()``; default ``scene``). ``perturb``: the world's physics (factors on
-    friction, grip force, mass). ``start_error``: the object starts this far from the plan's
-    start (the plan was made for a wrong estimate). ``noise``: standard deviation of the pose
-    measurement [m, m·(1/L) for θ]. Success: the object's true pose within the task's tolerance.
-    """
+def _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error) -> np.ndarray:
     if engine not in ENGINES:
         raise ArgumentError(f"invalid `engine`: must be one of {ENGINES} (got {engine!r})", "engine")
     if policy not in POLICIES:
@@ -137,99 +127,152 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
     se = np.asarray(start_error, float)
     if se.shape != (3,) or not np.all(np.isfinite(se)):
         raise ArgumentError("invalid `start_error`: must be 3 finite numbers dx, dz, dtheta", "start_error")
-    p = _plan_dict(plan)
-    path = p["path"]
-    poses = [list(map(float, k["pose"])) for k in path]
-    names = [k["pusher"] for k in path]
-    task = scene.task
-    goal = np.asarray(task.goal if task is not None else poses[-1], float)
-    tol = np.asarray(task.tolerance if task is not None else [1e-3, 1e-3, 0.0175], float)
-    cscene = controller_scene or scene
-    ctrl = _core.Mpc(cscene._core, poses, names, goal.tolist(), dt=dt, horizon=horizon, speed=speed, seed=check_seed(seed), **mpc)
-    knots = np.asarray(ctrl.knots)
-    knot_pushers = ctrl.knot_pushers
-    last_poke = max((pk.t for pk in pokes), default=0.0)
-    if max_time is None:
-        # time for the plan at its speed, slack for re-plans, and for recovering after the last poke
-        max_time = max(2.5 * len(knots) * dt + 6.0, last_poke + 1.5 * len(knots) * dt + 6.0)
-    elif last_poke > max_time:
-        raise ArgumentError(f"invalid `pokes`: a poke at {last_poke} s comes after `max_time` ({max_time} s)", "pokes")
-    q0 = np.asarray(poses[0], float) + se
-    if not scene.admissible(q0):
-        raise ArgumentError("invalid `start_error`: the object's start pose puts the pad off the object", "start_error")
-    plant = _plant(engine, scene, q0, perturb)
-    rng = np.random.default_rng(seed)
-    pending = sorted(pokes, key=lambda k: k.t)
-    L = scene.length
-    ts, qs, refs, used, sts, times = [], [], [], [], [], []
-    t, k, stuck, failure = 0.0, 0, 0, ""
-    while t <= max_time + 1e-9:
-        while pending and pending[0].t <= t + 1e-9:
-            plant.poke(pending.pop(0).delta)
-        q = plant.pose()
-        meas = q + (rng.normal(0.0, noise, 3) * np.array([1.0, 1.0, 1.0 / L]) if noise > 0 else 0.0)
-        ts.append(t)
-        qs.append(q)
-        if policy == "mpc":
-            c = ctrl.step(meas.tolist())
-            if c["status"] in ("tracking", "replanned"):  # steps that solved the QP (not at goal or stuck)
-                times.append(c["solve_time_s"])
-            if c["status"] == "replanned":
-                knots = np.asarray(ctrl.knots)
-            refs.append(knots[min(c["knot"], len(knots) - 1)])
-            sts.append(c["status"])
-            used.append(c["pusher"])
-            if c["status"] == "at_goal":
-                if not pending:
-                    break
-                plant.idle(dt)
-            elif c["status"] == "stuck":
-                stuck += 1
-                if stuck >= 3 and not pending:
-                    failure = "stuck: no push of the plan helps and re-planning found none"
-                    break
-                plant.idle(dt)
-            else:
-                stuck = 0
-                try:
-                    plant.push(c["pusher"], c["twist"], dt, meas)
-                except RegraspError as e:  # the world rejected the push (e.g. the grasp cannot hold the object)
-                    failure = f"the world failed: {e}"
-                    break
-        else:
-            if k + 1 >= len(knots):
-                sts.append("done")
-                used.append(None)
-                refs.append(knots[-1])
-                if not pending:
-                    break
-                plant.idle(dt)
-            else:
-                tw = body_twist(knots[k], knots[k + 1]) / dt
-                refs.append(knots[k])
-                sts.append("open_loop")
-                used.append(knot_pushers[k + 1])
-                try:
-                    plant.push(knot_pushers[k + 1], tw, dt, knots[k])
-                except RegraspError as e:
-                    failure = f"the world failed: {e}"
-                    break
-                k += 1
-        t += dt
-    q = plant.pose()
-    if not ts or ts[-1] != t:
-        ts.append(t)
-        qs.append(q)
-        refs.append(refs[-1] if refs else knots[-1])
-        sts.append(sts[-1] if sts else "")
-        used.append(None)
-    err = q - goal
-    ok = bool(np.all(np.abs(err) <= tol)) and not failure.startswith("the world")
-    if not ok and not failure:
-        failure = "time out" if t > max_time else "ended outside the tolerance"
-    return ControlResult(engine, policy, ok, q, err, ctrl.replans if policy == "mpc" else 0,
-                         float(np.median(times)) if times else 0.0, np.array(ts), np.array(qs), np.array(refs), used, sts,
-                         [(pk.t, pk.delta.tolist()) for pk in sorted(pokes, key=lambda k: k.t)], failure)
+    return se
 
 
-__all__ = ["Poke", "ControlResult", "control", "QuasistaticPlant"]
+class ControlRun:
+    """One run of :func:`control`: the plant (the simulated world), the MPC, the pokes still to
+    come and what was recorded. :meth:`tick` is one control period."""
+
+    def __init__(self, scene: Scene, plan, engine: str, policy: str, pokes, start_error, perturb: Perturbation,
+                 controller_scene: Scene | None, noise: float, seed: int, dt: float, speed: float, horizon: int,
+                 max_time: float | None, mpc: dict):
+        path = _plan_dict(plan)["path"]
+        poses = [list(map(float, k["pose"])) for k in path]
+        task = scene.task
+        self.scene, self.policy, self.engine, self.noise, self.dt = scene, policy, engine, noise, dt
+        self.goal = np.asarray(task.goal if task is not None else poses[-1], float)
+        self.tol = np.asarray(task.tolerance if task is not None else [1e-3, 1e-3, 0.0175], float)
+        cscene = controller_scene or scene
+        self.ctrl = _core.Mpc(cscene._core, poses, [k["pusher"] for k in path], self.goal.tolist(), dt=dt,
+                              horizon=horizon, speed=speed, seed=check_seed(seed), **mpc)
+        self.knots = np.asarray(self.ctrl.knots)
+        self.knot_pushers = self.ctrl.knot_pushers
+        self.pokes = sorted(pokes, key=lambda k: k.t)
+        last_poke = max((pk.t for pk in self.pokes), default=0.0)
+        if max_time is None:
+            # time for the plan at its speed, slack for re-plans, and for recovering after the last poke
+            n = len(self.knots)
+            max_time = max(2.5 * n * dt + 6.0, last_poke + 1.5 * n * dt + 6.0)
+        elif last_poke > max_time:
+            raise ArgumentError(f"invalid `pokes`: a poke at {last_poke} s comes after `max_time` ({max_time} s)",
+                                "pokes")
+        self.max_time = max_time
+        q0 = np.asarray(poses[0], float) + start_error
+        if not scene.admissible(q0):
+            raise ArgumentError("invalid `start_error`: the object's start pose puts the pad off the object",
+                                "start_error")
+        self.plant = _plant(engine, scene, q0, perturb)
+        self.rng = np.random.default_rng(seed)
+        self.pending = list(self.pokes)
+        self.ts, self.qs, self.refs, self.used, self.statuses, self.times = [], [], [], [], [], []
+        self.t, self.k, self.stuck, self.failure = 0.0, 0, 0, ""
+
+    def measure(self) -> np.ndarray:
+        """Applies the pokes due, records the true pose and returns its (noisy) measurement."""
+        while self.pending and self.pending[0].t <= self.t + 1e-9:
+            self.plant.poke(self.pending.pop(0).delta)
+        q = self.plant.pose()
+        self.ts.append(self.t)
+        self.qs.append(q)
+        if self.noise > 0:
+            return q + self.rng.normal(0.0, self.noise, 3) * np.array([1.0, 1.0, 1.0 / self.scene.length])
+        return q + 0.0
+
+    def _record(self, ref, status: str, pusher):
+        self.refs.append(ref)
+        self.statuses.append(status)
+        self.used.append(pusher)
+
+    def _push(self, pusher: str, twist, belief) -> bool:
+        try:
+            self.plant.push(pusher, twist, self.dt, belief)
+        except RegraspError as e:  # the world rejected the push (e.g. the grasp cannot hold the object)
+            self.failure = f"the world failed: {e}"
+            return False
+        return True
+
+    def _wait(self) -> bool:
+        """Nothing to push: goes on only while pokes are to come (the plant idles a period)."""
+        if not self.pending:
+            return False
+        self.plant.idle(self.dt)
+        return True
+
+    def mpc_tick(self, meas) -> bool:
+        c = self.ctrl.step(meas.tolist())
+        status = c["status"]
+        if status in ("tracking", "replanned"):  # steps that solved the QP (not at goal or stuck)
+            self.times.append(c["solve_time_s"])
+        if status == "replanned":
+            self.knots = np.asarray(self.ctrl.knots)
+        self._record(self.knots[min(c["knot"], len(self.knots) - 1)], status, c["pusher"])
+        if status == "at_goal":
+            return self._wait()
+        if status == "stuck":
+            self.stuck += 1
+            if self.stuck >= 3 and not self.pending:
+                self.failure = "stuck: no push of the plan helps and re-planning found none"
+                return False
+            self.plant.idle(self.dt)
+            return True
+        self.stuck = 0
+        return self._push(c["pusher"], c["twist"], meas)
+
+    def open_loop_tick(self) -> bool:
+        """The plan's next push at its planned time, whatever the object does."""
+        k, knots = self.k, self.knots
+        if k + 1 >= len(knots):
+            self._record(knots[-1], "done", None)
+            return self._wait()
+        self._record(knots[k], "open_loop", self.knot_pushers[k + 1])
+        if not self._push(self.knot_pushers[k + 1], body_twist(knots[k], knots[k + 1]) / self.dt, knots[k]):
+            return False
+        self.k += 1
+        return True
+
+    def tick(self) -> bool:
+        """One control period: pokes, measurement, action. False: the run is over."""
+        meas = self.measure()
+        return self.mpc_tick(meas) if self.policy == "mpc" else self.open_loop_tick()
+
+    def result(self) -> ControlResult:
+        q = self.plant.pose()
+        if not self.ts or self.ts[-1] != self.t:
+            self.ts.append(self.t)
+            self.qs.append(q)
+            ref = self.refs[-1] if self.refs else self.knots[-1]
+            self._record(ref, self.statuses[-1] if self.statuses else "", None)
+        err = q - self.goal
+        ok = bool(np.all(np.abs(err) <= self.tol)) and not self.failure.startswith("the world")
+        failure = self.failure
+        if not ok and not failure:
+            failure = "time out" if self.t > self.max_time else "ended outside the tolerance"
+        return ControlResult(self.engine, self.policy, ok, q, err, self.ctrl.replans if self.policy == "mpc" else 0,
+                             float(np.median(self.times)) if self.times else 0.0, np.array(self.ts), np.array(self.qs),
+                             np.array(self.refs), self.used, self.statuses,
+                             [(pk.t, pk.delta.tolist()) for pk in self.pokes], failure)
+
+
+def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc", pokes=(), start_error=(0.0, 0.0, 0.0),
+            perturb: Perturbation = Perturbation(), controller_scene: Scene | None = None, noise: float = 0.0,
+            seed: int = 0, dt: float = 0.1, speed: float = 0.01, horizon: int = 5, max_time: float | None = None,
+            **mpc) -> ControlResult:
+    """Runs ``plan`` (a ``regrasp.Plan`` or its dict) closed loop (``policy="mpc"``) or open loop
+    in ``engine``.
+
+    ``controller_scene``: the scene whose cones constrain the MPC and its re-planning (e.g.
+    ``scene.robust()``; default ``scene``). ``perturb``: the world's physics (factors on
+    friction, grip force, mass). ``start_error``: the object starts this far from the plan's
+    start (the plan was made for a wrong estimate). ``noise``: standard deviation of the pose
+    measurement [m, m·(1/L) for θ]. Success: the object's true pose within the task's tolerance.
+    """
+    se = _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error)
+    run = ControlRun(scene, plan, engine, policy, pokes, se, perturb, controller_scene, noise, seed, dt, speed, horizon,
+                     max_time, mpc)
+    while run.t <= run.max_time + 1e-9 and run.tick():
+        run.t += dt
+    return run.result()
+
+
+__all__ = ["Poke", "ControlResult", "ControlRun", "control", "QuasistaticPlant"]

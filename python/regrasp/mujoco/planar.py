@@ -6,20 +6,27 @@ where the plan needs it — relative to where the gripper is, with the object wh
 it is in the grasp (open loop) — 2 mm away from the object; the gripper closes the gap, then
 moves with the inverse of the virtual pusher's planned motion, so that the object, pressed
 against the fixed feature, moves in the grasp; then it backs off 2 mm and the next feature is
-brought (a switch-over). The object's pose in the grasp is recorded all along.
+brought (a switch-over). The object's pose in the grasp is recorded all along
+(:class:`PlanarExecution`; :func:`execute_plan` runs one).
+
+What the world's view needs — the model (``regrasp.mujoco.model``, built with ``mujoco.MjSpec``),
+the driven gripper, placing a feature and backing off from it — is :class:`GripperRig`, shared by
+:class:`PlanarExecution` and :class:`WorldRig`, which the closed loop (``regrasp.control.loop``)
+drives push by push.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from ..errors import ArgumentError
-from .model import (Contact, Driver, compose, driven_body_xml, feature_xml, header, inverse, object_xml,
-                           pads_xml, planar_pose, quat_y)
-from ..sim.quasistatic import Replay, body_twist, integrate_pose
 from ..scene.planar import Scene
+from ..sim.quasistatic import Replay, body_twist, integrate_pose
+from .model import (Contact, Driver, Rig, add_driven_body, add_feature, add_grip_motors, add_object, add_planar_pads,
+                    compose, inverse, plan_dict, planar_pose, planar_spec, put_object, quat_y, rotate)
 
 GAP = 0.002  # m between the object and a feature when it is brought
 PARK = np.array([0.0, 5.0, 0.0])
@@ -47,8 +54,19 @@ class Perturbation:
         return cls(b.friction * u[0], b.grip * u[1], b.mass * u[2])
 
 
-def _segments(plan: dict) -> list:
-    path = plan["path"]
+class Feature(NamedTuple):
+    """A feature brought against the object: its pusher, its mocap body, its frame in the world
+    (the pusher frame where it meets the object), its normal in the world and its geoms."""
+
+    pusher: str
+    mocap: int
+    frame: np.ndarray
+    normal: np.ndarray
+    geoms: set
+
+
+def _segments(path: list) -> list:
+    """The pushes of a path: consecutive steps with the same pusher, as their knots."""
     segs = []
     for a, b in zip(path[:-1], path[1:]):
         if not segs or segs[-1]["pusher"] != b["pusher"]:
@@ -57,116 +75,177 @@ def _segments(plan: dict) -> list:
     return segs
 
 
-def build(scene: Scene, plan: dict, perturb: Perturbation = Perturbation(), contact: Contact = Contact()) -> str:
-    """MJCF of the execution: object at the plan's start, gripper (mocap) with force-driven pads,
-    one parked feature (mocap) per pusher the plan uses."""
-    q0 = np.asarray(plan["path"][0]["pose"], float)
-    assets, obj = object_xml(scene, q0, mass_scale=perturb.mass)
-    pads, acts = pads_xml(scene, friction_scale=perturb.friction)
-    used = sorted({k["pusher"] for k in plan["path"][1:]})
-    feats = "\n".join(feature_xml(scene, p, f"feature_{p}", perturb.pusher, PARK) for p in used)
-    return (f'<mujoco model="{scene.name}-execution">{header(scene, contact)}<asset>{assets}</asset>\n'
-            f'<worldbody>\n{obj}\n{driven_body_xml("gripper", pads)}\n{feats}\n</worldbody>\n'
-            f'<actuator>{acts}</actuator></mujoco>')
+def _spec(scene: Scene, q0, pushers, perturb: Perturbation, contact: Contact):
+    spec = planar_spec(scene, f"{scene.name}-execution", contact)
+    add_object(spec, scene, q0, mass_scale=perturb.mass)
+    add_planar_pads(add_driven_body(spec.worldbody, "gripper"), scene, friction_scale=perturb.friction)
+    for p in pushers:
+        add_feature(spec, scene, p, f"feature_{p}", perturb.pusher, PARK)
+    add_grip_motors(spec)
+    return spec
 
 
-def execute_plan(scene: Scene, plan: dict, perturb: Perturbation = Perturbation(), speed: float = 0.01,
-                 record_dt: float = 0.02, contact: Contact = Contact(), settle: float = 0.2) -> Replay:
-    """Executes ``plan`` open loop in MuJoCo; returns the recorded object pose in the grasp."""
-    import mujoco
+def build(scene: Scene, plan, perturb: Perturbation = Perturbation(), contact: Contact = Contact()):
+    """The execution's model, a ``mujoco.MjSpec`` (``.compile()`` it; ``.to_xml()`` is its MJCF):
+    the object at the plan's start, the gripper (a driven body) with force-driven pads, one parked
+    feature (a mocap body) per pusher the plan uses."""
+    path = plan_dict(plan)["path"]
+    return _spec(scene, path[0]["pose"], sorted({k["pusher"] for k in path[1:]}), perturb, contact)
 
-    for i, k in enumerate(plan["path"][1:], 1):
-        if k["pusher"] not in scene.pusher_names:
-            raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r} in the scene",
-                                f"plan.path[{i}].pusher")
-    model = mujoco.MjModel.from_xml_string(build(scene, plan, perturb, contact))
-    data = mujoco.MjData(model)
-    data.ctrl[:] = scene.grip_force * perturb.grip
-    grip = Driver(model, "gripper")
-    dt = contact.timestep
-    every = max(1, int(round(record_dt / dt)))
-    rec_t, rec_q, rec_plan = [], [], []
-    state = {"t": 0.0, "k": 0, "gripper": np.zeros(3), "planned": np.asarray(plan["path"][0]["pose"], float)}
 
-    def set_gripper(g):
-        grip.move(data, g, dt)
-        state["gripper"] = np.asarray(g, float)
+class GripperRig(Rig):
+    """MuJoCo in the world's view: the object held by force-driven pads on a driven gripper (its
+    planar pose :attr:`g` in the world), the ``pushers``' features parked until one is brought
+    against the object (:attr:`current`)."""
 
-    def grasp_pose():
-        return compose(inverse(state["gripper"]), planar_pose(model, data, "object"))
+    def __init__(self, scene: Scene, q0, pushers, perturb: Perturbation = Perturbation(), contact: Contact = Contact()):
+        super().__init__(_spec(scene, q0, pushers, perturb, contact), contact, scene.grip_force * perturb.grip)
+        self.scene = scene
+        self.gripper = Driver(self.model, "gripper")
+        self.g = np.zeros(3)
+        self.gripper.set(self.data, self.g)
+        self.forward()
+        self.current: Feature | None = None
 
-    def step():
-        mujoco.mj_step(model, data)
-        state["t"] += dt
-        state["k"] += 1
-        if state["k"] % every == 0:
-            rec_t.append(state["t"])
-            rec_q.append(grasp_pose())
-            rec_plan.append(state["planned"].copy())
+    def step_to(self, g):
+        """One time step with the gripper moving to ``g``."""
+        self.gripper.move(self.data, g, self.dt)
+        self.g = np.asarray(g, float)
+        self.step()
 
-    def move(path_fn, duration):
-        n = max(1, int(np.ceil(duration / dt)))
+    def move(self, path, duration: float):
+        """Moves the gripper along ``path(u)``, u in (0, 1], over ``duration`` (whole time steps)."""
+        n = max(1, int(np.ceil(duration / self.dt)))
         for i in range(1, n + 1):
-            set_gripper(path_fn(i / n))
-            step()
+            self.step_to(path(i / n))
 
-    grip.set(data, np.zeros(3))
-    mujoco.mj_forward(model, data)
-    for _ in range(int(settle / dt)):
-        set_gripper(np.zeros(3))
-        step()
-    max_slip, steps = 0.0, []
-    for seg in _segments(plan):
-        pusher = seg["pusher"]
-        fm = int(model.body_mocapid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"feature_{pusher}")])
-        p = scene.pusher(pusher)
-        n_obj = p.normal / np.linalg.norm(p.normal)
-        # the feature where the plan needs it, relative to the gripper: F = G ∘ P0
-        F = compose(state["gripper"], seg["knots"][0])
-        c, s = np.cos(F[2]), np.sin(F[2])
-        n_w = np.array([c * n_obj[0] - s * n_obj[1], s * n_obj[0] + c * n_obj[1]])
-        data.mocap_pos[fm] = [F[0] - GAP * n_w[0], 0.0, F[1] - GAP * n_w[1]]
-        data.mocap_quat[fm] = quat_y(F[2])
-        g0 = state["gripper"].copy()
-        # approach: the object moves against the feature
-        move(lambda u: g0 - np.array([GAP * n_w[0], GAP * n_w[1], 0.0]) * u, GAP / speed)
-        F = F - np.array([GAP * n_w[0], GAP * n_w[1], 0.0])
-        ref = p.points.mean(axis=0)  # the feature's reference point, in its frame
-        r0 = compose(inverse(planar_pose(model, data, "object")), compose(F, np.r_[ref, 0.0]))[:2]
-        seg_slip = 0.0
-        Pa = seg["knots"][0]
-        for a, b in zip(seg["knots"][:-1], seg["knots"][1:]):
-            xi = body_twist(a, b)
-            length = float(np.linalg.norm(scene.metric_twist(xi)))
-            if length == 0:
-                continue
-            P_start = Pa
-            state["planned"] = a
+    def idle(self, duration: float):
+        for _ in range(max(1, int(round(duration / self.dt)))):
+            self.step_to(self.g)
 
-            def path(u, P_start=P_start, xi=xi, a=a, b=b):
-                P = integrate_pose(P_start, xi, u)
-                state["planned"] = a + (b - a) * u
-                return compose(F, inverse(P))
+    def pose(self) -> np.ndarray:
+        """The object's pose in the grasp."""
+        return compose(inverse(self.g), planar_pose(self.model, self.data, "object"))
 
-            move(path, length / speed)
-            Pa = integrate_pose(P_start, xi, 1.0)
-            r = compose(inverse(planar_pose(model, data, "object")), compose(F, np.r_[ref, 0.0]))[:2]
-            t_obj = np.array([-n_obj[1], n_obj[0]])
-            seg_slip = max(seg_slip, abs(float(t_obj @ (r - r0))))
-        max_slip = max(max_slip, seg_slip)
-        steps.append({"pusher": pusher, "slip": seg_slip, "end_pose": grasp_pose().tolist(),
-                      "planned_end": seg["knots"][-1].tolist()})
-        # back off and park the feature (a switch-over)
-        g1 = state["gripper"].copy()
-        move(lambda u: g1 + np.array([GAP * n_w[0], GAP * n_w[1], 0.0]) * u, GAP / speed)
-        data.mocap_pos[fm] = PARK
-    q = grasp_pose()
-    task = scene.task
-    goal = task.goal if task is not None else np.asarray(plan["path"][-1]["pose"], float)
-    tol = task.tolerance if task is not None else np.array([1e-3, 1e-3, 0.0175])
-    err = q - goal
-    return Replay("mujoco", q, err, bool(np.all(np.abs(err) <= tol)), max_slip, np.array(rec_t), np.array(rec_q),
-                  np.array(rec_plan), steps)
+    def place_feature(self, pusher: str, at, back: float) -> Feature:
+        """Puts ``pusher``'s feature where it meets the object at pose ``at`` in the grasp, then
+        ``back`` [m] further along its normal (away from the object)."""
+        p = self.scene.pusher(pusher)
+        F = compose(self.g, np.asarray(at, float))
+        n_w = rotate(F[2], p.normal / np.linalg.norm(p.normal))
+        F = F - np.array([back * n_w[0], back * n_w[1], 0.0])
+        m = self.mocap(f"feature_{pusher}")
+        self.data.mocap_pos[m] = [F[0], 0.0, F[1]]
+        self.data.mocap_quat[m] = quat_y(F[2])
+        self.current = Feature(pusher, m, F, n_w, self.geoms(f"feature_{pusher}"))
+        return self.current
+
+    def back_off(self, speed: float = 0.01):
+        """Moves the gripper the gap away from the current feature and parks it (a switch-over)."""
+        if self.current is None:
+            return
+        g1, d = self.g.copy(), GAP * np.r_[self.current.normal, 0.0]
+        self.move(lambda u: g1 + d * u, GAP / speed)
+        self.data.mocap_pos[self.current.mocap] = PARK
+        self.current = None
+
+
+class PlanarExecution(GripperRig):
+    """One open-loop execution of a plan in the world's view (see the module), recorded: the
+    object's pose in the grasp and the planned one every ``record_dt``, and per push its slip."""
+
+    def __init__(self, scene: Scene, plan, perturb: Perturbation = Perturbation(), contact: Contact = Contact(),
+                 speed: float = 0.01, record_dt: float = 0.02):
+        path = plan_dict(plan)["path"]
+        for i, k in enumerate(path[1:], 1):
+            if k["pusher"] not in scene.pusher_names:
+                raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r} in the scene",
+                                    f"plan.path[{i}].pusher")
+        super().__init__(scene, path[0]["pose"], sorted({k["pusher"] for k in path[1:]}), perturb, contact)
+        self.path, self.speed = path, speed
+        self.every = max(1, int(round(record_dt / self.dt)))
+        self.t, self.k = 0.0, 0
+        self.planned = np.asarray(path[0]["pose"], float)
+        self.rec_t, self.rec_q, self.rec_plan = [], [], []
+        self.steps = []  # per push: pusher, slip, end pose, planned end pose
+
+    def step_to(self, g):
+        super().step_to(g)
+        self.t += self.dt
+        self.k += 1
+        if self.k % self.every == 0:
+            self.rec_t.append(self.t)
+            self.rec_q.append(self.pose())
+            self.rec_plan.append(self.planned.copy())
+
+    def approach(self):
+        """Closes the gap to the feature just placed: the object meets it."""
+        g0, d = self.g.copy(), GAP * np.r_[self.current.normal, 0.0]
+        self.move(lambda u: g0 - d * u, GAP / self.speed)
+
+    def push(self, a, b, P) -> np.ndarray:
+        """One step of the plan, from knot ``a`` to ``b``, with the current feature at planned
+        pose ``P`` in the grasp: the gripper moves with the inverse of the virtual pusher's
+        motion (the step's body twist, at the execution's speed). Returns the feature's planned
+        pose at the end."""
+        xi = body_twist(a, b)
+        length = float(np.linalg.norm(self.scene.metric_twist(xi)))
+        if length == 0:
+            return P
+        F = self.current.frame
+
+        def path(u):
+            self.planned = a + (b - a) * u
+            return compose(F, inverse(integrate_pose(P, xi, u)))
+
+        self.move(path, length / self.speed)
+        return integrate_pose(P, xi, 1.0)
+
+    def contact_point(self) -> np.ndarray:
+        """The current feature's reference point (the middle of its pusher's points) in the
+        object's frame."""
+        ref = self.scene.pusher(self.current.pusher).points.mean(axis=0)
+        obj = planar_pose(self.model, self.data, "object")
+        return compose(inverse(obj), compose(self.current.frame, np.r_[ref, 0.0]))[:2]
+
+    def segment(self, pusher: str, knots: list) -> float:
+        """One push: the feature placed the gap away from where the plan needs it, the approach,
+        the plan's steps, the back-off. Returns the pusher's slip: the largest slide of its
+        reference point along the contact on the object."""
+        self.place_feature(pusher, knots[0], GAP)
+        self.approach()
+        n = self.scene.pusher(pusher).normal
+        n = n / np.linalg.norm(n)
+        along = np.array([-n[1], n[0]])
+        r0, slip, P = self.contact_point(), 0.0, knots[0]
+        for a, b in zip(knots[:-1], knots[1:]):
+            P = self.push(a, b, P)
+            slip = max(slip, abs(float(along @ (self.contact_point() - r0))))
+        self.steps.append({"pusher": pusher, "slip": slip, "end_pose": self.pose().tolist(),
+                           "planned_end": knots[-1].tolist()})
+        self.back_off(self.speed)
+        return slip
+
+    def run(self, settle: float = 0.2) -> Replay:
+        """Holds the object for ``settle`` [s], then executes the plan push by push."""
+        self.idle(settle)
+        max_slip = 0.0
+        for seg in _segments(self.path):
+            max_slip = max(max_slip, self.segment(seg["pusher"], seg["knots"]))
+        q = self.pose()
+        task = self.scene.task
+        goal = task.goal if task is not None else np.asarray(self.path[-1]["pose"], float)
+        tol = task.tolerance if task is not None else np.array([1e-3, 1e-3, 0.0175])
+        err = q - goal
+        return Replay("mujoco", q, err, bool(np.all(np.abs(err) <= tol)), max_slip, np.array(self.rec_t),
+                      np.array(self.rec_q), np.array(self.rec_plan), self.steps)
+
+
+def execute_plan(scene: Scene, plan, perturb: Perturbation = Perturbation(), speed: float = 0.01,
+                 record_dt: float = 0.02, contact: Contact = Contact(), settle: float = 0.2) -> Replay:
+    """Executes ``plan`` (a ``regrasp.Plan`` or its dict) open loop in MuJoCo; returns the
+    recorded object pose in the grasp (:class:`PlanarExecution`)."""
+    return PlanarExecution(scene, plan, perturb, contact, speed, record_dt).run(settle)
 
 
 def animate_execution(scene: Scene, rep: Replay, path, fps: int = 20, every: int = 3):
@@ -211,7 +290,7 @@ def animate_execution(scene: Scene, rep: Replay, path, fps: int = 20, every: int
     return path
 
 
-class WorldRig:
+class WorldRig(GripperRig):
     """MuJoCo in the world's view, driven push by push (for closed-loop control): every pusher's
     feature is parked; a push with a new pusher brings its feature against the object where the
     controller believes it is (12 mm back along the push normal, then the gripper approaches
@@ -223,107 +302,39 @@ class WorldRig:
 
     def __init__(self, scene: Scene, q0, perturb: Perturbation = Perturbation(), contact: Contact = Contact(),
                  settle: float = 0.2):
-        import mujoco
-
-        self.scene, self.contact = scene, contact
-        q0 = np.asarray(q0, float)
-        fake = {"path": [{"pose": q0.tolist(), "pusher": None}] + [{"pose": q0.tolist(), "pusher": p} for p in scene.pusher_names]}
-        self.model = mujoco.MjModel.from_xml_string(build(scene, fake, perturb, contact))
-        self.data = mujoco.MjData(self.model)
-        self.data.ctrl[:] = scene.grip_force * perturb.grip
-        self.grip = Driver(self.model, "gripper")
-        self.g = np.zeros(3)
-        self.grip.set(self.data, self.g)
-        mujoco.mj_forward(self.model, self.data)
-        self.dt = contact.timestep
-        self.current = None  # (pusher, mocap id, feature frame F, world normal)
-        self.feature_geoms = {}
-        for p in scene.pusher_names:
-            bid = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, f"feature_{p}")
-            self.feature_geoms[p] = {i for i in range(self.model.ngeom) if self.model.geom_bodyid[i] == bid}
+        super().__init__(scene, q0, sorted(scene.pusher_names), perturb, contact)
         self.idle(settle)
-
-    def _step(self, g):
-        import mujoco
-
-        self.grip.move(self.data, g, self.dt)
-        self.g = np.asarray(g, float)
-        mujoco.mj_step(self.model, self.data)
-
-    def pose(self) -> np.ndarray:
-        """The object's pose in the grasp."""
-        return compose(inverse(self.g), planar_pose(self.model, self.data, "object"))
-
-    def idle(self, duration: float):
-        for _ in range(max(1, int(round(duration / self.dt)))):
-            self._step(self.g)
-
-    def _touching(self, pusher: str) -> bool:
-        ids = self.feature_geoms[pusher]
-        return any(self.data.contact[i].geom1 in ids or self.data.contact[i].geom2 in ids for i in range(self.data.ncon))
-
-    def back_off(self, speed: float = 0.01):
-        """Moves the gripper away from the current feature and parks it (a switch-over)."""
-        if self.current is None:
-            return
-        _, fm, _, n_w = self.current
-        g1 = self.g.copy()
-        n = max(1, int(round(GAP / speed / self.dt)))
-        for i in range(1, n + 1):
-            self._step(g1 + np.array([GAP * n_w[0], GAP * n_w[1], 0.0]) * i / n)
-        self.data.mocap_pos[fm] = PARK
-        self.current = None
 
     def bring(self, pusher: str, belief, speed: float = 0.01):
         """Brings ``pusher``'s feature against the object, placed where it would meet the object
         at the believed pose ``belief`` (in the grasp)."""
-        import mujoco
-
         self.back_off(speed)
-        fm = int(self.model.body_mocapid[mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, f"feature_{pusher}")])
-        p = self.scene.pusher(pusher)
-        n_obj = p.normal / np.linalg.norm(p.normal)
-        F = compose(self.g, np.asarray(belief, float))
-        c, s = np.cos(F[2]), np.sin(F[2])
-        n_w = np.array([c * n_obj[0] - s * n_obj[1], s * n_obj[0] + c * n_obj[1]])
-        self.data.mocap_pos[fm] = [F[0] - self.APPROACH * n_w[0], 0.0, F[1] - self.APPROACH * n_w[1]]
-        self.data.mocap_quat[fm] = quat_y(F[2])
-        F = F - np.array([self.APPROACH * n_w[0], self.APPROACH * n_w[1], 0.0])
-        # approach until touching (at most twice the approach distance)
+        f = self.place_feature(pusher, belief, self.APPROACH)
         step = speed * self.dt
-        for _ in range(int(2 * self.APPROACH / step)):
-            if self._touching(pusher):
+        d = np.array([step * f.normal[0], step * f.normal[1], 0.0])
+        for _ in range(int(2 * self.APPROACH / step)):  # until touching, at most twice the approach distance
+            if self.touching(f.geoms):
                 break
-            self._step(self.g - np.array([step * n_w[0], step * n_w[1], 0.0]))
-        self.current = (pusher, fm, F, n_w)
+            self.step_to(self.g - d)
 
     def push(self, pusher: str, twist, duration: float, belief=None):
         """The object (believed at ``belief``) pushed with body twist ``twist`` for ``duration``
         against ``pusher``'s feature: the gripper moves so that the feature, seen from the
         gripper, follows the object's intended motion."""
         belief = self.pose() if belief is None else np.asarray(belief, float)
-        if self.current is None or self.current[0] != pusher:
+        if self.current is None or self.current.pusher != pusher:
             self.bring(pusher, belief)
-        F = self.current[2]
-        P0 = compose(inverse(self.g), F)  # the feature (virtual pusher) in the grasp
-        b = belief
-        rel = compose(inverse(b), P0)
+        F = self.current.frame
+        rel = compose(inverse(belief), compose(inverse(self.g), F))  # the feature seen from the object
         n = max(1, int(round(duration / self.dt)))
         tw = np.asarray(twist, float)
         for i in range(1, n + 1):
-            P = compose(integrate_pose(b, tw, duration * i / n), rel)
-            self._step(compose(F, inverse(P)))
+            P = compose(integrate_pose(belief, tw, duration * i / n), rel)
+            self.step_to(compose(F, inverse(P)))
 
     def poke(self, delta):
         """Displaces the object in the grasp by ``delta`` (the current feature backs off first)."""
-        import mujoco
-
         self.back_off()
-        q = self.pose() + np.asarray(delta, float)
-        w = compose(self.g, q)
-        a = int(self.model.jnt_qposadr[0])
-        self.data.qpos[a:a + 3] = [w[0], 0.0, w[1]]
-        self.data.qpos[a + 3:a + 7] = [np.cos(-w[2] / 2), 0.0, np.sin(-w[2] / 2), 0.0]
-        self.data.qvel[int(self.model.jnt_dofadr[0]):int(self.model.jnt_dofadr[0]) + 6] = 0.0
-        mujoco.mj_forward(self.model, self.data)
+        put_object(self.model, self.data, compose(self.g, self.pose() + np.asarray(delta, float)))
+        self.forward()
         self.idle(0.1)

@@ -10,71 +10,59 @@ from __future__ import annotations
 
 import numpy as np
 
-from .model import (FEATURE_RADIUS, Contact, Driver, compose, driven_body_xml, feature_xml, header, inverse, object_xml,
-                           pads_xml, planar_pose)
-from ..sim.quasistatic import integrate_pose
 from ..scene.planar import Scene
+from ..sim.quasistatic import integrate_pose
+from .model import (FEATURE_RADIUS, Contact, Driver, Rig, add_driven_body, add_feature_geom, add_grip_motors,
+                    add_object, add_planar_pads, compose, inverse, planar_pose, planar_spec, put_object, rotate)
 
 Settings = Contact  # kept for callers of the first version
 
 
-def _model(scene: Scene, pusher: str, contact: Contact):
-    import mujoco
-
-    assets, obj = object_xml(scene, np.zeros(3))
-    pads, acts = pads_xml(scene)
-    # the feature's geometry inside a driven body whose frame is the pusher frame
-    feat = feature_xml(scene, pusher, "feature")
-    inner = feat[feat.index(">") + 1: feat.rindex("</body>")]
-    xml = (f'<mujoco>{header(scene, contact)}<asset>{assets}</asset><worldbody>{obj}{pads}'
-           f'{driven_body_xml("pusher", inner)}</worldbody><actuator>{acts}</actuator></mujoco>')
-    return mujoco.MjModel.from_xml_string(xml)
+def _spec(scene: Scene, pusher: str, contact: Contact):
+    """The object at the origin held by pads fixed in the world, the pusher's feature on a driven
+    body whose frame is the pusher frame."""
+    spec = planar_spec(scene, f"{scene.name}-push-{pusher}", contact)
+    add_object(spec, scene, np.zeros(3))
+    add_planar_pads(spec.worldbody, scene)
+    add_feature_geom(add_driven_body(spec.worldbody, "pusher"), scene, pusher)
+    add_grip_motors(spec)
+    return spec
 
 
-class PushRig:
+class PushRig(Rig):
     """A reusable MuJoCo model of one pusher of a scene (reset for each push)."""
 
     def __init__(self, scene: Scene, pusher: str, contact: Contact = Contact()):
-        import mujoco
-
-        self.scene, self.pusher, self.contact = scene, pusher, contact
-        self.model = _model(scene, pusher, contact)
-        self.data = mujoco.MjData(self.model)
+        super().__init__(_spec(scene, pusher, contact), contact, scene.grip_force)
+        self.scene, self.pusher = scene, pusher
         self.driver = Driver(self.model, "pusher")
-        # the object's free joint is the model's first joint
-        self.obj_qadr = int(self.model.jnt_qposadr[0])
 
     def reset(self, pose):
         import mujoco
 
         mujoco.mj_resetData(self.model, self.data)
-        q = np.asarray(pose, float)
-        a = self.obj_qadr
-        self.data.qpos[a:a + 3] = [q[0], 0.0, q[1]]
-        self.data.qpos[a + 3:a + 7] = [np.cos(-q[2] / 2), 0.0, np.sin(-q[2] / 2), 0.0]
-        self.data.ctrl[:] = self.scene.grip_force
-        self.driver.set(self.data, q)
-        mujoco.mj_forward(self.model, self.data)
+        put_object(self.model, self.data, pose)
+        self.data.ctrl[:] = self.grip_force
+        self.driver.set(self.data, pose)
+        self.forward()
 
     def push(self, pose, twist, duration: float, settle: float = 0.1, record_dt: float = 0.02) -> dict:
         """The pusher starts in contact at the object's pose and moves with constant body
         ``twist``; returns times, object poses (gripper frame) and pusher poses."""
-        import mujoco
-
         self.reset(pose)
-        dt = self.contact.timestep
+        dt = self.dt
         m, d = self.model, self.data
         q0 = np.asarray(pose, float)
         for _ in range(int(round(settle / dt))):
             self.driver.move(d, q0, dt)
-            mujoco.mj_step(m, d)
+            self.step()
         every = max(1, int(round(record_dt / dt)))
         t, poses, pushers = [0.0], [planar_pose(m, d, "object")], [q0]
         n = int(round(duration / dt))
         for k in range(1, n + 1):
             qp = integrate_pose(q0, twist, k * dt)
             self.driver.move(d, qp, dt)
-            mujoco.mj_step(m, d)
+            self.step()
             if k % every == 0 or k == n:
                 t.append(k * dt)
                 poses.append(planar_pose(m, d, "object"))
@@ -120,8 +108,7 @@ class PushRig:
         for k in range(len(r["t"]) - 1):
             q0, q1 = r["pose"][k], r["pose"][k + 1]
             p0, p1 = r["pusher_pose"][k], r["pusher_pose"][k + 1]
-            cw, sw = np.cos(q0[2]), np.sin(q0[2])
-            nw = np.array([cw * n[0] - sw * n[1], sw * n[0] + cw * n[1]])
+            nw = rotate(q0[2], n)
             x = compose(p0, centre)[:2] + FEATURE_RADIUS * nw  # the contact point (world)
             mo = compose(inverse(q0), np.r_[x, 0.0])  # material points there
             mp = compose(inverse(p0), np.r_[x, 0.0])

@@ -11,7 +11,9 @@ assumed it fixed in the gripper frame. The bundled examples turn the gripper by 
 regrasp angle and execute within tolerance in both views (`docs/execution3d.py` prints both); a
 plan with large gripper rotations should be executed in the planner's view.
 
-The object: a box or the scene's convex mesh, with its mass, centre of mass and inertia. The pads:
+The model (:func:`build`, a ``mujoco.MjSpec`` from the pieces of ``regrasp.mujoco.model``; the
+execution itself is :class:`SpatialExecution`): the object, a sphere or the scene's convex mesh,
+with its mass, centre of mass and inertia. The pads:
 as in the planar model (``regrasp.mujoco.model``), one contact point each through a large sphere
 on a slide joint along Y, squeezed by a force actuator, with sliding friction ``μ_s`` and
 torsional friction ``(2/3) r μ_s`` (the pad's ring of points at 2/3 of its radius in the
@@ -28,14 +30,15 @@ import numpy as np
 
 from .. import _core
 from ..errors import ArgumentError
-from .model import FEATURE_BITS as BITS_FEAT
-from .model import OBJECT_BITS as BITS_OBJ
-from .model import PAD_BITS as BITS_PAD
-from .model import PAD_SPHERE, Contact
-from .model import _fmt as _f
+from .model import (FEATURE_BITS, OBJECT_BITS, PAD_BITS, Contact, Driver, Rig, add_driven_body, add_geom,
+                    add_grip_motors, add_pad_sphere, add_pads, new_spec, plan_dict, set_inertial)
+
 PARK = np.array([0.0, 0.0, 5.0])
 R_FEATURE = 0.0015
 GAP = 0.002
+PLANE_HALF = 0.15  # m, half the side of a plane feature (a floor or a wall)
+PAD_BALL = 0.001  # m, the small spheres of a ring pad
+IDENTITY = np.r_[0.0, 0, 0, 1, 0, 0, 0]
 
 
 def compose(a, b) -> np.ndarray:
@@ -49,151 +52,254 @@ def inverse(a) -> np.ndarray:
 
 def _exp(u, t) -> np.ndarray:
     """exp of body twist u over time t, as a pose."""
-    return np.array(_core.se3_integrate([0, 0, 0, 1, 0, 0, 0], list(map(float, u)), float(t)))
+    return np.array(_core.se3_integrate(list(IDENTITY), list(map(float, u)), float(t)))
 
 
-PLANE_HALF = 0.15  # m, half the side of a plane feature (a floor or a wall)
+def _shift(v) -> np.ndarray:
+    """The translation by ``v`` as a pose."""
+    return np.r_[v, 1, 0, 0, 0]
+
+
+def _tangents(n) -> tuple:
+    """Two unit vectors t1, t2 with (t1, t2, n) a right-handed frame."""
+    a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+    t1 = np.cross(a, n)
+    t1 /= np.linalg.norm(t1)
+    return t1, np.cross(n, t1)
+
+
+def _quat(t1, t2, n) -> np.ndarray:
+    """The quaternion [w, x, y, z] of the frame with axes t1, t2, n."""
+    from scipy.spatial.transform import Rotation
+
+    q = Rotation.from_matrix(np.c_[t1, t2, n]).as_quat()
+    return np.r_[q[3], q[:3]]
 
 
 def plane_frame(scene, name: str, pose) -> np.ndarray:
     """For a plane pusher brought against the object at ``pose``: the pose, in the pusher's frame
     (the object frame then), of the plane's own frame (origin at the contact, +Z its normal)."""
-    from scipy.spatial.transform import Rotation
-
     pts, n, _ = scene._core.pusher_spec(name, list(map(float, pose)))
     n = np.asarray(n, float) / np.linalg.norm(n)
-    a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
-    t1 = np.cross(a, n)
-    t1 /= np.linalg.norm(t1)
-    q = Rotation.from_matrix(np.c_[t1, np.cross(n, t1), n]).as_quat()
-    return np.r_[np.asarray(pts, float).mean(axis=0), q[3], q[:3]]
+    return np.r_[np.asarray(pts, float).mean(axis=0), _quat(*_tangents(n), n)]
 
 
-def feature_geoms(scene, name: str, friction: float) -> str:
+def add_feature_geoms(body, scene, name: str, friction: float):
+    """The pusher's feature in its frame: a 1.5 mm sphere behind a point pusher, a capsule behind a
+    line pusher, a thin plate behind a patch, a thick slab whose top face is the plane z = 0 of
+    the feature's frame for a plane (see :func:`plane_frame`)."""
+    kw = dict(bits=FEATURE_BITS, friction=[friction], condim=3)
     if scene._core.is_plane(name):
-        # a thick slab whose top face is the plane z = 0 of the feature's frame (see plane_frame)
-        g = f'friction="{friction:.9g} 0 0" condim="3" {BITS_FEAT}'
-        return f'<geom type="box" size="{PLANE_HALF} {PLANE_HALF} 0.005" pos="0 0 -0.005" {g}/>'
+        return add_geom(body, "box", [PLANE_HALF, PLANE_HALF, 0.005], pos=[0.0, 0.0, -0.005], **kw)
     pts, n, _ = scene._core.pusher_spec(name)
     pts, n = np.asarray(pts, float), np.asarray(n, float) / np.linalg.norm(n)
-    g = f'friction="{friction:.9g} 0 0" condim="3" {BITS_FEAT}'
     if len(pts) == 1:
-        return f'<geom type="sphere" size="{R_FEATURE}" pos="{_f(pts[0] - n * R_FEATURE)}" {g}/>'
+        return add_geom(body, "sphere", [R_FEATURE], pos=pts[0] - n * R_FEATURE, **kw)
     if len(pts) == 2:
-        a, b = pts - n * R_FEATURE
-        return f'<geom type="capsule" size="{R_FEATURE}" fromto="{_f(a)} {_f(b)}" {g}/>'
-    # a plate behind the patch, in the frame (t1, t2, n)
-    a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
-    t1 = np.cross(n, a)
-    t1 /= np.linalg.norm(t1)
-    t2 = np.cross(n, t1)
+        return add_geom(body, "capsule", [R_FEATURE], fromto=np.ravel(pts - n * R_FEATURE), **kw)
+    t1, t2 = (-t for t in _tangents(n))
     c = pts.mean(axis=0)
     e1, e2 = np.abs((pts - c) @ t1).max(), np.abs((pts - c) @ t2).max()
-    from scipy.spatial.transform import Rotation
-
-    q = Rotation.from_matrix(np.c_[t1, t2, n]).as_quat()
-    return (f'<geom type="box" size="{e1:.9g} {e2:.9g} 0.0015" pos="{_f(c - n * 0.0015)}" '
-            f'quat="{q[3]:.9g} {q[0]:.9g} {q[1]:.9g} {q[2]:.9g}" {g}/>')
+    return add_geom(body, "box", [e1, e2, 0.0015], pos=c - n * 0.0015, quat=_quat(t1, t2, n), **kw)
 
 
-PAD_BALL = 0.001  # m, the small spheres of a ring pad
+def _add_object(spec, scene, s0, mesh, mass_scale: float):
+    """The object at pose ``s0`` on a free joint: a sphere or the scene's convex ``mesh``
+    (vertices, triangles)."""
+    m = scene.mass * mass_scale
+    I = np.asarray(scene.inertia, float) * mass_scale
+    body = spec.worldbody.add_body(name="object", pos=s0[:3], quat=s0[3:])
+    body.add_freejoint()
+    full = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+    set_inertial(body, np.asarray(scene._core.com, float), m, full=full)
+    kw = dict(bits=OBJECT_BITS, friction=[0.0], condim=4)
+    if scene._core.sphere:
+        return add_geom(body, "sphere", [scene._core.sphere], **kw)
+    v, t = mesh
+    spec.add_mesh(name="obj", uservert=np.ravel(v).tolist(), userface=np.ravel(t).tolist())
+    return add_geom(body, "mesh", [], meshname="obj", **kw)
 
 
-def _driven_joints(name: str) -> str:
-    """Slides along X, Y, Z and a ball joint of a heavy body driven by :class:`Driver6`."""
-    return (f'<joint name="{name}_x" type="slide" axis="1 0 0"/><joint name="{name}_y" type="slide" axis="0 1 0"/>'
-            f'<joint name="{name}_z" type="slide" axis="0 0 1"/><joint name="{name}_r" type="ball"/>'
-            f'<inertial pos="0 0 0" mass="1000" diaginertia="1000 1000 1000"/>')
+def _add_pads(parent, scene, s0, vertices, friction_scale: float, pad: str):
+    """The pads at the object's extreme points (of its mesh's ``vertices``) along ±Y at pose
+    ``s0``: one contact each (:func:`add_pad_sphere`, torsional friction (2/3) r μ) or,
+    ``pad="ring"``, 8 point contacts on a ring at 2/3 of the pad's radius (the quasi-static
+    model's pad)."""
+    mu = scene._core.grip_friction * friction_scale
+    k = 2.0 / 3.0 * scene._core.pad_radius
+    R = scene._core.sphere
+    w = np.array([compose(s0, _shift(x))[:3] for x in vertices])
+    ys = [s0[1] + sign * R if R else np.max(sign * w[:, 1]) * sign for sign in (1, -1)]
+
+    def geoms(body, sign):
+        if pad != "ring":
+            return add_pad_sphere(body, sign, mu, k)
+        for a in 2 * np.pi * (np.arange(8) + 0.5) / 8:
+            add_geom(body, "sphere", [PAD_BALL], PAD_BITS, [mu], pos=[k * np.cos(a), sign * PAD_BALL, k * np.sin(a)],
+                     mass=0.01, condim=3)
+
+    add_pads(parent, ys, geoms)
 
 
 def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
-          contact: Contact = Contact(), pad: str = "point", world: bool = False) -> str:
-    """MJCF of a 3-D execution: planner's view (pads fixed, features on driven 6-DoF bodies) or,
-    with ``world``, the world's view (the pads on a driven 6-DoF gripper, features fixed where
-    they are put: mocap bodies)."""
+          contact: Contact = Contact(), pad: str = "point", world: bool = False):
+    """The model of a 3-D execution, a ``mujoco.MjSpec`` (``.compile()`` it; ``.to_xml()`` is its
+    MJCF): planner's view (pads fixed, features on driven 6-DoF bodies) or, with ``world``, the
+    world's view (the pads on a driven 6-DoF gripper, features fixed where they are put: mocap
+    bodies). ``grip_scale`` is the controls' (:class:`SpatialExecution`), not the model's."""
+    s0 = np.asarray(start, float)
     v, t = scene.mesh()
     v, t = np.asarray(v, float), np.asarray(t, int)
-    m = scene.mass * mass_scale
-    I = np.asarray(scene.inertia, float) * mass_scale
-    com = np.asarray(scene._core.com, float)
-    s0 = np.asarray(start, float)
-    asset = f'<mesh name="obj" vertex="{_f(v)}" face="{_f(t)}"/>'
-    obj = (f'<body name="object" pos="{_f(s0[:3])}" quat="{_f(s0[3:])}"><freejoint/>'
-           f'<inertial pos="{_f(com)}" mass="{m:.9g}" fullinertia="{I[0,0]:.9g} {I[1,1]:.9g} {I[2,2]:.9g} {I[0,1]:.9g} {I[0,2]:.9g} {I[1,2]:.9g}"/>'
-           + (f'<geom type="sphere" size="{scene._core.sphere:.9g}" friction="0 0 0" condim="4" {BITS_OBJ}/></body>'
-              if scene._core.sphere else f'<geom type="mesh" mesh="obj" friction="0 0 0" condim="4" {BITS_OBJ}/></body>'))
-    mu = scene._core.grip_friction * friction_scale
-    k = 2.0 / 3.0 * scene._core.pad_radius
-    # pads at the object's extreme points along ±Y at the start
-    w = np.array([compose(s0, np.r_[x, 1, 0, 0, 0])[:3] for x in v])
-    pads = []
-    R = scene._core.sphere
-    for name, sign in (("pad_left", 1), ("pad_right", -1)):
-        y = s0[1] + sign * R if R else np.max(sign * w[:, 1]) * sign
-        if pad == "ring":
-            # 8 point contacts on a ring at 2/3 of the pad's radius: the quasi-static model's pad
-            geoms = "".join(
-                f'<geom type="sphere" size="{PAD_BALL}" pos="{k * np.cos(a):.9g} {sign * PAD_BALL:.9g} {k * np.sin(a):.9g}" '
-                f'mass="0.01" friction="{mu:.9g} 0 0" condim="3" {BITS_PAD}/>'
-                for a in 2 * np.pi * (np.arange(8) + 0.5) / 8)
-        else:
-            geoms = (f'<geom type="sphere" size="{PAD_SPHERE}" pos="0 {sign * PAD_SPHERE:.9g} 0" mass="0.05" '
-                     f'friction="{mu:.9g} {k * mu:.9g} 0" condim="4" {BITS_PAD}/>')
-        pads.append(f'<body name="{name}" pos="0 {y:.9g} 0" gravcomp="1"><joint name="{name}" type="slide" axis="0 1 0" damping="20"/>'
-                    f'{geoms}</body>')
-    feats = []
+    spec = new_spec(scene.name, np.asarray(scene._core.gravity, float), contact)
+    _add_object(spec, scene, s0, (v, t), mass_scale)
+    _add_pads(add_driven_body(spec.worldbody, "gripper", spatial=True) if world else spec.worldbody, scene, s0, v,
+              friction_scale, pad)
     for i, p in enumerate(scene.pusher_names):
         _, _, fr = scene._core.pusher_spec(p)
-        if world:
-            feats.append(f'<body name="feature_{p}" mocap="true" pos="{_f(PARK + [0.1 * i, 0, 0])}">'
-                         f'{feature_geoms(scene, p, fr * friction_scale)}</body>')
+        body = (spec.worldbody.add_body(name=f"feature_{p}", mocap=True, pos=PARK + [0.1 * i, 0, 0]) if world
+                else add_driven_body(spec.worldbody, f"feature_{p}", spatial=True))
+        add_feature_geoms(body, scene, p, fr * friction_scale)
+    add_grip_motors(spec)
+    return spec
+
+
+def _check_options(pad: str, view: str):
+    if pad not in ("point", "ring"):
+        raise ArgumentError(f"invalid `pad`: 'point' or 'ring' (got {pad!r})", "pad")
+    if view not in ("world", "planner"):
+        raise ArgumentError(f"invalid `view`: 'world' or 'planner' (got {view!r})", "view")
+
+
+class SpatialExecution(Rig):
+    """A 3-D plan executed in MuJoCo step by step (see :func:`execute_plan3d`): the model, the
+    gripper's driver (world's view) or the features' drivers (planner's view), the feature in use
+    (its pusher, its pose :attr:`P` in the grasp and its normal :attr:`n` in the object frame) and
+    where it is fixed in the world's view (:attr:`F`)."""
+
+    def __init__(self, scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
+                 contact: Contact = Contact(), pad: str = "point", view: str = "world"):
+        _check_options(pad, view)
+        self.scene, self.view, self.world = scene, view, view == "world"
+        spec = build(scene, start, friction_scale, grip_scale, mass_scale, contact, pad, world=self.world)
+        super().__init__(spec, contact, scene._core.grip_force * grip_scale)
+        self.gripper = Driver(self.model, "gripper") if self.world else None
+        self.drivers = {} if self.world else {p: Driver(self.model, f"feature_{p}") for p in scene.pusher_names}
+        if self.world:
+            self.gripper.set(self.data, IDENTITY)
+        for i, d in enumerate(self.drivers.values()):
+            d.set(self.data, np.r_[PARK + [0.1 * i, 0, 0], 1, 0, 0, 0])
+        self.forward()
+        self.obj = self.model.body("object").id
+        self.creep = 0.005 * self.dt  # approach and back-off at 5 mm/s
+        self.pusher, self.P, self.n, self.F = None, None, None, None
+        # the feature body's pose in the pusher's frame: identity for rigid pushers (built in the
+        # object frame), the plane's frame for planes (set when the plane is brought)
+        self.T = IDENTITY
+
+    def in_grasp(self) -> np.ndarray:
+        """The object's pose in the grasp (the gripper frame)."""
+        G = self.gripper.pose if self.world else IDENTITY
+        return compose(inverse(G), np.r_[self.data.xpos[self.obj], self.data.xquat[self.obj]])
+
+    def place(self, P):
+        """One time step with the feature in use at pose ``P`` in the grasp (None: nothing moves)."""
+        if self.world:
+            self.gripper.move(self.data, self.gripper.pose if P is None else compose(self.F, inverse(P)), self.dt)
+        for p, d in self.drivers.items():
+            d.move(self.data, compose(P, self.T) if p == self.pusher and P is not None else d.pose, self.dt)
+        self.step()
+
+    def put(self, p: str, P) -> set:
+        """Puts pusher ``p``'s feature at ``P`` in the grasp (where it stays, in the world's view);
+        returns its geoms."""
+        self.T = plane_frame(self.scene, p, self.in_grasp()) if self.scene._core.is_plane(p) else IDENTITY
+        if self.world:
+            self.F = compose(self.gripper.pose, P)
+            F = compose(self.F, self.T)
+            m = self.mocap(f"feature_{p}")
+            self.data.mocap_pos[m], self.data.mocap_quat[m] = F[:3], F[3:]
         else:
-            feats.append(f'<body name="feature_{p}" pos="0 0 0" gravcomp="1">{_driven_joints(f"feature_{p}")}'
-                         f'{feature_geoms(scene, p, fr * friction_scale)}</body>')
-    if world:
-        pads = [f'<body name="gripper" pos="0 0 0" gravcomp="1">{_driven_joints("gripper")}{"".join(pads)}</body>']
-    g = np.asarray(scene._core.gravity, float)
-    acts = ('<motor joint="pad_left" gear="-1" ctrllimited="false"/><motor joint="pad_right" gear="1" ctrllimited="false"/>')
-    return (f'<mujoco model="{scene.name}"><option timestep="{contact.timestep}" gravity="{_f(g)}" cone="{contact.cone}" '
-            f'impratio="{contact.impratio}" noslip_iterations="{contact.noslip_iterations}"/>'
-            f'<default><geom solref="{contact.solref}" solimp="{contact.solimp}"/></default>'
-            f'<asset>{asset}</asset><worldbody>{obj}{"".join(pads)}{"".join(feats)}</worldbody>'
-            f'<actuator>{acts}</actuator></mujoco>')
+            self.drivers[p].set(self.data, compose(P, self.T))
+        self.pusher = p
+        self.forward()
+        return self.geoms(f"feature_{p}")
+
+    def park(self, p: str):
+        if self.world:
+            self.data.mocap_pos[self.mocap(f"feature_{p}")] = PARK
+        else:
+            self.drivers[p].set(self.data, np.r_[PARK, 1, 0, 0, 0])
+
+    def settle(self, duration: float):
+        for _ in range(int(duration / self.dt)):
+            self.place(None)
+
+    def back_off(self):
+        """Moves the feature in use the gap back along its normal, then parks it (a switch-over)."""
+        P0 = self.P.copy()
+        for k in range(1, int(GAP / self.creep) + 1):
+            self.P = compose(P0, _shift(-self.n * self.creep * k))
+            self.place(self.P)
+        self.park(self.pusher)
+
+    def approach(self, p: str):
+        """Brings pusher ``p``'s feature (the one in use backs off first): the gap back from where
+        it meets the object (as the object is now), then closer until it touches (at most 3
+        gaps)."""
+        if self.pusher is not None:
+            self.back_off()
+        _, n, _ = self.scene._core.pusher_spec(p, list(map(float, self.in_grasp())))
+        self.n = np.asarray(n, float) / np.linalg.norm(n)
+        self.P = compose(self.in_grasp(), _shift(-GAP * self.n))
+        ids = self.put(p, self.P)
+        for _ in range(int(3 * GAP / self.creep)):
+            if self.touching(ids):
+                break
+            self.P = compose(self.P, _shift(self.n * self.creep))
+            self.place(self.P)
+
+    def push(self, a: dict, b: dict) -> np.ndarray:
+        """One step of the plan, from path entry ``a`` to ``b``: brings b's pusher if it is a new
+        one, then moves it with the step's pusher twist over unit time. Returns the object's
+        measured pose in the grasp."""
+        from ..scene.spatial import twist_between
+
+        p = b["pusher"]
+        if self.pusher != p:
+            self.approach(p)
+        u = b.get("pusher_twist")
+        u = np.asarray(twist_between(a["pose"], b["pose"]) if u is None else u, float)
+        # the step's twist is the pusher's body twist in the object's frame at the step's start
+        # (where the planner and the quasi-static replay put the pusher); the feature, wherever
+        # it is now (offset D from that frame), makes the same rigid motion: P(t) = A exp(ut) D
+        # (a plane: the planned frame, so it makes its planned motion in the gripper frame and
+        # stays level whatever the object's measured pose)
+        A = np.asarray(a["pose"], float) if self.scene._core.is_plane(p) else self.in_grasp()
+        D = compose(inverse(A), self.P)
+        n = int(round(1.0 / self.dt))
+        for k in range(1, n + 1):
+            self.P = compose(A, compose(_exp(u, k / n), D))
+            self.place(self.P)
+        return self.in_grasp()
+
+    def run(self, path: list, settle: float = 0.2, feedback: bool = False, max_replans: int = 10,
+            seed: int = 0) -> dict:
+        """Holds the object for ``settle`` [s], then executes ``path`` step by step (re-planning
+        from the measured pose with ``feedback``, see :func:`execute_plan3d`)."""
+        from ..scene.spatial import goal_report, run_plan3d
+
+        self.settle(settle)
+        q, poses, replans = run_plan3d(self.scene, path, self.push, self.in_grasp(), feedback, max_replans, seed)
+        return {"engine": "mujoco", "view": self.view, **goal_report(self.scene, q), "poses": np.array(poses),
+                "replans": replans}
 
 
-class Driver6:
-    """Sets a driven 6-DoF body's pose and velocity each step (slides + ball joint)."""
-
-    def __init__(self, model, name: str):
-        import mujoco
-
-        j = lambda s: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{name}_{s}")  # noqa: E731
-        self.qa = [int(model.jnt_qposadr[j(s)]) for s in "xyz"]
-        self.da = [int(model.jnt_dofadr[j(s)]) for s in "xyz"]
-        self.qr, self.dr = int(model.jnt_qposadr[j("r")]), int(model.jnt_dofadr[j("r")])
-        self.pose = np.r_[PARK, 1, 0, 0, 0]
-
-    def set(self, data, pose, vel=np.zeros(6)):
-        for k in range(3):
-            data.qpos[self.qa[k]] = pose[k]
-            data.qvel[self.da[k]] = vel[k]
-        data.qpos[self.qr:self.qr + 4] = pose[3:]
-        data.qvel[self.dr:self.dr + 3] = vel[3:]
-        self.pose = np.asarray(pose, float)
-
-    def move(self, data, pose, dt):
-        pose = np.asarray(pose, float)
-        # body-frame angular velocity: the SO(3) log of the relative rotation (the ball joint's qvel)
-        w = np.array(_core.se3_log([0, 0, 0, *map(float, self.pose[3:])], [0, 0, 0, *map(float, pose[3:])]))[3:] / dt
-        self.set(data, self.pose, np.r_[(pose[:3] - self.pose[:3]) / dt, w])
-        self.pose = pose
-
-
-def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
+def execute_plan3d(scene, plan, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
                    contact: Contact = Contact(), settle: float = 0.2, pad: str = "point", view: str = "world",
                    feedback: bool = False, max_replans: int = 10, seed: int = 0) -> dict:
-    """Executes a 3-D plan in MuJoCo; returns the final pose, the error to the goal (position,
-    angle), success, the object's pose in the grasp after each step and the re-plans made.
+    """Executes a 3-D plan (a ``regrasp.Plan`` or its dict) in MuJoCo; returns the final pose, the
+    error to the goal (position, angle), success, the object's pose in the grasp after each step
+    and the re-plans made.
 
     ``feedback``: closed loop by re-planning — after each step the object's pose is measured; when
     it is off the plan by more than half the goal tolerance (position or angle), or the plan ends
@@ -207,104 +313,9 @@ def execute_plan3d(scene, plan: dict, friction_scale: float = 1.0, grip_scale: f
     pose in the grasp, ``P``, follows the plan's pusher twists (each a body twist in the object's
     frame at the step's start, as the planner and the quasi-static replay apply it); only what
     moves differs."""
-    import mujoco
+    from ..scene.spatial import check_plan3d
 
-    from ..scene.spatial import check_plan3d, goal_report, run_plan3d, twist_between
-
-    if pad not in ("point", "ring"):
-        raise ArgumentError(f"invalid `pad`: 'point' or 'ring' (got {pad!r})", "pad")
-    if view not in ("world", "planner"):
-        raise ArgumentError(f"invalid `view`: 'world' or 'planner' (got {view!r})", "view")
-    world = view == "world"
-    path = check_plan3d(scene, plan)
-    model = mujoco.MjModel.from_xml_string(build(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact,
-                                                 pad, world=world))
-    data = mujoco.MjData(model)
-    data.ctrl[:] = scene._core.grip_force * grip_scale
-    dt = contact.timestep
-    identity = np.r_[0.0, 0, 0, 1, 0, 0, 0]
-    grip = Driver6(model, "gripper") if world else None
-    drivers = {} if world else {p: Driver6(model, f"feature_{p}") for p in scene.pusher_names}
-    if world:
-        grip.set(data, identity)
-    for i, d in enumerate(drivers.values()):
-        d.set(data, np.r_[PARK + [0.1 * i, 0, 0], 1, 0, 0, 0])
-    mujoco.mj_forward(model, data)
-    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "object")
-    G = lambda: grip.pose if world else identity  # noqa: E731 - the gripper in the world
-    in_grasp = lambda: compose(inverse(G()), np.r_[data.xpos[bid], data.xquat[bid]])  # noqa: E731
-    # the feature body's pose in the pusher's frame: identity for rigid pushers (built in the
-    # object frame), the plane's frame for planes (set when the plane is brought)
-    state = {"pusher": None, "F": None, "T": identity}
-
-    def place(P):
-        """One time step with the active feature at pose ``P`` in the grasp (None: nothing moves)."""
-        if world:
-            grip.move(data, grip.pose if P is None else compose(state["F"], inverse(P)), dt)
-        for p, d in drivers.items():
-            d.move(data, compose(P, state["T"]) if p == state["pusher"] and P is not None else d.pose, dt)
-        mujoco.mj_step(model, data)
-
-    def put(p, P):
-        """Puts pusher ``p``'s feature at ``P`` in the grasp (where it stays, in the world's view)."""
-        fid = model.body(f"feature_{p}").id
-        state["T"] = plane_frame(scene, p, in_grasp()) if scene._core.is_plane(p) else identity
-        if world:
-            state["F"] = compose(G(), P)
-            F = compose(state["F"], state["T"])
-            fm = int(model.body_mocapid[fid])
-            data.mocap_pos[fm], data.mocap_quat[fm] = F[:3], F[3:]
-        else:
-            drivers[p].set(data, compose(P, state["T"]))
-        state["pusher"] = p
-        mujoco.mj_forward(model, data)
-        return {i for i in range(model.ngeom) if model.geom_bodyid[i] == fid}
-
-    def park(p):
-        if world:
-            data.mocap_pos[int(model.body_mocapid[model.body(f"feature_{p}").id])] = PARK
-        else:
-            drivers[p].set(data, np.r_[PARK, 1, 0, 0, 0])
-
-    for _ in range(int(settle / dt)):
-        place(None)
-    st = {"P": None, "n": None}
-    creep = 0.005 * dt  # approach and back-off at 5 mm/s
-
-    def step(a, b):
-        """One step of the plan: bring the step's pusher if it is a new one, then move it."""
-        P, n, p = st["P"], st["n"], b["pusher"]
-        if state["pusher"] != p:
-            if state["pusher"] is not None:  # back off, park the old feature (a switch-over)
-                P0 = P.copy()
-                for k in range(1, int(GAP / creep) + 1):
-                    P = compose(P0, np.r_[-n * creep * k, 1, 0, 0, 0])
-                    place(P)
-                park(state["pusher"])
-            _, n, _ = scene._core.pusher_spec(p, list(map(float, in_grasp())))
-            n = np.asarray(n, float) / np.linalg.norm(n)
-            P = compose(in_grasp(), np.r_[-GAP * n, 1, 0, 0, 0])  # where it meets the object, backed off
-            ids = put(p, P)
-            for _ in range(int(3 * GAP / creep)):  # approach until touching (at most 3 gaps)
-                if any(data.contact[j].geom1 in ids or data.contact[j].geom2 in ids for j in range(data.ncon)):
-                    break
-                P = compose(P, np.r_[n * creep, 1, 0, 0, 0])
-                place(P)
-        u = b.get("pusher_twist")
-        u = np.asarray(twist_between(a["pose"], b["pose"]) if u is None else u, float)
-        # the step's twist is the pusher's body twist in the object's frame at the step's start
-        # (where the planner and the quasi-static replay put the pusher); the feature, wherever
-        # it is now (offset D from that frame), makes the same rigid motion: P(t) = A exp(ut) D
-        # (a plane: the planned frame, so it makes its planned motion in the gripper frame and
-        # stays level whatever the object's measured pose)
-        A = np.asarray(a["pose"], float) if scene._core.is_plane(p) else in_grasp()
-        D = compose(inverse(A), P)
-        nsteps = int(round(1.0 / dt))
-        for k in range(1, nsteps + 1):
-            P = compose(A, compose(_exp(u, k / nsteps), D))
-            place(P)
-        st["P"], st["n"] = P, n
-        return in_grasp()
-
-    q, poses, replans = run_plan3d(scene, path, step, in_grasp(), feedback, max_replans, seed)
-    return {"engine": "mujoco", "view": view, **goal_report(scene, q), "poses": np.array(poses), "replans": replans}
+    _check_options(pad, view)
+    path = check_plan3d(scene, plan_dict(plan))
+    ex = SpatialExecution(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact, pad, view)
+    return ex.run(path, settle, feedback, max_replans, seed)
