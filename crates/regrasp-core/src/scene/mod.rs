@@ -5,6 +5,7 @@ pub mod perturb;
 pub mod planar;
 pub mod planar_file;
 pub mod spatial;
+pub mod spatial_file;
 
 pub use planar::Scene;
 pub use spatial::Scene3;
