@@ -75,66 +75,100 @@ pub fn project_with_margin_on(frame: &SupportFrame, model: &PusherModel, gens: &
     Some(x * (vn / m.twist_norm(&x)))
 }
 
-/// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images of
-/// the boundary fans of `W_p`). Each fan is sampled until consecutive rays are less than 4°
-/// apart (the boundary can turn quickly where gravity matters most), then the best two local
-/// maxima are refined by golden-section search. Returns the cosine and the unit ray.
-fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> (f64, Vec3) {
+/// A sample of the exact cone's boundary: (parameter along the fan, cosine to the desired
+/// direction, unit ray in the metric, ray).
+type Sample = (f64, f64, Vec3, Vec3);
+
+/// The rays of the exact cone's boundary fans compared with one desired direction.
+struct BoundaryRays<'a> {
+    frame: &'a SupportFrame,
+    model: &'a PusherModel,
+    /// The desired direction, a unit vector in the metric.
+    ds: Vec3,
+}
+
+impl BoundaryRays<'_> {
     const MAX_STEP: f64 = 0.07; // rad between consecutive samples
     const MAX_SAMPLES: usize = 4096;
-    let m = &model.metric;
-    let ds = m.twist(d).normalize();
-    // (t, cosine, unit ray in the metric, ray)
-    type Sample = (f64, f64, Vec3, Vec3);
-    let sample = |p: &Vec3, t: f64| -> Sample {
-        match frame.ray(&m.wrench_inv(p), m) {
+
+    /// The boundary ray of pusher wrench direction `p` (`t`: its parameter on the fan).
+    fn sample(&self, p: &Vec3, t: f64) -> Sample {
+        let m = &self.model.metric;
+        match self.frame.ray(&m.wrench_inv(p), m) {
             Some(v) => {
                 let s = m.twist(&v);
-                (t, s.dot(&ds), s, v)
+                (t, s.dot(&self.ds), s, v)
             }
             None => (t, f64::NEG_INFINITY, Vec3::zeros(), Vec3::zeros()),
         }
-    };
-    let mut best = (f64::NEG_INFINITY, Vec3::zeros());
-    // sample every boundary fan finely enough, keeping (segment, samples)
-    let segments = model.cone.boundary_segments();
-    let mut sampled: Vec<Vec<Sample>> = Vec::with_capacity(segments.len());
-    for &(i, j) in &segments {
-        let (ea, eb) = (model.cone.edges[i], model.cone.edges[j]);
+    }
+
+    /// Samples the fan between edges `ea` and `eb` by depth-first subdivision until
+    /// consecutive rays are less than `MAX_STEP` apart.
+    fn fan(&self, ea: Vec3, eb: Vec3) -> Vec<Sample> {
         let at = |t: f64| ea * (1.0 - t) + eb * t;
-        if i == j {
-            sampled.push(vec![sample(&ea, 0.0)]);
-            continue;
-        }
-        // depth-first subdivision of each interval until its end rays are close
-        let cos_step = MAX_STEP.cos();
-        let mut pts: Vec<Sample> = Vec::with_capacity(64);
-        let mut stack: Vec<Sample> = Vec::with_capacity(32);
-        let first = sample(&at(0.0), 0.0);
-        pts.push(first);
-        for k in (1..=8).rev() {
-            stack.push(sample(&at(k as f64 / 8.0), k as f64 / 8.0));
-        }
+        let cos_step = Self::MAX_STEP.cos();
+        let mut pts: Vec<Sample> = vec![self.sample(&at(0.0), 0.0)];
+        let mut stack: Vec<Sample> = (1..=8).rev().map(|k| self.sample(&at(k as f64 / 8.0), k as f64 / 8.0)).collect();
         while let Some(right) = stack.pop() {
             let left = *pts.last().expect("samples");
-            if left.2.dot(&right.2) < cos_step && right.0 - left.0 > 1e-9 && pts.len() + stack.len() < MAX_SAMPLES {
+            if left.2.dot(&right.2) < cos_step && right.0 - left.0 > 1e-9 && pts.len() + stack.len() < Self::MAX_SAMPLES {
                 let t = 0.5 * (left.0 + right.0);
                 stack.push(right);
-                stack.push(sample(&at(t), t));
+                stack.push(self.sample(&at(t), t));
             } else {
                 pts.push(right);
             }
         }
-        sampled.push(pts);
+        pts
     }
+
+    /// Golden-section search for the largest cosine on the fan `ea`–`eb` within `[lo, hi]`;
+    /// returns the two last samples.
+    fn golden(&self, ea: Vec3, eb: Vec3, mut lo: f64, mut hi: f64) -> [Sample; 2] {
+        let at = |t: f64| ea * (1.0 - t) + eb * t;
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        let (mut f1, mut f2) = (self.sample(&at(x1), x1), self.sample(&at(x2), x2));
+        let stop = 1e-7 * (hi - lo);
+        while hi - lo > stop {
+            if f1.1 >= f2.1 {
+                hi = x2;
+                x2 = x1;
+                f2 = f1;
+                x1 = hi - g * (hi - lo);
+                f1 = self.sample(&at(x1), x1);
+            } else {
+                lo = x1;
+                x1 = x2;
+                f1 = f2;
+                x2 = lo + g * (hi - lo);
+                f2 = self.sample(&at(x2), x2);
+            }
+        }
+        [f1, f2]
+    }
+}
+
+/// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images of
+/// the boundary fans of `W_p`). Each fan is sampled until consecutive rays are less than 4°
+/// apart (the boundary can turn quickly where gravity matters most), then every local maximum
+/// near the best is refined by golden-section search. Returns the cosine and the unit ray.
+fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> (f64, Vec3) {
+    let rays = BoundaryRays { frame, model, ds: model.metric.twist(d).normalize() };
+    let segments = model.cone.boundary_segments();
+    let edges = |(i, j): (usize, usize)| (model.cone.edges[i], model.cone.edges[j]);
+    let sampled: Vec<Vec<Sample>> = segments
+        .iter()
+        .map(|&(i, j)| if i == j { vec![rays.sample(&model.cone.edges[i], 0.0)] } else { rays.fan(edges((i, j)).0, edges((i, j)).1) })
+        .collect();
     let top = sampled.iter().flatten().map(|s| s.1).fold(f64::NEG_INFINITY, f64::max);
     // between samples at most MAX_STEP apart the cosine can rise by about MAX_STEP²/2 above
     // the better sample: refine every local maximum within that of the best one
-    let slack = MAX_STEP * MAX_STEP;
+    let slack = BoundaryRays::MAX_STEP * BoundaryRays::MAX_STEP;
+    let mut best = (f64::NEG_INFINITY, Vec3::zeros());
     for (seg, pts) in sampled.iter().enumerate() {
-        let (i, j) = segments[seg];
-        let (ea, eb) = (model.cone.edges[i], model.cone.edges[j]);
-        let at = |t: f64| ea * (1.0 - t) + eb * t;
+        let (ea, eb) = edges(segments[seg]);
         for k in 0..pts.len() {
             let is_peak = (k == 0 || pts[k].1 >= pts[k - 1].1) && (k + 1 == pts.len() || pts[k].1 >= pts[k + 1].1);
             if !is_peak || pts[k].1 < top - slack {
@@ -146,27 +180,8 @@ fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> 
             if pts.len() < 2 {
                 continue;
             }
-            let (mut lo, mut hi) = (pts[k.saturating_sub(1)].0, pts[(k + 1).min(pts.len() - 1)].0);
-            let g = 0.5 * (5f64.sqrt() - 1.0);
-            let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-            let (mut f1, mut f2) = (sample(&at(x1), x1), sample(&at(x2), x2));
-            let stop = 1e-7 * (hi - lo);
-            while hi - lo > stop {
-                if f1.1 >= f2.1 {
-                    hi = x2;
-                    x2 = x1;
-                    f2 = f1;
-                    x1 = hi - g * (hi - lo);
-                    f1 = sample(&at(x1), x1);
-                } else {
-                    lo = x1;
-                    x1 = x2;
-                    f1 = f2;
-                    x2 = lo + g * (hi - lo);
-                    f2 = sample(&at(x2), x2);
-                }
-            }
-            for f in [f1, f2] {
+            let (lo, hi) = (pts[k.saturating_sub(1)].0, pts[(k + 1).min(pts.len() - 1)].0);
+            for f in rays.golden(ea, eb, lo, hi) {
                 if f.1 > best.0 {
                     best = (f.1, f.3);
                 }

@@ -293,60 +293,59 @@ impl Mpc {
             .unwrap_or(0)
     }
 
-    /// The QP from pose `q` with reference knots after `j`.
-    pub fn solve_qp(&self, q: &[f64; 3], j: usize) -> Result<QpSolution> {
-        if !q.iter().all(|x| x.is_finite()) {
-            return Err(Error::arg("pose", "has a non-finite component"));
+    /// The generators of pusher `p`'s cone at pose `at` (none where the pad is off the object or
+    /// the grasp cannot hold), plus the reference twist towards `target` or its projection on
+    /// the exact cone: the polyhedral approximation may miss the reference's own direction.
+    fn step_generators(&self, at: &[f64; 3], p: usize, target: &[f64; 3]) -> Vec<Vec3> {
+        if !self.scene.admissible(at) {
+            return Vec::new();
         }
-        let j = j.min(self.knots.len() - 1);
-        let s = &self.settings;
-        let ds = s.speed * s.dt;
+        let f = self.scene.frame(at);
+        if !(f.hold_ratio < 1.0) {
+            return Vec::new();
+        }
+        let metric = self.scene.metric();
+        let model = &self.scene.pushers[p].model;
+        let mut g = generators(&f, model);
+        let d = body_twist(at, target);
+        if metric.twist_norm(&d) > 1e-12 && !g.is_empty() {
+            if let Some(u) = project_with_margin_on(&f, model, &g, &d, self.settings.margin) {
+                let n = metric.twist_norm(&u);
+                if n > 1e-12 {
+                    g.push(u / n);
+                }
+            }
+        }
+        g
+    }
+
+    /// The horizon's steps from pose `q` with reference knots after `j`: (pusher, generators,
+    /// target knot, heading at the step's start).
+    fn horizon(&self, q: &[f64; 3], j: usize) -> Vec<(usize, Vec<Vec3>, [f64; 3], f64)> {
         let n_knots = self.knots.len();
         let last_pusher = self.pushers.iter().rev().find_map(|p| *p);
-        let metric = self.scene.metric();
-        let mut steps: Vec<(usize, Vec<Vec3>, [f64; 3])> = Vec::with_capacity(s.horizon);
-        for i in 0..s.horizon {
+        let mut steps = Vec::with_capacity(self.settings.horizon);
+        for i in 0..self.settings.horizon {
             let r = (j + 1 + i).min(n_knots - 1);
             let Some(p) = self.pushers[r].or(last_pusher) else { break };
             let at = if i == 0 { *q } else { self.knots[(j + i).min(n_knots - 1)] };
-            let gens = if self.scene.admissible(&at) {
-                let f = self.scene.frame(&at);
-                if f.hold_ratio < 1.0 {
-                    let model = &self.scene.pushers[p].model;
-                    let mut g = generators(&f, model);
-                    // the polyhedral approximation may miss the reference's own direction (it is
-                    // not the exact cone): add the reference twist, or its projection on the
-                    // exact cone, as one more generator
-                    let d = body_twist(&at, &self.knots[r]);
-                    if metric.twist_norm(&d) > 1e-12 && !g.is_empty() {
-                        if let Some(u) = project_with_margin_on(&f, model, &g, &d, s.margin) {
-                            let n = metric.twist_norm(&u);
-                            if n > 1e-12 {
-                                g.push(u / n);
-                            }
-                        }
-                    }
-                    g
-                } else {
-                    Vec::new()
-                }
-            } else {
-                Vec::new()
-            };
-            steps.push((p, gens, self.knots[r]));
+            steps.push((p, self.step_generators(&at, p, &self.knots[r]), self.knots[r], at[2]));
         }
-        let sizes: Vec<usize> = steps.iter().map(|s| s.1.len()).collect();
-        let n: usize = sizes.iter().sum();
-        if n == 0 {
-            return Ok(QpSolution { steps: steps.into_iter().map(|(p, g, _)| (p, g, Vec::new())).collect(), status_ok: false });
-        }
-        let offs: Vec<usize> = sizes.iter().scan(0, |acc, &k| { let o = *acc; *acc += k; Some(o) }).collect();
+        steps
+    }
+
+    /// The tracking cost `½ αᵀPα + cᵀα` over the generator weights (offsets `offs`, counts
+    /// `sizes`): per step the pose error after the step (stage or terminal weight, positions and
+    /// `L θ` in units of one step) plus the effort `Σ α²`.
+    fn cost(&self, q: &[f64; 3], steps: &[(usize, Vec<Vec3>, [f64; 3], f64)], offs: &[usize], sizes: &[usize]) -> (DMatrix<f64>, DVector<f64>) {
+        let s = &self.settings;
+        let ds = s.speed * s.dt;
         let l = self.scene.length;
+        let n: usize = sizes.iter().sum();
         // columns: pose change (in units of one step, metric-scaled) per unit weight (α/v_max)
         let mut b = DMatrix::<f64>::zeros(3, n);
-        for (i, (_, gens, _)) in steps.iter().enumerate() {
-            let th = if i == 0 { q[2] } else { self.knots[(j + i).min(n_knots - 1)][2] };
-            let r = rot(th);
+        for (i, (_, gens, _, th)) in steps.iter().enumerate() {
+            let r = rot(*th);
             for (k, g) in gens.iter().enumerate() {
                 let d = r * Vec2::new(g.x, g.y);
                 // pose rate of the unit twist × v_max × δt, in steps: [dx, dz, L dθ] / ds
@@ -357,28 +356,32 @@ impl Mpc {
         let mut p_mat = DMatrix::<f64>::identity(n, n) * (2.0 * s.effort_weight);
         let mut c = DVector::<f64>::zeros(n);
         let q0 = Vec3::new(q[0], q[1], l * q[2]) / ds;
-        for (i, (_, _, target)) in steps.iter().enumerate() {
+        for (i, (_, _, target, _)) in steps.iter().enumerate() {
             let w = if i + 1 == steps.len() { s.terminal_weight } else { s.stage_weight };
             let upto = offs[i] + sizes[i];
             let m = b.columns(0, upto).into_owned();
             let e0 = q0 - Vec3::new(target[0], target[1], l * target[2]) / ds;
-            let mtm = m.transpose() * &m * (2.0 * w);
-            let mte = m.transpose() * DVector::from_row_slice(e0.as_slice()) * (2.0 * w);
             let mut pv = p_mat.view_mut((0, 0), (upto, upto));
-            pv += &mtm;
+            pv += m.transpose() * &m * (2.0 * w);
             let mut cv = c.rows_mut(0, upto);
-            cv += &mte;
+            cv += m.transpose() * DVector::from_row_slice(e0.as_slice()) * (2.0 * w);
         }
-        // constraints: −α ≤ 0; Σ αᵢ ≤ 10 per step (bounded weights); ‖Σₖ αᵢₖ S gᵢₖ‖ ≤ 1 per step
-        // (the twist's speed in the metric at most v_max: a second-order cone)
-        let h = steps.len();
+        (p_mat, c)
+    }
+
+    /// The constraints `A α + s = b, s ∈ K`: `−α ≤ 0`; `Σ αᵢ ≤ 10` per step (bounded weights);
+    /// `‖Σₖ αᵢₖ S gᵢₖ‖ ≤ 1` per step (the twist's speed in the metric at most v_max: a
+    /// second-order cone).
+    fn constraints(&self, steps: &[(usize, Vec<Vec3>, [f64; 3], f64)], offs: &[usize], sizes: &[usize]) -> (CscMatrix<f64>, Vec<f64>, Vec<SupportedConeT<f64>>) {
+        let metric = self.scene.metric();
+        let (n, h) = (sizes.iter().sum::<usize>(), steps.len());
         let rows = n + h + 4 * h;
         let mut a = vec![vec![0.0; n]; rows];
         let mut bvec = vec![0.0; rows];
         for k in 0..n {
             a[k][k] = -1.0;
         }
-        for (i, (_, gens, _)) in steps.iter().enumerate() {
+        for (i, (_, gens, _, _)) in steps.iter().enumerate() {
             for k in 0..sizes[i] {
                 a[n + i][offs[i] + k] = 1.0;
             }
@@ -392,27 +395,41 @@ impl Mpc {
                 }
             }
         }
-        let a = CscMatrix::from(&a);
-        let mut pu = vec![vec![0.0; n]; n];
-        for r in 0..n {
-            for cc in r..n {
-                pu[r][cc] = p_mat[(r, cc)];
-            }
-        }
-        let p = CscMatrix::from(&pu);
         let mut cones = vec![SupportedConeT::NonnegativeConeT(n + h)];
         cones.extend(std::iter::repeat_n(SupportedConeT::SecondOrderConeT(4), h));
+        (CscMatrix::from(&a), bvec, cones)
+    }
+
+    /// The QP from pose `q` with reference knots after `j`: non-negative weights of each
+    /// horizon step's generators minimizing the tracking cost under the speed bound (clarabel).
+    pub fn solve_qp(&self, q: &[f64; 3], j: usize) -> Result<QpSolution> {
+        if !q.iter().all(|x| x.is_finite()) {
+            return Err(Error::arg("pose", "has a non-finite component"));
+        }
+        let j = j.min(self.knots.len() - 1);
+        let steps = self.horizon(q, j);
+        let sizes: Vec<usize> = steps.iter().map(|s| s.1.len()).collect();
+        let n: usize = sizes.iter().sum();
+        if n == 0 {
+            return Ok(QpSolution { steps: steps.into_iter().map(|(p, g, _, _)| (p, g, Vec::new())).collect(), status_ok: false });
+        }
+        let offs: Vec<usize> = sizes.iter().scan(0, |acc, &k| { let o = *acc; *acc += k; Some(o) }).collect();
+        let (p_mat, c) = self.cost(q, &steps, &offs, &sizes);
+        let (a, bvec, cones) = self.constraints(&steps, &offs, &sizes);
+        let upper: Vec<Vec<f64>> = (0..n).map(|r| (0..n).map(|cc| if cc >= r { p_mat[(r, cc)] } else { 0.0 }).collect()).collect();
+        let p = CscMatrix::from(&upper);
         let settings = DefaultSettings { verbose: false, ..DefaultSettings::default() };
         let mut solver = DefaultSolver::new(&p, c.as_slice(), &a, &bvec, &cones, settings)
             .map_err(|e| Error::arg("mpc", format!("QP setup failed: {e:?}")))?;
         solver.solve();
         let ok = matches!(solver.solution.status, SolverStatus::Solved | SolverStatus::AlmostSolved);
         let x = &solver.solution.x;
+        let speed = self.settings.speed;
         Ok(QpSolution {
             steps: steps
                 .into_iter()
                 .enumerate()
-                .map(|(i, (p, g, _))| (p, g, (0..sizes[i]).map(|k| x[offs[i] + k].max(0.0) * s.speed).collect()))
+                .map(|(i, (p, g, _, _))| (p, g, (0..sizes[i]).map(|k| x[offs[i] + k].max(0.0) * speed).collect()))
                 .collect(),
             status_ok: ok,
         })
@@ -446,6 +463,29 @@ impl Mpc {
         self.best_tracking = f64::INFINITY;
         self.since_tracking = 0;
         true
+    }
+
+    /// The first push of the QP's solution from `q` (knot `j`): (pusher, twist, whether it was
+    /// projected to pass the exact test with the margin), if it moves the object at all.
+    fn first_push(&self, q: &[f64; 3], j: usize) -> Result<Option<(usize, Vec3, bool)>> {
+        let sol = self.solve_qp(q, j)?;
+        let Some((p, gens, w)) = sol.steps.first() else { return Ok(None) };
+        if !sol.status_ok || w.is_empty() {
+            return Ok(None);
+        }
+        let v = gens.iter().zip(w).fold(Vec3::zeros(), |a, (g, &x)| a + g * x);
+        let m = self.scene.metric();
+        let slow = 1e-3 * self.settings.speed;
+        if m.twist_norm(&v) <= slow {
+            return Ok(None);
+        }
+        let f = self.scene.frame(q);
+        let model = &self.scene.pushers[*p].model;
+        if f.classify(model, &v).margin >= self.settings.margin {
+            return Ok(Some((*p, v, false)));
+        }
+        let u = project_with_margin_on(&f, model, gens, &v, self.settings.margin).unwrap_or_else(Vec3::zeros);
+        Ok((m.twist_norm(&u) > slow).then_some((*p, u, true)))
     }
 
     /// One control step from the measured pose `q`.
@@ -497,31 +537,10 @@ impl Mpc {
         for attempt in 0..2 {
             let j = self.closest_knot(q);
             self.last_knot = j;
-            let sol = self.solve_qp(q, j)?;
-            if let Some((p, gens, w)) = sol.steps.first() {
-                if sol.status_ok && !w.is_empty() {
-                    let v = gens.iter().zip(w).fold(Vec3::zeros(), |a, (g, &x)| a + g * x);
-                    let m = self.scene.metric();
-                    if m.twist_norm(&v) > 1e-3 * self.settings.speed {
-                        let f = self.scene.frame(q);
-                        let model = &self.scene.pushers[*p].model;
-                        let mut projected = false;
-                        let v = if f.classify(model, &v).margin >= self.settings.margin {
-                            v
-                        } else {
-                            projected = true;
-                            match project_with_margin_on(&f, model, gens, &v, self.settings.margin) {
-                                Some(u) => u,
-                                None => Vec3::zeros(),
-                            }
-                        };
-                        if m.twist_norm(&v) > 1e-3 * self.settings.speed {
-                            let mut c = self.command(q, status, Some(*p), v, projected, t0, replan_time);
-                            c.solve_time_s -= replan_time;
-                            return Ok(c);
-                        }
-                    }
-                }
+            if let Some((p, v, projected)) = self.first_push(q, j)? {
+                let mut c = self.command(q, status, Some(p), v, projected, t0, replan_time);
+                c.solve_time_s -= replan_time;
+                return Ok(c);
             }
             // no push of the horizon helps: re-plan once, then give up this step
             if attempt == 0 {
