@@ -17,6 +17,7 @@ import numpy as np
 import regrasp
 from regrasp.mujoco import push as mujoco_sim
 from regrasp.sim import quasistatic
+from regrasp.viz.plotting import save_time_figure
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -42,15 +43,8 @@ def horizontal_push(out: Path):
         rows.append((mu, qs["pose"][-1], mj["pose"][-1]))
     ax[0].set_ylabel("object x in the grasp [mm]")
     ax[1].set_ylabel("object z in the grasp [mm]")
-    for a in ax:
-        a.set_xlabel("t [s]")
-        a.grid(alpha=0.3)
-        a.legend(fontsize=8)
-    fig.suptitle("horizontal push, 20 N grip, 10 mm/s: the object drifts down (−Z) when the pusher cannot carry its weight\n"
-                 "(MuJoCo: soft contact lets it creep down even when rigid Coulomb friction would hold it)")
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
+    save_time_figure(fig, ax, "horizontal push, 20 N grip, 10 mm/s: the object drifts down (−Z) when the pusher cannot carry its weight\n"
+                     "(MuJoCo: soft contact lets it creep down even when rigid Coulomb friction would hold it)", out)
     return rows
 
 
@@ -75,15 +69,8 @@ def pivot(out: Path):
         ax[1].plot(qs["t"], 1e3 * qs["pose"][:, k], label=f"quasi-static {name}")
         ax[1].plot(mj["t"], 1e3 * mj["pose"][:, k], "--", label=f"MuJoCo {name}")
     ax[1].set_ylabel("object position in the grasp [mm]")
-    for a in ax:
-        a.set_xlabel("t [s]")
-        a.grid(alpha=0.3)
-        a.legend(fontsize=8)
-    fig.suptitle("pivoting at 20 N grip and 10 deg/s about the centre of the bottom face: the pusher slips,"
-                 " the object turns about half as far")
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
+    save_time_figure(fig, ax, "pivoting at 20 N grip and 10 deg/s about the centre of the bottom face: the pusher slips,"
+                     " the object turns about half as far", out)
     return qs["pose"][-1], mj["pose"][-1]
 
 

@@ -144,21 +144,11 @@ def test_every_example_uses_only_documented_keys(path):
 
 
 # (example, table header line or None for the top level, dotted prefix of that table's keys)
-TABLES = [
-    ("block-low-friction.toml", None, ""),
-    ("block-low-friction.toml", "[object]", "object."),
-    ("block-low-friction.toml", "[grasp]", "grasp."),
-    ("block-low-friction.toml", "[gravity]", "gravity."),
-    ("block-low-friction.toml", "[[pushers]]", "pushers[]."),
-    ("block-low-friction.toml", "[task]", "task."),
+_SECTIONS = [(None, ""), ("[object]", "object."), ("[grasp]", "grasp."), ("[gravity]", "gravity."),
+             ("[[pushers]]", "pushers[]."), ("[task]", "task.")]
+TABLES = [(ex, h, p) for ex in ("block-low-friction.toml", "offset-3d.toml") for h, p in _SECTIONS] + [
     ("block-on-incline.toml", "[surface]", "surface."),
     ("block-fixtureless.toml", "[uncertainty]", "uncertainty."),
-    ("offset-3d.toml", None, ""),
-    ("offset-3d.toml", "[object]", "object."),
-    ("offset-3d.toml", "[grasp]", "grasp."),
-    ("offset-3d.toml", "[gravity]", "gravity."),
-    ("offset-3d.toml", "[[pushers]]", "pushers[]."),
-    ("offset-3d.toml", "[task]", "task."),
 ]
 
 
@@ -214,19 +204,21 @@ def test_an_unknown_key_is_an_error_that_names_it_and_the_cli_exits_2(tmp_path):
 
 # --- plan files ------------------------------------------------------------------------------
 
+_SCALAR_TYPES = {
+    "str": lambda v: isinstance(v, str),
+    "bool": lambda v: isinstance(v, bool),
+    "int": lambda v: isinstance(v, int) and not isinstance(v, bool),
+    "float": lambda v: isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v),
+    "str|null": lambda v: v is None or isinstance(v, str),
+    "object[]": lambda v: isinstance(v, list) and all(isinstance(x, dict) for x in v),
+}
+
+
 def _type_ok(v, t: str) -> bool:
-    if t == "str":
-        return isinstance(v, str)
-    if t == "bool":
-        return isinstance(v, bool)
-    if t == "int":
-        return isinstance(v, int) and not isinstance(v, bool)
-    if t == "float":
-        return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-    if t == "str|null":
-        return v is None or isinstance(v, str)
-    if t == "object[]":
-        return isinstance(v, list) and all(isinstance(x, dict) for x in v)
+    """Whether ``v`` has the JSON type ``t`` written in docs/plan-file.md (written out here, not
+    taken from the package, so that the check is independent of the code it checks)."""
+    if t in _SCALAR_TYPES:
+        return _SCALAR_TYPES[t](v)
     m = re.fullmatch(r"float\[(\d*)\]", t)
     if m:
         return isinstance(v, list) and (m[1] == "" or len(v) == int(m[1])) and all(_type_ok(x, "float") for x in v)
@@ -279,12 +271,19 @@ def written_plans(tmp_path_factory):
     return d, runs
 
 
-def test_a_planar_plan_file_has_exactly_the_documented_keys(written_plans):
+def _written(written_plans, k: int, file: str, kind: str, scene: str) -> dict:
+    """Plan file `file` written by run `k`: it succeeded, has the documented keys, found a path."""
     d, runs = written_plans
-    assert runs[0].returncode == 0, runs[0].stderr
-    plan = _strict_json((d / "planar.json").read_text())
-    check_plan(plan, "planar plan key")
-    assert plan["found"] and plan["scene"] == "t-shape" and len(plan["path"]) >= 2
+    assert runs[k].returncode == 0, runs[k].stderr
+    plan = _strict_json((d / file).read_text())
+    check_plan(plan, kind)
+    assert plan["found"] and plan["scene"] == scene and len(plan["path"]) >= 2
+    return plan
+
+
+def test_a_planar_plan_file_has_exactly_the_documented_keys(written_plans):
+    _, runs = written_plans
+    plan = _written(written_plans, 0, "planar.json", "planar plan key", "t-shape")
     assert all(len(k["pose"]) == 3 for k in plan["path"])
     assert len(plan["step_margins"]) == len(plan["path"]) - 1
     assert plan["valid"] == all(m >= -1e-9 for m in plan["step_margins"])
@@ -303,11 +302,7 @@ def test_a_plan_not_found_is_written_with_the_documented_keys_and_exits_1(writte
 
 
 def test_a_3d_plan_file_has_exactly_the_documented_keys(written_plans):
-    d, runs = written_plans
-    assert runs[1].returncode == 0, runs[1].stderr
-    plan = _strict_json((d / "3d.json").read_text())
-    check_plan(plan, "3-D plan key")
-    assert plan["found"] and plan["scene"] == "offset-3d" and len(plan["path"]) >= 2
+    plan = _written(written_plans, 1, "3d.json", "3-D plan key", "offset-3d")
     assert plan["propagation"] == "mncp_inverse"
     for k in plan["path"]:
         assert abs(math.sqrt(sum(x * x for x in k["pose"][3:])) - 1) < 1e-6, "poses carry unit quaternions"

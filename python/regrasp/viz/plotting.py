@@ -228,12 +228,17 @@ def plot_replay(scene, rep, path, extra=None) -> Path:
         _axes_pose(ax, r.t, r.poses, f"{name} ", dict(ls=":"))
     ax[0].set_ylabel("object position in the grasp [mm]")
     ax[1].set_ylabel("object angle in the grasp [deg]")
-    for a in ax:
+    return save_time_figure(fig, ax, f"{scene.name}: plan replayed ({'success' if rep.success else 'outside tolerance'}, "
+                            f"largest pusher slip {1e3 * rep.max_pusher_slip:.2f} mm)", path, fontsize=7)
+
+
+def save_time_figure(fig, axes, title: str, path, fontsize: int = 8) -> Path:
+    """Time on every x axis, a grid and a legend on each, the title, then :func:`_save`."""
+    for a in axes:
         a.set_xlabel("t [s]")
         a.grid(alpha=0.3)
-        a.legend(fontsize=7)
-    fig.suptitle(f"{scene.name}: plan replayed ({'success' if rep.success else 'outside tolerance'}, "
-                 f"largest pusher slip {1e3 * rep.max_pusher_slip:.2f} mm)")
+        a.legend(fontsize=fontsize)
+    fig.suptitle(title)
     return _save(fig, path)
 
 

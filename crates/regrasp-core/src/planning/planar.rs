@@ -17,7 +17,7 @@ use crate::dynamics::planar::{push_problem, Options as QsOptions, SupportModel};
 use crate::error::{Error, Result};
 use crate::mechanics::geometry::{rot, Vec2, Vec3};
 use crate::planning::tree::pusher_order;
-use crate::planning::trrt::{self, gauss, SearchSettings, Space, Step};
+use crate::planning::trrt::{self, gauss, SearchSettings, Space, SpaceCore, Step};
 use crate::pose::planar::{body_twist, distance, integrate};
 use crate::scene::Scene;
 use rand::Rng;
@@ -89,10 +89,9 @@ pub type PlanarPlan = trrt::Plan<[f64; 3], ()>;
 
 /// The planar space: a scene, a goal with its tolerance, and the planner's settings.
 pub struct PlanarSpace<'a> {
+    core: SpaceCore<[f64; 3]>,
     scene: &'a Scene,
     s: &'a PlanarSettings,
-    step: f64,
-    goal: [f64; 3],
     tol: [f64; 3],
     bounds: ([f64; 2], [f64; 2], [f64; 2]),
     qs_opts: QsOptions,
@@ -117,11 +116,11 @@ impl<'a> PlanarSpace<'a> {
         let reach = scene.outline.vertices().iter().map(|v| v.norm()).fold(0.0, f64::max);
         let m = s.search.theta_margin;
         let (tlo, thi) = (start[2].min(goal[2]) - m, start[2].max(goal[2]) + m);
+        let step = s.search.step.unwrap_or(0.1 * scene.length);
         Ok(Self {
+            core: SpaceCore { search: s.search.clone(), length: scene.length, step, pushers: scene.pushers.len(), goal },
             scene,
             s,
-            step: s.search.step.unwrap_or(0.1 * scene.length),
-            goal,
             tol,
             bounds: ([-reach, reach], [-reach, reach], [tlo, thi]),
             qs_opts: QsOptions { support: SupportModel::Points { rings: 2, points: 0, merge_fingers: true }, ..QsOptions::default() },
@@ -192,7 +191,7 @@ impl<'a> PlanarSpace<'a> {
     fn desired(&self, q: &[f64; 3], target: &[f64; 3]) -> Option<(Vec3, f64)> {
         let xi = body_twist(q, target);
         let len = self.scene.metric().twist_norm(&xi);
-        (len >= 1e-12).then(|| (xi * (self.step.min(len) / len), len))
+        (len >= 1e-12).then(|| (xi * (self.core.step.min(len) / len), len))
     }
 
     /// Propagation by motion cones: the desired step if some cone contains it (parent's pusher
@@ -225,7 +224,7 @@ impl<'a> PlanarSpace<'a> {
         }
         let (_, p, v) = best?;
         // a step of the unit length along the projection, halved until feasible along it
-        let mut tw = v * (self.step.min(len) / m.twist_norm(&v));
+        let mut tw = v * (self.core.step.min(len) / m.twist_norm(&v));
         for _ in 0..4 {
             if self.step_feasible(q, &tw, p) {
                 return Some(self.step_to(q, p, tw));
@@ -270,20 +269,8 @@ impl Space<3> for PlanarSpace<'_> {
     type Edge = ();
     type Motion = Vec3;
 
-    fn search(&self) -> &SearchSettings {
-        &self.s.search
-    }
-    fn length(&self) -> f64 {
-        self.scene.length
-    }
-    fn step(&self) -> f64 {
-        self.step
-    }
-    fn pushers(&self) -> usize {
-        self.scene.pushers.len()
-    }
-    fn goal(&self) -> &[f64; 3] {
-        &self.goal
+    fn core(&self) -> &SpaceCore<[f64; 3]> {
+        &self.core
     }
     fn root_edge(&self) {}
     fn key(&self, q: &[f64; 3]) -> [f64; 3] {
@@ -293,7 +280,7 @@ impl Space<3> for PlanarSpace<'_> {
         distance(self.scene.length, a, b)
     }
     fn at_goal(&self, q: &[f64; 3]) -> bool {
-        (0..3).all(|k| (q[k] - self.goal[k]).abs() <= self.tol[k])
+        (0..3).all(|k| (q[k] - self.core.goal[k]).abs() <= self.tol[k])
     }
     fn sample(&self, rng: &mut ChaCha8Rng, _start: &[f64; 3]) -> [f64; 3] {
         let (bx, bz, bt) = self.bounds;
@@ -303,7 +290,7 @@ impl Space<3> for PlanarSpace<'_> {
                 return q;
             }
         }
-        self.goal
+        self.core.goal
     }
     fn propagate(&self, rng: &mut ChaCha8Rng, q: &[f64; 3], pusher: Option<usize>, target: &[f64; 3]) -> Option<Step<[f64; 3], ()>> {
         match self.s.propagation {
@@ -321,12 +308,12 @@ impl Space<3> for PlanarSpace<'_> {
     /// Straight push to the goal: unit steps of one constant body twist, all feasible for one
     /// pusher (the node's first), at most 200 of them.
     fn connect_goal(&self, q: &[f64; 3], pusher: Option<usize>) -> Option<(usize, Vec<([f64; 3], (), f64)>)> {
-        let xi = body_twist(q, &self.goal);
+        let xi = body_twist(q, &self.core.goal);
         let len = self.scene.metric().twist_norm(&xi);
         if len < 1e-12 {
             return None;
         }
-        let n = (len / self.step).ceil().max(1.0) as usize;
+        let n = (len / self.core.step).ceil().max(1.0) as usize;
         if n > 200 {
             return None;
         }

@@ -22,7 +22,7 @@ use crate::dynamics::mncp;
 use crate::dynamics::spatial::{push_problem, simulate_push};
 use crate::error::{Error, Result};
 use crate::planning::tree::pusher_order;
-use crate::planning::trrt::{self, gauss, SearchSettings, Space, Step};
+use crate::planning::trrt::{self, gauss, SearchSettings, Space, SpaceCore, Step};
 use crate::pose::spatial::{distance, integrate, log as se3_log, twist_length, Twist6, V3};
 use crate::scene::spatial::Scene3;
 use nalgebra::{DVector, Isometry3, UnitQuaternion};
@@ -153,10 +153,9 @@ pub fn simulate_step(scene: &Scene3, q: &Isometry3<f64>, u: &Twist6, p: usize, n
 
 /// The spatial space: a scene, a goal, the settings and a count of the solves made.
 pub struct SpatialSpace<'a> {
+    core: SpaceCore<Isometry3<f64>>,
     scene: &'a Scene3,
     s: &'a SpatialSettings,
-    step: f64,
-    goal: Isometry3<f64>,
     solves: AtomicUsize,
 }
 
@@ -236,14 +235,14 @@ impl<'a> SpatialSpace<'a> {
         planes.par_iter().find_map_first(|&p| {
             let (mut q, mut steps) = (*q0, Vec::new());
             for _ in 0..n + 4 {
-                let aim = if self.within_position(&q) { Isometry3::from_parts(q.translation, self.goal.rotation) } else { self.goal };
+                let aim = if self.within_position(&q) { Isometry3::from_parts(q.translation, self.core.goal.rotation) } else { self.core.goal };
                 let xi = se3_log(&q, &aim);
                 let len = twist_length(self.l(), &xi);
-                let u: Twist6 = xi.map(|x| x * self.step.min(len) / len.max(1e-300));
+                let u: Twist6 = xi.map(|x| x * self.core.step.min(len) / len.max(1e-300));
                 let up = pusher_motion(self.scene, &q, p, &u);
                 self.solves.fetch_add(FORWARD_STEPS + 1, Ordering::Relaxed);
                 let end = simulate_step(self.scene, &q, &up, p, FORWARD_STEPS)?;
-                if self.dist(&end, &self.goal) >= self.dist(&q, &self.goal) {
+                if self.dist(&end, &self.core.goal) >= self.dist(&q, &self.core.goal) {
                     return None;
                 }
                 steps.push((end, up, self.dist(&q, &end)));
@@ -258,7 +257,7 @@ impl<'a> SpatialSpace<'a> {
 
     /// Whether the position of `q` is within the goal's tolerance.
     fn within_position(&self, q: &Isometry3<f64>) -> bool {
-        let d = q.translation.vector - self.goal.translation.vector;
+        let d = q.translation.vector - self.core.goal.translation.vector;
         let t = self.scene.tolerance;
         d.x.abs() <= t[0] && d.y.abs() <= t[1] && d.z.abs() <= t[2]
     }
@@ -269,20 +268,8 @@ impl Space<7> for SpatialSpace<'_> {
     type Edge = Twist6;
     type Motion = Twist6;
 
-    fn search(&self) -> &SearchSettings {
-        &self.s.search
-    }
-    fn length(&self) -> f64 {
-        self.scene.length
-    }
-    fn step(&self) -> f64 {
-        self.step
-    }
-    fn pushers(&self) -> usize {
-        self.scene.pushers.len()
-    }
-    fn goal(&self) -> &Isometry3<f64> {
-        &self.goal
+    fn core(&self) -> &SpaceCore<Isometry3<f64>> {
+        &self.core
     }
     fn root_edge(&self) -> Twist6 {
         [0.0; 6]
@@ -294,18 +281,18 @@ impl Space<7> for SpatialSpace<'_> {
         distance(self.l(), a, b)
     }
     fn at_goal(&self, q: &Isometry3<f64>) -> bool {
-        self.within_position(q) && (self.goal.inverse() * q).rotation.angle() <= self.scene.tolerance[3]
+        self.within_position(q) && (self.core.goal.inverse() * q).rotation.angle() <= self.scene.tolerance[3]
     }
     /// A random pose near the start–goal region: translation within the object's reach, rotation
     /// a random interpolation between start and goal perturbed by up to `theta_margin`.
     fn sample(&self, rng: &mut ChaCha8Rng, start: &Isometry3<f64>) -> Isometry3<f64> {
         let t: f64 = rng.random();
-        let rot = start.rotation.slerp(&self.goal.rotation, t);
+        let rot = start.rotation.slerp(&self.core.goal.rotation, t);
         let ax = V3::new(gauss(rng), gauss(rng), gauss(rng));
         let ang = self.s.search.theta_margin * rng.random::<f64>();
         let rot = UnitQuaternion::from_scaled_axis(ax.normalize() * ang) * rot;
-        let c = (start.translation.vector + self.goal.translation.vector) * 0.5;
-        let span = (start.translation.vector - self.goal.translation.vector).norm() + 0.5 * self.scene.size();
+        let c = (start.translation.vector + self.core.goal.translation.vector) * 0.5;
+        let span = (start.translation.vector - self.core.goal.translation.vector).norm() + 0.5 * self.scene.size();
         let p = c + V3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)) * span;
         Isometry3::from_parts(p.into(), rot)
     }
@@ -316,7 +303,7 @@ impl Space<7> for SpatialSpace<'_> {
         if len < 1e-12 {
             return None;
         }
-        let want: Twist6 = xi.map(|x| x * self.step.min(len) / len);
+        let want: Twist6 = xi.map(|x| x * self.core.step.min(len) / len);
         let order = pusher_order(self.scene.pushers.len(), pusher);
         if let Some(s) = self.feasible_pusher(q, &want, &order) {
             return Some(s);
@@ -333,17 +320,17 @@ impl Space<7> for SpatialSpace<'_> {
     /// Straight push to the goal (unit steps of one constant twist, one pusher, at most 100);
     /// when no pusher can take it (and it is at most 20 steps), rolling with a plane.
     fn connect_goal(&self, q: &Isometry3<f64>, pusher: Option<usize>) -> Option<(usize, Vec<(Isometry3<f64>, Twist6, f64)>)> {
-        let xi = se3_log(q, &self.goal);
+        let xi = se3_log(q, &self.core.goal);
         let len = twist_length(self.l(), &xi);
         if len < 1e-12 {
             return None;
         }
-        let n = (len / self.step).ceil().max(1.0) as usize;
+        let n = (len / self.core.step).ceil().max(1.0) as usize;
         if n > 100 {
             return None;
         }
         let u: Twist6 = xi.map(|x| x / n as f64);
-        let poses: Vec<Isometry3<f64>> = (1..=n).map(|k| if k == n { self.goal } else { integrate(q, &u, k as f64) }).collect();
+        let poses: Vec<Isometry3<f64>> = (1..=n).map(|k| if k == n { self.core.goal } else { integrate(q, &u, k as f64) }).collect();
         let order = pusher_order(self.scene.pushers.len(), pusher);
         let ok: Vec<bool> = order
             .par_iter()
@@ -373,7 +360,8 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
     }
     settings.search.check()?;
     let step = settings.search.step.unwrap_or(0.2 * scene.length);
-    let space = SpatialSpace { scene, s: settings, step, goal, solves: AtomicUsize::new(0) };
+    let core = SpaceCore { search: settings.search.clone(), length: scene.length, step, pushers: scene.pushers.len(), goal };
+    let space = SpatialSpace { core, scene, s: settings, solves: AtomicUsize::new(0) };
     let plan = trrt::plan(&space, start);
     Ok(SpatialPlan { plan, solves: space.solves.load(Ordering::Relaxed) })
 }

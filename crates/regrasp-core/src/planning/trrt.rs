@@ -157,6 +157,17 @@ pub struct Step<Q, E> {
     pub length: f64,
 }
 
+/// What every space holds: the search settings, the object's characteristic length L [m]
+/// (radius of gyration), the unit step [m], the number of pushers and the goal.
+#[derive(Clone, Debug)]
+pub struct SpaceCore<Q> {
+    pub search: SearchSettings,
+    pub length: f64,
+    pub step: f64,
+    pub pushers: usize,
+    pub goal: Q,
+}
+
 /// A space of object poses in the grasp, with its metric, sampling and unit-step propagation.
 /// `K` is the dimension of the k-d tree keys ([`Space::key`]).
 pub trait Space<const K: usize>: Sync {
@@ -167,13 +178,24 @@ pub trait Space<const K: usize>: Sync {
     /// The constant motion interpolating two poses (a body twist).
     type Motion;
 
-    fn search(&self) -> &SearchSettings;
+    fn core(&self) -> &SpaceCore<Self::Q>;
+    fn search(&self) -> &SearchSettings {
+        &self.core().search
+    }
     /// The object's characteristic length L [m] (radius of gyration).
-    fn length(&self) -> f64;
+    fn length(&self) -> f64 {
+        self.core().length
+    }
     /// The unit step [m].
-    fn step(&self) -> f64;
-    fn pushers(&self) -> usize;
-    fn goal(&self) -> &Self::Q;
+    fn step(&self) -> f64 {
+        self.core().step
+    }
+    fn pushers(&self) -> usize {
+        self.core().pushers
+    }
+    fn goal(&self) -> &Self::Q {
+        &self.core().goal
+    }
     /// The step data stored with the root.
     fn root_edge(&self) -> Self::Edge;
     /// A k-d tree key whose squared Euclidean distance approximates the squared metric.
