@@ -288,34 +288,22 @@ fn degenerate_outlines_are_rejected() {
 
 #[test]
 fn pusher_point_off_the_outline_is_rejected() {
-    // inside the block, 10 mm above the bottom face
-    let text = edit("points = [[-0.02, -0.04], [0.02, -0.04]]", "points = [[-0.02, -0.03], [0.02, -0.04]]");
-    expect_field("inside", &text, "pushers[0].points[0]");
-    // outside the block
-    let text = edit("points = [[-0.02, -0.04], [0.02, -0.04]]", "points = [[-0.02, -0.05], [0.02, -0.04]]");
-    expect_field("outside", &text, "pushers[0].points[0]");
+    let old = "points = [[-0.02, -0.04], [0.02, -0.04]]";
+    // inside the block, 10 mm above the bottom face; outside it
+    for (what, first) in [("inside", "[-0.02, -0.03]"), ("outside", "[-0.02, -0.05]")] {
+        expect_field(what, &edit(old, &format!("points = [{first}, [0.02, -0.04]]")), "pushers[0].points[0]");
+    }
 }
 
 #[test]
-fn pusher_normal_pointing_out_is_rejected() {
+fn bad_pusher_normals_are_rejected() {
     let old = "points = [[-0.02, -0.04], [0.02, -0.04]]\nnormal = [0.0, 1.0]";
-    let text = edit(old, "points = [[-0.02, -0.04], [0.02, -0.04]]\nnormal = [0.0, -1.0]");
-    expect_field("outward", &text, "pushers[0].normal");
-}
-
-#[test]
-fn line_pusher_normal_must_be_perpendicular_to_its_line() {
-    // still points into the object, but tilted by ~6 degrees from the face normal
-    let old = "points = [[-0.02, -0.04], [0.02, -0.04]]\nnormal = [0.0, 1.0]";
-    let text = edit(old, "points = [[-0.02, -0.04], [0.02, -0.04]]\nnormal = [0.1, 0.995]");
-    expect_field("tilted", &text, "pushers[0].normal");
-}
-
-#[test]
-fn zero_pusher_normal_is_rejected() {
-    let old = "points = [[-0.02, -0.04], [0.02, -0.04]]\nnormal = [0.0, 1.0]";
-    let text = edit(old, "points = [[-0.02, -0.04], [0.02, -0.04]]\nnormal = [0.0, 0.0]");
-    expect_field("zero normal", &text, "pushers[0].normal");
+    // pointing out; still into the object but tilted by ~6 degrees from the face normal (a line
+    // pusher's normal must be perpendicular to its line); zero
+    for (what, normal) in [("outward", "[0.0, -1.0]"), ("tilted", "[0.1, 0.995]"), ("zero normal", "[0.0, 0.0]")] {
+        let text = edit(old, &format!("points = [[-0.02, -0.04], [0.02, -0.04]]\nnormal = {normal}"));
+        expect_field(what, &text, "pushers[0].normal");
+    }
 }
 
 #[test]
@@ -353,15 +341,16 @@ fn grasp_scene_needs_a_task() {
 
 #[test]
 fn goal_with_the_pad_off_the_object_is_rejected() {
-    // pad centre at object point (-0.03, 0): outside the 50 mm wide block
-    let text = edit("goal = [0.012, 0.008, 0.0]", "goal = [0.03, 0.0, 0.0]");
-    expect_field("goal off the object", &text, "task.goal");
-    // pad centre inside but 5 mm from the edge, with a 7 mm pad
-    let text = edit("goal = [0.012, 0.008, 0.0]", "goal = [0.02, 0.0, 0.0]");
-    expect_field("goal pad overhangs", &text, "task.goal");
-    // and the same for the start
-    let text = edit("start = [0.0, 0.0, 0.0]", "start = [0.0, 0.035, 0.0]");
-    expect_field("start pad overhangs", &text, "task.start");
+    let cases = [
+        // pad centre at object point (-0.03, 0): outside the 50 mm wide block
+        ("goal off the object", "goal = [0.012, 0.008, 0.0]", "goal = [0.03, 0.0, 0.0]", "task.goal"),
+        // pad centre inside but 5 mm from the edge, with a 7 mm pad
+        ("goal pad overhangs", "goal = [0.012, 0.008, 0.0]", "goal = [0.02, 0.0, 0.0]", "task.goal"),
+        ("start pad overhangs", "start = [0.0, 0.0, 0.0]", "start = [0.0, 0.035, 0.0]", "task.start"),
+    ];
+    for (what, old, new, field) in cases {
+        expect_field(what, &edit(old, new), field);
+    }
 }
 
 #[test]
