@@ -2,7 +2,7 @@
 
 Units are SI, angles radians. Poses are ``[x, z, theta]`` of the object frame in the gripper
 frame; twists ``[vx, vz, omega]`` in the object frame; wrenches ``[fx, fz, tau]`` (tau
-counter-clockwise in the X-Z drawing). See ``interface.md`` for the scene file contract.
+counter-clockwise in the X-Z drawing). See ``docs/scene-file.md`` for the scene file contract.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 //! Planar geometry of the manipulation plane (the gripper's X-Z plane).
 //!
-//! Conventions (interface.md): points are `[x, z]` with X to the right and Z up; angles and
+//! Conventions (docs/scene-file.md): points are `[x, z]` with X to the right and Z up; angles and
 //! moments are counter-clockwise positive in that drawing. A planar twist is `[vx, vz, omega]`
 //! and a planar wrench `[fx, fz, tau]`, dual to each other (power = f·v + tau·omega).
 

@@ -1,4 +1,4 @@
-//! Planar scenes (the TOML contract of `interface.md`), validated field by field.
+//! Planar scenes (the TOML contract of `docs/scene-file.md`), validated field by field.
 //!
 //! A scene is immutable once built: object outline, mass and centre of mass; the support
 //! (a parallel-jaw grasp, or a surface the object lies on); gravity; named pushers; the task.
