@@ -3,4 +3,5 @@
 
 pub mod batch;
 pub mod motion_cone;
+pub mod polyhedral;
 pub mod robust;
