@@ -1,7 +1,7 @@
 //! Control (`regrasp::control::mpc`): the MPC that tracks a plan's reference within the
 //! scene's motion cones, re-planning when it stalls.
 
-use crate::convert::{arg, dict, matrix_rows, optional, path, pose3, rows_array};
+use crate::convert::{Arg, arg, dict, matrix_rows, optional, path, pose3, rows_array};
 use crate::errors::{arg_err, to_py};
 use crate::scene::Scene;
 use crate::settings;
@@ -32,28 +32,28 @@ impl Mpc {
                         replan_time_limit=None, seed=None, **settings))]
     #[allow(clippy::too_many_arguments)]
     fn new<'py>(
-        scene: &Bound<'py, PyAny>,
-        poses: &Bound<'py, PyAny>,
-        pushers: &Bound<'py, PyAny>,
-        goal: Option<&Bound<'py, PyAny>>,
-        dt: Option<Bound<'py, PyAny>>,
-        horizon: Option<Bound<'py, PyAny>>,
-        speed: Option<Bound<'py, PyAny>>,
-        stage_weight: Option<Bound<'py, PyAny>>,
-        terminal_weight: Option<Bound<'py, PyAny>>,
-        effort_weight: Option<Bound<'py, PyAny>>,
-        margin: Option<Bound<'py, PyAny>>,
-        stall_steps: Option<Bound<'py, PyAny>>,
-        max_replans: Option<Bound<'py, PyAny>>,
-        replan_time_limit: Option<Bound<'py, PyAny>>,
-        seed: Option<Bound<'py, PyAny>>,
+        scene: &Arg<'py>,
+        poses: &Arg<'py>,
+        pushers: &Arg<'py>,
+        goal: Option<&Arg<'py>>,
+        dt: Option<Arg<'py>>,
+        horizon: Option<Arg<'py>>,
+        speed: Option<Arg<'py>>,
+        stage_weight: Option<Arg<'py>>,
+        terminal_weight: Option<Arg<'py>>,
+        effort_weight: Option<Arg<'py>>,
+        margin: Option<Arg<'py>>,
+        stall_steps: Option<Arg<'py>>,
+        max_replans: Option<Arg<'py>>,
+        replan_time_limit: Option<Arg<'py>>,
+        seed: Option<Arg<'py>>,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Self> {
         let named = [("dt", dt), ("horizon", horizon), ("speed", speed), ("stage_weight", stage_weight),
                      ("terminal_weight", terminal_weight), ("effort_weight", effort_weight), ("margin", margin),
                      ("stall_steps", stall_steps), ("max_replans", max_replans),
                      ("replan_time_limit", replan_time_limit), ("seed", seed)];
-        let mut given: Vec<(String, Bound<'py, PyAny>)> =
+        let mut given: Vec<(String, Arg<'py>)> =
             named.into_iter().filter_map(|(k, v)| v.map(|v| (k.to_string(), v))).collect();
         given.extend(settings::items(settings.map(|d| d.as_any()))?);
         let scene = scene.downcast::<Scene>().map_err(|_| arg_err("scene", "must be a regrasp._core.Scene"))?.get();
@@ -65,7 +65,7 @@ impl Mpc {
 
     /// One control step from the measured pose: a dict with status, pusher, twist, knot,
     /// tracking_error, projected, solve_time_s, replan_time_s.
-    fn step<'py>(&mut self, py: Python<'py>, pose: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+    fn step<'py>(&mut self, py: Python<'py>, pose: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
         let q = pose3("pose", pose)?;
         let inner = &mut self.inner;
         // a step may re-plan (up to the re-planning time limit): other Python threads run meanwhile
@@ -79,7 +79,7 @@ impl Mpc {
 
     /// The QP at pose `pose` with the reference after knot `knot`: per horizon step a dict with
     /// the pusher, generators (k, 3) and weights (k,); and whether clarabel solved it.
-    fn solve_qp<'py>(&self, py: Python<'py>, pose: &Bound<'py, PyAny>, knot: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyTuple>> {
+    fn solve_qp<'py>(&self, py: Python<'py>, pose: &Arg<'py>, knot: &Arg<'py>) -> PyResult<Bound<'py, PyTuple>> {
         let sol = self.inner.solve_qp(&pose3("pose", pose)?, arg("knot", knot)?).map_err(to_py)?;
         let step = |(p, g, w): &(usize, Vec<_>, Vec<f64>)| -> PyResult<_> {
             Ok(dict!(py; "pusher" => self.name(Some(*p)), "generators" => matrix_rows(py, g), "weights" => w.clone()))
@@ -89,22 +89,10 @@ impl Mpc {
     }
 
     /// Reference knots (n, 3).
-    #[getter]
-    fn knots<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        rows_array(py, self.inner.knots().to_vec())
-    }
+    #[getter] fn knots<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> { rows_array(py, self.inner.knots().to_vec()) }
     /// The pusher reaching each knot.
-    #[getter]
-    fn knot_pushers(&self) -> Vec<Option<String>> {
-        self.inner.knot_pushers().iter().map(|&p| self.name(p)).collect()
-    }
-    #[getter]
-    fn replans(&self) -> usize {
-        self.inner.replans
-    }
+    #[getter] fn knot_pushers(&self) -> Vec<Option<String>> { self.inner.knot_pushers().iter().map(|&p| self.name(p)).collect() }
+    #[getter] fn replans(&self) -> usize { self.inner.replans }
     /// Why the last re-planning failed (None if it did not).
-    #[getter]
-    fn replan_error(&self) -> Option<String> {
-        self.inner.last_replan_error.clone()
-    }
+    #[getter] fn replan_error(&self) -> Option<String> { self.inner.last_replan_error.clone() }
 }

@@ -14,6 +14,9 @@ use pyo3::IntoPyObjectExt;
 use regrasp::mechanics::geometry::Vec3;
 use regrasp::Error;
 
+/// A Python argument, as every binding takes it (converted by the functions below).
+pub type Arg<'py> = Bound<'py, PyAny>;
+
 /// A Rust type a Python argument converts to, and how an error message describes it.
 pub trait Kind<'py>: FromPyObject<'py> {
     const WHAT: &'static str;
@@ -36,26 +39,26 @@ kinds!(
     Option<f64> => "a number or None",
     Vec<f64> => "a list of numbers",
     Vec<Option<String>> => "a list of pusher names (None for the start)",
-    Vec<Bound<'py, PyAny>> => "a list",
+    Vec<Arg<'py>> => "a list",
 );
 
 /// Argument `name` as a `T`.
-pub fn arg<'py, T: Kind<'py>>(name: &str, v: &Bound<'py, PyAny>) -> PyResult<T> {
+pub fn arg<'py, T: Kind<'py>>(name: &str, v: &Arg<'py>) -> PyResult<T> {
     v.extract().map_err(|_| arg_err(name, format!("must be {} (got {v})", T::WHAT)))
 }
 
 /// An optional argument converted by `f`: `None` when absent or None.
-pub fn optional<'py, T>(v: Option<&Bound<'py, PyAny>>, f: impl FnOnce(&Bound<'py, PyAny>) -> PyResult<T>) -> PyResult<Option<T>> {
+pub fn optional<'py, T>(v: Option<&Arg<'py>>, f: impl FnOnce(&Arg<'py>) -> PyResult<T>) -> PyResult<Option<T>> {
     v.filter(|v| !v.is_none()).map(f).transpose()
 }
 
 /// Optional argument `name` as a `T`: `None` when absent or None.
-pub fn opt<'py, T: Kind<'py>>(name: &str, v: Option<&Bound<'py, PyAny>>) -> PyResult<Option<T>> {
+pub fn opt<'py, T: Kind<'py>>(name: &str, v: Option<&Arg<'py>>) -> PyResult<Option<T>> {
     optional(v, |v| arg(name, v))
 }
 
 /// Argument `name`: `N` finite numbers laid out as `layout` (a list, tuple or 1-D array).
-pub fn numbers<const N: usize>(name: &str, v: &Bound<'_, PyAny>, layout: &str) -> PyResult<[f64; N]> {
+pub fn numbers<const N: usize>(name: &str, v: &Arg<'_>, layout: &str) -> PyResult<[f64; N]> {
     let bad = |got: String| arg_err(name, format!("must be {N} finite numbers {layout} (got {got})"));
     let xs: Vec<f64> = v.extract().map_err(|_| bad(v.to_string()))?;
     let a: [f64; N] = xs.try_into().map_err(|xs: Vec<f64>| bad(format!("{} numbers", xs.len())))?;
@@ -66,7 +69,7 @@ pub fn numbers<const N: usize>(name: &str, v: &Bound<'_, PyAny>, layout: &str) -
 }
 
 /// A finite number.
-pub fn finite(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
+pub fn finite(name: &str, v: &Arg<'_>) -> PyResult<f64> {
     let x: f64 = arg(name, v)?;
     if !x.is_finite() {
         return Err(arg_err(name, format!("must be finite (got {x})")));
@@ -75,22 +78,22 @@ pub fn finite(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
 }
 
 /// A planar pose `[x, z, θ]`.
-pub fn pose3(name: &str, v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
+pub fn pose3(name: &str, v: &Arg<'_>) -> PyResult<[f64; 3]> {
     numbers(name, v, "[x, z, θ]")
 }
 
 /// A planar twist `[vx, vz, ω]`.
-pub fn twist3(name: &str, v: &Bound<'_, PyAny>) -> PyResult<Vec3> {
+pub fn twist3(name: &str, v: &Arg<'_>) -> PyResult<Vec3> {
     numbers(name, v, "[vx, vz, ω]").map(Vec3::from)
 }
 
 /// A 3-D body twist `[vx, vy, vz, wx, wy, wz]`.
-pub fn twist6(name: &str, v: &Bound<'_, PyAny>) -> PyResult<[f64; 6]> {
+pub fn twist6(name: &str, v: &Arg<'_>) -> PyResult<[f64; 6]> {
     numbers(name, v, "[vx, vy, vz, wx, wy, wz]")
 }
 
 /// A 3-D pose `[x, y, z, qw, qx, qy, qz]` (the quaternion normalized).
-pub fn pose7(name: &str, v: &Bound<'_, PyAny>) -> PyResult<Isometry3<f64>> {
+pub fn pose7(name: &str, v: &Arg<'_>) -> PyResult<Isometry3<f64>> {
     let a = numbers::<7>(name, v, "[x, y, z, qw, qx, qy, qz]")?;
     regrasp::pose::spatial::from_array(name, &a).map_err(|e| match e {
         Error::Scene { message, .. } => arg_err(name, message),
@@ -99,7 +102,7 @@ pub fn pose7(name: &str, v: &Bound<'_, PyAny>) -> PyResult<Isometry3<f64>> {
 }
 
 /// Argument `name` as an `(n, N)` array of numbers (any array-like), one row a `[f64; N]`.
-pub fn rows<const N: usize>(name: &str, v: &Bound<'_, PyAny>) -> PyResult<Vec<[f64; N]>> {
+pub fn rows<const N: usize>(name: &str, v: &Arg<'_>) -> PyResult<Vec<[f64; N]>> {
     let a: PyArrayLike2<'_, f64, AllowTypeChange> =
         v.extract().map_err(|_| arg_err(name, format!("must be an (n, {N}) array of numbers (got {v})")))?;
     let a = a.as_array();
@@ -110,17 +113,18 @@ pub fn rows<const N: usize>(name: &str, v: &Bound<'_, PyAny>) -> PyResult<Vec<[f
 }
 
 /// Argument `pusher` (a pusher's name) as its index by `index`.
-pub fn pusher(v: &Bound<'_, PyAny>, index: impl Fn(&str) -> regrasp::Result<usize>) -> PyResult<usize> {
+pub fn pusher(v: &Arg<'_>, index: impl Fn(&str) -> regrasp::Result<usize>) -> PyResult<usize> {
     index(&arg::<String>("pusher", v)?).map_err(to_py)
 }
 
-/// Arguments `poses` and `twists`: two `(n, 3)` arrays with as many rows.
-pub fn poses_and_twists(poses: &Bound<'_, PyAny>, twists: &Bound<'_, PyAny>) -> PyResult<(Vec<[f64; 3]>, Vec<[f64; 3]>)> {
+/// The arguments of a batch query: `poses` and `twists`, two `(n, 3)` arrays with as many rows,
+/// and the `pusher`'s index by `index`.
+pub fn batch(poses: &Arg<'_>, twists: &Arg<'_>, pusher: &Arg<'_>, index: impl Fn(&str) -> regrasp::Result<usize>) -> PyResult<(Vec<[f64; 3]>, Vec<[f64; 3]>, usize)> {
     let (q, t) = (rows::<3>("poses", poses)?, rows::<3>("twists", twists)?);
     if q.len() != t.len() {
         return Err(arg_err("twists", format!("has {} rows but poses has {}", t.len(), q.len())));
     }
-    Ok((q, t))
+    Ok((q, t, self::pusher(pusher, index)?))
 }
 
 /// A path from argument lists `poses` and `pushers` (pusher names, None for the start): step
@@ -128,17 +132,17 @@ pub fn poses_and_twists(poses: &Bound<'_, PyAny>, twists: &Bound<'_, PyAny>) -> 
 /// `{prefix}[i].pusher`.
 pub fn path<'py, Q>(
     prefix: &str,
-    poses: &Bound<'py, PyAny>,
-    pushers: &Bound<'py, PyAny>,
-    pose: impl Fn(&str, &Bound<'py, PyAny>) -> PyResult<Q>,
+    poses: &Arg<'py>,
+    pushers: &Arg<'py>,
+    pose: impl Fn(&str, &Arg<'py>) -> PyResult<Q>,
     index: impl Fn(&str) -> regrasp::Result<usize>,
 ) -> PyResult<Vec<(Q, Option<usize>)>> {
-    let poses: Vec<Bound<'py, PyAny>> = arg("poses", poses)?;
+    let poses: Vec<Arg<'py>> = arg("poses", poses)?;
     let names: Vec<Option<String>> = arg("pushers", pushers)?;
     if poses.len() != names.len() {
         return Err(arg_err(prefix, format!("{} poses but {} pushers", poses.len(), names.len())));
     }
-    let step = |i: usize, q: &Bound<'py, PyAny>, p: &Option<String>| {
+    let step = |i: usize, q: &Arg<'py>, p: &Option<String>| {
         let q = pose(&format!("{prefix}[{i}].pose"), q)?;
         let p = p.as_deref().map(|n| index(n).map_err(|_| arg_err(&format!("{prefix}[{i}].pusher"), format!("no pusher {n:?} in the scene"))));
         Ok((q, p.transpose()?))

@@ -1,7 +1,7 @@
 //! Quasi-static dynamics (`regrasp::dynamics`): the `MncpProblem` of one instant, and the
 //! problems, pushes and simulated pushes of planar and 3-D scenes.
 
-use crate::convert::{arg, array1, dict, matrix, pose3, pose7, poses_and_twists, pusher, rows_array, twist3, twist6, vector};
+use crate::convert::{Arg, arg, array1, dict, matrix, pose3, pose7, batch, pusher, rows_array, twist3, twist6, vector};
 use crate::errors::{arg_err, to_py};
 use nalgebra::DVector;
 use numpy::{PyArray1, PyArray2};
@@ -21,7 +21,7 @@ pub struct MncpProblem {
 }
 
 /// Argument `name`: a list of `n` numbers.
-fn sized(name: &str, v: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<f64>> {
+fn sized(name: &str, v: &Arg<'_>, n: usize) -> PyResult<Vec<f64>> {
     let x: Vec<f64> = arg(name, v)?;
     if x.len() != n {
         return Err(arg_err(name, format!("must have {n} numbers (got {})", x.len())));
@@ -30,12 +30,12 @@ fn sized(name: &str, v: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<f64>> {
 }
 
 /// Argument `friction_forces`: one list of numbers per contact, of its tangent dimension.
-fn friction_forces(p: &mncp::Problem, v: &Bound<'_, PyAny>) -> PyResult<Vec<DVector<f64>>> {
-    let fs: Vec<Bound<'_, PyAny>> = arg("friction_forces", v)?;
+fn friction_forces(p: &mncp::Problem, v: &Arg<'_>) -> PyResult<Vec<DVector<f64>>> {
+    let fs: Vec<Arg<'_>> = arg("friction_forces", v)?;
     if fs.len() != p.contacts.len() {
         return Err(arg_err("friction_forces", format!("must have one entry per contact ({})", p.contacts.len())));
     }
-    let one = |(i, (c, f)): (usize, (&Contact, &Bound<'_, PyAny>))| sized(&format!("friction_forces[{i}]"), f, c.tangent_dim());
+    let one = |(i, (c, f)): (usize, (&Contact, &Arg<'_>))| sized(&format!("friction_forces[{i}]"), f, c.tangent_dim());
     p.contacts.iter().zip(&fs).enumerate().map(|x| one(x).map(DVector::from_vec)).collect()
 }
 
@@ -83,24 +83,18 @@ fn contact_dict<'py>(py: Python<'py>, c: &Contact) -> PyResult<Bound<'py, PyDict
 
 #[pymethods]
 impl MncpProblem {
-    #[getter]
-    fn dim(&self) -> usize {
-        self.inner.dim
-    }
-    #[getter]
-    fn labels(&self) -> Vec<String> {
-        self.inner.contacts.iter().map(|c| c.label.clone()).collect()
-    }
+    #[getter] fn dim(&self) -> usize { self.inner.dim }
+    #[getter] fn labels(&self) -> Vec<String> { self.inner.contacts.iter().map(|c| c.label.clone()).collect() }
 
     /// Forward problem: pusher twist given; returns the solution as a dict.
-    fn solve_forward<'py>(&self, py: Python<'py>, pusher_twist: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+    fn solve_forward<'py>(&self, py: Python<'py>, pusher_twist: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
         let u = DVector::from_vec(arg("pusher_twist", pusher_twist)?);
         let s = py.allow_threads(|| mncp::solve_forward(&self.inner, &u, &mncp::Settings::default())).map_err(to_py)?;
         solution_dict(py, &self.inner, &s)
     }
 
     /// Inverse problem: object twist given; returns the pusher motion and forces.
-    fn solve_inverse<'py>(&self, py: Python<'py>, twist: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+    fn solve_inverse<'py>(&self, py: Python<'py>, twist: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
         let v = DVector::from_vec(arg("twist", twist)?);
         let s = py.allow_threads(|| mncp::solve_inverse(&self.inner, &v, &mncp::Settings::default())).map_err(to_py)?;
         solution_dict(py, &self.inner, &s)
@@ -108,12 +102,7 @@ impl MncpProblem {
 
     /// Scaled violation of every constraint for a candidate solution (e.g. the reference's).
     fn residuals<'py>(
-        &self,
-        py: Python<'py>,
-        twist: &Bound<'py, PyAny>,
-        pusher_twist: &Bound<'py, PyAny>,
-        normal_forces: &Bound<'py, PyAny>,
-        friction_forces: &Bound<'py, PyAny>,
+        &self, py: Python<'py>, twist: &Arg<'py>, pusher_twist: &Arg<'py>, normal_forces: &Arg<'py>, friction_forces: &Arg<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let p = &self.inner;
         let v = DVector::from_vec(sized("twist", twist, p.dim)?);
@@ -133,7 +122,7 @@ impl MncpProblem {
 }
 
 /// `Scene.quasistatic_problem`: the problem of pusher `name` (or of no pusher) at `pose`.
-pub fn planar_problem(scene: &Scene, pose: &Bound<'_, PyAny>, name: Option<&Bound<'_, PyAny>>, opts: &Options) -> PyResult<MncpProblem> {
+pub fn planar_problem(scene: &Scene, pose: &Arg<'_>, name: Option<&Arg<'_>>, opts: &Options) -> PyResult<MncpProblem> {
     let q = pose3("pose", pose)?;
     let inner = match name.filter(|n| !n.is_none()) {
         Some(n) => quasistatic::push_problem(scene, &q, pusher(n, |n| scene.pusher_index(n))?, opts),
@@ -143,26 +132,18 @@ pub fn planar_problem(scene: &Scene, pose: &Bound<'_, PyAny>, name: Option<&Boun
 }
 
 /// `Scene3D.quasistatic_problem`: the problem of pusher `name` in contact at its points.
-pub fn spatial_problem(scene: &Scene3, pose: &Bound<'_, PyAny>, name: &Bound<'_, PyAny>, h: f64) -> PyResult<MncpProblem> {
+pub fn spatial_problem(scene: &Scene3, pose: &Arg<'_>, name: &Arg<'_>, h: f64) -> PyResult<MncpProblem> {
     let p = pose7("pose", pose)?;
     let i = pusher(name, |n| scene.pusher_index(n))?;
     Ok(MncpProblem { inner: quasistatic3d::push_problem(scene, &p, i, h).map_err(to_py)? })
 }
 
 /// The results of `Scene.push_outcomes`: sticks, object twists, max residuals, errors.
-type Outcomes<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Vec<Option<String>>);
+pub type Outcomes<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Vec<Option<String>>);
 
 /// `Scene.push_outcomes`: instantaneous pushes of pusher `name`, twist i at pose i.
-pub fn push_outcomes<'py>(
-    py: Python<'py>,
-    scene: &Scene,
-    poses: &Bound<'py, PyAny>,
-    name: &Bound<'py, PyAny>,
-    twists: &Bound<'py, PyAny>,
-    opts: &Options,
-) -> PyResult<Outcomes<'py>> {
-    let (q, t) = poses_and_twists(poses, twists)?;
-    let i = pusher(name, |n| scene.pusher_index(n))?;
+pub fn push_outcomes<'py>(py: Python<'py>, scene: &Scene, poses: &Arg<'py>, name: &Arg<'py>, twists: &Arg<'py>, opts: &Options) -> PyResult<Outcomes<'py>> {
+    let (q, t, i) = batch(poses, twists, name, |n| scene.pusher_index(n))?;
     let res: Vec<_> = py.allow_threads(|| {
         q.par_iter().zip(t.par_iter()).with_min_len(4).map(|(q, t)| quasistatic::push_outcome(scene, q, i, &(*t).into(), opts)).collect()
     });
@@ -198,11 +179,11 @@ macro_rules! trajectory_dict {
 
 /// A push's pusher, twist, duration and time step, as `simulate_push` takes them.
 pub struct PushArgs<'a, 'py> {
-    pub pose: &'a Bound<'py, PyAny>,
-    pub pusher: &'a Bound<'py, PyAny>,
-    pub twist: &'a Bound<'py, PyAny>,
-    pub duration: &'a Bound<'py, PyAny>,
-    pub dt: &'a Bound<'py, PyAny>,
+    pub pose: &'a Arg<'py>,
+    pub pusher: &'a Arg<'py>,
+    pub twist: &'a Arg<'py>,
+    pub duration: &'a Arg<'py>,
+    pub dt: &'a Arg<'py>,
 }
 
 /// `Scene.simulate_push`: explicit time stepping of one push.

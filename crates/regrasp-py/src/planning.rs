@@ -1,7 +1,7 @@
 //! Planning (`regrasp::planning`): T-RRT* plans of planar and 3-D scenes as dicts, and the
 //! checks of a given path.
 
-use crate::convert::{arg, dict, optional, path, pose3, pose7, twist6};
+use crate::convert::{Arg, arg, dict, optional, path, pose3, pose7, twist6};
 use crate::errors::to_py;
 use crate::settings;
 use pyo3::prelude::*;
@@ -12,6 +12,20 @@ use regrasp::planning::trrt::Plan;
 use regrasp::pose::spatial::to_array;
 use regrasp::scene::spatial::Scene3;
 use regrasp::Scene;
+
+/// The arguments of `plan`: optional start and goal poses, optional settings overrides.
+pub struct Request<'a, 'py> {
+    pub start: Option<&'a Arg<'py>>,
+    pub goal: Option<&'a Arg<'py>>,
+    pub settings: Option<&'a Arg<'py>>,
+}
+
+impl Request<'_, '_> {
+    /// The start and goal poses, each converted by `pose` when given.
+    fn ends<Q>(&self, pose: impl Fn(&str, &Arg<'_>) -> PyResult<Q>) -> PyResult<(Option<Q>, Option<Q>)> {
+        Ok((optional(self.start, |v| pose("start", v))?, optional(self.goal, |v| pose("goal", v))?))
+    }
+}
 
 /// What a plan dict says beyond the plan: the scene's name and pushers, the propagation, the seed.
 struct About<'a> {
@@ -47,35 +61,25 @@ fn plan_dict<'py, Q, E>(
 
 /// `Scene.plan`: a planar plan from `start` to `goal` (default: the task's) with `settings`
 /// overriding `planner_defaults(2)`.
-pub fn plan_planar<'py>(
-    py: Python<'py>,
-    scene: &Scene,
-    start: Option<&Bound<'py, PyAny>>,
-    goal: Option<&Bound<'py, PyAny>>,
-    overrides: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let (start, goal) = (optional(start, |v| pose3("start", v))?, optional(goal, |v| pose3("goal", v))?);
-    let s = settings::planar(overrides)?;
-    let r = py.allow_threads(|| trrt::plan(scene, start, goal, &s)).map_err(to_py)?;
+pub fn plan_planar<'py>(py: Python<'py>, scene: &Scene, r: Request<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
+    let ((start, goal), s) = (r.ends(pose3)?, settings::planar(r.settings)?);
+    let plan = py.allow_threads(|| trrt::plan(scene, start, goal, &s)).map_err(to_py)?;
     let pushers = scene.pushers.iter().map(|p| p.name.clone()).collect();
     let about = About { scene: &scene.name, pushers, propagation: s.propagation.label(), seed: s.search.seed };
-    plan_dict(py, about, &r, |k, q, _, _| k.set_item("pose", q.to_vec()))
+    plan_dict(py, about, &plan, |k, q, _, _| k.set_item("pose", q.to_vec()))
 }
 
 /// `Scene3D.plan`: a 3-D plan (poses `[x, y, z, qw, qx, qy, qz]`, each step's pusher twist),
 /// `settings` overriding `planner_defaults(3)`; the dict also gives the number of solves.
-pub fn plan_spatial<'py>(
-    py: Python<'py>,
-    scene: &Scene3,
-    start: Option<&Bound<'py, PyAny>>,
-    goal: Option<&Bound<'py, PyAny>>,
-    overrides: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let (start, goal) = (optional(start, |v| pose7("start", v))?, optional(goal, |v| pose7("goal", v))?);
-    let s = settings::spatial(overrides)?;
+pub fn plan_spatial<'py>(py: Python<'py>, scene: &Scene3, r: Request<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
+    let ((start, goal), s) = (r.ends(pose7)?, settings::spatial(r.settings)?);
     let r = py.allow_threads(|| plan3(scene, start, goal, &s)).map_err(to_py)?;
-    let pushers = scene.pushers.iter().map(|p| p.name.clone()).collect();
-    let about = About { scene: &scene.name, pushers, propagation: "mncp_inverse", seed: s.search.seed };
+    let about = About {
+        scene: &scene.name,
+        pushers: scene.pushers.iter().map(|p| p.name.clone()).collect(),
+        propagation: "mncp_inverse",
+        seed: s.search.seed,
+    };
     let d = plan_dict(py, about, &r.plan, |k, q, p, u| {
         k.set_item("pose", to_array(q).to_vec())?;
         if p.is_some() {
@@ -89,7 +93,7 @@ pub fn plan_spatial<'py>(
 
 /// `Scene.validate_path`: the smallest exact-test margin along each step of a path, checked
 /// at `checks` poses a step (default: the planner's).
-pub fn validate_planar(scene: &Scene, poses: &Bound<'_, PyAny>, pushers: &Bound<'_, PyAny>, checks: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<f64>> {
+pub fn validate_planar(scene: &Scene, poses: &Arg<'_>, pushers: &Arg<'_>, checks: Option<&Arg<'_>>) -> PyResult<Vec<f64>> {
     let path = path("path", poses, pushers, pose3, |n| scene.pusher_index(n))?;
     let checks = optional(checks, |v| arg("checks", v))?.unwrap_or(PlanarSettings::default().search.checks);
     trrt::validate_path(scene, &path, checks).map_err(to_py)
@@ -97,9 +101,9 @@ pub fn validate_planar(scene: &Scene, poses: &Bound<'_, PyAny>, pushers: &Bound<
 
 /// `Scene3D.validate_path`: whether each step of a path can be taken by its pusher (with
 /// the steps' pusher twists `twists`, when given).
-pub fn validate_spatial(scene: &Scene3, poses: &Bound<'_, PyAny>, pushers: &Bound<'_, PyAny>, twists: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<bool>> {
+pub fn validate_spatial(scene: &Scene3, poses: &Arg<'_>, pushers: &Arg<'_>, twists: Option<&Arg<'_>>) -> PyResult<Vec<bool>> {
     let twists = optional(twists, |t| {
-        let t: Vec<Bound<'_, PyAny>> = arg("twists", t)?;
+        let t: Vec<Arg<'_>> = arg("twists", t)?;
         t.iter().enumerate().map(|(i, v)| twist6(&format!("path[{i}].pusher_twist"), v)).collect::<PyResult<Vec<_>>>()
     })?;
     let path = path("path", poses, pushers, pose7, |n| scene.pusher_index(n))?;

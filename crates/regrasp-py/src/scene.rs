@@ -2,12 +2,12 @@
 //! variants (grip force, robust scaling), and the entry points of the later pipeline stages
 //! (cones, dynamics, planning), whose conversion lives in their own modules.
 
-use crate::cones::{self, MotionCone};
-use crate::convert::{arg, array1, finite, opt, pose3, pusher, rows, rows_array};
-use crate::dynamics::{self, MncpProblem, PushArgs};
+use crate::cones::{self, Classified, Generated, MotionCone, Projected};
+use crate::convert::{Arg, arg, array1, finite, opt, pose3, pusher, rows, rows_array};
+use crate::dynamics::{self, MncpProblem, Outcomes, PushArgs};
 use crate::errors::{arg_err, to_py};
 use crate::{planning, settings};
-use numpy::{PyArray1, PyArray2, PyArray3};
+use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use regrasp::cones::robust::{self, ConeMode};
@@ -22,11 +22,11 @@ pub struct Scene {
 
 /// The support options among the arguments of the quasi-static entry points.
 fn support<'a, 'py>(
-    support: Option<&'a Bound<'py, PyAny>>,
-    rings: Option<&'a Bound<'py, PyAny>>,
-    points: Option<&'a Bound<'py, PyAny>>,
-    merge_fingers: Option<&'a Bound<'py, PyAny>>,
-) -> [(&'static str, Option<&'a Bound<'py, PyAny>>); 4] {
+    support: Option<&'a Arg<'py>>,
+    rings: Option<&'a Arg<'py>>,
+    points: Option<&'a Arg<'py>>,
+    merge_fingers: Option<&'a Arg<'py>>,
+) -> [(&'static str, Option<&'a Arg<'py>>); 4] {
     [("support", support), ("rings", rings), ("points", points), ("merge_fingers", merge_fingers)]
 }
 
@@ -34,20 +34,17 @@ fn support<'a, 'py>(
 impl Scene {
     /// Parse and validate a scene from TOML text.
     #[staticmethod]
-    fn from_toml(text: &Bound<'_, PyAny>) -> PyResult<Self> {
+    fn from_toml(text: &Arg<'_>) -> PyResult<Self> {
         regrasp::Scene::from_toml_str(&arg::<String>("text", text)?).map(|inner| Self { inner }).map_err(to_py)
     }
 
     /// Parse and validate a scene from JSON text (same layout as the TOML file).
     #[staticmethod]
-    fn from_json(text: &Bound<'_, PyAny>) -> PyResult<Self> {
+    fn from_json(text: &Arg<'_>) -> PyResult<Self> {
         regrasp::Scene::from_json_str(&arg::<String>("text", text)?).map(|inner| Self { inner }).map_err(to_py)
     }
 
-    #[getter]
-    fn name(&self) -> String {
-        self.inner.name.clone()
-    }
+    #[getter] fn name(&self) -> String { self.inner.name.clone() }
     #[getter]
     fn kind(&self) -> &'static str {
         match self.inner.support {
@@ -55,34 +52,13 @@ impl Scene {
             Support::Surface(_) => "surface",
         }
     }
-    #[getter]
-    fn pusher_names(&self) -> Vec<String> {
-        self.inner.pushers.iter().map(|p| p.name.clone()).collect()
-    }
-    #[getter]
-    fn length(&self) -> f64 {
-        self.inner.length
-    }
-    #[getter]
-    fn mass(&self) -> f64 {
-        self.inner.mass
-    }
-    #[getter]
-    fn com(&self) -> (f64, f64) {
-        (self.inner.com.x, self.inner.com.y)
-    }
-    #[getter]
-    fn gravity(&self) -> (f64, f64, f64) {
-        (self.inner.gravity_dir.x, self.inner.gravity_dir.y, self.inner.g)
-    }
-    #[getter]
-    fn grip_force(&self) -> Option<f64> {
-        self.inner.grip_force()
-    }
-    #[getter]
-    fn friction_scale(&self) -> f64 {
-        self.inner.friction_scale()
-    }
+    #[getter] fn pusher_names(&self) -> Vec<String> { self.inner.pushers.iter().map(|p| p.name.clone()).collect() }
+    #[getter] fn length(&self) -> f64 { self.inner.length }
+    #[getter] fn mass(&self) -> f64 { self.inner.mass }
+    #[getter] fn com(&self) -> (f64, f64) { (self.inner.com.x, self.inner.com.y) }
+    #[getter] fn gravity(&self) -> (f64, f64, f64) { (self.inner.gravity_dir.x, self.inner.gravity_dir.y, self.inner.g) }
+    #[getter] fn grip_force(&self) -> Option<f64> { self.inner.grip_force() }
+    #[getter] fn friction_scale(&self) -> f64 { self.inner.friction_scale() }
     #[getter]
     fn outline<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         rows_array(py, self.inner.outline.vertices().iter().map(|p| [p.x, p.y]).collect())
@@ -107,30 +83,27 @@ impl Scene {
         }
     }
     /// Pusher `name`: (points (k, 2), normal (2,), friction).
-    fn pusher<'py>(&self, py: Python<'py>, name: &Bound<'py, PyAny>) -> PyResult<(Bound<'py, PyArray2<f64>>, (f64, f64), f64)> {
+    fn pusher<'py>(&self, py: Python<'py>, name: &Arg<'py>) -> PyResult<(Bound<'py, PyArray2<f64>>, (f64, f64), f64)> {
         let c = &self.inner.pushers[pusher(name, |n| self.inner.pusher_index(n))?].contact;
         Ok((rows_array(py, c.points.iter().map(|p| [p.x, p.y]).collect()), (c.normal.x, c.normal.y), c.friction))
     }
     /// (start, goal, tolerance) or None.
-    #[getter]
-    fn task(&self) -> Option<([f64; 3], [f64; 3], [f64; 3])> {
-        self.inner.task.map(|t| (t.start, t.goal, t.tolerance))
-    }
+    #[getter] fn task(&self) -> Option<([f64; 3], [f64; 3], [f64; 3])> { self.inner.task.map(|t| (t.start, t.goal, t.tolerance)) }
 
-    fn admissible(&self, pose: &Bound<'_, PyAny>) -> PyResult<bool> {
+    fn admissible(&self, pose: &Arg<'_>) -> PyResult<bool> {
         Ok(self.inner.admissible(&pose3("pose", pose)?))
     }
 
-    fn admissible_many<'py>(&self, py: Python<'py>, poses: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    fn admissible_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>) -> PyResult<Bound<'py, PyArray1<bool>>> {
         let q = rows::<3>("poses", poses)?;
         Ok(array1(py, py.allow_threads(|| q.iter().map(|p| self.inner.admissible(p)).collect())))
     }
 
-    fn hold_ratio(&self, pose: &Bound<'_, PyAny>) -> PyResult<f64> {
+    fn hold_ratio(&self, pose: &Arg<'_>) -> PyResult<f64> {
         Ok(self.inner.hold_ratio(&pose3("pose", pose)?))
     }
 
-    fn with_grip_force(&self, force: &Bound<'_, PyAny>) -> PyResult<Self> {
+    fn with_grip_force(&self, force: &Arg<'_>) -> PyResult<Self> {
         let force = finite("force", force)?;
         if !(force > 0.0) {
             return Err(arg_err("force", "must be a positive number"));
@@ -144,7 +117,7 @@ impl Scene {
     /// The motion cone of pusher `pusher` at `pose` (raises GraspError if the grasp cannot
     /// hold, unless `check_hold` is False).
     #[pyo3(signature = (pose, pusher, check_hold=None))]
-    fn motion_cone(&self, pose: &Bound<'_, PyAny>, pusher: &Bound<'_, PyAny>, check_hold: Option<&Bound<'_, PyAny>>) -> PyResult<MotionCone> {
+    fn motion_cone(&self, pose: &Arg<'_>, pusher: &Arg<'_>, check_hold: Option<&Arg<'_>>) -> PyResult<MotionCone> {
         let q = pose3("pose", pose)?;
         let name: String = arg("pusher", pusher)?;
         let i = self.inner.pusher_index(&name).map_err(to_py)?;
@@ -157,37 +130,17 @@ impl Scene {
 
     /// Polyhedral (or gravity-free) generators at many poses: (generators (n, k, 3),
     /// status (n,) uint8; 0 = ok, see `status_messages`).
-    #[allow(clippy::type_complexity)]
-    fn generators_many<'py>(
-        &self,
-        py: Python<'py>,
-        poses: &Bound<'py, PyAny>,
-        pusher: &Bound<'py, PyAny>,
-        gravity_free: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<u8>>)> {
-        cones::generators_many(py, &self.inner, poses, pusher, arg("gravity_free", gravity_free)?)
+    fn generators_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>, pusher: &Arg<'py>, gravity_free: &Arg<'py>) -> PyResult<Generated<'py>> {
+        cones::generators_many(py, &self.inner, poses, pusher, gravity_free)
     }
 
     /// Exact test of twist i at pose i: (feasible, margin, active-limit codes, status).
-    #[allow(clippy::type_complexity)]
-    fn classify_many<'py>(
-        &self,
-        py: Python<'py>,
-        poses: &Bound<'py, PyAny>,
-        twists: &Bound<'py, PyAny>,
-        pusher: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u8>>, Bound<'py, PyArray1<u8>>)> {
+    fn classify_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>, twists: &Arg<'py>, pusher: &Arg<'py>) -> PyResult<Classified<'py>> {
         cones::classify_many(py, &self.inner, poses, twists, pusher)
     }
 
     /// Closest feasible twist to twist i at pose i: (projections (n, 3), status).
-    fn project_many<'py>(
-        &self,
-        py: Python<'py>,
-        poses: &Bound<'py, PyAny>,
-        twists: &Bound<'py, PyAny>,
-        pusher: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>)> {
+    fn project_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>, twists: &Arg<'py>, pusher: &Arg<'py>) -> PyResult<Projected<'py>> {
         cones::project_many(py, &self.inner, poses, twists, pusher)
     }
 
@@ -208,15 +161,9 @@ impl Scene {
     #[pyo3(signature = (pose, pusher=None, support=None, rings=None, points=None, merge_fingers=None, h=None, speed=None))]
     #[allow(clippy::too_many_arguments)]
     fn quasistatic_problem(
-        &self,
-        pose: &Bound<'_, PyAny>,
-        pusher: Option<&Bound<'_, PyAny>>,
-        support: Option<&Bound<'_, PyAny>>,
-        rings: Option<&Bound<'_, PyAny>>,
-        points: Option<&Bound<'_, PyAny>>,
-        merge_fingers: Option<&Bound<'_, PyAny>>,
-        h: Option<&Bound<'_, PyAny>>,
-        speed: Option<&Bound<'_, PyAny>>,
+        &self, pose: &Arg<'_>, pusher: Option<&Arg<'_>>,
+        support: Option<&Arg<'_>>, rings: Option<&Arg<'_>>, points: Option<&Arg<'_>>, merge_fingers: Option<&Arg<'_>>,
+        h: Option<&Arg<'_>>, speed: Option<&Arg<'_>>,
     ) -> PyResult<MncpProblem> {
         let [a, b, c, d] = self::support(support, rings, points, merge_fingers);
         let opts = settings::quasistatic(&[a, b, c, d, ("h", h), ("speed", speed)])?;
@@ -226,18 +173,11 @@ impl Scene {
     /// Instantaneous pushes: pusher `pusher` at pose i moving with twist i (object frame).
     /// Returns (sticks (n,), object twists (n, 3), max residual (n,), errors (None if solved)).
     #[pyo3(signature = (poses, pusher, twists, support=None, rings=None, points=None, merge_fingers=None))]
-    #[allow(clippy::type_complexity, clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments)]
     fn push_outcomes<'py>(
-        &self,
-        py: Python<'py>,
-        poses: &Bound<'py, PyAny>,
-        pusher: &Bound<'py, PyAny>,
-        twists: &Bound<'py, PyAny>,
-        support: Option<&Bound<'py, PyAny>>,
-        rings: Option<&Bound<'py, PyAny>>,
-        points: Option<&Bound<'py, PyAny>>,
-        merge_fingers: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<(Bound<'py, PyArray1<bool>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Vec<Option<String>>)> {
+        &self, py: Python<'py>, poses: &Arg<'py>, pusher: &Arg<'py>, twists: &Arg<'py>,
+        support: Option<&Arg<'py>>, rings: Option<&Arg<'py>>, points: Option<&Arg<'py>>, merge_fingers: Option<&Arg<'py>>,
+    ) -> PyResult<Outcomes<'py>> {
         let opts = settings::quasistatic(&self::support(support, rings, points, merge_fingers))?;
         dynamics::push_outcomes(py, &self.inner, poses, pusher, twists, &opts)
     }
@@ -246,17 +186,8 @@ impl Scene {
     #[pyo3(signature = (pose, pusher, twist, duration, dt, support=None, rings=None, points=None, merge_fingers=None))]
     #[allow(clippy::too_many_arguments)]
     fn simulate_push<'py>(
-        &self,
-        py: Python<'py>,
-        pose: &Bound<'py, PyAny>,
-        pusher: &Bound<'py, PyAny>,
-        twist: &Bound<'py, PyAny>,
-        duration: &Bound<'py, PyAny>,
-        dt: &Bound<'py, PyAny>,
-        support: Option<&Bound<'py, PyAny>>,
-        rings: Option<&Bound<'py, PyAny>>,
-        points: Option<&Bound<'py, PyAny>>,
-        merge_fingers: Option<&Bound<'py, PyAny>>,
+        &self, py: Python<'py>, pose: &Arg<'py>, pusher: &Arg<'py>, twist: &Arg<'py>, duration: &Arg<'py>, dt: &Arg<'py>,
+        support: Option<&Arg<'py>>, rings: Option<&Arg<'py>>, points: Option<&Arg<'py>>, merge_fingers: Option<&Arg<'py>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let opts = settings::quasistatic(&self::support(support, rings, points, merge_fingers))?;
         dynamics::simulate_planar(py, &self.inner, PushArgs { pose, pusher, twist, duration, dt }, &opts)
@@ -265,28 +196,19 @@ impl Scene {
     /// T-RRT* regrasp plan (see `regrasp.plan`): `settings` overrides the defaults of
     /// `planner_defaults(2)`. Returns a dict.
     #[pyo3(signature = (start=None, goal=None, settings=None))]
-    fn plan<'py>(
-        &self,
-        py: Python<'py>,
-        start: Option<&Bound<'py, PyAny>>,
-        goal: Option<&Bound<'py, PyAny>>,
-        settings: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyDict>> {
-        planning::plan_planar(py, &self.inner, start, goal, settings)
+    fn plan<'py>(&self, py: Python<'py>, start: Option<&Arg<'py>>, goal: Option<&Arg<'py>>, settings: Option<&Arg<'py>>) -> PyResult<Bound<'py, PyDict>> {
+        planning::plan_planar(py, &self.inner, planning::Request { start, goal, settings })
     }
 
     /// Smallest exact-test margin along each step of a path (poses, pusher names), checked at
     /// `checks` poses a step (default: the planner's `checks`).
     #[pyo3(signature = (poses, pushers, checks=None))]
-    fn validate_path(&self, poses: &Bound<'_, PyAny>, pushers: &Bound<'_, PyAny>, checks: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<f64>> {
+    fn validate_path(&self, poses: &Arg<'_>, pushers: &Arg<'_>, checks: Option<&Arg<'_>>) -> PyResult<Vec<f64>> {
         planning::validate_planar(&self.inner, poses, pushers, checks)
     }
 
     /// The cone mode: "nominal", "robust" or "fixtureless".
-    #[getter]
-    fn mode(&self) -> &'static str {
-        self.inner.mode.label()
-    }
+    #[getter] fn mode(&self) -> &'static str { self.inner.mode.label() }
 
     /// The `[uncertainty]` table as a dict of relative spreads (None when absent).
     #[getter]
@@ -297,23 +219,20 @@ impl Scene {
     }
 
     /// `ρ = μ_s N / (m g)` (grasp scenes).
-    #[getter]
-    fn rho(&self) -> Option<f64> {
-        robust::rho(&self.inner)
-    }
+    #[getter] fn rho(&self) -> Option<f64> { robust::rho(&self.inner) }
 
     /// A copy with scaled parameters and a cone mode (see `regrasp.robust`; default: the
     /// nominal cone).
     #[pyo3(signature = (finger_friction=None, grip=None, mass=None, pusher_friction=None, mode=None))]
     fn scaled(
         &self,
-        finger_friction: Option<&Bound<'_, PyAny>>,
-        grip: Option<&Bound<'_, PyAny>>,
-        mass: Option<&Bound<'_, PyAny>>,
-        pusher_friction: Option<&Bound<'_, PyAny>>,
-        mode: Option<&Bound<'_, PyAny>>,
+        finger_friction: Option<&Arg<'_>>,
+        grip: Option<&Arg<'_>>,
+        mass: Option<&Arg<'_>>,
+        pusher_friction: Option<&Arg<'_>>,
+        mode: Option<&Arg<'_>>,
     ) -> PyResult<Self> {
-        let factor = |name: &str, v: Option<&Bound<'_, PyAny>>| opt::<f64>(name, v).map(|f| f.unwrap_or(1.0));
+        let factor = |name: &str, v: Option<&Arg<'_>>| opt::<f64>(name, v).map(|f| f.unwrap_or(1.0));
         let (f, g) = (factor("finger_friction", finger_friction)?, factor("grip", grip)?);
         let (m, p) = (factor("mass", mass)?, factor("pusher_friction", pusher_friction)?);
         let mode = opt::<String>("mode", mode)?.map(|m| ConeMode::parse(&m)).transpose().map_err(to_py)?.unwrap_or_default();
@@ -321,7 +240,7 @@ impl Scene {
     }
 
     /// Whether pusher `pusher` alone can carry the object's weight at pose `q` (the invariant case).
-    fn carries_weight(&self, q: &Bound<'_, PyAny>, pusher: &Bound<'_, PyAny>) -> PyResult<bool> {
+    fn carries_weight(&self, q: &Arg<'_>, pusher: &Arg<'_>) -> PyResult<bool> {
         let (q, p) = (pose3("pose", q)?, self::pusher(pusher, |n| self.inner.pusher_index(n))?);
         Ok(self.inner.push_unchecked(&q, p).map_err(to_py)?.carries_weight())
     }

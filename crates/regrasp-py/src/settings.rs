@@ -2,7 +2,7 @@
 //! CLI read them from: `planner_defaults`, `mpc_defaults`, `quasistatic_defaults`) and
 //! overrides applied onto them, each key checked (an unknown key is an `ArgumentError`).
 
-use crate::convert::{arg, dict, finite};
+use crate::convert::{Arg, arg, dict, finite};
 use crate::errors::{arg_err, to_py};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -21,7 +21,7 @@ macro_rules! fields {
             Ok(())
         }
 
-        fn $set(s: &mut $t, key: &str, v: &Bound<'_, PyAny>) -> PyResult<bool> {
+        fn $set(s: &mut $t, key: &str, v: &Arg<'_>) -> PyResult<bool> {
             match key {
                 $(stringify!($f) => s.$f = arg(key, v)?,)*
                 _ => return Ok(false),
@@ -41,7 +41,7 @@ fields!(mpc_dict, set_mpc, MpcSettings;
     replan_error, max_replans, goal_fraction);
 
 /// Argument `settings` (a dict or None) as `(key, value)` pairs.
-pub fn items<'py>(settings: Option<&Bound<'py, PyAny>>) -> PyResult<Vec<(String, Bound<'py, PyAny>)>> {
+pub fn items<'py>(settings: Option<&Arg<'py>>) -> PyResult<Vec<(String, Arg<'py>)>> {
     let Some(s) = settings.filter(|s| !s.is_none()) else { return Ok(Vec::new()) };
     let d = s.downcast::<PyDict>().map_err(|_| arg_err("settings", format!("must be a dict (got {s})")))?;
     d.iter().map(|(k, v)| Ok((k.extract::<String>().map_err(|_| arg_err("settings", "keys must be strings"))?, v))).collect()
@@ -55,7 +55,7 @@ fn planar_dict<'py>(py: Python<'py>, s: &PlanarSettings) -> PyResult<Bound<'py, 
 }
 
 /// The planar planner's settings: the defaults with `overrides` applied.
-pub fn planar(overrides: Option<&Bound<'_, PyAny>>) -> PyResult<PlanarSettings> {
+pub fn planar(overrides: Option<&Arg<'_>>) -> PyResult<PlanarSettings> {
     let mut s = PlanarSettings::default();
     for (k, v) in items(overrides)? {
         if set_search(&mut s.search, &k, &v)? {
@@ -73,7 +73,7 @@ pub fn planar(overrides: Option<&Bound<'_, PyAny>>) -> PyResult<PlanarSettings> 
 }
 
 /// The 3-D planner's settings: the defaults with `overrides` applied.
-pub fn spatial(overrides: Option<&Bound<'_, PyAny>>) -> PyResult<SpatialSettings> {
+pub fn spatial(overrides: Option<&Arg<'_>>) -> PyResult<SpatialSettings> {
     let mut s = SpatialSettings::default();
     for (k, v) in items(overrides)? {
         if !set_search(&mut s.search, &k, &v)? {
@@ -86,7 +86,7 @@ pub fn spatial(overrides: Option<&Bound<'_, PyAny>>) -> PyResult<SpatialSettings
 
 /// The planner's default settings for scenes of `dimension` 2 or 3 (the Rust `Default`s).
 #[pyfunction]
-pub fn planner_defaults<'py>(py: Python<'py>, dimension: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+pub fn planner_defaults<'py>(py: Python<'py>, dimension: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
     match arg::<usize>("dimension", dimension)? {
         2 => planar_dict(py, &PlanarSettings::default()),
         3 => {
@@ -110,7 +110,7 @@ pub fn mpc_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 
 /// The MPC's settings: the defaults with `overrides` applied (None values are skipped); checked
 /// by the controller.
-pub fn mpc(overrides: &[(String, Bound<'_, PyAny>)]) -> PyResult<MpcSettings> {
+pub fn mpc(overrides: &[(String, Arg<'_>)]) -> PyResult<MpcSettings> {
     let mut s = MpcSettings::default();
     for (k, v) in overrides.iter().filter(|(_, v)| !v.is_none()) {
         if set_mpc(&mut s, k, v)? {
@@ -144,7 +144,7 @@ pub fn quasistatic_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 }
 
 /// A positive, finite number.
-fn positive(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
+fn positive(name: &str, v: &Arg<'_>) -> PyResult<f64> {
     let x = finite(name, v)?;
     if !(x > 0.0) {
         return Err(arg_err(name, format!("must be positive (got {x})")));
@@ -153,7 +153,7 @@ fn positive(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
 }
 
 /// The quasi-static model's options: the defaults with the `given` ones (None: the default).
-pub fn quasistatic(given: &[(&str, Option<&Bound<'_, PyAny>>)]) -> PyResult<Options> {
+pub fn quasistatic(given: &[(&str, Option<&Arg<'_>>)]) -> PyResult<Options> {
     let mut o = Options::default();
     let (label, mut rings, mut points, mut merge_fingers) = support_parts(o.support);
     let mut support = label.to_string();
