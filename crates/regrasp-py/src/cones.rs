@@ -2,7 +2,7 @@
 //! cones in `regrasp::cones::polyhedral`) and the planar scene's batch queries
 //! (`regrasp::cones::batch`).
 
-use crate::convert::{Arg, array1, dict, matrix, matrix_rows, numbers, one_or_array, opt, batch, arg, pusher, rows, rows_array, twist3, vector};
+use crate::convert::{Arg, arg, array1, batch, dict, matrix, matrix_rows, numbers, one_or_array, opt, pusher, rows, rows_array, twist3, vector};
 use crate::errors::{arg_err, to_py};
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};

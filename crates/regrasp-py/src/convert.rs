@@ -77,6 +77,15 @@ pub fn finite(name: &str, v: &Arg<'_>) -> PyResult<f64> {
     Ok(x)
 }
 
+/// A positive, finite number.
+pub fn positive(name: &str, v: &Arg<'_>) -> PyResult<f64> {
+    let x = finite(name, v)?;
+    if x <= 0.0 {
+        return Err(arg_err(name, format!("must be positive (got {x})")));
+    }
+    Ok(x)
+}
+
 /// A planar pose `[x, z, θ]`.
 pub fn pose3(name: &str, v: &Arg<'_>) -> PyResult<[f64; 3]> {
     numbers(name, v, "[x, z, θ]")
@@ -117,9 +126,12 @@ pub fn pusher(v: &Arg<'_>, index: impl Fn(&str) -> regrasp::Result<usize>) -> Py
     index(&arg::<String>("pusher", v)?).map_err(to_py)
 }
 
+/// A batch query's poses, twists and pusher index.
+pub type Batch = (Vec<[f64; 3]>, Vec<[f64; 3]>, usize);
+
 /// The arguments of a batch query: `poses` and `twists`, two `(n, 3)` arrays with as many rows,
 /// and the `pusher`'s index by `index`.
-pub fn batch(poses: &Arg<'_>, twists: &Arg<'_>, pusher: &Arg<'_>, index: impl Fn(&str) -> regrasp::Result<usize>) -> PyResult<(Vec<[f64; 3]>, Vec<[f64; 3]>, usize)> {
+pub fn batch(poses: &Arg<'_>, twists: &Arg<'_>, pusher: &Arg<'_>, index: impl Fn(&str) -> regrasp::Result<usize>) -> PyResult<Batch> {
     let (q, t) = (rows::<3>("poses", poses)?, rows::<3>("twists", twists)?);
     if q.len() != t.len() {
         return Err(arg_err("twists", format!("has {} rows but poses has {}", t.len(), q.len())));

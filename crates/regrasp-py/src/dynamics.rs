@@ -1,7 +1,7 @@
 //! Quasi-static dynamics (`regrasp::dynamics`): the `MncpProblem` of one instant, and the
 //! problems, pushes and simulated pushes of planar and 3-D scenes.
 
-use crate::convert::{Arg, arg, array1, dict, matrix, pose3, pose7, batch, pusher, rows_array, twist3, twist6, vector};
+use crate::convert::{Arg, arg, array1, batch, dict, matrix, pose3, pose7, pusher, rows_array, twist3, twist6, vector};
 use crate::errors::{arg_err, to_py};
 use nalgebra::DVector;
 use numpy::{PyArray1, PyArray2};
@@ -177,7 +177,7 @@ macro_rules! trajectory_dict {
     }};
 }
 
-/// A push's pusher, twist, duration and time step, as `simulate_push` takes them.
+/// The arguments of `simulate_push`: the start pose, the pusher, its twist, the duration and the time step.
 pub struct PushArgs<'a, 'py> {
     pub pose: &'a Arg<'py>,
     pub pusher: &'a Arg<'py>,

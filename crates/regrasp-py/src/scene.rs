@@ -3,7 +3,7 @@
 //! (cones, dynamics, planning), whose conversion lives in their own modules.
 
 use crate::cones::{self, Classified, Generated, MotionCone, Projected};
-use crate::convert::{Arg, arg, array1, finite, opt, pose3, pusher, rows, rows_array};
+use crate::convert::{Arg, arg, array1, opt, pose3, positive, pusher, rows, rows_array};
 use crate::dynamics::{self, MncpProblem, Outcomes, PushArgs};
 use crate::errors::{arg_err, to_py};
 use crate::{planning, settings};
@@ -19,6 +19,9 @@ use std::collections::HashMap;
 pub struct Scene {
     pub inner: regrasp::Scene,
 }
+
+/// A planar pusher: its points (k, 2), its normal and its friction coefficient.
+type PusherSpec<'py> = (Bound<'py, PyArray2<f64>>, (f64, f64), f64);
 
 /// The support options among the arguments of the quasi-static entry points.
 fn support<'a, 'py>(
@@ -83,7 +86,7 @@ impl Scene {
         }
     }
     /// Pusher `name`: (points (k, 2), normal (2,), friction).
-    fn pusher<'py>(&self, py: Python<'py>, name: &Arg<'py>) -> PyResult<(Bound<'py, PyArray2<f64>>, (f64, f64), f64)> {
+    fn pusher<'py>(&self, py: Python<'py>, name: &Arg<'py>) -> PyResult<PusherSpec<'py>> {
         let c = &self.inner.pushers[pusher(name, |n| self.inner.pusher_index(n))?].contact;
         Ok((rows_array(py, c.points.iter().map(|p| [p.x, p.y]).collect()), (c.normal.x, c.normal.y), c.friction))
     }
@@ -104,10 +107,7 @@ impl Scene {
     }
 
     fn with_grip_force(&self, force: &Arg<'_>) -> PyResult<Self> {
-        let force = finite("force", force)?;
-        if !(force > 0.0) {
-            return Err(arg_err("force", "must be a positive number"));
-        }
+        let force = positive("force", force)?;
         if self.inner.grip_force().is_none() {
             return Err(arg_err("force", "only a grasp scene has a grip force"));
         }

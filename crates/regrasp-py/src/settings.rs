@@ -2,7 +2,7 @@
 //! CLI read them from: `planner_defaults`, `mpc_defaults`, `quasistatic_defaults`) and
 //! overrides applied onto them, each key checked (an unknown key is an `ArgumentError`).
 
-use crate::convert::{Arg, arg, dict, finite};
+use crate::convert::{Arg, arg, dict, positive};
 use crate::errors::{arg_err, to_py};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -141,15 +141,6 @@ pub fn quasistatic_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let (support, rings, points, merge_fingers) = support_parts(o.support);
     Ok(dict!(py; "support" => support, "rings" => rings, "points" => points, "merge_fingers" => merge_fingers,
                  "h" => o.h, "speed" => o.speed))
-}
-
-/// A positive, finite number.
-fn positive(name: &str, v: &Arg<'_>) -> PyResult<f64> {
-    let x = finite(name, v)?;
-    if !(x > 0.0) {
-        return Err(arg_err(name, format!("must be positive (got {x})")));
-    }
-    Ok(x)
 }
 
 /// The quasi-static model's options: the defaults with the `given` ones (None: the default).
