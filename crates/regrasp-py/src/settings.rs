@@ -1,108 +1,70 @@
-//! Planner settings across the boundary: the Rust `Default`s as a dict (the only place Python
-//! and the CLI read them from) and a dict of overrides applied onto them, each key checked.
+//! Settings across the boundary: the Rust `Default`s as dicts (the only place Python and the
+//! CLI read them from: `planner_defaults`, `mpc_defaults`, `quasistatic_defaults`) and
+//! overrides applied onto them, each key checked (an unknown key is an `ArgumentError`).
 
-use crate::{arg_err, to_py};
+use crate::convert::{Arg, arg, dict, positive};
+use crate::errors::{arg_err, to_py};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use regrasp::control::mpc::MpcSettings;
+use regrasp::dynamics::planar::{Options, SupportModel};
 use regrasp::planning::planar::{PlanarSettings, Propagation};
 use regrasp::planning::spatial::SpatialSettings;
 use regrasp::planning::trrt::SearchSettings;
 
-/// Extracts `v` as a `T`, or an `ArgumentError` naming `key`.
-fn get<'py, T: FromPyObject<'py>>(key: &str, v: &Bound<'py, PyAny>, what: &str) -> PyResult<T> {
-    v.extract().map_err(|_| arg_err(key, format!("must be {what} (got {v})")))
+/// `fields!(to_dict, set, T; a, b)`: `to_dict` writes fields `a`, `b` of a `T` into a dict;
+/// `set` sets the field named `key` from a Python value (false when `key` names none).
+macro_rules! fields {
+    ($to_dict:ident, $set:ident, $t:ty; $($f:ident),* $(,)?) => {
+        fn $to_dict(s: &$t, d: &Bound<'_, PyDict>) -> PyResult<()> {
+            $(d.set_item(stringify!($f), s.$f)?;)*
+            Ok(())
+        }
+
+        fn $set(s: &mut $t, key: &str, v: &Arg<'_>) -> PyResult<bool> {
+            match key {
+                $(stringify!($f) => s.$f = arg(key, v)?,)*
+                _ => return Ok(false),
+            }
+            Ok(true)
+        }
+    };
 }
 
-/// The search settings as `(name, value)` pairs.
-fn search_dict<'py>(py: Python<'py>, s: &SearchSettings, d: &Bound<'py, PyDict>) -> PyResult<()> {
-    let _ = py;
-    d.set_item("seed", s.seed)?;
-    d.set_item("time_limit", s.time_limit)?;
-    d.set_item("max_nodes", s.max_nodes)?;
-    d.set_item("max_iterations", s.max_iterations)?;
-    d.set_item("goal_bias", s.goal_bias)?;
-    d.set_item("step", s.step)?;
-    d.set_item("checks", s.checks)?;
-    d.set_item("k", s.k)?;
-    d.set_item("t0", s.t0)?;
-    d.set_item("alpha", s.alpha)?;
-    d.set_item("n_fail", s.n_fail)?;
-    d.set_item("c_max", s.c_max)?;
-    d.set_item("neighbour_steps", s.neighbour_steps)?;
-    d.set_item("same_pusher_cost", s.same_pusher_cost)?;
-    d.set_item("switch_cost", s.switch_cost)?;
-    d.set_item("length_weight", s.length_weight)?;
-    d.set_item("cost_threshold", s.cost_threshold)?;
-    d.set_item("random_tries", s.random_tries)?;
-    d.set_item("theta_margin", s.theta_margin)?;
-    d.set_item("connect", s.connect)?;
-    Ok(())
-}
+fields!(search_dict, set_search, SearchSettings;
+    seed, time_limit, max_nodes, max_iterations, goal_bias, step, checks, k, t0, alpha, n_fail, c_max,
+    neighbour_steps, same_pusher_cost, switch_cost, length_weight, cost_threshold, random_tries,
+    theta_margin, connect);
 
-/// Sets search setting `key` from `v`; false when `key` is not a search setting.
-fn set_search(s: &mut SearchSettings, key: &str, v: &Bound<'_, PyAny>) -> PyResult<bool> {
-    const WHOLE: &str = "a whole number >= 0";
-    const NUM: &str = "a number";
-    match key {
-        "seed" => s.seed = get(key, v, WHOLE)?,
-        "time_limit" => s.time_limit = get(key, v, NUM)?,
-        "max_nodes" => s.max_nodes = get(key, v, WHOLE)?,
-        "max_iterations" => s.max_iterations = get(key, v, WHOLE)?,
-        "goal_bias" => s.goal_bias = get(key, v, NUM)?,
-        "step" => s.step = get(key, v, "a number or None")?,
-        "checks" => s.checks = get(key, v, WHOLE)?,
-        "k" => s.k = get(key, v, NUM)?,
-        "t0" => s.t0 = get(key, v, NUM)?,
-        "alpha" => s.alpha = get(key, v, NUM)?,
-        "n_fail" => s.n_fail = get(key, v, WHOLE)?,
-        "c_max" => s.c_max = get(key, v, NUM)?,
-        "neighbour_steps" => s.neighbour_steps = get(key, v, NUM)?,
-        "same_pusher_cost" => s.same_pusher_cost = get(key, v, NUM)?,
-        "switch_cost" => s.switch_cost = get(key, v, NUM)?,
-        "length_weight" => s.length_weight = get(key, v, NUM)?,
-        "cost_threshold" => s.cost_threshold = get(key, v, NUM)?,
-        "random_tries" => s.random_tries = get(key, v, WHOLE)?,
-        "theta_margin" => s.theta_margin = get(key, v, NUM)?,
-        "connect" => s.connect = get(key, v, "True or False")?,
-        _ => return Ok(false),
-    }
-    Ok(true)
-}
+fields!(mpc_dict, set_mpc, MpcSettings;
+    dt, horizon, speed, stage_weight, terminal_weight, effort_weight, margin, stall_steps, progress,
+    replan_error, max_replans, goal_fraction);
 
-/// The planar settings as a dict.
-pub fn planar_dict<'py>(py: Python<'py>, s: &PlanarSettings) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    search_dict(py, &s.search, &d)?;
-    d.set_item("margin", s.margin)?;
-    d.set_item("propagation", s.propagation.label())?;
-    d.set_item("plain", s.plain)?;
-    Ok(d)
-}
-
-/// The spatial settings as a dict.
-pub fn spatial_dict<'py>(py: Python<'py>, s: &SpatialSettings) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    search_dict(py, &s.search, &d)?;
-    Ok(d)
-}
-
-/// The keys of `overrides` in order, as strings.
-fn items<'py>(overrides: Option<&Bound<'py, PyDict>>) -> PyResult<Vec<(String, Bound<'py, PyAny>)>> {
-    let Some(d) = overrides else { return Ok(Vec::new()) };
+/// Argument `settings` (a dict or None) as `(key, value)` pairs.
+pub fn items<'py>(settings: Option<&Arg<'py>>) -> PyResult<Vec<(String, Arg<'py>)>> {
+    let Some(s) = settings.filter(|s| !s.is_none()) else { return Ok(Vec::new()) };
+    let d = s.downcast::<PyDict>().map_err(|_| arg_err("settings", format!("must be a dict (got {s})")))?;
     d.iter().map(|(k, v)| Ok((k.extract::<String>().map_err(|_| arg_err("settings", "keys must be strings"))?, v))).collect()
 }
 
-/// The planar settings: the defaults with `overrides` applied (unknown keys are errors).
-pub fn planar(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<PlanarSettings> {
+/// The planar planner's settings as a dict.
+fn planar_dict<'py>(py: Python<'py>, s: &PlanarSettings) -> PyResult<Bound<'py, PyDict>> {
+    let d = dict!(py; "margin" => s.margin, "propagation" => s.propagation.label(), "plain" => s.plain);
+    search_dict(&s.search, &d)?;
+    Ok(d)
+}
+
+/// The planar planner's settings: the defaults with `overrides` applied.
+pub fn planar(overrides: Option<&Arg<'_>>) -> PyResult<PlanarSettings> {
     let mut s = PlanarSettings::default();
     for (k, v) in items(overrides)? {
         if set_search(&mut s.search, &k, &v)? {
             continue;
         }
         match k.as_str() {
-            "margin" => s.margin = get(&k, &v, "a number")?,
-            "propagation" => s.propagation = Propagation::parse(&get::<String>(&k, &v, "a string")?).map_err(to_py)?,
-            "plain" => s.plain = get(&k, &v, "True or False")?,
+            "margin" => s.margin = arg(&k, &v)?,
+            "propagation" => s.propagation = Propagation::parse(&arg::<String>(&k, &v)?).map_err(to_py)?,
+            "plain" => s.plain = arg(&k, &v)?,
             _ => return Err(arg_err(&k, "is not a setting of the planar planner")),
         }
     }
@@ -110,8 +72,8 @@ pub fn planar(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<PlanarSettings>
     Ok(s)
 }
 
-/// The spatial settings: the defaults with `overrides` applied (unknown keys are errors).
-pub fn spatial(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<SpatialSettings> {
+/// The 3-D planner's settings: the defaults with `overrides` applied.
+pub fn spatial(overrides: Option<&Arg<'_>>) -> PyResult<SpatialSettings> {
     let mut s = SpatialSettings::default();
     for (k, v) in items(overrides)? {
         if !set_search(&mut s.search, &k, &v)? {
@@ -124,10 +86,84 @@ pub fn spatial(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<SpatialSetting
 
 /// The planner's default settings for scenes of `dimension` 2 or 3 (the Rust `Default`s).
 #[pyfunction]
-pub fn planner_defaults(py: Python<'_>, dimension: u8) -> PyResult<Bound<'_, PyDict>> {
-    match dimension {
+pub fn planner_defaults<'py>(py: Python<'py>, dimension: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
+    match arg::<usize>("dimension", dimension)? {
         2 => planar_dict(py, &PlanarSettings::default()),
-        3 => spatial_dict(py, &SpatialSettings::default()),
+        3 => {
+            let d = PyDict::new(py);
+            search_dict(&SpatialSettings::default().search, &d)?;
+            Ok(d)
+        }
         _ => Err(arg_err("dimension", "must be 2 or 3")),
     }
+}
+
+/// The MPC's default settings (`regrasp::control::mpc::MpcSettings::default()`): the keywords
+/// `_core.Mpc` takes, `replan_time_limit` and `seed` being those of its re-planning.
+#[pyfunction]
+pub fn mpc_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let s = MpcSettings::default();
+    let d = dict!(py; "replan_time_limit" => s.planner.search.time_limit, "seed" => s.planner.search.seed);
+    mpc_dict(&s, &d)?;
+    Ok(d)
+}
+
+/// The MPC's settings: the defaults with `overrides` applied (None values are skipped); checked
+/// by the controller.
+pub fn mpc(overrides: &[(String, Arg<'_>)]) -> PyResult<MpcSettings> {
+    let mut s = MpcSettings::default();
+    for (k, v) in overrides.iter().filter(|(_, v)| !v.is_none()) {
+        if set_mpc(&mut s, k, v)? {
+            continue;
+        }
+        match k.as_str() {
+            "replan_time_limit" => s.planner.search.time_limit = arg(k, v)?,
+            "seed" => s.planner.search.seed = arg(k, v)?,
+            _ => return Err(arg_err(k, "is not a setting of the MPC")),
+        }
+    }
+    Ok(s)
+}
+
+/// The support model's parts: (label, rings, points, merge_fingers).
+fn support_parts(m: SupportModel) -> (&'static str, usize, usize, bool) {
+    match m {
+        SupportModel::Points { rings, points, merge_fingers } => ("points", rings, points, merge_fingers),
+        SupportModel::LimitSurface => ("limit_surface", 0, 0, true),
+    }
+}
+
+/// The quasi-static model's default options (`regrasp::dynamics::planar::Options::default()`):
+/// the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`.
+#[pyfunction]
+pub fn quasistatic_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let o = Options::default();
+    let (support, rings, points, merge_fingers) = support_parts(o.support);
+    Ok(dict!(py; "support" => support, "rings" => rings, "points" => points, "merge_fingers" => merge_fingers,
+                 "h" => o.h, "speed" => o.speed))
+}
+
+/// The quasi-static model's options: the defaults with the `given` ones (None: the default).
+pub fn quasistatic(given: &[(&str, Option<&Arg<'_>>)]) -> PyResult<Options> {
+    let mut o = Options::default();
+    let (label, mut rings, mut points, mut merge_fingers) = support_parts(o.support);
+    let mut support = label.to_string();
+    for (k, v) in given.iter().filter_map(|(k, v)| v.filter(|v| !v.is_none()).map(|v| (*k, v))) {
+        match k {
+            "support" => support = arg(k, v)?,
+            "rings" => rings = arg(k, v)?,
+            "points" => points = arg(k, v)?,
+            "merge_fingers" => merge_fingers = arg(k, v)?,
+            "h" => o.h = positive(k, v)?,
+            "speed" => o.speed = positive(k, v)?,
+            _ => return Err(arg_err(k, "is not an option of the quasi-static model")),
+        }
+    }
+    o.support = match support.as_str() {
+        "points" if rings == 0 && points == 0 => return Err(arg_err("points", "give rings > 0 or points > 0")),
+        "points" => SupportModel::Points { rings, points, merge_fingers },
+        "limit_surface" => SupportModel::LimitSurface,
+        other => return Err(arg_err("support", format!("must be \"points\" or \"limit_surface\", got {other:?}"))),
+    };
+    Ok(o)
 }

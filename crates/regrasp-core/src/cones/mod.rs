@@ -4,5 +4,6 @@
 pub mod batch;
 pub mod frame;
 pub mod motion_cone;
+pub mod polyhedral;
 pub mod projection;
 pub mod robust;
