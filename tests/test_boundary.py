@@ -14,7 +14,7 @@ import pytest
 from regrasp import _core
 from regrasp.errors import ArgumentError, RegraspError
 
-EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 BAD = [-1, 2**70, 1.5, float("nan"), "x", None, [], [1.0, 2.0], [[1.0, 2.0, 3.0]], np.zeros((2, 2)), {}, object(), True]
 
 Q = [0.0, 0.0, 0.0]
