@@ -1,7 +1,7 @@
 //! Test problems: a planar block held by finger points or one limit-surface patch, pushed by a
 //! line pusher.
 
-use super::{Contact, FrictionLaw, NormalLaw, Problem, Side};
+use super::{solve_forward, Contact, FrictionLaw, NormalLaw, Problem, Settings, Side, Solution};
 use nalgebra::{DMatrix, DVector};
 
 /// A planar block held by a circular patch of `k` points at the origin, pushed by a line
@@ -58,4 +58,9 @@ pub(super) fn with_patch(mut p: Problem, k: usize) -> Problem {
         },
     );
     p
+}
+
+/// The forward solution of `p` for pusher twist `u` (default settings).
+pub(super) fn push(p: &Problem, u: &[f64]) -> Solution {
+    solve_forward(p, &DVector::from_row_slice(u), &Settings::default()).unwrap()
 }

@@ -147,17 +147,14 @@ fn starts(p: &Problem, u: &DVector<f64>, nw: &Newton<'_>, settings: &Settings) -
 
 #[cfg(test)]
 mod tests {
-    use super::super::fixtures::block;
+    use super::super::fixtures::{block, push};
     use super::super::ContactState;
-    use super::*;
 
     #[test]
     fn push_along_the_normal_sticks_and_the_fingers_slide() {
-        let p = block(8, 20.0, 0.5);
-        let u = DVector::from_row_slice(&[0.01, 0.0, 0.0]);
-        let s = solve_forward(&p, &u, &Settings::default()).unwrap();
+        let s = push(&block(8, 20.0, 0.5), &[0.01, 0.0, 0.0]);
         assert!(s.residuals.max() < 1e-8, "{:?}", s.residuals);
-        assert!((&s.twist - &u).norm() < 1e-9, "moves with the pusher: {}", s.twist);
+        assert!((&s.twist - &s.pusher_twist).norm() < 1e-9, "moves with the pusher: {}", s.twist);
         let (fingers, pushers) = s.states.split_at(8);
         assert!(fingers.iter().all(|c| *c == ContactState::Slide));
         assert!(pushers.iter().all(|c| *c == ContactState::Stick));
@@ -165,18 +162,14 @@ mod tests {
 
     #[test]
     fn lifting_with_a_side_pusher_slips() {
-        let p = block(8, 20.0, 0.2);
-        let u = DVector::from_row_slice(&[0.002, 0.01, 0.0]);
-        let s = solve_forward(&p, &u, &Settings::default()).unwrap();
+        let s = push(&block(8, 20.0, 0.2), &[0.002, 0.01, 0.0]);
         assert!(s.residuals.max() < 1e-8, "{:?}", s.residuals);
         assert!(s.states[8..].iter().all(|c| *c == ContactState::Slide), "{:?}", s.states);
     }
 
     #[test]
     fn zero_grip_drops_the_object() {
-        let p = block(8, 0.0, 0.5);
-        let u = DVector::from_row_slice(&[0.01, 0.0, 0.0]);
-        let s = solve_forward(&p, &u, &Settings::default()).unwrap();
+        let s = push(&block(8, 0.0, 0.5), &[0.01, 0.0, 0.0]);
         assert!(s.twist[1] < -1.0, "falls: {}", s.twist);
     }
 }

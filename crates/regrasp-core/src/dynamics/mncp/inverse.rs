@@ -283,8 +283,7 @@ impl Program {
 
 #[cfg(test)]
 mod tests {
-    use super::super::fixtures::block;
-    use super::super::solve_forward;
+    use super::super::fixtures::{block, push};
     use super::*;
 
     #[test]
@@ -293,7 +292,7 @@ mod tests {
         let v = DVector::from_row_slice(&[0.01, 0.001, 0.05]);
         let inv = solve_inverse(&p, &v, &Settings::default()).unwrap();
         assert!(inv.residuals.max() < 1e-7, "{:?}", inv.residuals);
-        let fwd = solve_forward(&p, &inv.pusher_twist, &Settings::default()).unwrap();
+        let fwd = push(&p, inv.pusher_twist.as_slice());
         assert!((&fwd.twist - &v).norm() < 1e-7 * v.norm(), "{} vs {}", fwd.twist, v);
         // lifting straight up with the side pusher: impossible
         let up = DVector::from_row_slice(&[0.0, 0.01, 0.0]);
