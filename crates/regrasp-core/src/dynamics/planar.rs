@@ -145,7 +145,7 @@ fn support_contacts(scene: &Scene, q: &[f64; 3], frame: &SupportFrame, model: Su
     // a point of the support at `r` (object frame) with normal force `f` and friction `mu`
     let point = |label: String, side: Side, f: f64, mu: f64, r: &Vec2| {
         let jt = DMatrix::from_row_slice(2, 3, &[1.0, 0.0, -r.y, 0.0, 1.0, r.x]);
-        Contact::held(label, side, f, mu, DVector::zeros(3), jt)
+        Contact::fixed_normal(label, side, f, mu, DVector::zeros(3), jt)
     };
     match (&scene.support, model) {
         (_, SupportModel::LimitSurface) => vec![Contact {
@@ -193,7 +193,7 @@ fn pusher_contacts<'a>(mu: f64, points: &'a [Vec2], gaps: &'a [f64], normal: Vec
     points.iter().zip(gaps).enumerate().map(move |(k, (r, gap))| {
         let jn = DVector::from_row_slice(&[n.x, n.y, cross2(r, &n)]);
         let jt = DMatrix::from_row_slice(1, 3, &[t.x, t.y, cross2(r, &t)]);
-        Contact::pushed(format!("pusher[{k}]"), mu, jn, jt, *gap)
+        Contact::pusher_point(format!("pusher[{k}]"), mu, jn, jt, *gap)
     })
 }
 

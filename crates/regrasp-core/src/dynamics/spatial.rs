@@ -53,7 +53,7 @@ pub fn problem(
         let t = tangents(&n);
         for (k, (r, g)) in points.iter().zip(gaps).enumerate() {
             let jn = DVector::from_row_slice(&row(r, &n));
-            contacts.push(Contact::pushed(format!("pusher[{k}]"), mu, jn, tangent_rows(r, &t), *g));
+            contacts.push(Contact::pusher_point(format!("pusher[{k}]"), mu, jn, tangent_rows(r, &t), *g));
         }
     }
     let (mass, wrench) = mass_and_gravity(scene, pose);
@@ -84,7 +84,7 @@ fn finger_contacts(scene: &Scene3, pose: &Isometry3<f64>) -> Result<Vec<Contact>
         let share = scene.grip_force / pts.len() as f64;
         for (k, r) in pts.iter().enumerate() {
             let jn = DVector::from_row_slice(&row(r, &n));
-            contacts.push(Contact::held(format!("finger{side}[{k}]"), Side::Finger, share, scene.grip_friction, jn, tangent_rows(r, &t)));
+            contacts.push(Contact::fixed_normal(format!("finger{side}[{k}]"), Side::Finger, share, scene.grip_friction, jn, tangent_rows(r, &t)));
         }
     }
     Ok(contacts)

@@ -14,14 +14,14 @@ pub(super) fn block(k: usize, grip: f64, mu_p: f64) -> Problem {
         let a = 2.0 * std::f64::consts::PI * i as f64 / k as f64;
         let r = [rho * a.cos(), rho * a.sin()];
         let jt = DMatrix::from_row_slice(2, 3, &[1.0, 0.0, -r[1], 0.0, 1.0, r[0]]);
-        contacts.push(Contact::held(format!("finger[{i}]"), Side::Finger, 2.0 * grip / k as f64, mu_s, DVector::zeros(d), jt));
+        contacts.push(Contact::fixed_normal(format!("finger[{i}]"), Side::Finger, 2.0 * grip / k as f64, mu_s, DVector::zeros(d), jt));
     }
     for (i, z) in [-0.02, 0.02].iter().enumerate() {
         let r = [-0.025, *z];
         // n = +x, t = +z: jn = [1, 0, r×n] with r×n = r_x n_z − r_z n_x = −r_z
         let jn = DVector::from_row_slice(&[1.0, 0.0, -r[1]]);
         let jt = DMatrix::from_row_slice(1, 3, &[0.0, 1.0, r[0]]);
-        contacts.push(Contact::pushed(format!("pusher[{i}]"), mu_p, jn, jt, 0.0));
+        contacts.push(Contact::pusher_point(format!("pusher[{i}]"), mu_p, jn, jt, 0.0));
     }
     let m = 0.13;
     Problem {

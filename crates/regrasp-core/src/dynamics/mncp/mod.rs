@@ -20,7 +20,6 @@
 //! and forces) is convex: with the object's motion given every contact's mode is known except
 //! the pusher's, which may as well stick; it is a second-order cone program (clarabel).
 //! [`residuals`] checks any candidate solution against every constraint in its original form.
-
 //!
 //! Files: this one holds the problem and its [`residuals`]; `newton` the semismooth Newton
 //! solver, `forward` the forward solve's attempts, `inverse` the cone program.
@@ -87,14 +86,14 @@ pub struct Contact {
 impl Contact {
     /// A point with a given normal force `normal_force` and a Coulomb disc `μ` (a finger pad's
     /// share of the grip force, eq 3.5, or a point of a support): nothing on its other side moves.
-    pub fn held(label: String, side: Side, normal_force: f64, mu: f64, jn: DVector<f64>, jt: DMatrix<f64>) -> Self {
+    pub fn fixed_normal(label: String, side: Side, normal_force: f64, mu: f64, jn: DVector<f64>, jt: DMatrix<f64>) -> Self {
         let (jn_other, jt_other) = (DVector::zeros(jn.len()), DMatrix::zeros(jt.nrows(), jt.ncols()));
         Self { label, side, normal: NormalLaw::Fixed(normal_force), friction: FrictionLaw::Coulomb(mu), jn, jt, jn_other, jt_other, gap: 0.0 }
     }
 
     /// A point of the pusher at gap `gap`: unilateral (eq 3.16) with a Coulomb cone `μ`, the
     /// pusher's twist entering through the same rows as the object's (the point is on both).
-    pub fn pushed(label: String, mu: f64, jn: DVector<f64>, jt: DMatrix<f64>, gap: f64) -> Self {
+    pub fn pusher_point(label: String, mu: f64, jn: DVector<f64>, jt: DMatrix<f64>, gap: f64) -> Self {
         let (jn_other, jt_other) = (jn.clone(), jt.clone());
         Self { label, side: Side::Pusher, normal: NormalLaw::Unilateral, friction: FrictionLaw::Coulomb(mu), jn, jt, jn_other, jt_other, gap }
     }
