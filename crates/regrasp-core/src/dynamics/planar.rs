@@ -7,17 +7,18 @@
 //! Newton–Euler equation (eq 3.13). Twists are in the object frame, as for the motion cones, so
 //! a pusher moving with twist `U` sticks exactly when the object moves with `V = U`.
 
+use crate::cones::frame::SupportFrame;
+use crate::dynamics::mncp::{self, Contact, ContactState, FrictionLaw, NormalLaw, Problem, Settings, Side, Solution};
+use crate::dynamics::stepping::{march, pusher_at, solve_step, step_count, within_reach, PusherContacts};
 use crate::error::{Error, Result};
-pub use crate::pose::planar::{integrate, relative};
-use crate::pose::planar::twist_in;
 use crate::mechanics::geometry::{cross2, perp, rot, Vec2, Vec3};
 use crate::mechanics::limit_surface::{Pressure, PressureDistribution};
-use crate::dynamics::mncp::{self, Contact, ContactState, FrictionLaw, NormalLaw, Problem, Settings, Side, Solution};
+pub use crate::pose::planar::{integrate, relative};
+use crate::pose::planar::twist_in;
 use crate::scene::planar::{PadShape, Scene, Support};
 use nalgebra::{DMatrix, DVector};
 
-/// Most time steps one simulated push may take (a typo in `dt` must not run for hours).
-pub const MAX_STEPS: f64 = 1e6;
+pub use crate::dynamics::stepping::MAX_STEPS;
 
 /// How the support (finger pads, or the surface under the object) enters the problem.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -110,123 +111,104 @@ pub fn pad_points(pad: &PadShape, pressure: Pressure, rings: usize, points: usiz
 }
 
 /// The planar scene at pose `q` with pusher `pusher` (its points at `points` with gaps
-/// `gaps`, object frame; `normal` the direction it pushes, object frame) as a problem.
+/// `gaps`, object frame; `normal` the direction it pushes, object frame) as a problem: the
+/// support's contacts, the pusher's, and the quasi-static Newton–Euler terms over the step
+/// (eq 3.13).
 pub fn planar_problem(
     scene: &Scene,
     q: &[f64; 3],
     pusher: Option<(f64, &[Vec2], &[f64], Vec2)>,
     opts: &Options,
 ) -> Result<Problem> {
-    let d = 3;
-    let h = opts.h;
-    let mut contacts = Vec::new();
-    let r_t = rot(-q[2]);
-    let c_pad = -(r_t * Vec2::new(q[0], q[1]));
-    let tangent_rows = |r: &Vec2| DMatrix::from_row_slice(2, 3, &[1.0, 0.0, -r.y, 0.0, 1.0, r.x]);
     let frame = scene.frame(q);
-    match (&scene.support, opts.support) {
-        (_, SupportModel::LimitSurface) => {
-            let a = frame.a;
-            contacts.push(Contact {
-                label: "support".into(),
-                side: Side::Finger,
-                normal: NormalLaw::Fixed(scene.friction_scale()),
-                friction: FrictionLaw::Ellipsoid(DMatrix::from_fn(3, 3, |i, j| a[(i, j)])),
-                jn: DVector::zeros(d),
-                jt: DMatrix::from_fn(3, 3, |i, j| frame.js[(i, j)]),
-                jn_other: DVector::zeros(d),
-                jt_other: DMatrix::zeros(3, 3),
-                gap: 0.0,
-            });
-        }
-        (Support::Grasp(g), SupportModel::Points { rings, points, merge_fingers }) => {
-            let pts = pad_points(&g.pad, g.pressure, rings, points);
-            let fingers = if merge_fingers { 1 } else { 2 };
-            let share = 2.0 * g.force / fingers as f64;
-            for f in 0..fingers {
-                for (k, (p, w)) in pts.iter().enumerate() {
-                    // pad point in the gripper frame → object frame
-                    let r = c_pad + r_t * p;
-                    contacts.push(Contact {
-                        label: format!("finger{f}[{k}]"),
-                        side: Side::Finger,
-                        normal: NormalLaw::Fixed(share * w),
-                        friction: FrictionLaw::Coulomb(g.friction),
-                        jn: DVector::zeros(d),
-                        jt: tangent_rows(&r),
-                        jn_other: DVector::zeros(d),
-                        jt_other: DMatrix::zeros(2, d),
-                        gap: 0.0,
-                    });
-                }
-            }
-        }
-        (Support::Surface(s), SupportModel::Points { rings, .. }) => {
-            let n = (rings.max(1) * 6).max(6);
-            let dist = PressureDistribution::polygon(&scene.outline, &s.cop, n);
-            let total = scene.mass * scene.g * s.incline.cos();
-            for (k, (p, w)) in dist.cells.iter().enumerate() {
-                let r = s.cop + p;
-                contacts.push(Contact {
-                    label: format!("surface[{k}]"),
-                    side: Side::Fixed,
-                    normal: NormalLaw::Fixed(total * w),
-                    friction: FrictionLaw::Coulomb(s.friction),
-                    jn: DVector::zeros(d),
-                    jt: tangent_rows(&r),
-                    jn_other: DVector::zeros(d),
-                    jt_other: DMatrix::zeros(2, d),
-                    gap: 0.0,
-                });
-            }
-        }
-    }
+    let mut contacts = support_contacts(scene, q, &frame, opts.support);
     if let Some((mu, points, gaps, normal)) = pusher {
-        let n = normal.normalize();
-        let t = perp(&n);
-        for (k, (r, gap)) in points.iter().zip(gaps).enumerate() {
-            let jn = DVector::from_row_slice(&[n.x, n.y, cross2(r, &n)]);
-            let jt = DMatrix::from_row_slice(1, 3, &[t.x, t.y, cross2(r, &t)]);
-            contacts.push(Contact {
-                label: format!("pusher[{k}]"),
-                side: Side::Pusher,
-                normal: NormalLaw::Unilateral,
-                friction: FrictionLaw::Coulomb(mu),
-                jn_other: jn.clone(),
-                jt_other: jt.clone(),
-                jn,
-                jt,
-                gap: *gap,
-            });
-        }
+        contacts.extend(pusher_contacts(mu, points, gaps, normal));
     }
-    // mass matrix about the object-frame origin, over the step
-    let m = scene.mass;
-    let c = scene.com;
-    let i_c = m * scene.length * scene.length;
-    let mass = DMatrix::from_row_slice(
-        3,
-        3,
-        &[m, 0.0, -m * c.y, 0.0, m, m * c.x, -m * c.y, m * c.x, i_c + m * c.norm_squared()],
-    ) / h;
     let wg = frame.gravity;
-    let force_scale = scene.friction_scale() + scene.mass * scene.g;
     Ok(Problem {
-        dim: d,
-        mass,
+        dim: 3,
+        mass: mass_matrix(scene, opts.h),
         wrench: DVector::from_row_slice(wg.as_slice()),
         contacts,
-        h,
-        force_scale,
+        h: opts.h,
+        force_scale: scene.friction_scale() + scene.mass * scene.g,
         velocity_scale: opts.speed,
         length: scene.length,
     })
 }
 
+/// The support's contacts at pose `q`: one limit-surface patch (eq 3.7), the finger pads' points
+/// with their shares of the grip force (eq 3.5), or the points of a surface under the object
+/// with their shares of its weight.
+fn support_contacts(scene: &Scene, q: &[f64; 3], frame: &SupportFrame, model: SupportModel) -> Vec<Contact> {
+    // a point of the support at `r` (object frame) with normal force `f` and friction `mu`
+    let point = |label: String, side: Side, f: f64, mu: f64, r: &Vec2| {
+        let jt = DMatrix::from_row_slice(2, 3, &[1.0, 0.0, -r.y, 0.0, 1.0, r.x]);
+        Contact::fixed_normal(label, side, f, mu, DVector::zeros(3), jt)
+    };
+    match (&scene.support, model) {
+        (_, SupportModel::LimitSurface) => vec![Contact {
+            label: "support".into(),
+            side: Side::Finger,
+            normal: NormalLaw::Fixed(scene.friction_scale()),
+            friction: FrictionLaw::Ellipsoid(DMatrix::from_fn(3, 3, |i, j| frame.a[(i, j)])),
+            jn: DVector::zeros(3),
+            jt: DMatrix::from_fn(3, 3, |i, j| frame.js[(i, j)]),
+            jn_other: DVector::zeros(3),
+            jt_other: DMatrix::zeros(3, 3),
+            gap: 0.0,
+        }],
+        (Support::Grasp(g), SupportModel::Points { rings, points, merge_fingers }) => {
+            let pts = pad_points(&g.pad, g.pressure, rings, points);
+            let fingers = if merge_fingers { 1 } else { 2 };
+            let share = 2.0 * g.force / fingers as f64;
+            let r_t = rot(-q[2]);
+            let c_pad = -(r_t * Vec2::new(q[0], q[1]));
+            let mut out = Vec::new();
+            for f in 0..fingers {
+                for (k, (p, w)) in pts.iter().enumerate() {
+                    // pad point in the gripper frame → object frame
+                    let r = c_pad + r_t * p;
+                    out.push(point(format!("finger{f}[{k}]"), Side::Finger, share * w, g.friction, &r));
+                }
+            }
+            out
+        }
+        (Support::Surface(s), SupportModel::Points { rings, .. }) => {
+            let n = (rings.max(1) * 6).max(6);
+            let dist = PressureDistribution::polygon(&scene.outline, &s.cop, n);
+            let total = scene.mass * scene.g * s.incline.cos();
+            let cells = dist.cells.iter().enumerate();
+            cells.map(|(k, (p, w))| point(format!("surface[{k}]"), Side::Fixed, total * w, s.friction, &(s.cop + p))).collect()
+        }
+    }
+}
+
+/// The pusher's points `points` (object frame) with gaps `gaps`, pushing along `normal`:
+/// unilateral contacts (eq 3.16) with Coulomb friction `mu`.
+fn pusher_contacts<'a>(mu: f64, points: &'a [Vec2], gaps: &'a [f64], normal: Vec2) -> impl Iterator<Item = Contact> + 'a {
+    let n = normal.normalize();
+    let t = perp(&n);
+    points.iter().zip(gaps).enumerate().map(move |(k, (r, gap))| {
+        let jn = DVector::from_row_slice(&[n.x, n.y, cross2(r, &n)]);
+        let jt = DMatrix::from_row_slice(1, 3, &[t.x, t.y, cross2(r, &t)]);
+        Contact::pusher_point(format!("pusher[{k}]"), mu, jn, jt, *gap)
+    })
+}
+
+/// The mass matrix about the object-frame origin over a step `h`: `M / h` (eq 3.13).
+fn mass_matrix(scene: &Scene, h: f64) -> DMatrix<f64> {
+    let m = scene.mass;
+    let c = scene.com;
+    let i_c = m * scene.length * scene.length;
+    DMatrix::from_row_slice(3, 3, &[m, 0.0, -m * c.y, 0.0, m, m * c.x, -m * c.y, m * c.x, i_c + m * c.norm_squared()]) / h
+}
+
 /// The problem of pusher `pusher` of the scene at pose `q`, in contact at its scene points.
 pub fn push_problem(scene: &Scene, q: &[f64; 3], pusher: usize, opts: &Options) -> Result<Problem> {
     scene.check_pose(q)?;
-    let p = scene.pushers.get(pusher).ok_or_else(|| Error::arg("pusher", format!("index {pusher} out of range")))?;
+    let p = pusher_at(&scene.pushers, pusher)?;
     let gaps = vec![0.0; p.contact.points.len()];
     planar_problem(scene, q, Some((p.contact.friction, &p.contact.points, &gaps, p.contact.normal)), opts)
 }
@@ -276,8 +258,8 @@ pub struct Trajectory {
 
 /// Simulates a push: the pusher starts in contact at its scene points with the object at `q0`
 /// and moves with constant body twist `u` (its frame coincides with the object frame at the
-/// start) for `duration` seconds, in steps of `dt` (explicit time stepping). Contact points
-/// move with the pusher; a point whose gap exceeds `reach` leaves the problem.
+/// start) for `duration` seconds, in steps of `dt` (explicit time stepping, thesis §3.2.3).
+/// Contact points move with the pusher; a point whose gap exceeds `reach` leaves the problem.
 pub fn simulate_push(
     scene: &Scene,
     q0: &[f64; 3],
@@ -287,79 +269,66 @@ pub fn simulate_push(
     dt: f64,
     opts: &Options,
 ) -> Result<Trajectory> {
-    if !(dt > 0.0) || !(duration >= 0.0) || !duration.is_finite() {
-        return Err(Error::arg("dt", "time step and duration must be positive and finite"));
-    }
-    if duration / dt > MAX_STEPS {
-        return Err(Error::arg("dt", format!("{:.0} time steps asked for (duration / dt); at most {MAX_STEPS:.0}", duration / dt)));
-    }
+    let steps = step_count(duration, dt)?;
     scene.check_pose(q0)?;
-    let pz = scene.pushers.get(pusher).ok_or_else(|| Error::arg("pusher", format!("index {pusher} out of range")))?;
-    let steps = (duration / dt).round() as usize;
+    let pz = pusher_at(&scene.pushers, pusher)?;
     let opts = Options { h: dt, ..*opts };
     let mut traj = Trajectory::default();
-    let (mut q, mut qp) = (*q0, *q0);
     let reach = 0.002 + 2.0 * dt * (Vec2::new(u.x, u.y).norm() + u.z.abs() * scene.length);
-    for k in 0..=steps {
-        let t = k as f64 * dt;
+    march(steps, dt, *q0, u, integrate, |t, q, qp| {
         // pusher points and normal in the object frame
-        let rel = relative(&q, &qp);
+        let rel = relative(q, qp);
         let pr = rot(rel[2]);
         let off = Vec2::new(rel[0], rel[1]);
         let normal = pr * pz.contact.normal;
-        let mut pts = Vec::new();
-        let mut gaps = Vec::new();
-        for p in &pz.contact.points {
-            let r = pr * p + off;
-            let gap = -scene.outline.signed_distance(&r);
-            if gap < reach {
-                pts.push(r);
-                gaps.push(gap);
-            }
-        }
-        if !scene.admissible(&q) {
+        let candidates = pz.contact.points.iter().map(|p| pr * p + off).map(|r| (r, -scene.outline.signed_distance(&r)));
+        let (pts, gaps) = within_reach(candidates, reach);
+        if !scene.admissible(q) {
             return Err(Error::arg(
                 "push",
                 format!("after {t:.3} s the finger pad leaves the object (pose {q:?}): the push goes too far"),
             ));
         }
-        let prob = planar_problem(scene, &q, Some((pz.contact.friction, &pts, &gaps, normal)), &opts)?;
-        let uo = twist_in(&rel, u);
-        let sol = mncp::solve_forward(&prob, &DVector::from_row_slice(uo.as_slice()), &opts.settings)
-            .map_err(|e| Error::arg("push", format!("at t = {t:.3} s: {e}")))?;
-        let v = Vec3::new(sol.twist[0], sol.twist[1], sol.twist[2]);
-        let (mut wp, mut ws) = (Vec3::zeros(), Vec3::zeros());
-        let (mut slip, mut n_contact, mut n_stick) = (0.0f64, 0, 0);
-        for (i, c) in prob.contacts.iter().enumerate() {
-            let f = &c.jn * sol.normal_forces[i] + c.jt.transpose() * &sol.friction_forces[i];
-            let f = Vec3::new(f[0], f[1], f[2]);
-            if c.side == Side::Pusher {
-                wp += f;
-                if sol.states[i] != ContactState::Separate {
-                    n_contact += 1;
-                    slip = slip.max(sol.tangent_velocities[i].norm());
-                    n_stick += (sol.states[i] == ContactState::Stick) as usize;
-                }
-            } else {
-                ws += f;
-            }
-        }
-        traj.t.push(t);
-        traj.pose.push(q);
-        traj.pusher_pose.push(qp);
-        traj.twist.push([v.x, v.y, v.z]);
-        traj.pusher_wrench.push([wp.x, wp.y, wp.z]);
-        traj.support_wrench.push([ws.x, ws.y, ws.z]);
-        traj.pusher_slip.push(slip);
-        traj.pusher_contacts.push(n_contact);
-        traj.pusher_sticking.push(n_stick);
-        traj.residual.push(sol.residuals.max());
-        if k < steps {
-            q = integrate(&q, &v, dt);
-            qp = integrate(&qp, u, dt);
+        let prob = planar_problem(scene, q, Some((pz.contact.friction, &pts, &gaps, normal)), &opts)?;
+        let sol = solve_step(&prob, twist_in(&rel, u).as_slice(), &opts.settings, t)?;
+        traj.record(t, q, qp, &prob, &sol);
+        Ok(Vec3::new(sol.twist[0], sol.twist[1], sol.twist[2]))
+    })?;
+    Ok(traj)
+}
+
+impl Trajectory {
+    /// Appends the step at time `t` (object at `q`, pusher at `qp`) solved by `sol`.
+    fn record(&mut self, t: f64, q: &[f64; 3], qp: &[f64; 3], prob: &Problem, sol: &Solution) {
+        let pc = PusherContacts::of(prob, sol);
+        let (wp, ws) = wrenches(prob, sol);
+        self.t.push(t);
+        self.pose.push(*q);
+        self.pusher_pose.push(*qp);
+        self.twist.push([sol.twist[0], sol.twist[1], sol.twist[2]]);
+        self.pusher_wrench.push([wp.x, wp.y, wp.z]);
+        self.support_wrench.push([ws.x, ws.y, ws.z]);
+        self.pusher_slip.push(pc.slip);
+        self.pusher_contacts.push(pc.touching);
+        self.pusher_sticking.push(pc.sticking);
+        self.residual.push(sol.residuals.max());
+    }
+}
+
+/// The wrenches on the object (object frame) of the pusher's contacts and of the others (the
+/// support's): `Σ J_nᵀ f_n + J_tᵀ f_t` of each side (eq 3.13).
+fn wrenches(prob: &Problem, sol: &Solution) -> (Vec3, Vec3) {
+    let (mut wp, mut ws) = (Vec3::zeros(), Vec3::zeros());
+    for (i, c) in prob.contacts.iter().enumerate() {
+        let f = &c.jn * sol.normal_forces[i] + c.jt.transpose() * &sol.friction_forces[i];
+        let f = Vec3::new(f[0], f[1], f[2]);
+        if c.side == Side::Pusher {
+            wp += f;
+        } else {
+            ws += f;
         }
     }
-    Ok(traj)
+    (wp, ws)
 }
 
 #[cfg(test)]

@@ -8,13 +8,13 @@
 //! pusher touches the object where it is lowest along the plane's normal at each time step
 //! (the contact point moves over the object as it rolls).
 
+use crate::dynamics::mncp::{Contact, Problem, Settings, Side};
+use crate::dynamics::stepping::{march, pusher_at, solve_step, step_count, within_reach, PusherContacts};
 use crate::error::{Error, Result};
 pub use crate::pose::spatial::integrate;
 use crate::pose::spatial::{skew, twist_in};
-use crate::dynamics::planar::MAX_STEPS;
-use crate::dynamics::mncp::{self, Contact, ContactState, FrictionLaw, NormalLaw, Problem, Settings, Side, Solution};
-use crate::scene::spatial::{Scene3, V3};
-use nalgebra::{DMatrix, DVector, Isometry3, Matrix3};
+use crate::scene::spatial::{pose_to_array, Scene3, V3};
+use nalgebra::{DMatrix, DVector, Isometry3, Matrix3, Point3};
 
 /// Two unit tangents completing `n` to an orthonormal frame.
 fn tangents(n: &V3) -> (V3, V3) {
@@ -29,8 +29,17 @@ fn row(r: &V3, d: &V3) -> [f64; 6] {
     [d.x, d.y, d.z, m.x, m.y, m.z]
 }
 
+/// Tangent rows `[row(r, t1); row(r, t2)]` of object point `r`.
+fn tangent_rows(r: &V3, (t1, t2): &(V3, V3)) -> DMatrix<f64> {
+    let mut jt = DMatrix::zeros(2, 6);
+    jt.row_mut(0).copy_from_slice(&row(r, t1));
+    jt.row_mut(1).copy_from_slice(&row(r, t2));
+    jt
+}
+
 /// The problem at pose `pose`, with pusher contacts at object-frame points `points` (gaps
-/// `gaps`, common normal `normal`, friction `mu`), over a step `h`.
+/// `gaps`, common normal `normal`, friction `mu`), over a step `h`: the pads' and the pusher's
+/// contacts, and the quasi-static Newton–Euler terms (eq 3.13).
 pub fn problem(
     scene: &Scene3,
     pose: &Isometry3<f64>,
@@ -38,58 +47,53 @@ pub fn problem(
     h: f64,
     speed: f64,
 ) -> Result<Problem> {
-    let d = 6;
+    let mut contacts = finger_contacts(scene, pose)?;
+    if let Some((mu, points, gaps, normal)) = pusher {
+        let n = normal.normalize();
+        let t = tangents(&n);
+        for (k, (r, g)) in points.iter().zip(gaps).enumerate() {
+            let jn = DVector::from_row_slice(&row(r, &n));
+            contacts.push(Contact::pusher_point(format!("pusher[{k}]"), mu, jn, tangent_rows(r, &t), *g));
+        }
+    }
+    let (mass, wrench) = mass_and_gravity(scene, pose);
+    Ok(Problem {
+        dim: 6,
+        mass: mass / h,
+        wrench,
+        contacts,
+        h,
+        force_scale: 2.0 * scene.grip_force * scene.grip_friction + scene.mass * scene.gravity.norm(),
+        velocity_scale: speed,
+        length: scene.length,
+    })
+}
+
+/// The finger pads' contact points at pose `pose` with equal shares of the grip force (eq 3.5)
+/// and Coulomb discs in the pad plane; an error when a pad does not touch the object.
+fn finger_contacts(scene: &Scene3, pose: &Isometry3<f64>) -> Result<Vec<Contact>> {
     let mut contacts = Vec::new();
-    let pads = scene.pad_contacts(pose);
     let inv_rot = pose.rotation.inverse();
-    for (side, pts) in pads.iter().enumerate() {
+    for (side, pts) in scene.pad_contacts(pose).iter().enumerate() {
         if pts.is_empty() {
             return Err(Error::arg("pose", format!("finger pad {side} does not touch the object")));
         }
         let sign = if side == 0 { 1.0 } else { -1.0 };
         let n = inv_rot * V3::new(0.0, -sign, 0.0);
-        let (t1, t2) = tangents(&n);
+        let t = tangents(&n);
         let share = scene.grip_force / pts.len() as f64;
         for (k, r) in pts.iter().enumerate() {
-            let mut jt = DMatrix::zeros(2, d);
-            jt.row_mut(0).copy_from_slice(&row(r, &t1));
-            jt.row_mut(1).copy_from_slice(&row(r, &t2));
-            contacts.push(Contact {
-                label: format!("finger{side}[{k}]"),
-                side: Side::Finger,
-                normal: NormalLaw::Fixed(share),
-                friction: FrictionLaw::Coulomb(scene.grip_friction),
-                jn: DVector::from_row_slice(&row(r, &n)),
-                jt,
-                jn_other: DVector::zeros(d),
-                jt_other: DMatrix::zeros(2, d),
-                gap: 0.0,
-            });
-        }
-    }
-    if let Some((mu, points, gaps, normal)) = pusher {
-        let n = normal.normalize();
-        let (t1, t2) = tangents(&n);
-        for (k, (r, g)) in points.iter().zip(gaps).enumerate() {
-            let mut jt = DMatrix::zeros(2, d);
-            jt.row_mut(0).copy_from_slice(&row(r, &t1));
-            jt.row_mut(1).copy_from_slice(&row(r, &t2));
             let jn = DVector::from_row_slice(&row(r, &n));
-            contacts.push(Contact {
-                label: format!("pusher[{k}]"),
-                side: Side::Pusher,
-                normal: NormalLaw::Unilateral,
-                friction: FrictionLaw::Coulomb(mu),
-                jn_other: jn.clone(),
-                jt_other: jt.clone(),
-                jn,
-                jt,
-                gap: *g,
-            });
+            contacts.push(Contact::fixed_normal(format!("finger{side}[{k}]"), Side::Finger, share, scene.grip_friction, jn, tangent_rows(r, &t)));
         }
     }
-    // the fingers' normal forces are given: they must not push the object along the grasp axis
-    // on their own (equal and opposite totals), their moments are balanced by the pad frictions
+    Ok(contacts)
+}
+
+/// The mass matrix `M` about the object-frame origin and the gravity wrench, object frame. The
+/// fingers' normal forces are given: they must not push the object along the grasp axis on
+/// their own (equal and opposite totals), their moments are balanced by the pad frictions.
+fn mass_and_gravity(scene: &Scene3, pose: &Isometry3<f64>) -> (DMatrix<f64>, DVector<f64>) {
     let m = scene.mass;
     let c = scene.com;
     let cx = skew(&c);
@@ -98,25 +102,15 @@ pub fn problem(
     mass.view_mut((0, 3), (3, 3)).copy_from(&(-cx * m));
     mass.view_mut((3, 0), (3, 3)).copy_from(&(cx * m));
     mass.view_mut((3, 3), (3, 3)).copy_from(&(scene.inertia - cx * cx * m));
-    let f = inv_rot * (scene.gravity * m);
+    let f = pose.rotation.inverse() * (scene.gravity * m);
     let tq = c.cross(&f);
-    let wrench = DVector::from_row_slice(&[f.x, f.y, f.z, tq.x, tq.y, tq.z]);
-    Ok(Problem {
-        dim: d,
-        mass: mass / h,
-        wrench,
-        contacts,
-        h,
-        force_scale: 2.0 * scene.grip_force * scene.grip_friction + m * scene.gravity.norm(),
-        velocity_scale: speed,
-        length: scene.length,
-    })
+    (mass, DVector::from_row_slice(&[f.x, f.y, f.z, tq.x, tq.y, tq.z]))
 }
 
 /// The problem of pusher `pusher` in contact at pose `pose` (its scene points, or for a plane
 /// the object's lowest points, [`Scene3::pusher_contacts`]).
 pub fn push_problem(scene: &Scene3, pose: &Isometry3<f64>, pusher: usize, h: f64) -> Result<Problem> {
-    let p = scene.pushers.get(pusher).ok_or_else(|| Error::arg("pusher", format!("index {pusher} out of range")))?;
+    let p = pusher_at(&scene.pushers, pusher)?;
     let (points, normal) = scene.pusher_contacts(pusher, pose);
     let gaps = vec![0.0; points.len()];
     problem(scene, pose, Some((p.friction, &points, &gaps, normal)), h, 0.01)
@@ -135,9 +129,10 @@ pub struct Trajectory3 {
 }
 
 /// Simulates a push in 3-D: the pusher starts at its scene points with the object at `start`
-/// and moves with constant body twist `u` (its frame = the object frame at the start). A plane
-/// starts touching the object's lowest points; at each step its contacts are the object's
-/// lowest points along its current normal, with their gaps to it.
+/// and moves with constant body twist `u` (its frame = the object frame at the start), in steps
+/// of `dt` (explicit time stepping, thesis §3.2.3). A plane starts touching the object's lowest
+/// points; at each step its contacts are the object's lowest points along its current normal,
+/// with their gaps to it.
 pub fn simulate_push(
     scene: &Scene3,
     start: &Isometry3<f64>,
@@ -147,101 +142,78 @@ pub fn simulate_push(
     dt: f64,
     settings: &Settings,
 ) -> Result<Trajectory3> {
-    if !(dt > 0.0) || !(duration >= 0.0) || !duration.is_finite() {
-        return Err(Error::arg("dt", "time step and duration must be positive and finite"));
-    }
-    if duration / dt > MAX_STEPS {
-        return Err(Error::arg("dt", format!("{:.0} time steps asked for (duration / dt); at most {MAX_STEPS:.0}", duration / dt)));
-    }
-    let pz = scene.pushers.get(pusher).ok_or_else(|| Error::arg("pusher", format!("index {pusher} out of range")))?;
-    let steps = (duration / dt).round() as usize;
-    let (mut q, mut qp) = (*start, *start);
+    let steps = step_count(duration, dt)?;
+    let pz = pusher_at(&scene.pushers, pusher)?;
     let speed = V3::new(u[0], u[1], u[2]).norm() + V3::new(u[3], u[4], u[5]).norm() * scene.length;
     let reach = 0.002 + 2.0 * dt * speed;
     let mut tr = Trajectory3::default();
     // in the pusher's frame (the object frame at the start): its points (or a point of the
     // plane) and its normal
     let (points0, normal0) = scene.pusher_contacts(pusher, start);
-    for k in 0..=steps {
-        let t = k as f64 * dt;
+    march(steps, dt, *start, u, integrate, |t, q, qp| {
         let rel = q.inverse() * qp;
         let normal = rel.rotation * normal0;
-        let (mut pts, mut gaps) = (Vec::new(), Vec::new());
-        if pz.plane {
-            let on = (rel * nalgebra::Point3::from(points0[0])).coords;
-            for r in scene.plane_contacts(&normal, Some(&on), reach) {
-                let gap = normal.dot(&(r - on));
-                if gap < reach {
-                    pts.push(r);
-                    gaps.push(gap);
-                }
-            }
+        let (pts, gaps) = if pz.plane {
+            let on = (rel * Point3::from(points0[0])).coords;
+            let candidates = scene.plane_contacts(&normal, Some(&on), reach).into_iter().map(|r| (r, normal.dot(&(r - on))));
+            within_reach(candidates, reach)
         } else {
-            for p in &points0 {
-                let r = (rel * nalgebra::Point3::from(*p)).coords;
-                let gap = scene.signed_distance(&r);
-                if gap < reach {
-                    pts.push(r);
-                    gaps.push(gap);
-                }
-            }
-        }
-        let prob = problem(scene, &q, Some((pz.friction, &pts, &gaps, normal)), dt, speed.max(1e-3))?;
-        let uo = twist_in(&rel, u);
-        let sol: Solution = mncp::solve_forward(&prob, &DVector::from_row_slice(&uo), settings)
-            .map_err(|e| Error::arg("push", format!("at t = {t:.3} s: {e}")))?;
+            let candidates = points0.iter().map(|p| (rel * Point3::from(*p)).coords).map(|r| (r, scene.signed_distance(&r)));
+            within_reach(candidates, reach)
+        };
+        let prob = problem(scene, q, Some((pz.friction, &pts, &gaps, normal)), dt, speed.max(1e-3))?;
+        let sol = solve_step(&prob, &twist_in(&rel, u), settings, t)?;
         let v: [f64; 6] = std::array::from_fn(|i| sol.twist[i]);
-        let (mut slip, mut n_contact, mut n_stick) = (0.0f64, 0, 0);
-        for (i, c) in prob.contacts.iter().enumerate() {
-            if c.side == Side::Pusher && sol.states[i] != ContactState::Separate {
-                n_contact += 1;
-                slip = slip.max(sol.tangent_velocities[i].norm());
-                n_stick += (sol.states[i] == ContactState::Stick) as usize;
-            }
-        }
+        let pc = PusherContacts::of(&prob, &sol);
         tr.t.push(t);
-        tr.pose.push(crate::scene::spatial::pose_to_array(&q));
+        tr.pose.push(pose_to_array(q));
         tr.twist.push(v);
-        tr.pusher_slip.push(slip);
-        tr.pusher_contacts.push(n_contact);
-        tr.pusher_sticking.push(n_stick);
+        tr.pusher_slip.push(pc.slip);
+        tr.pusher_contacts.push(pc.touching);
+        tr.pusher_sticking.push(pc.sticking);
         tr.residual.push(sol.residuals.max());
-        if k < steps {
-            q = integrate(&q, &v, dt);
-            qp = integrate(&qp, u, dt);
-        }
-    }
+        Ok(v)
+    })?;
     Ok(tr)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dynamics::mncp;
     use crate::dynamics::planar::{Options, SupportModel};
     use nalgebra::{Translation3, UnitQuaternion};
     use crate::Scene;
 
-    const BLOCK3: &str = r#"
-dimension = 3
-name = "block-3d"
-[object]
-shape = "box"
-size = [0.05, 0.012, 0.08]
-mass = 0.13
-[grasp]
-force = 20.0
-friction = 0.6
-pad_radius = 0.007
-[[pushers]]
-name = "left"
-friction = 0.25
-points = [[-0.025, 0.0, -0.03], [-0.025, 0.0, 0.03]]
-normal = [1.0, 0.0, 0.0]
-[task]
-start = [0, 0, 0, 1, 0, 0, 0]
-goal = [0, 0, 0, 1, 0, 0, 0]
-tolerance = [0.001, 0.001, 0.001, 0.0175]
-"#;
+    /// A 3-D test scene named `name`: the `[object]` table's keys, a grasp `[force, friction, pad
+    /// radius]`, the `[[pushers]]` tables, and a task holding the start within `tol` metres.
+    fn scene3(name: &str, object: &str, [force, friction, pad]: [f64; 3], pushers: &str, tol: f64) -> Scene3 {
+        let toml = format!(
+            "dimension = 3\nname = \"{name}\"\n[object]\n{object}\n\
+             [grasp]\nforce = {force:?}\nfriction = {friction:?}\npad_radius = {pad:?}\n{pushers}\n\
+             [task]\nstart = [0, 0, 0, 1, 0, 0, 0]\ngoal = [0, 0, 0, 1, 0, 0, 0]\ntolerance = [{tol:?}, {tol:?}, {tol:?}, 0.0175]\n"
+        );
+        Scene3::from_toml_str(&toml, None).unwrap()
+    }
+
+    /// The planar example's block as a box, with pushers `pushers`.
+    fn block3(pushers: &str) -> Scene3 {
+        scene3("block-3d", "shape = \"box\"\nsize = [0.05, 0.012, 0.08]\nmass = 0.13", [20.0, 0.6, 0.007], pushers, 0.001)
+    }
+
+    /// A line pusher at the box's left face.
+    const LEFT: &str =
+        "[[pushers]]\nname = \"left\"\nfriction = 0.25\npoints = [[-0.025, 0.0, -0.03], [-0.025, 0.0, 0.03]]\nnormal = [1.0, 0.0, 0.0]";
+
+    /// A plane pusher under the object (normal up) with friction `mu`.
+    fn floor(mu: f64) -> String {
+        format!("[[pushers]]\nname = \"floor\"\nfriction = {mu:?}\nplane = true\nnormal = [0.0, 0.0, 1.0]")
+    }
+
+    /// A ball held by two pads, over a floor.
+    fn ball3() -> Scene3 {
+        scene3("ball", "shape = \"sphere\"\nradius = 0.035\nmass = 0.058", [2.5, 0.5, 0.006], &floor(0.9), 0.002)
+    }
 
     #[test]
     fn box_mass_properties() {
@@ -264,7 +236,7 @@ tolerance = [0.001, 0.001, 0.001, 0.0175]
     /// A planar push of a box in 3-D gives the planar model's answer (same pad points).
     #[test]
     fn planar_case_matches_the_planar_model() {
-        let s3 = Scene3::from_toml_str(BLOCK3, None).unwrap();
+        let s3 = block3(LEFT);
         let s2 = Scene::from_toml_str(include_str!("../../../../examples/block-low-friction.toml")).unwrap();
         let opts = Options { support: SupportModel::Points { rings: 0, points: 8, merge_fingers: false }, ..Options::default() };
         let i2 = s2.pusher_index("left").unwrap();
@@ -287,35 +259,13 @@ tolerance = [0.001, 0.001, 0.001, 0.0175]
 
     #[test]
     fn time_stepping_moves_the_box_with_a_sticking_pusher() {
-        let s3 = Scene3::from_toml_str(BLOCK3, None).unwrap();
+        let s3 = block3(LEFT);
         let tr = simulate_push(&s3, &Isometry3::identity(), 0, &[0.01, 0.0, 0.0, 0.0, 0.0, 0.0], 1.0, 0.1, &Settings::default()).unwrap();
         let last = tr.pose.last().unwrap();
         assert!((last[0] - 0.01).abs() < 1e-6 && last[2].abs() < 1e-6, "{last:?}");
         assert!(tr.residual.iter().all(|r| *r < 1e-6));
         assert!(tr.pusher_sticking.iter().all(|n| *n == 2));
     }
-
-    const BALL3: &str = r#"
-dimension = 3
-name = "ball"
-[object]
-shape = "sphere"
-radius = 0.035
-mass = 0.058
-[grasp]
-force = 2.5
-friction = 0.5
-pad_radius = 0.006
-[[pushers]]
-name = "floor"
-friction = 0.9
-plane = true
-normal = [0.0, 0.0, 1.0]
-[task]
-start = [0, 0, 0, 1, 0, 0, 0]
-goal = [0, 0, 0, 1, 0, 0, 0]
-tolerance = [0.002, 0.002, 0.002, 0.0175]
-"#;
 
     #[test]
     fn icosphere_is_a_closed_convex_sphere() {
@@ -331,16 +281,13 @@ tolerance = [0.002, 0.002, 0.002, 0.0175]
     /// box's face (4 vertices) or edge (2).
     #[test]
     fn planes_touch_the_lowest_points() {
-        let ball = Scene3::from_toml_str(BALL3, None).unwrap();
+        let ball = ball3();
         let q = Isometry3::from_parts(Translation3::new(0.001, 0.0, 0.002), UnitQuaternion::from_scaled_axis(V3::new(0.3, 0.7, -0.2)));
         let (pts, n) = ball.pusher_contacts(0, &q);
         assert_eq!(pts.len(), 1);
         // in the gripper frame: straight below the centre, normal up
         assert!(((q.rotation * pts[0]) - V3::new(0.0, 0.0, -0.035)).norm() < 1e-12 && ((q.rotation * n) - V3::z()).norm() < 1e-12);
-        let boxy = Scene3::from_toml_str(&BLOCK3.replace(
-            "[[pushers]]\nname = \"left\"",
-            "[[pushers]]\nname = \"floor\"\nfriction = 0.5\nplane = true\nnormal = [0.0, 0.0, 1.0]\n[[pushers]]\nname = \"left\"",
-        ), None).unwrap();
+        let boxy = block3(&format!("{}\n{LEFT}", floor(0.5)));
         assert_eq!(boxy.pusher_contacts(0, &Isometry3::identity()).0.len(), 4);
         let tilted = Isometry3::from_parts(Translation3::identity(), UnitQuaternion::from_scaled_axis(V3::new(0.0, 0.3, 0.0)));
         assert_eq!(boxy.pusher_contacts(0, &tilted).0.len(), 2);
@@ -360,7 +307,7 @@ tolerance = [0.002, 0.002, 0.002, 0.0175]
     /// the ball (it is always the lowest point).
     #[test]
     fn a_floor_rolls_the_ball() {
-        let ball = Scene3::from_toml_str(BALL3, None).unwrap();
+        let ball = ball3();
         let q0 = Isometry3::identity();
         let w = 0.2;
         let u = crate::planning::spatial::pusher_motion(&ball, &q0, 0, &[0.0, 0.0, 0.0, 0.0, w, 0.0]);
