@@ -169,10 +169,13 @@ def run_mujoco(steps: int = 4000) -> dict:
     }
 
 
-def _mpc_qp_scipy(scene: Scene, q, steps, targets, speed=0.01, dt=0.1, stage=1.0, terminal=5.0, effort=1e-3):
-    """The MPC's QP (see crates/regrasp-core/src/mpc.rs) solved by scipy's SLSQP: the baseline."""
+def _mpc_qp_scipy(scene: Scene, q, steps, targets, settings: dict):
+    """The MPC's QP (see crates/regrasp-core/src/control/mpc.rs) solved by scipy's SLSQP: the
+    baseline; ``settings`` the MPC's (``_core.mpc_defaults()``)."""
     from scipy.optimize import minimize
 
+    speed, dt = settings["speed"], settings["dt"]
+    stage, terminal, effort = settings["stage_weight"], settings["terminal_weight"], settings["effort_weight"]
     L = scene.length
     ds = speed * dt
     gens = [np.asarray(st["generators"]) for st in steps]
@@ -227,7 +230,7 @@ def run_mpc(reps: int = 200) -> dict:
         steps, _ = m.solve_qp(q, 0)
         knots = np.asarray(m.knots)
         targets = [knots[min(1 + i, len(knots) - 1)] for i in range(len(steps))]
-        t_base = _median_time(lambda: _mpc_qp_scipy(scene, q, steps, targets), 5)
+        t_base = _median_time(lambda: _mpc_qp_scipy(scene, q, steps, targets, _core.mpc_defaults()), 5)
         t = float(np.median(times))
         out[f"mpc_step_{name}"] = {
             "median_s": t, "baseline_median_s": t_base, "ratio": t_base / t,

@@ -256,8 +256,8 @@ class ControlRun:
 
 def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc", pokes=(), start_error=(0.0, 0.0, 0.0),
             perturb: Perturbation = Perturbation(), controller_scene: Scene | None = None, noise: float = 0.0,
-            seed: int = 0, dt: float = 0.1, speed: float = 0.01, horizon: int = 5, max_time: float | None = None,
-            **mpc) -> ControlResult:
+            seed: int = 0, dt: float | None = None, speed: float | None = None, horizon: int | None = None,
+            max_time: float | None = None, **mpc) -> ControlResult:
     """Runs ``plan`` (a ``regrasp.Plan`` or its dict) closed loop (``policy="mpc"``) or open loop
     in ``engine``.
 
@@ -266,7 +266,11 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
     friction, grip force, mass). ``start_error``: the object starts this far from the plan's
     start (the plan was made for a wrong estimate). ``noise``: standard deviation of the pose
     measurement [m, m·(1/L) for θ]. Success: the object's true pose within the task's tolerance.
+    ``dt`` [s], ``speed`` [m/s], ``horizon`` and the other MPC settings default to the core's
+    (``regrasp._core.mpc_defaults()``).
     """
+    d = _core.mpc_defaults()
+    dt, speed, horizon = (d[k] if v is None else v for k, v in (("dt", dt), ("speed", speed), ("horizon", horizon)))
     se = _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error)
     run = ControlRun(scene, plan, engine, policy, pokes, se, perturb, controller_scene, noise, seed, dt, speed, horizon,
                      max_time, mpc)

@@ -12,21 +12,30 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import _core
 from ..errors import ArgumentError
 from ..planning.plan import as_plan
 from ..scene.planar import Scene, _vec
 
-SPEED = 0.01  # m/s, the thesis' pushing speed
+#: The simulator's defaults, stated once in the Rust core (``quasistatic::Options``).
+DEFAULTS = _core.quasistatic_defaults()
+SPEED = DEFAULTS["speed"]  # m/s, the thesis' pushing speed
 
 
-def support_kwargs(support: str = "points", rings: int = 3, points: int = 0, merge_fingers: bool = True) -> dict:
-    if support not in ("points", "limit_surface"):
-        raise ArgumentError(f"invalid `support`: must be 'points' or 'limit_surface', got {support!r}", "support")
-    return dict(support=support, rings=rings, points=points, merge_fingers=merge_fingers)
+def support_kwargs(support: str | None = None, rings: int | None = None, points: int | None = None,
+                   merge_fingers: bool | None = None) -> dict:
+    """The finger support model (defaults: the core's): ``support`` "points" (pads as rings of
+    contact points) or "limit_surface" (each pad one ellipsoidal patch)."""
+    given = dict(support=support, rings=rings, points=points, merge_fingers=merge_fingers)
+    kw = {k: DEFAULTS[k] if v is None else v for k, v in given.items()}
+    if kw["support"] not in ("points", "limit_surface"):
+        raise ArgumentError(f"invalid `support`: must be 'points' or 'limit_surface', got {kw['support']!r}", "support")
+    return kw
 
 
-def problem(scene: Scene, pose, pusher: str | None = None, h: float = 1.0, **support):
-    """The instantaneous complementarity problem (``regrasp._core.MncpProblem``)."""
+def problem(scene: Scene, pose, pusher: str | None = None, h: float | None = None, **support):
+    """The instantaneous complementarity problem (``regrasp._core.MncpProblem``); ``h`` the time
+    step [s] (default: the core's)."""
     kw = support_kwargs(**support)
     return scene._core.quasistatic_problem(list(_vec(pose, 3, "pose")), pusher, kw["support"], kw["rings"],
                                            kw["points"], kw["merge_fingers"], h, SPEED)
