@@ -326,10 +326,9 @@ fn pushers_are_required() {
 #[test]
 fn gravity_direction_must_be_unit() {
     let old = "direction = [0.0, -1.0]";
-    expect_field("norm 2", &edit(old, "direction = [0.0, -2.0]"), "gravity.direction");
-    expect_field("norm 0.5", &edit(old, "direction = [0.3, -0.4]"), "gravity.direction");
-    expect_field("zero", &edit(old, "direction = [0.0, 0.0]"), "gravity.direction");
-    expect_field("NaN", &edit(old, "direction = [nan, -1.0]"), "gravity.direction");
+    for (what, d) in [("norm 2", "[0.0, -2.0]"), ("norm 0.5", "[0.3, -0.4]"), ("zero", "[0.0, 0.0]"), ("NaN", "[nan, -1.0]")] {
+        expect_field(what, &edit(old, &format!("direction = {d}")), "gravity.direction");
+    }
     // a unit vector other than -Z is fine
     Scene::from_toml_str(&edit(old, "direction = [-0.6, -0.8]")).expect("a tilted unit gravity is valid");
 }
@@ -356,9 +355,10 @@ fn goal_with_the_pad_off_the_object_is_rejected() {
 #[test]
 fn tolerance_components_must_be_positive() {
     let old = "tolerance = [0.001, 0.001, 0.0175]";
-    expect_field("zero theta tol", &edit(old, "tolerance = [0.001, 0.001, 0.0]"), "task.tolerance[2]");
-    expect_field("negative x tol", &edit(old, "tolerance = [-0.001, 0.001, 0.0175]"), "task.tolerance[0]");
-    expect_field("zero z tol", &edit(old, "tolerance = [0.001, 0.0, 0.0175]"), "task.tolerance[1]");
+    let cases = [("zero theta tol", "[0.001, 0.001, 0.0]", 2), ("negative x tol", "[-0.001, 0.001, 0.0175]", 0), ("zero z tol", "[0.001, 0.0, 0.0175]", 1)];
+    for (what, tol, k) in cases {
+        expect_field(what, &edit(old, &format!("tolerance = {tol}")), &format!("task.tolerance[{k}]"));
+    }
 }
 
 #[test]
