@@ -18,6 +18,9 @@ from .planning.plan import Plan, plan, planner_defaults
 from .scene import load_scene
 from .scene.planar import Classification, GravityFreeCone, MotionCone, MotionConeBatch, Pusher, Scene, Task
 from .scene.spatial import Scene3D
+from . import _moved
+
+_moved.install()
 
 __all__ = [
     "__version__",
