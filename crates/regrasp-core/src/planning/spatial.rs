@@ -347,6 +347,10 @@ impl Space<7> for SpatialSpace<'_> {
     fn key_slack(&self) -> f64 {
         1.5
     }
+    /// Neighbours by the metric distance of the poses (the key's search radius is 1.5 r).
+    fn within(&self, a: &Isometry3<f64>, b: &Isometry3<f64>, _len: f64, r: f64) -> bool {
+        self.dist(a, b) <= r
+    }
 }
 
 /// Plans a 3-D regrasp from `start` to `goal` (defaults: the scene's task).

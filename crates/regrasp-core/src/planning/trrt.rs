@@ -230,6 +230,11 @@ pub trait Space<const K: usize>: Sync {
     fn key_slack(&self) -> f64 {
         1.0
     }
+    /// Whether `b` is an RRT* neighbour of `a` within radius `r` [m], given the length `len` of
+    /// the motion interpolating them (default: that length).
+    fn within(&self, _a: &Self::Q, _b: &Self::Q, len: f64, r: f64) -> bool {
+        len <= r
+    }
 }
 
 /// The planner's answer: the path (or the best partial path) and statistics.
@@ -403,7 +408,7 @@ impl<'a, S: Space<K>, const K: usize> Search<'a, S, K> {
                 continue;
             }
             let (motion, len) = self.space.interpolate(&self.nodes[k].q, &step.q);
-            if len > r {
+            if !self.space.within(&self.nodes[k].q, &step.q, len, r) {
                 continue;
             }
             for p in pusher_order(self.space.pushers(), self.nodes[k].pusher) {
@@ -432,7 +437,7 @@ impl<'a, S: Space<K>, const K: usize> Search<'a, S, K> {
             }
             let Some(pk) = self.nodes[k].pusher else { continue };
             let (motion, len) = self.space.interpolate(&qi, &self.nodes[k].q);
-            if len > r {
+            if !self.space.within(&qi, &self.nodes[k].q, len, r) {
                 continue;
             }
             let c = self.nodes[i].cost + self.edge_cost(self.nodes[i].pusher, pk, len);
