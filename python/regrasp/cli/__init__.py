@@ -1,6 +1,7 @@
 """Command line: ``regrasp plan | cone | approx-error | validate | simulate | control | push | bench | demo``.
 
-Exit status: 0 success, 1 the task cannot be done (reason printed), 2 invalid input.
+Exit status: 0 success, 1 the task cannot be done (reason printed; also an internal error), 2 invalid
+input, 130 interrupted (Ctrl-C), 141 standard output closed early (e.g. piped into ``head``).
 
 One module per command group: ``cones`` (cone, approx-error), ``planning`` (plan), ``dynamics``
 (validate, simulate, push), ``control`` (control), ``tools`` (bench, demo). Each has
@@ -10,20 +11,36 @@ One module per command group: ``cones`` (cone, approx-error), ``planning`` (plan
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
+from .. import errors
 from ..errors import ArgumentError, RegraspError, SceneError
+from ..files import check_writable, refuse_overwrite_input
 from ..planning.plan import Plan, planner_defaults
 from ..scene import load_scene
 from ..scene.planar import Scene
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 
-#: exit statuses (docs/cli.md)
-OK, CANNOT, INVALID = 0, 1, 2
+#: exit statuses (docs/cli.md): 130 = 128 + SIGINT, 141 = 128 + SIGPIPE (the shell's convention)
+OK, CANNOT, INVALID, INTERRUPTED, BROKEN_PIPE = 0, 1, 2, 130, 141
+
+#: upper bounds of the count options (docs/cli.md): larger values are invalid input, not hours of work
+MAX_PUSHES = 100_000
+MAX_SAMPLES = 10_000_000
+MAX_CONES = 10_000_000
+MAX_WORKERS = 1024
+MAX_HORIZON = 1000
+#: most time steps of one simulated push (`--duration` / `--dt`)
+MAX_STEPS = 1_000_000
+#: suffixes of --plot (matplotlib), of animations (Pillow) and of --video (Pillow, or ffmpeg for MP4)
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff", ".webp")
+ANIMATION_SUFFIXES = (".gif", ".webp", ".png", ".tif", ".tiff")
+VIDEO_SUFFIXES = ANIMATION_SUFFIXES + (".mp4",)
 
 
 # --- arguments ---------------------------------------------------------------------------------
@@ -37,6 +54,50 @@ def seed_arg(text: str) -> int:
     if not 0 <= v < 2**64:
         raise argparse.ArgumentTypeError(f"a whole number >= 0 (got {text!r})")
     return v
+
+
+def check_count(a, name: str, lo: int, hi: int) -> None:
+    """Whole-number option ``name`` (attribute), when given, within [lo, hi]."""
+    v = getattr(a, name, None)
+    opt = option(name)
+    if v is not None and not lo <= v <= hi:
+        raise ArgumentError(f"invalid `{opt}`: a whole number in [{lo}, {hi}] (got {v})", opt)
+
+
+def check_number(a, name: str, lo: float, hi: float = float("inf"), what: str = "number",
+                 lo_open: bool = False, finite: bool = True) -> None:
+    """Number option ``name`` (attribute), when given: not NaN, finite (unless ``finite`` is
+    False: then +inf is allowed), within [lo, hi] (lo excluded with ``lo_open``)."""
+    v = getattr(a, name, None)
+    if v is None:
+        return
+    opt = option(name)
+    ok = v == v and (np.isfinite(v) or (not finite and v > 0)) and (v > lo if lo_open else v >= lo) and v <= hi
+    if not ok:
+        lo_text = f"> {lo}" if lo_open else f">= {lo}"
+        hi_text = "" if hi == float("inf") else f" and <= {hi}"
+        raise ArgumentError(f"invalid `{opt}`: must be a {'' if finite else 'non-NaN '}{what} {lo_text}{hi_text} "
+                            f"(got {v})", opt)
+
+
+def option(name: str) -> str:
+    """The option of attribute ``name``: ``time_limit`` -> ``--time-limit`` (one letter: ``-n``)."""
+    return ("-" if len(name) == 1 else "--") + name.replace("_", "-")
+
+
+def check_outputs(a, outputs: dict, inputs=(), create_folder: bool = True) -> None:
+    """The output options ``{attribute: suffixes or None}`` given: writable (before the work),
+    not an input file, not one another, with a suffix of ``suffixes``."""
+    paths = {option(k): getattr(a, k, None) for k in outputs}
+    refuse_overwrite_input(paths, inputs)
+    for k, suffixes in outputs.items():
+        v = getattr(a, k, None)
+        if v is None:
+            continue
+        if suffixes and Path(v).suffix.lower() not in suffixes:
+            raise ArgumentError(f"invalid `{option(k)}`: cannot write {v}: the name must end in one of "
+                                f"{', '.join(suffixes)}", option(k))
+        check_writable(v, option(k), create_folder=create_folder)
 
 
 def floats(text: str, n: int, name: str) -> np.ndarray:
@@ -101,9 +162,19 @@ def reject_flags(a, flags, why: str) -> None:
 
 # --- scenes and plans --------------------------------------------------------------------------
 
-def load_planar(path, cmd: str) -> Scene:
-    """A planar scene for commands that have no 3-D counterpart (a clear error for a 3-D one)."""
+def load(path, a=None):
+    """The scene file ``path`` (planar or 3-D); with ``--verbose`` its notes (e.g. pusher points
+    snapped onto the outline) are printed on stderr."""
     scene = load_scene(path)
+    if getattr(a, "verbose", False):
+        for note in getattr(scene, "notes", None) or []:
+            print(f"regrasp: {path}: {note}", file=sys.stderr)
+    return scene
+
+
+def load_planar(path, cmd: str, a=None) -> Scene:
+    """A planar scene for commands that have no 3-D counterpart (a clear error for a 3-D one)."""
+    scene = load(path, a)
     if scene.dimension == 3:
         raise ArgumentError(f"invalid `scene`: `regrasp {cmd}` works on planar scenes; {path} is a 3-D scene "
                             "(3-D scenes: plan, simulate, push, control)", "scene")
@@ -148,33 +219,91 @@ def execute3d(scene, plan: Plan, a, **kw) -> dict:
 
 # --- the command -------------------------------------------------------------------------------
 
+def add_verbose(p) -> None:
+    """-v/--verbose of a command that loads scenes (a subcommand's default does not override the
+    global option's)."""
+    p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS,
+                   help="print the scene's notes (e.g. pusher points snapped onto the outline) on stderr")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from . import cones, control, dynamics, planning, tools
 
     ap = argparse.ArgumentParser(prog="regrasp", description=__doc__.splitlines()[0])
+    ap.add_argument("-v", "--verbose", action="store_true", help="print the scenes' notes on stderr")
     sub = ap.add_subparsers(dest="cmd", required=True)
     for group in (planning, cones, dynamics, control, tools):
         group.add_parsers(sub)
     return ap
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+def _internal(e: BaseException) -> str:
+    return f"internal error (please report): {type(e).__name__}: {e}"
+
+
+def _run(args) -> tuple[int, str | None]:
+    """Runs the command: (exit status, message for stderr or None)."""
+    internal = getattr(errors, "InternalError", ())
     try:
-        return args.fn(args)
+        return args.fn(args), None
     except (SceneError, ArgumentError) as e:
-        status = INVALID
-        message = str(e)
+        return INVALID, str(e)
+    except internal as e:  # a caught panic of the Rust core
+        return CANNOT, _internal(e)
     except RegraspError as e:  # GraspError and the rest: the task cannot be done
-        status = CANNOT
-        message = str(e)
-    except OSError as e:  # a file that cannot be read or written (e.g. --plot into a missing folder)
+        return CANNOT, str(e)
+    except (KeyboardInterrupt, BrokenPipeError):
+        raise
+    except OSError as e:  # a file that cannot be read or written
         if e.filename is None:
-            raise
-        status = INVALID
-        message = f"cannot write or read {e.filename}: {e.strerror or e}"
-    print(f"regrasp: {message}", file=sys.stderr)
-    return status
+            return _unexpected(e)
+        return INVALID, f"cannot write or read {e.filename}: {e.strerror or e}"
+    except Exception as e:
+        return _unexpected(e)
+
+
+def _unexpected(e: Exception) -> tuple[int, str]:
+    """Any other exception: a one-line internal error (exit 1); REGRASP_TRACEBACK=1 re-raises it."""
+    if os.environ.get("REGRASP_TRACEBACK"):
+        raise e
+    return CANNOT, _internal(e)
+
+
+def _quiet_stdout() -> None:
+    """Standard output was closed (``| head``): point it at /dev/null so that the interpreter's
+    last flush does not fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+def _say(message: str) -> None:
+    try:
+        print(f"regrasp: {message}", file=sys.stderr)
+    except (OSError, ValueError):  # stderr closed too
+        pass
+
+
+def main(argv=None) -> int:
+    """The `regrasp` command; returns its exit status (docs/cli.md). Ctrl-C: 130, after
+    "regrasp: interrupted" (outputs are written atomically: nothing half-done is left); a closed
+    standard output (``| head``): 141, quietly."""
+    try:
+        args = build_parser().parse_args(argv)
+        status, message = _run(args)
+        if message is not None:
+            _say(message)
+        sys.stdout.flush()
+        return status
+    except KeyboardInterrupt:
+        _say("interrupted")
+        return INTERRUPTED
+    except BrokenPipeError:
+        _quiet_stdout()
+        return BROKEN_PIPE
 
 
 if __name__ == "__main__":

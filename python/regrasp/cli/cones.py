@@ -10,7 +10,8 @@ import numpy as np
 from ..errors import ArgumentError, GraspError
 from ..scene.common import is_3d_text, read_scene_file
 from ..scene.planar import Scene
-from . import CANNOT, EXAMPLES, OK, floats, load_planar, seed_arg
+from . import (CANNOT, EXAMPLES, FIGURE_SUFFIXES, MAX_SAMPLES, OK, add_verbose, check_count, check_outputs, floats,
+               load_planar, seed_arg)
 
 
 def _json_float(x):
@@ -75,7 +76,8 @@ def _print_cone(scene: Scene, rep: dict, plot) -> None:
 
 
 def cmd_cone(a) -> int:
-    scene = load_planar(a.scene, "cone")
+    check_outputs(a, {"plot": FIGURE_SUFFIXES}, [a.scene])
+    scene = load_planar(a.scene, "cone", a)
     pose = floats(a.pose, 3, "--pose")
     twist = None if a.twist is None else floats(a.twist, 3, "--twist")
     try:
@@ -102,12 +104,11 @@ def _bundled_planar_examples() -> list:
 def cmd_approx_error(a) -> int:
     from ..reference.approx_error import approximation_report, format_report
 
-    scenes = [load_planar(p, "approx-error") for p in a.scenes or _bundled_planar_examples()]
+    check_count(a, "samples", 1, MAX_SAMPLES)
     forces = floats(a.forces, len(a.forces.split(",")), "--forces")
-    if a.samples < 1:
-        raise ArgumentError(f"invalid `--samples`: must be at least 1 (got {a.samples})", "--samples")
     if (forces <= 0).any():
         raise ArgumentError("invalid `--forces`: grip forces must be positive", "--forces")
+    scenes = [load_planar(p, "approx-error", a) for p in a.scenes or _bundled_planar_examples()]
     skipped = [s.name for s in scenes if s.kind != "grasp"]
     if skipped and not a.json:
         print(f"(skipped {', '.join(skipped)}: no grasp, so no grip force to vary)", file=sys.stderr)
@@ -124,12 +125,14 @@ def add_parsers(sub) -> None:
     c.add_argument("--twist", help="vx,vz,omega for min_grip_force (default: the central gravity-free twist)")
     c.add_argument("--json", action="store_true")
     c.add_argument("--plot", metavar="PNG")
+    add_verbose(c)
     c.set_defaults(fn=cmd_cone)
 
     e = sub.add_parser("approx-error", help="polyhedral approximation vs exact cone, per scene and grip force")
     e.add_argument("scenes", nargs="*", help="scene files (default: every bundled example)")
     e.add_argument("--forces", default="5,20,80", help="grip forces per finger, N")
-    e.add_argument("--samples", type=int, default=20000)
+    e.add_argument("--samples", type=int, default=20000, help=f"random pushes per row, 1 to {MAX_SAMPLES}")
     e.add_argument("--seed", type=seed_arg, default=0)
     e.add_argument("--json", action="store_true")
+    add_verbose(e)
     e.set_defaults(fn=cmd_approx_error)

@@ -8,9 +8,9 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..planning.plan import Plan
-from ..scene import load_scene
-from . import (CANNOT, OK, SCALES, add_scale_options, check_positive, execute3d, floats, given, mode_scene,
-               reject_flags, scales, seed_arg)
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_scale_options, add_verbose, check_count,
+               check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, reject_flags,
+               scales, seed_arg)
 
 #: options of the planar MPC, without meaning for 3-D control
 PLANAR_ONLY = ("poke", "start_error", "robust", "uncertainty", "fixtureless", "plot", "dt", "horizon", "noise")
@@ -35,11 +35,9 @@ def _control3d(scene, plan: Plan, a) -> int:
 
 
 def _check_mpc_options(a) -> None:
-    if a.horizon is not None and a.horizon < 1:
-        raise ArgumentError(f"invalid `--horizon`: must be at least 1 step (got {a.horizon})", "--horizon")
+    check_count(a, "horizon", 1, MAX_HORIZON)
     check_positive(a, "dt", "control period [s]")
-    if a.noise is not None and not (a.noise >= 0 and np.isfinite(a.noise)):
-        raise ArgumentError("invalid `--noise`: must be a non-negative standard deviation", "--noise")
+    check_number(a, "noise", 0.0, what="standard deviation")
 
 
 def cmd_control(a) -> int:
@@ -47,7 +45,8 @@ def cmd_control(a) -> int:
     from ..mujoco.planar import Perturbation
 
     scales(a)
-    scene = load_scene(a.scene)
+    check_outputs(a, {"plot": FIGURE_SUFFIXES}, [a.scene, a.plan])
+    scene = load(a.scene, a)
     plan = Plan.load(a.plan, scene)
     if scene.dimension == 3:
         return _control3d(scene, plan, a)
@@ -91,4 +90,5 @@ def add_parsers(sub) -> None:
     k.add_argument("--seed", type=seed_arg, default=0)
     k.add_argument("--plot", metavar="PNG", help="planned against executed poses, pokes marked")
     k.add_argument("--json", action="store_true")
+    add_verbose(k)
     k.set_defaults(fn=cmd_control)

@@ -7,18 +7,20 @@ import json
 import numpy as np
 
 from ..errors import ArgumentError
+from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
-from ..scene import load_scene
-from . import CANNOT, OK, add_scale_options, check_positive, execute3d, floats, given, load_planar, reject_flags, scales, seed_arg
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, VIDEO_SUFFIXES, add_scale_options,
+               add_verbose, check_count, check_number, check_outputs, check_positive, execute3d, floats, given, load,
+               load_planar, reject_flags, scales, seed_arg)
 
 
 def cmd_validate(a) -> int:
     from ..sim.validation import format_validation, validate
 
-    scene = load_planar(a.scene, "validate")
+    check_count(a, "pushes", 1, MAX_PUSHES)
+    check_count(a, "workers", 1, MAX_WORKERS)
+    scene = load_planar(a.scene, "validate", a)
     engines = tuple(e.strip() for e in a.engines.split(",") if e.strip())
-    if a.workers is not None and a.workers < 1:
-        raise ArgumentError("invalid `--workers`: must be at least 1", "--workers")
     res = validate(scene, a.pushes, a.seed, engines=engines, support=a.support, workers=a.workers,
                    ray_address=a.ray, progress=not a.json and a.pushes >= 500)
     print(json.dumps(res) if a.json else format_validation(res))
@@ -46,15 +48,9 @@ def _replay_planar(scene, plan: Plan, a):
         return replay_plan(scene, plan, **given(a, "dt"))
     from ..mujoco.planar import Perturbation, execute_plan
 
-    if a.perturb is not None and not (0 <= a.perturb < 1):
-        raise ArgumentError("invalid `--perturb`: a spread in [0, 1)", "--perturb")
     base = Perturbation(*scales(a))
     pert = Perturbation.draw(a.perturb, np.random.default_rng(a.seed), base) if a.perturb else base
     rep = execute_plan(scene, plan, pert)
-    if a.video:
-        from ..mujoco.planar import animate_execution
-
-        animate_execution(scene, rep, a.video)
     return rep
 
 
@@ -66,18 +62,41 @@ def _print_replay(scene, rep) -> None:
           f"{'success' if rep.success else 'outside the tolerance'}; largest pusher slip {1e3 * rep.max_pusher_slip:.3f} mm")
 
 
-def cmd_simulate(a) -> int:
+def _check_simulate(a) -> None:
+    """The options of `regrasp simulate`, before any work."""
     scales(a)
     check_positive(a, "dt", "time step [s]")
-    scene = load_scene(a.scene)
+    if a.perturb is not None and not (0 <= a.perturb < 1):
+        raise ArgumentError("invalid `--perturb`: a spread in [0, 1)", "--perturb")
+    check_outputs(a, {"plot": FIGURE_SUFFIXES, "video": VIDEO_SUFFIXES}, [a.scene, a.plan])
+    if a.video and a.video.lower().endswith(".mp4"):
+        import matplotlib.animation
+
+        if not matplotlib.animation.writers.is_available("ffmpeg"):
+            raise ArgumentError("invalid `--video`: MP4 needs ffmpeg, which is not installed; use a .gif", "--video")
+
+
+def _write_figures(scene, rep, a) -> None:
+    """--video (MuJoCo) and --plot of a planar replay, all or none."""
+    with Outputs() as outs:
+        if a.video and a.engine == "mujoco":
+            from ..mujoco.planar import animate_execution
+
+            outs.write(a.video, lambda tmp: animate_execution(scene, rep, tmp))
+        if a.plot:
+            from ..viz.plotting import plot_replay
+
+            outs.write(a.plot, lambda tmp: plot_replay(scene, rep, tmp))
+
+
+def cmd_simulate(a) -> int:
+    _check_simulate(a)
+    scene = load(a.scene, a)
     plan = Plan.load(a.plan, scene)
     if scene.dimension == 3:
         return _simulate3d(scene, plan, a)
     rep = _replay_planar(scene, plan, a)
-    if a.plot:
-        from ..viz.plotting import plot_replay
-
-        plot_replay(scene, rep, a.plot)
+    _write_figures(scene, rep, a)
     if a.json:
         print(json.dumps(rep.to_json()))
     else:
@@ -108,8 +127,19 @@ def _push_report(scene, a, twist, tr: dict) -> int:
     return OK
 
 
+def _check_push(a) -> None:
+    """--duration, --dt (positive, at most MAX_STEPS steps) and --plot, before any work."""
+    check_number(a, "duration", 0.0, what="duration [s]", lo_open=True)
+    check_number(a, "dt", 0.0, what="time step [s]", lo_open=True)
+    if a.duration / a.dt > MAX_STEPS:
+        raise ArgumentError(f"invalid `--dt`: --duration / --dt is at most {MAX_STEPS} steps "
+                            f"(got {a.duration / a.dt:.3g})", "--dt")
+    check_outputs(a, {"plot": FIGURE_SUFFIXES}, [a.scene])
+
+
 def cmd_push(a) -> int:
-    scene = load_scene(a.scene)
+    _check_push(a)
+    scene = load(a.scene, a)
     pose = floats(a.pose, POSE_SIZE[scene.dimension], "--pose")
     twist = floats(a.twist, 6 if scene.dimension == 3 else 3, "--twist")
     if scene.dimension == 3:
@@ -128,14 +158,15 @@ def cmd_push(a) -> int:
 def add_parsers(sub) -> None:
     v = sub.add_parser("validate", help="motion-cone predictions against the simulators")
     v.add_argument("scene")
-    v.add_argument("--pushes", type=int, default=2000)
+    v.add_argument("--pushes", type=int, default=2000, help=f"random pushes, 1 to {MAX_PUSHES}")
     v.add_argument("--engines", default="quasistatic", help="comma-separated: quasistatic,mujoco")
     v.add_argument("--seed", type=seed_arg, default=0)
-    v.add_argument("--workers", type=int, help="local processes for MuJoCo (default: all cores)")
+    v.add_argument("--workers", type=int, help=f"local processes for MuJoCo, 1 to {MAX_WORKERS} (default: all cores)")
     v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
     v.add_argument("--support", default="points", choices=["points", "limit_surface"],
                    help="quasi-static pads as point sets (default) or as the motion cones' limit surface")
     v.add_argument("--json", action="store_true")
+    add_verbose(v)
     v.set_defaults(fn=cmd_validate)
 
     s = sub.add_parser("simulate", help="replay a plan in a simulator")
@@ -150,6 +181,7 @@ def add_parsers(sub) -> None:
     s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo: an animation of the execution")
     s.add_argument("--plot", metavar="PNG")
     s.add_argument("--json", action="store_true")
+    add_verbose(s)
     s.set_defaults(fn=cmd_simulate)
 
     p = sub.add_parser("push", help="simulate one push and plot object motion and contact forces")
@@ -162,4 +194,5 @@ def add_parsers(sub) -> None:
     p.add_argument("--dt", type=float, default=0.02)
     p.add_argument("--plot", metavar="PNG")
     p.add_argument("--json", action="store_true")
+    add_verbose(p)
     p.set_defaults(fn=cmd_push)

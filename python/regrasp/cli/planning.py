@@ -4,11 +4,16 @@ from __future__ import annotations
 
 import json
 import sys
+from pathlib import Path
 
 from ..errors import ArgumentError
-from ..planning.plan import POSE_SIZE, Plan, same_file, plan
-from ..scene import load_scene
-from . import CANNOT, OK, floats, mode_scene, planner_default, pusher_runs, reject_flags, seed_arg
+from ..files import Outputs
+from ..planning.plan import POSE_SIZE, Plan, plan
+from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_verbose, check_number, check_outputs, floats, load,
+               mode_scene, planner_default, pusher_runs, reject_flags, seed_arg)
+
+#: the output options of `regrasp plan` and the file-name suffixes they take (None: any)
+OUTPUTS = {"out": None, "partial_out": None, "plot": FIGURE_SUFFIXES, "animate": ANIMATION_SUFFIXES, "html": None}
 
 PLANAR_ONLY = ("robust", "fixtureless", "uncertainty", "propagation", "plot", "animate")
 
@@ -16,7 +21,7 @@ PLANAR_ONLY = ("robust", "fixtureless", "uncertainty", "propagation", "plot", "a
 def _scene_for(a):
     """The scene to plan on: a 3-D scene as it is (no planar-only flags), a planar one in the
     cone mode of the flags."""
-    scene = load_scene(a.scene)
+    scene = load(a.scene, a)
     if scene.dimension == 3:
         reject_flags(a, PLANAR_ONLY, "it plans with the inverse dynamics only; use --html for a view")
         return scene
@@ -35,20 +40,45 @@ def _endpoints(scene, a):
     return start, goal
 
 
-def _figures(scene, p: Plan, a) -> None:
-    """--plot, --animate (planar) and --html (3-D)."""
+def _figure_writers(scene, p: Plan, a) -> list:
+    """(option, path, write_fn) of --plot, --animate (planar) and --html (3-D) given."""
+    out = []
     if a.plot:
         from ..viz.plotting import plot_plan
 
-        plot_plan(scene, p, a.plot)
+        out.append(("--plot", a.plot, lambda tmp: plot_plan(scene, p, tmp)))
     if a.animate:
         from ..viz.plotting import animate_plan
 
-        animate_plan(scene, p, a.animate)
+        out.append(("--animate", a.animate, lambda tmp: animate_plan(scene, p, tmp)))
     if a.html:
         from ..viz.viewer import write_html
 
-        write_html(scene, p, a.html)
+        out.append(("--html", a.html, lambda tmp: write_html(scene, p, tmp)))
+    return out
+
+
+def _write_outputs(scene, p: Plan, a) -> list[str]:
+    """Writes the outputs asked for, all or none (each atomically). A plan found: --out and the
+    figures. None found: the best partial plan to --partial-out, else to --out when that file does
+    not exist yet; figures only where no file exists yet (an existing output is left untouched).
+    Returns what to say on stderr about the outputs of a partial plan."""
+    plan_file = a.out if p.found else (a.partial_out or a.out)
+    writers = ([("--partial-out" if plan_file == a.partial_out and not p.found else "--out", plan_file,
+                 lambda tmp: p.save(tmp))] if plan_file else []) + _figure_writers(scene, p, a)
+    said = []
+    with Outputs() as outs:
+        for opt, path, write in writers:
+            if not p.found and opt != "--partial-out" and Path(path).exists():
+                said.append(f"{path} (`{opt}`) left unchanged: no plan found"
+                            + ("; --partial-out PATH writes the best partial plan" if opt == "--out" else ""))
+                continue
+            Path(path).parent.mkdir(parents=True, exist_ok=True)
+            outs.write(path, write)
+            if not p.found:
+                what = "plan" if opt in ("--out", "--partial-out") else "plan's figure"
+                said.append(f"wrote the best partial {what} to {path} (`{opt}`)")
+    return said
 
 
 def summary(scene, p: Plan) -> str:
@@ -69,19 +99,19 @@ def summary(scene, p: Plan) -> str:
 
 
 def cmd_plan(a) -> int:
+    check_number(a, "time_limit", 0.0, what="planning budget [s]", finite=False)
+    check_outputs(a, OUTPUTS, [a.scene])
     scene = _scene_for(a)
-    if a.out and same_file(a.out, a.scene):
-        raise ArgumentError(f"invalid `--out`: {a.out} is the scene file", "--out")
     start, goal = _endpoints(scene, a)
     settings = {k: v for k, v in (("seed", a.seed), ("time_limit", a.time_limit), ("propagation", a.propagation))
                 if v is not None}
     p = plan(scene, start, goal, **settings)
-    if a.out:
-        p.save(a.out)
-    _figures(scene, p, a)
+    said = _write_outputs(scene, p, a)
     print(json.dumps(p.to_json()) if a.json else summary(scene, p))
     if not p.found:
         print(f"regrasp: no plan found: {p.stop_reason}", file=sys.stderr)
+        for line in said:
+            print(f"regrasp: {line}", file=sys.stderr)
         return CANNOT
     return OK
 
@@ -89,9 +119,13 @@ def cmd_plan(a) -> int:
 def add_parsers(sub) -> None:
     pl = sub.add_parser("plan", help="plan a regrasp (T-RRT* with motion-cone propagation)")
     pl.add_argument("scene")
-    pl.add_argument("--out", metavar="PLAN.json")
+    pl.add_argument("--out", metavar="PLAN.json",
+                    help="write the plan file here (no plan found: the best partial plan, unless the file exists)")
+    pl.add_argument("--partial-out", metavar="PLAN.json",
+                    help="when no plan is found, write the best partial plan here (--out is then left alone)")
     pl.add_argument("--seed", type=seed_arg, help=f"random seed, a whole number >= 0 ({planner_default('seed')})")
-    pl.add_argument("--time-limit", type=float, help=f"planning budget [s] ({planner_default('time_limit')})")
+    pl.add_argument("--time-limit", type=float,
+                    help=f"planning budget [s], inf for none ({planner_default('time_limit')})")
     pl.add_argument("--propagation", choices=["motion_cone", "stable_check", "mncp"],
                     help=f"planar only: how steps are made ({planner_default('propagation')})")
     pl.add_argument("--start", help="x,z,theta; 3-D: x,y,z,qw,qx,qy,qz (default: the scene's task)")
@@ -106,4 +140,5 @@ def add_parsers(sub) -> None:
     pl.add_argument("--fixtureless", action="store_true",
                     help="plan only with fixtureless-fixturing pushes (invariant to mass, grip force, finger friction)")
     pl.add_argument("--html", metavar="HTML", help="3-D scenes: an interactive 3-D view of the plan (self-contained page)")
+    add_verbose(pl)
     pl.set_defaults(fn=cmd_plan)

@@ -8,12 +8,14 @@ from pathlib import Path
 import numpy as np
 
 from ..scene.planar import Scene
-from . import CANNOT, EXAMPLES, OK, given, planner_default, pusher_runs, seed_arg
+from ..files import Outputs, check_writable
+from . import CANNOT, EXAMPLES, MAX_CONES, OK, check_count, given, planner_default, pusher_runs, seed_arg
 
 
 def cmd_bench(a) -> int:
     from ..bench import format_results, run
 
+    check_count(a, "n", 1, MAX_CONES)
     n = 10_000 if a.quick else a.n
     res = run(n=n, reps=5 if a.quick else 11, baseline_reps=1 if a.quick else 3)
     print(json.dumps(res) if a.json else format_results(res))
@@ -26,27 +28,28 @@ def cmd_demo(a) -> int:
     from ..viz.plotting import animate_plan, plot_motion_cone, plot_plan, plot_replay
 
     out = Path(a.out)
-    out.mkdir(parents=True, exist_ok=True)
+    check_writable(out / "t-shape-plan.json", "--out", create_folder=True)
     path = EXAMPLES / "t-shape.toml"
     scene = Scene.load(path)
     t = scene.task
     print(f"demo: regrasp of the T-shaped object ({path.name}) from {t.start.tolist()} to {t.goal.tolist()}")
     p = plan(scene, **given(a, "seed"))
-    p.save(out / "t-shape-plan.json")
-    plot_plan(scene, p, out / "t-shape-plan.png")
-    animate_plan(scene, p, out / "t-shape-plan.gif")
     print(f"  {'plan found' if p.found else 'NO plan found'} in {1e3 * p.planning_time_s:.2f} ms: {len(p.poses) - 1} steps, "
           f"{p.switch_overs} switch-overs ({pusher_runs(p.pushers)})")
     print(f"  every step sticks along its length by the exact motion-cone test: {p.valid}")
-    # the motion cones the first push relies on
+    # the motion cones the first push relies on, and the plan replayed in the quasi-static simulator
     first = p.pushers[1] if len(p.pushers) > 1 else scene.pusher_names[0]
-    plot_motion_cone(scene.motion_cone(t.start, first), out / f"cone-{first}.png")
-    # and the plan replayed in the quasi-static simulator
     rep = replay_plan(scene, p)
-    plot_replay(scene, rep, out / "t-shape-replay.png")
     print(f"  replayed in the quasi-static simulator: final pose {np.round(rep.final_pose, 4).tolist()}, "
           f"error {np.round(1e3 * rep.goal_error[:2], 2).tolist()} mm / {np.degrees(rep.goal_error[2]):.2f} deg, "
           f"{'within' if rep.success else 'outside'} the tolerance")
+    out.mkdir(parents=True, exist_ok=True)
+    with Outputs() as outs:  # all or none
+        outs.write(out / "t-shape-plan.json", lambda tmp: p.save(tmp))
+        outs.write(out / "t-shape-plan.png", lambda tmp: plot_plan(scene, p, tmp))
+        outs.write(out / "t-shape-plan.gif", lambda tmp: animate_plan(scene, p, tmp))
+        outs.write(out / f"cone-{first}.png", lambda tmp: plot_motion_cone(scene.motion_cone(t.start, first), tmp))
+        outs.write(out / "t-shape-replay.png", lambda tmp: plot_replay(scene, rep, tmp))
     print(f"wrote {out}/t-shape-plan.json, t-shape-plan.png, t-shape-plan.gif, t-shape-replay.png, cone-{first}.png")
     return OK if p.found else CANNOT
 
@@ -55,7 +58,7 @@ def add_parsers(sub) -> None:
     b = sub.add_parser("bench", help="speed probe against numpy baselines")
     b.add_argument("--json", action="store_true")
     b.add_argument("--quick", action="store_true", help="10,000 cones instead of 100,000")
-    b.add_argument("-n", type=int, default=100_000)
+    b.add_argument("-n", type=int, default=100_000, help=f"cones per batch, 1 to {MAX_CONES}")
     b.set_defaults(fn=cmd_bench)
 
     d = sub.add_parser("demo", help="the bundled example end to end, writing its figures")

@@ -258,7 +258,7 @@ def animate_execution(scene: Scene, rep: Replay, path, fps: int = 20, every: int
     from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
     from matplotlib.patches import Circle, Polygon
 
-    from ..viz.plotting import _object_at, animation_axes
+    from ..viz.plotting import _object_at, animation_axes, save_animation
 
     idx = list(range(0, len(rep.t), every))
     fig, ax = animation_axes(scene, [rep.poses[i] for i in idx])
@@ -283,11 +283,10 @@ def animate_execution(scene: Scene, rep: Replay, path, fps: int = 20, every: int
         if not matplotlib.animation.writers.is_available("ffmpeg"):
             plt.close(fig)
             raise ArgumentError("invalid `--video`: MP4 needs ffmpeg, which is not installed; use a .gif", "--video")
-        anim.save(path, writer=FFMpegWriter(fps=fps))
+        writer = FFMpegWriter(fps=fps)
     else:
-        anim.save(path, writer=PillowWriter(fps=fps))
-    plt.close(fig)
-    return path
+        writer = PillowWriter(fps=fps)
+    return save_animation(anim, fig, path, writer)
 
 
 class WorldRig(GripperRig):

@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import json
 import numbers
-import os
-import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional
@@ -20,6 +18,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import ArgumentError, check_seed
+from ..files import same_file as _same_file, write_text
 
 #: the keys of a plan file, in the order they are written (docs/plan-file.md), by dimension
 KEYS = {
@@ -244,6 +243,11 @@ class Plan:
             raise ArgumentError(f"invalid `plan`: cannot read {p}: {e}", "plan") from e
         except ValueError as e:
             raise ArgumentError(f"invalid `plan`: {p} is not JSON: {e}", "plan") from e
+        except RecursionError as e:
+            raise ArgumentError(f"invalid `plan`: {p} is nested too deeply", "plan") from e
+        if not isinstance(d, dict):
+            raise ArgumentError(f"invalid `plan`: {p} is not a plan file: a JSON object with a `path` "
+                                f"(got a JSON {_json_type(d)})", "plan")
         return cls.from_json(d, scene)
 
     def check_for(self, scene, name: str = "plan") -> None:
@@ -282,17 +286,17 @@ class Plan:
         if self.scene_file is not None and same_file(p, self.scene_file):
             raise ArgumentError(f"invalid `path`: {p} is the scene file the plan was made from (not overwritten)", "path")
         text = json.dumps(self.to_json(), indent=1, allow_nan=False)
-        tmp = p.with_name(f".{p.name}.{uuid.uuid4().hex[:12]}.tmp")
         try:
-            with open(tmp, "x") as f:
-                f.write(text)
-                f.flush()
-                os.fsync(f.fileno())
-            os.replace(tmp, p)
+            write_text(p, text)
         except OSError as e:
-            tmp.unlink(missing_ok=True)
             raise ArgumentError(f"invalid `path`: cannot write {p}: {e.strerror or e}", "path") from e
         return p
+
+
+def _json_type(v) -> str:
+    """The JSON type name of a parsed value."""
+    names = {list: "array", str: "string", bool: "boolean", int: "number", float: "number", type(None): "null"}
+    return names.get(type(v), type(v).__name__)
 
 
 def _plain(v):
@@ -303,10 +307,8 @@ def _plain(v):
 
 
 def same_file(a: Path, b: Path) -> bool:
-    try:
-        return os.path.samefile(a, b)
-    except OSError:  # either does not exist
-        return False
+    """Whether ``a`` and ``b`` name one file (see :func:`regrasp.files.same_file`)."""
+    return _same_file(a, b)
 
 
 def as_plan(plan, scene=None, name: str = "plan") -> Plan:

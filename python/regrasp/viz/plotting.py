@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import atomic_write
 from ..planning.plan import as_plan
 from ..scene.planar import MotionCone
 
@@ -249,8 +250,24 @@ def _save(fig, path) -> Path:
     fig.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    fmt = path.suffix[1:].lower() or "png"
+    try:
+        atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110, format=fmt))
+    finally:
+        plt.close(fig)
+    return path
+
+
+def save_animation(anim, fig, path, writer) -> Path:
+    """Writes an animation atomically with ``writer`` (creating the folder) and closes its figure."""
+    import matplotlib.pyplot as plt
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        atomic_write(path, lambda tmp: anim.save(str(tmp), writer=writer))
+    finally:
+        plt.close(fig)
     return path
 
 
@@ -388,11 +405,7 @@ def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> 
         return obj, line, title
 
     anim = FuncAnimation(fig, draw, frames=len(frames), blit=False)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    anim.save(path, writer=PillowWriter(fps=fps))
-    plt.close(fig)
-    return path
+    return save_animation(anim, fig, path, PillowWriter(fps=fps))
 
 
 def plot_control(scene, res, path, extra=None) -> Path:
@@ -509,8 +522,4 @@ def animate_plan3d(scene, plan, path, fps: int = 12, frames_per_step: int = 6) -
         ax.set_box_aspect((1, 1, 1))
 
     anim = FuncAnimation(fig, draw, frames=len(seq), interval=1000 / fps)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    anim.save(path, writer=PillowWriter(fps=fps))
-    plt.close(fig)
-    return path
+    return save_animation(anim, fig, path, PillowWriter(fps=fps))

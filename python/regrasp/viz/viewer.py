@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import write_text
 from ..planning.plan import as_plan
 
 PAGE = r"""<!doctype html>
@@ -186,5 +187,4 @@ def page(scene, plan) -> str:
 def write_html(scene, plan, path) -> Path:
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    p.write_text(page(scene, plan))
-    return p
+    return write_text(p, page(scene, plan))

@@ -1,0 +1,179 @@
+"""Writing output files: atomically, never onto an input, all of a command's outputs or none.
+
+Every file the package writes goes through :func:`atomic_write`: the content is written to a
+temporary file in the output's own folder (``.NAME.tmpXXXXXXXX.SUFFIX``, the suffix kept so that
+writers that pick the format by the name still do), flushed to disk, then renamed over the output
+(``os.replace``, atomic on POSIX and Windows). On any failure, ``KeyboardInterrupt`` included,
+the temporary file is removed and an existing output is left as it was. :class:`Outputs` stages
+several outputs this way and renames them only when every one was written.
+"""
+
+from __future__ import annotations
+
+import os
+import uuid
+from pathlib import Path
+from typing import Callable, Iterable, Mapping, Optional
+
+from .errors import ArgumentError
+
+__all__ = ["atomic_write", "write_text", "temp_path", "check_writable", "refuse_overwrite_input", "Outputs",
+           "same_file"]
+
+
+def same_file(a, b) -> bool:
+    """Whether paths ``a`` and ``b`` name one file: the same existing file (``samefile``) or the
+    same resolved path."""
+    try:
+        if os.path.samefile(a, b):
+            return True
+    except OSError:  # either does not exist
+        pass
+    return Path(a).resolve() == Path(b).resolve()
+
+
+def temp_path(path) -> Path:
+    """A fresh temporary name beside ``path``: ``.NAME.tmpXXXXXXXX.SUFFIX``."""
+    p = Path(path)
+    return p.with_name(f".{p.stem}.tmp{uuid.uuid4().hex[:8]}{p.suffix}")
+
+
+def _fsync(path: Path) -> None:
+    """Flushes a written file to disk (best effort where a file system cannot)."""
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _remove(path: Path) -> None:
+    try:
+        path.unlink()
+    except FileNotFoundError:
+        pass
+
+
+def _write_temp(path: Path, write_fn: Callable[[Path], object]) -> Path:
+    """Runs ``write_fn(tmp)`` on a temporary name beside ``path``; returns the written temporary
+    file (removed again on any failure)."""
+    tmp = temp_path(path)
+    try:
+        write_fn(tmp)
+        if not tmp.is_file():
+            raise OSError(f"nothing was written to {tmp}")
+        _fsync(tmp)
+    except BaseException:
+        _remove(tmp)
+        raise
+    return tmp
+
+
+def atomic_write(path, write_fn: Callable[[Path], object]) -> Path:
+    """Writes ``path`` atomically: ``write_fn(tmp)`` writes the content to the temporary path it
+    is given (same folder, same suffix), which then replaces ``path``. On failure (any exception,
+    KeyboardInterrupt included) the temporary file is removed and ``path`` is untouched."""
+    p = Path(path)
+    tmp = _write_temp(p, write_fn)
+    try:
+        os.replace(tmp, p)
+    except BaseException:
+        _remove(tmp)
+        raise
+    return p
+
+
+def write_text(path, text: str) -> Path:
+    """``text`` written atomically to ``path`` (UTF-8)."""
+    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+
+
+def _existing_ancestor(p: Path) -> Path:
+    q = p.parent
+    while not q.exists() and q != q.parent:
+        q = q.parent
+    return q
+
+
+def check_writable(path, name: str, create_folder: bool = False) -> Path:
+    """That ``path`` can be written (before a long computation): not a folder, its folder exists
+    (or, with ``create_folder``, can be created) and is writable. ArgumentError naming option
+    ``name``: ``invalid `--out`: cannot write PATH: REASON``."""
+    p = Path(path)
+
+    def fail(reason: str):
+        raise ArgumentError(f"invalid `{name}`: cannot write {p}: {reason}", name)
+
+    if str(path) == "" or p.name in ("", ".", ".."):
+        fail("not a file name")
+    if p.is_dir():
+        fail("is a folder")
+    folder = p.parent if p.parent.exists() or not create_folder else _existing_ancestor(p)
+    if not folder.exists():
+        fail(f"no folder {folder}")
+    if not folder.is_dir():
+        fail(f"{folder} is not a folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        fail(f"the folder {folder} is not writable")
+    return p
+
+
+def refuse_overwrite_input(outputs: Mapping[str, Optional[object]], inputs: Iterable[Optional[object]]) -> None:
+    """ArgumentError naming the option when an output (``{option: path}``; None: not asked for)
+    is one of the ``inputs`` files or the same file as another output."""
+    given = [(k, v) for k, v in outputs.items() if v is not None]
+    ins = [i for i in inputs if i is not None]
+    for k, v in given:
+        for i in ins:
+            if same_file(v, i):
+                raise ArgumentError(f"invalid `{k}`: {v} is an input file ({i}); it is not overwritten", k)
+    for n, (k, v) in enumerate(given):
+        for k2, v2 in given[n + 1:]:
+            if same_file(v, v2):
+                raise ArgumentError(f"invalid `{k2}`: {v2} is also the output of `{k}`", k2)
+
+
+class Outputs:
+    """Several outputs written all or none: :meth:`write` stages each in a temporary file beside
+    it; :meth:`commit` renames them all over their outputs; :meth:`discard` (or leaving a ``with``
+    block by an exception) removes the staged files, leaving every existing output untouched."""
+
+    def __init__(self):
+        self._staged: list[tuple[Path, Path]] = []
+
+    def write(self, path, write_fn: Callable[[Path], object]) -> Path:
+        """Stages ``write_fn(tmp)`` for ``path`` (see :func:`atomic_write`)."""
+        p = Path(path)
+        self._staged.append((_write_temp(p, write_fn), p))
+        return p
+
+    def commit(self) -> list[Path]:
+        """Renames every staged file over its output."""
+        done = []
+        try:
+            for tmp, p in self._staged:
+                os.replace(tmp, p)
+                done.append(p)
+        finally:
+            self.discard()
+        return done
+
+    def discard(self) -> None:
+        """Removes the staged files not yet committed."""
+        for tmp, _ in self._staged:
+            _remove(tmp)
+        self._staged = []
+
+    def __enter__(self) -> "Outputs":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            self.commit()
+        else:
+            self.discard()
