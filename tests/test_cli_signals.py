@@ -1,0 +1,63 @@
+"""Ctrl-C (SIGINT) stops the `regrasp` command within a fraction of a second, with status 130,
+`regrasp: interrupted` and no traceback, and leaves no output behind (issue 13)."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process is POSIX")
+
+
+@pytest.fixture(scope="module")
+def top_only(tmp_path_factory) -> Path:
+    """A planar scene whose only pusher pushes down while the goal is up: the planner searches
+    until its limits (with --time-limit 30, about 15 s of iterations on a laptop core)."""
+    parts = (EXAMPLES / "block-low-friction.toml").read_text().split("[[pushers]]")
+    top = [p for p in parts[1:] if 'name = "top"' in p][0]
+    f = tmp_path_factory.mktemp("scenes") / "top-only.toml"
+    f.write_text(parts[0] + "[[pushers]]" + top)
+    return f
+
+
+def interrupt(args: list, after: float, cwd: Path) -> tuple[int, str, float]:
+    """Runs `regrasp ARGS`, sends SIGINT ``after`` seconds in; (status, stderr, seconds from the
+    signal to the exit)."""
+    p = subprocess.Popen([sys.executable, "-m", "regrasp.cli", *map(str, args)], cwd=cwd,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(after)
+        assert p.poll() is None, f"it ended before the signal: {p.communicate()}"
+        p.send_signal(signal.SIGINT)
+        t0 = time.perf_counter()
+        _, err = p.communicate(timeout=30)
+        return p.returncode, err, time.perf_counter() - t0
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+
+
+def test_ctrl_c_stops_planning_quickly_with_130_and_writes_nothing(tmp_path, top_only):
+    out, png = tmp_path / "plan.json", tmp_path / "plan.png"
+    status, err, took = interrupt(["plan", top_only, "--time-limit", "30", "--out", out, "--plot", png], 1.5, tmp_path)
+    assert status == 130, err
+    assert err.strip() == "regrasp: interrupted" and "Traceback" not in err, err
+    assert took < 3.0, f"planning went on {took:.1f} s after Ctrl-C"
+    assert not out.exists() and not png.exists()
+    assert [p.name for p in tmp_path.iterdir() if ".tmp" in p.name] == []
+
+
+def test_ctrl_c_stops_validation_quickly_with_130(tmp_path):
+    status, err, took = interrupt(["validate", EXAMPLES / "block-low-friction.toml", "--pushes", "100000"], 2.5,
+                                  tmp_path)
+    assert status == 130 and err.strip().endswith("regrasp: interrupted") and "Traceback" not in err, err
+    assert took < 3.0, f"validation went on {took:.1f} s after Ctrl-C"
