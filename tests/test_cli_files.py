@@ -342,6 +342,8 @@ def test_time_limit_inf_means_no_limit_and_nan_or_negative_are_invalid(capsys):
     (["approx-error", BLOCK, "--samples", "100000000000"], "--samples"),
     (["approx-error", BLOCK, "--forces", "nan"], "--forces"),
     (["approx-error", BLOCK, "--forces", "5,-1"], "--forces"),
+    (["approx-error", BLOCK, "--forces", "1e300"], "--forces"),
+    (["control", BLOCK, "--plan", "PLAN", "--scale-grip", "1e300"], "--scale-grip"),
     (["bench", "-n", "0"], "-n"),
     (["bench", "-n", "1000000000000"], "-n"),
     (["push", BLOCK, "--pose", "0,0,0", "--pusher", "left", "--twist", "0.01,0,0", "--duration", "0"], "--duration"),

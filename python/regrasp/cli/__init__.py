@@ -37,6 +37,9 @@ MAX_WORKERS = 1024
 MAX_HORIZON = 1000
 #: most time steps of one simulated push (`--duration` / `--dt`)
 MAX_STEPS = 1_000_000
+#: largest --scale-* factor and largest grip force of `approx-error --forces` [N]
+MAX_SCALE = 1000.0
+MAX_FORCE = 10_000.0
 #: suffixes of --plot (matplotlib), of animations (Pillow) and of --video (Pillow, or ffmpeg for MP4)
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff", ".webp")
 ANIMATION_SUFFIXES = (".gif", ".webp", ".png", ".tif", ".tiff")
@@ -138,8 +141,9 @@ def scales(a) -> tuple[float, float, float]:
     out = []
     for name in SCALES:
         v = getattr(a, name)
-        if v is not None and not (np.isfinite(v) and v > 0):
-            raise ArgumentError(f"invalid `--{name.replace('_', '-')}`: must be a positive factor", name)
+        if v is not None and not (np.isfinite(v) and 0 < v <= MAX_SCALE):
+            raise ArgumentError(f"invalid `--{name.replace('_', '-')}`: must be a positive factor, at most {MAX_SCALE:g} "
+                                f"(got {v})", option(name))
         out.append(1.0 if v is None else float(v))
     return tuple(out)
 

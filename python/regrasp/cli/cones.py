@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import ArgumentError, GraspError
 from ..scene.common import is_3d_text, read_scene_file
 from ..scene.planar import Scene
-from . import (CANNOT, EXAMPLES, FIGURE_SUFFIXES, MAX_SAMPLES, OK, add_verbose, check_count, check_outputs, floats,
+from . import (CANNOT, EXAMPLES, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, add_verbose, check_count, check_outputs, floats,
                load_planar, seed_arg)
 
 
@@ -106,8 +106,8 @@ def cmd_approx_error(a) -> int:
 
     check_count(a, "samples", 1, MAX_SAMPLES)
     forces = floats(a.forces, len(a.forces.split(",")), "--forces")
-    if (forces <= 0).any():
-        raise ArgumentError("invalid `--forces`: grip forces must be positive", "--forces")
+    if (forces <= 0).any() or (forces > MAX_FORCE).any():
+        raise ArgumentError(f"invalid `--forces`: grip forces must be positive, at most {MAX_FORCE:g} N", "--forces")
     scenes = [load_planar(p, "approx-error", a) for p in a.scenes or _bundled_planar_examples()]
     skipped = [s.name for s in scenes if s.kind != "grasp"]
     if skipped and not a.json:
