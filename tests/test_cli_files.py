@@ -123,6 +123,26 @@ def test_an_output_onto_an_input_or_onto_another_output_is_refused(tmp_path, mon
     refuse_overwrite_input({"--out": "p.json", "--plot": "p.png", "--html": None}, [scene])
 
 
+def test_a_symlinked_output_is_written_through_and_a_pipe_in_place(tmp_path):
+    import threading
+
+    target = tmp_path / "real.txt"
+    target.write_text("old")
+    link = tmp_path / "link.txt"
+    link.symlink_to(target)
+    write_text(link, "new")
+    assert link.is_symlink() and target.read_text() == "new" and temp_files(tmp_path) == []
+    fifo = tmp_path / "pipe.txt"
+    os.mkfifo(fifo)
+    got = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()))
+    reader.start()
+    with Outputs() as outs:
+        outs.write(fifo, lambda p: Path(p).write_text("streamed"))
+    reader.join(timeout=10)
+    assert got == ["streamed"] and fifo.exists() and not fifo.is_file()
+
+
 KILLED_WRITER = r"""
 import sys, time
 from pathlib import Path

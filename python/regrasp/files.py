@@ -11,6 +11,7 @@ several outputs this way and renames them only when every one was written.
 from __future__ import annotations
 
 import os
+import stat
 import uuid
 from pathlib import Path
 from typing import Callable, Iterable, Mapping, Optional
@@ -74,18 +75,39 @@ def _write_temp(path: Path, write_fn: Callable[[Path], object]) -> Path:
     return tmp
 
 
+def _is_stream(path) -> bool:
+    """An existing output that is not a regular file or folder (``/dev/stdout``, a pipe): it
+    cannot be replaced by a rename, so it is written in place."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return False
+    return not stat.S_ISREG(mode) and not stat.S_ISDIR(mode)
+
+
+def _target(path) -> Path:
+    """Where ``path`` writes: a symbolic link's target (the link itself stays)."""
+    p = Path(path)
+    return Path(os.path.realpath(p)) if p.is_symlink() else p
+
+
 def atomic_write(path, write_fn: Callable[[Path], object]) -> Path:
     """Writes ``path`` atomically: ``write_fn(tmp)`` writes the content to the temporary path it
     is given (same folder, same suffix), which then replaces ``path``. On failure (any exception,
-    KeyboardInterrupt included) the temporary file is removed and ``path`` is untouched."""
-    p = Path(path)
+    KeyboardInterrupt included) the temporary file is removed and ``path`` is untouched. A
+    symbolic link is written through (its target is replaced); a device or pipe
+    (``/dev/stdout``) is written in place."""
+    if _is_stream(path):
+        write_fn(Path(path))
+        return Path(path)
+    p = _target(path)
     tmp = _write_temp(p, write_fn)
     try:
         os.replace(tmp, p)
     except BaseException:
         _remove(tmp)
         raise
-    return p
+    return Path(path)
 
 
 def write_text(path, text: str) -> Path:
@@ -147,10 +169,14 @@ class Outputs:
         self._staged: list[tuple[Path, Path]] = []
 
     def write(self, path, write_fn: Callable[[Path], object]) -> Path:
-        """Stages ``write_fn(tmp)`` for ``path`` (see :func:`atomic_write`)."""
-        p = Path(path)
-        self._staged.append((_write_temp(p, write_fn), p))
-        return p
+        """Stages ``write_fn(tmp)`` for ``path`` (see :func:`atomic_write`; a device or pipe is
+        written at once)."""
+        if _is_stream(path):
+            write_fn(Path(path))
+        else:
+            p = _target(path)
+            self._staged.append((_write_temp(p, write_fn), p))
+        return Path(path)
 
     def commit(self) -> list[Path]:
         """Renames every staged file over its output."""
