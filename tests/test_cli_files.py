@@ -110,6 +110,25 @@ def test_outputs_are_written_all_or_none(tmp_path):
     assert (a.read_text(), b.read_text()) == ("new a", "new b")
 
 
+def test_ctrl_c_while_outputs_are_renamed_waits_until_all_are(tmp_path, monkeypatch):
+    import regrasp.files as files
+
+    real = os.replace
+
+    def replace_then_ctrl_c(src, dst):
+        real(src, dst)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
+    outs = Outputs()
+    outs.write(a, lambda tmp: Path(tmp).write_text("a"))
+    outs.write(b, lambda tmp: Path(tmp).write_text("b"))
+    monkeypatch.setattr(files.os, "replace", replace_then_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        outs.commit()
+    assert (a.read_text(), b.read_text()) == ("a", "b") and temp_files(tmp_path) == []
+
+
 def test_an_output_onto_an_input_or_onto_another_output_is_refused(tmp_path, monkeypatch):
     scene = tmp_path / "s.toml"
     scene.write_text("x")

@@ -10,8 +10,11 @@ several outputs this way and renames them only when every one was written.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
 import stat
+import threading
 import uuid
 from pathlib import Path
 from typing import Callable, Iterable, Mapping, Optional
@@ -160,6 +163,18 @@ def refuse_overwrite_input(outputs: Mapping[str, Optional[object]], inputs: Iter
                 raise ArgumentError(f"invalid `{k2}`: {v2} is also the output of `{k}`", k2)
 
 
+@contextlib.contextmanager
+def _sigint_deferred():
+    """SIGINT blocked for the block (POSIX, main thread): a Ctrl-C arrives after it."""
+    block = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if block else None
+    try:
+        yield
+    finally:
+        if block:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 class Outputs:
     """Several outputs written all or none: :meth:`write` stages each in a temporary file beside
     it; :meth:`commit` renames them all over their outputs; :meth:`discard` (or leaving a ``with``
@@ -179,14 +194,15 @@ class Outputs:
         return Path(path)
 
     def commit(self) -> list[Path]:
-        """Renames every staged file over its output."""
+        """Renames every staged file over its output (Ctrl-C waits until all are renamed)."""
         done = []
-        try:
-            for tmp, p in self._staged:
-                os.replace(tmp, p)
-                done.append(p)
-        finally:
-            self.discard()
+        with _sigint_deferred():
+            try:
+                for tmp, p in self._staged:
+                    os.replace(tmp, p)
+                    done.append(p)
+            finally:
+                self.discard()
         return done
 
     def discard(self) -> None:
