@@ -165,14 +165,21 @@ def refuse_overwrite_input(outputs: Mapping[str, Optional[object]], inputs: Iter
 
 @contextlib.contextmanager
 def _sigint_deferred():
-    """SIGINT blocked for the block (POSIX, main thread): a Ctrl-C arrives after it."""
-    block = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if block else None
+    """A Ctrl-C (SIGINT) during the block takes effect after it (main thread; elsewhere Python
+    does not deliver signals anyway)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: got.append(signum))
     try:
         yield
     finally:
-        if block:
-            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        signal.signal(signal.SIGINT, old)
+        if got and callable(old):
+            old(signal.SIGINT, None)
+        elif got and old == signal.SIG_DFL:
+            raise KeyboardInterrupt
 
 
 class Outputs:
@@ -194,7 +201,7 @@ class Outputs:
         return Path(path)
 
     def commit(self) -> list[Path]:
-        """Renames every staged file over its output (Ctrl-C waits until all are renamed)."""
+        """Renames every staged file over its output (a Ctrl-C waits until all are renamed)."""
         done = []
         with _sigint_deferred():
             try:
