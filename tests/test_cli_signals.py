@@ -38,7 +38,7 @@ def interrupt(args: list, after: float, cwd: Path) -> tuple[int, str, float]:
         assert p.poll() is None, f"it ended before the signal: {p.communicate()}"
         p.send_signal(signal.SIGINT)
         t0 = time.perf_counter()
-        _, err = p.communicate(timeout=30)
+        _, err = p.communicate(timeout=120)
         return p.returncode, err, time.perf_counter() - t0
     finally:
         if p.poll() is None:
@@ -61,3 +61,13 @@ def test_ctrl_c_stops_validation_quickly_with_130(tmp_path):
                                   tmp_path)
     assert status == 130 and err.strip().endswith("regrasp: interrupted") and "Traceback" not in err, err
     assert took < 3.0, f"validation went on {took:.1f} s after Ctrl-C"
+
+
+def test_ctrl_c_stops_a_long_simulated_push_quickly_with_130(tmp_path):
+    # 1,000,000 quasi-static steps (the most --duration / --dt allows): tens of seconds
+    args = ["push", EXAMPLES / "block-low-friction.toml", "--pose", "0,0,0", "--pusher", "left", "--twist",
+            "0.00001,0,0", "--duration", "20000", "--dt", "0.02", "--plot", tmp_path / "push.png"]
+    status, err, took = interrupt(args, 1.5, tmp_path)
+    assert status == 130 and err.strip() == "regrasp: interrupted" and "Traceback" not in err, err
+    assert took < 3.0, f"the simulation went on {took:.1f} s after Ctrl-C"
+    assert list(tmp_path.iterdir()) == []
