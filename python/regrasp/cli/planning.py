@@ -63,9 +63,9 @@ def _write_outputs(scene, p: Plan, a) -> list[str]:
     figures. None found: the best partial plan to --partial-out, else to --out when that file does
     not exist yet; figures only where no file exists yet (an existing output is left untouched).
     Returns what to say on stderr about the outputs of a partial plan."""
-    plan_file = a.out if p.found else (a.partial_out or a.out)
-    writers = ([("--partial-out" if plan_file == a.partial_out and not p.found else "--out", plan_file,
-                 lambda tmp: p.save(tmp))] if plan_file else []) + _figure_writers(scene, p, a)
+    opt = "--partial-out" if not p.found and a.partial_out else "--out"
+    plan_file = getattr(a, opt[2:].replace("-", "_"))
+    writers = ([(opt, plan_file, lambda tmp: p.save(tmp))] if plan_file else []) + _figure_writers(scene, p, a)
     said = []
     with Outputs() as outs:
         for opt, path, write in writers:
