@@ -77,9 +77,9 @@ def check_number(a, name: str, lo: float, hi: float = float("inf"), what: str = 
     opt = option(name)
     ok = v == v and (np.isfinite(v) or (not finite and v > 0)) and (v > lo if lo_open else v >= lo) and v <= hi
     if not ok:
-        lo_text = f"> {lo}" if lo_open else f">= {lo}"
-        hi_text = "" if hi == float("inf") else f" and <= {hi}"
-        raise ArgumentError(f"invalid `{opt}`: must be a {'' if finite else 'non-NaN '}{what} {lo_text}{hi_text} "
+        lo_text = f"> {lo:g}" if lo_open else f">= {lo:g}"
+        hi_text = "" if hi == float("inf") else f" and <= {hi:g}"
+        raise ArgumentError(f"invalid `{opt}`: must be a finite {what} {lo_text}{hi_text}{'' if finite else ', or inf'} "
                             f"(got {v})", opt)
 
 
