@@ -20,7 +20,7 @@ from ..errors import ArgumentError, RegraspError, check_seed
 from ..mujoco.model import plan_dict
 from ..mujoco.planar import Perturbation
 from ..sim.quasistatic import body_twist, simulate_push
-from ..scene.planar import Scene
+from ..scene.planar import Scene, _count, _number, _vec
 
 ENGINES = ("quasistatic", "mujoco")
 POLICIES = ("mpc", "open_loop")
@@ -113,21 +113,28 @@ def _plan_dict(plan) -> dict:
     return d
 
 
-def _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error) -> np.ndarray:
-    if engine not in ENGINES:
+def _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error, noise, seed, pokes) -> np.ndarray:
+    if not isinstance(engine, str) or engine not in ENGINES:
         raise ArgumentError(f"invalid `engine`: must be one of {ENGINES} (got {engine!r})", "engine")
-    if policy not in POLICIES:
+    if not isinstance(policy, str) or policy not in POLICIES:
         raise ArgumentError(f"invalid `policy`: must be one of {POLICIES} (got {policy!r})", "policy")
-    if not (dt > 0 and speed > 0 and np.isfinite(dt) and np.isfinite(speed)):
-        raise ArgumentError("invalid `dt`/`speed`: must be positive", "dt")
-    if not isinstance(horizon, (int, np.integer)) or horizon < 1:
-        raise ArgumentError(f"invalid `horizon`: must be a whole number of steps >= 1 (got {horizon!r})", "horizon")
-    if max_time is not None and not (np.isfinite(max_time) and max_time > 0):
-        raise ArgumentError("invalid `max_time`: must be a positive number of seconds", "max_time")
-    se = np.asarray(start_error, float)
-    if se.shape != (3,) or not np.all(np.isfinite(se)):
-        raise ArgumentError("invalid `start_error`: must be 3 finite numbers dx, dz, dtheta", "start_error")
-    return se
+    _number(dt, "dt"), _number(speed, "speed"), _count(horizon, "horizon", 1, 10_000)
+    if max_time is not None:
+        _number(max_time, "max_time")
+    _number(noise, "noise", strict=False)
+    check_seed(seed)
+    if not all(isinstance(p, Poke) for p in _iterable(pokes, "pokes")):
+        raise ArgumentError("invalid `pokes`: a list of Poke (Poke.parse('T,dx,dz,dtheta'))", "pokes")
+    return _vec(start_error, 3, "start_error")
+
+
+def _iterable(x, name: str) -> list:
+    if isinstance(x, (str, bytes, dict)):
+        raise ArgumentError(f"invalid `{name}`: a list (got {type(x).__name__})", name)
+    try:
+        return list(x)
+    except TypeError:
+        raise ArgumentError(f"invalid `{name}`: a list (got {type(x).__name__})", name) from None
 
 
 class ControlRun:
@@ -271,7 +278,7 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
     """
     d = _core.mpc_defaults()
     dt, speed, horizon = (d[k] if v is None else v for k, v in (("dt", dt), ("speed", speed), ("horizon", horizon)))
-    se = _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error)
+    se = _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error, noise, seed, pokes)
     run = ControlRun(scene, plan, engine, policy, pokes, se, perturb, controller_scene, noise, seed, dt, speed, horizon,
                      max_time, mpc)
     while run.t <= run.max_time + 1e-9 and run.tick():

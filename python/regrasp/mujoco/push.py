@@ -10,7 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..scene.planar import Scene
+from ..scene.planar import Scene, _name, _number, _vec
+
+#: the longest push :func:`simulate_push` simulates [s] (MuJoCo steps of 0.5 ms: a bound on its time)
+MAX_DURATION = 60.0
 from ..sim.quasistatic import integrate_pose
 from .model import (FEATURE_RADIUS, Contact, Driver, Rig, add_driven_body, add_feature_geom, add_grip_motors,
                     add_object, add_planar_pads, compose, inverse, planar_pose, planar_spec, put_object, rotate)
@@ -130,6 +133,9 @@ def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, recor
                   settings: Contact = Contact()) -> dict:
     """A push in MuJoCo: the pads squeeze for 0.3 s, then the pusher moves with constant body
     ``twist`` (object frame at the start). Returns times and object poses (gripper frame)."""
+    pose, twist, pusher = _vec(pose, 3, "pose"), _vec(twist, 3, "twist"), _name(pusher, "pusher")
+    duration = _number(duration, "duration", high=MAX_DURATION)
+    record_dt = _number(record_dt, "record_dt")
     rig = PushRig(scene, pusher, settings)
     r = rig.push(pose, twist, duration, settle=0.3, record_dt=record_dt)
     return {"t": r["t"], "pose": r["pose"], "settled_pose": r["pose"][0]}

@@ -20,8 +20,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ArgumentError, GraspError
-from ..scene.planar import Scene
+from ..errors import ArgumentError, GraspError, check_seed
+from ..scene.planar import Scene, _count, _name, _vec
+
+#: most random pushes one row takes (a bound on its time)
+MAX_SAMPLES = 1_000_000
 
 
 def _point_velocity(g: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -41,14 +44,15 @@ def _cap(axis: np.ndarray, radius: float, n: int, rng) -> np.ndarray:
 
 def approximation_error(scene: Scene, pusher: str, pose=None, samples: int = 20000, seed: int = 0) -> dict:
     """Misclassification shares of the polyhedral approximation for one pusher at one pose."""
-    pose = scene.task.start if pose is None else np.asarray(pose, float)
-    rng = np.random.default_rng(seed)
+    if pose is None and scene.task is None:
+        raise ArgumentError("invalid `pose`: the scene has no [task]; give the pose", "pose")
+    pose = scene.task.start if pose is None else _vec(pose, 3, "pose")
+    samples, pusher = _count(samples, "samples", 1, MAX_SAMPLES), _name(pusher, "pusher")
+    rng = np.random.default_rng(check_seed(seed))
     try:
         cone = scene.motion_cone(pose, pusher)
     except GraspError as e:
         return {"pusher": pusher, "error": str(e)}
-    if samples < 1:
-        raise ArgumentError(f"invalid `samples`: must be at least 1 (got {samples})", "samples")
     if cone.is_line_pusher:
         G = scene.metric_twist(cone.generators)
         axis = G.sum(axis=0)

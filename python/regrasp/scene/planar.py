@@ -21,22 +21,89 @@ from .common import core_property, read_scene_file
 ArrayLike = Sequence[float] | np.ndarray
 
 
-def _vec(x, n: int, name: str) -> np.ndarray:
-    a = np.asarray(x, dtype=float)
-    if a.shape != (n,):
-        raise ArgumentError(f"invalid `{name}`: expected {n} numbers, got shape {a.shape}", name)
+def _array(x, name: str) -> np.ndarray:
+    """``x`` as a float array, or an ArgumentError naming ``name`` (text, ragged lists, objects
+    that are not numbers, integers too large for a float)."""
+    if isinstance(x, (str, bytes)):
+        raise ArgumentError(f"invalid `{name}`: expected numbers, got {type(x).__name__} {x!r:.60}", name)
+    try:
+        a = np.asarray(x)
+        if a.dtype.kind not in "biuf":
+            if a.dtype.kind != "O":
+                raise TypeError(f"{a.dtype} values")
+            a = a.astype(float)
+        return np.asarray(a, dtype=float)
+    except (TypeError, ValueError, OverflowError) as e:
+        raise ArgumentError(f"invalid `{name}`: expected numbers ({e})", name) from None
+
+
+def _finite(a: np.ndarray, name: str) -> np.ndarray:
     if not np.all(np.isfinite(a)):
         raise ArgumentError(f"invalid `{name}`: has a non-finite component", name)
     return a
 
 
-def _rows(x, name: str) -> np.ndarray:
-    a = np.ascontiguousarray(np.asarray(x, dtype=float))
-    if a.ndim == 1 and a.shape == (3,):
+def _vec(x, n: int, name: str) -> np.ndarray:
+    """A vector of ``n`` finite numbers."""
+    a = _array(x, name)
+    if a.shape != (n,):
+        raise ArgumentError(f"invalid `{name}`: expected {n} numbers, got shape {a.shape}", name)
+    return _finite(a, name)
+
+
+def _rows(x, name: str, n: int = 3) -> np.ndarray:
+    """An (m, n) array of finite numbers (one vector of ``n`` is one row), m >= 1."""
+    a = np.ascontiguousarray(_array(x, name))
+    if a.ndim == 1 and a.shape == (n,):
         a = a[None, :]
-    if a.ndim != 2 or a.shape[1] != 3:
-        raise ArgumentError(f"invalid `{name}`: expected an (n, 3) array, got shape {a.shape}", name)
-    return a
+    if a.ndim != 2 or a.shape[1] != n or a.shape[0] == 0:
+        raise ArgumentError(f"invalid `{name}`: expected an (m, {n}) array with m >= 1, got shape {a.shape}", name)
+    return _finite(a, name)
+
+
+def _vec_or_rows(x, name: str):
+    """One 3-vector (a list for the core) or an (m, 3) array: what the cone tests take."""
+    a = _array(x, name)
+    return _rows(a, name) if a.ndim == 2 else list(_vec(a, 3, name))
+
+
+def _twists(x, name: str) -> np.ndarray:
+    """Twists: one 3-vector or an array of them (shape (..., 3)), finite."""
+    a = _array(x, name)
+    if a.ndim == 0 or a.shape[-1] != 3:
+        raise ArgumentError(f"invalid `{name}`: expected twists of 3 numbers, got shape {a.shape}", name)
+    return _finite(a, name)
+
+
+def _number(x, name: str, low: float = 0.0, strict: bool = True, high: float = np.inf) -> float:
+    """A finite real number in (low, high] (``strict``) or [low, high]."""
+    ok = isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, (bool, np.bool_))
+    v = float(x) if ok and abs(x) < 1e308 else np.nan
+    if not (np.isfinite(v) and (v > low if strict else v >= low) and v <= high):
+        what = f"{'>' if strict else '>='} {low:g}" + ("" if high == np.inf else f" and <= {high:g}")
+        raise ArgumentError(f"invalid `{name}`: must be a finite number {what} (got {x!r:.60})", name)
+    return v
+
+
+def _count(x, name: str, low: int = 1, high: int = 2**31 - 1) -> int:
+    """A whole number in [low, high]."""
+    ok = isinstance(x, (int, np.integer)) and not isinstance(x, (bool, np.bool_))
+    if not (ok and low <= int(x) <= high):
+        raise ArgumentError(f"invalid `{name}`: must be a whole number in [{low}, {high}] (got {x!r:.60})", name)
+    return int(x)
+
+
+def _name(x, name: str) -> str:
+    """A name (of a pusher, a mode): a non-empty string."""
+    if not isinstance(x, str) or not x.strip():
+        raise ArgumentError(f"invalid `{name}`: must be a non-empty name (got {x!r:.60})", name)
+    return x
+
+
+def _flag(x, name: str) -> bool:
+    if not isinstance(x, (bool, np.bool_)):
+        raise ArgumentError(f"invalid `{name}`: must be True or False (got {x!r:.60})", name)
+    return bool(x)
 
 
 @dataclass(frozen=True)
@@ -116,12 +183,10 @@ class MotionCone:
 
     def contains(self, twist):
         """Exact test for one twist (bool) or an (n, 3) array (bool array)."""
-        t = np.asarray(twist, dtype=float)
-        return self._core.contains(np.ascontiguousarray(t) if t.ndim == 2 else list(_vec(t, 3, "twist")))
+        return self._core.contains(_vec_or_rows(twist, "twist"))
 
     def margin(self, twist):
-        t = np.asarray(twist, dtype=float)
-        return self._core.margin(np.ascontiguousarray(t) if t.ndim == 2 else list(_vec(t, 3, "twist")))
+        return self._core.margin(_vec_or_rows(twist, "twist"))
 
     def classify(self, twist: ArrayLike) -> Classification:
         d = self._core.classify(list(_vec(twist, 3, "twist")))
@@ -136,8 +201,7 @@ class MotionCone:
     def project(self, twist):
         """Closest feasible twist (exact cone) to one twist or to each row of an (n, 3) array,
         in the metric of :meth:`Scene.metric_twist`."""
-        t = np.asarray(twist, dtype=float)
-        return self._core.project(np.ascontiguousarray(t) if t.ndim == 2 else list(_vec(t, 3, "twist")))
+        return self._core.project(_vec_or_rows(twist, "twist"))
 
     def project_polyhedral(self, twist: ArrayLike) -> np.ndarray:
         """Closest twist in the polyhedral approximation (non-negative least squares)."""
@@ -145,8 +209,7 @@ class MotionCone:
 
     def contains_polyhedral(self, twist):
         """Membership in the polyhedral approximation (one twist, or an (n, 3) array)."""
-        t = np.asarray(twist, dtype=float)
-        return self._core.contains_polyhedral(np.ascontiguousarray(t) if t.ndim == 2 else list(_vec(t, 3, "twist")))
+        return self._core.contains_polyhedral(_vec_or_rows(twist, "twist"))
 
     def grip_force_range(self, twist: ArrayLike) -> Optional[tuple[float, float]]:
         """Per-finger grip forces [min, max] (max may be inf) for which the pusher motion of
@@ -285,18 +348,22 @@ class Scene:
 
     @classmethod
     def from_toml(cls, text: str) -> "Scene":
+        if not isinstance(text, str):
+            raise ArgumentError(f"invalid `text`: the scene file's text, a str (got {type(text).__name__})", "text")
         return cls(_core.Scene.from_toml(text), None, ("toml", text))
 
     @classmethod
     def from_dict(cls, d: dict) -> "Scene":
         """A scene from a dict with the layout of the TOML file (numbers may be numpy scalars)."""
+        if not isinstance(d, dict):
+            raise ArgumentError(f"invalid `d`: a scene is a dict with the layout of the TOML file (got {type(d).__name__})", "d")
         bad = _non_finite(d, "")
         if bad is not None:
             raise SceneError(f"scene field `{bad}`: must be a finite number", bad)
         try:
             text = json.dumps(d, allow_nan=False, default=_jsonable)
-        except (TypeError, ValueError) as e:
-            raise SceneError(f"scene is not serializable: {e}", None) from e
+        except (TypeError, ValueError, RecursionError) as e:
+            raise SceneError(f"scene is not serializable: {e}", "(scene)") from e
         return cls(_core.Scene.from_json(text), None, ("json", text))
 
     def __repr__(self) -> str:
@@ -315,7 +382,7 @@ class Scene:
         return out
 
     def pusher(self, name: str) -> Pusher:
-        pts, normal, mu = self._core.pusher(name)
+        pts, normal, mu = self._core.pusher(_name(name, "name"))
         return Pusher(name, np.asarray(pts), np.asarray(normal), mu)
 
     length = core_property("length", "Characteristic length L [m] weighing rotation against translation.")
@@ -323,14 +390,14 @@ class Scene:
     def metric_twist(self, twist) -> np.ndarray:
         """Twists (rows) in the frame-invariant metric: [velocity of the COM, L omega]. Norms,
         distances and projections of regrasp are Euclidean in these coordinates."""
-        v = np.asarray(twist, dtype=float)
+        v = _twists(twist, "twist")
         c, L = self.com, self.length
         w = v[..., 2]
         return np.stack([v[..., 0] - w * c[1], v[..., 1] + w * c[0], L * w], axis=-1)
 
     def metric_twist_inv(self, scaled) -> np.ndarray:
         """Inverse of :meth:`metric_twist`."""
-        s = np.asarray(scaled, dtype=float)
+        s = _twists(scaled, "scaled")
         c, L = self.com, self.length
         w = s[..., 2] / L
         return np.stack([s[..., 0] + w * c[1], s[..., 1] - w * c[0], w], axis=-1)
@@ -355,7 +422,8 @@ class Scene:
     def with_grip_force(self, force: float) -> "Scene":
         """The same scene with another grip force per finger (not re-validated: the task's
         poses may not be held at that force)."""
-        return self._view(self._core.with_grip_force(float(force)), "with_grip_force", force=float(force))
+        force = _number(force, "force")
+        return self._view(self._core.with_grip_force(force), "with_grip_force", force=force)
 
     def _view(self, core, op: str, **kw) -> "Scene":
         """A view of this scene (a new core) that remembers how it was taken, so it pickles."""
@@ -372,7 +440,9 @@ class Scene:
                pusher_friction: float = 1.0, mode: str = "nominal") -> "Scene":
         """A copy with the finger friction, grip force, mass and every pusher's friction
         multiplied by the given factors, answering with the cones of ``mode``."""
-        core = self._core.scaled(float(finger_friction), float(grip), float(mass), float(pusher_friction), mode)
+        f = {k: _number(v, k) for k, v in dict(finger_friction=finger_friction, grip=grip, mass=mass,
+                                                pusher_friction=pusher_friction).items()}
+        core = self._core.scaled(f["finger_friction"], f["grip"], f["mass"], f["pusher_friction"], _name(mode, "mode"))
         return self._view(core, "scaled", finger_friction=finger_friction, grip=grip, mass=mass,
                           pusher_friction=pusher_friction, mode=mode)
 
@@ -382,6 +452,8 @@ class Scene:
         stick for every value in the ranges. ``uncertainty``: relative spreads
         ``{"pusher_friction", "finger_friction", "grip_force", "mass"}`` (default: the scene's
         ``[uncertainty]`` table)."""
+        if uncertainty is not None and not isinstance(uncertainty, dict):
+            raise ArgumentError(f"invalid `uncertainty`: a dict of relative spreads (got {uncertainty!r:.60})", "uncertainty")
         u = dict(self.uncertainty or {}) if uncertainty is None else dict(uncertainty)
         if uncertainty is None and self.uncertainty is None:
             raise ArgumentError("invalid `uncertainty`: the scene has no [uncertainty] table; give the spreads", "uncertainty")
@@ -389,7 +461,7 @@ class Scene:
         for k, v in u.items():
             if k not in keys:
                 raise ArgumentError(f"invalid `uncertainty.{k}`: unknown (expected {', '.join(keys)})", f"uncertainty.{k}")
-            if not (isinstance(v, (int, float)) and np.isfinite(v) and 0 <= v < 1):
+            if not (isinstance(v, (int, float)) and not isinstance(v, bool) and 0 <= v < 1):
                 raise ArgumentError(f"invalid `uncertainty.{k}`: must be a relative spread in [0, 1) (got {v!r})",
                                     f"uncertainty.{k}")
         f = {k: float(u.get(k, 0.0)) for k in keys}
@@ -405,13 +477,13 @@ class Scene:
     def carries_weight(self, pose, pusher: str) -> bool:
         """Whether ``pusher`` alone can carry the object's weight at ``pose`` (the invariant case
         of §5.1: its gravity-free pushes stick for any mass, grip force and finger friction)."""
-        return self._core.carries_weight(list(_vec(pose, 3, "pose")), pusher)
+        return self._core.carries_weight(list(_vec(pose, 3, "pose")), _name(pusher, "pusher"))
 
     def admissible(self, pose) -> bool | np.ndarray:
         """Whether the whole finger pad lies on the object at ``pose`` (or each row of an array)."""
-        a = np.asarray(pose, dtype=float)
+        a = _array(pose, "pose")
         if a.ndim == 2:
-            return self._core.admissible_many(_rows(a, "poses"))
+            return self._core.admissible_many(_rows(a, "pose"))
         return self._core.admissible(list(_vec(a, 3, "pose")))
 
     def hold_ratio(self, pose) -> float:
@@ -430,7 +502,8 @@ class Scene:
     def motion_cone(self, pose, pusher: str, check_hold: bool = True) -> MotionCone:
         """The motion cone of ``pusher`` at ``pose``. Raises GraspError when the grasp cannot
         hold the object there (pass ``check_hold=False`` for gravity-free and grip-force queries)."""
-        return MotionCone(self._core.motion_cone(list(_vec(pose, 3, "pose")), pusher, check_hold), self)
+        q = list(_vec(pose, 3, "pose"))
+        return MotionCone(self._core.motion_cone(q, _name(pusher, "pusher"), _flag(check_hold, "check_hold")), self)
 
     def gravity_free_cone(self, pose, pusher: str) -> GravityFreeCone:
         return self.motion_cone(pose, pusher, check_hold=False).gravity_free
@@ -438,7 +511,8 @@ class Scene:
     def motion_cones(self, poses, pusher: str, strict: bool = False) -> MotionConeBatch:
         """Motion cones at many poses. With ``strict`` the first invalid pose raises."""
         q = _rows(poses, "poses")
-        g, status = self._core.generators_many(q, pusher, False)
+        g, status = self._core.generators_many(q, _name(pusher, "pusher"), False)
+        strict = _flag(strict, "strict")
         if strict and status.any():
             i = int(np.flatnonzero(status)[0])
             raise ArgumentError(f"invalid `poses[{i}]`: {_STATUS[int(status[i])]}", f"poses[{i}]")

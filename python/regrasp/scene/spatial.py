@@ -11,9 +11,10 @@ from typing import Optional
 import numpy as np
 
 from .. import _core
-from ..errors import ArgumentError, RegraspError
+from ..errors import ArgumentError, RegraspError, check_seed
 from ..planning.plan import Plan, as_plan
 from .common import core_property, read_scene_file
+from .planar import _flag, _name, _number, _vec
 
 
 class Scene3D:
@@ -33,6 +34,11 @@ class Scene3D:
 
     @classmethod
     def from_toml(cls, text: str, base=None) -> "Scene3D":
+        """A 3-D scene from the text of its file; ``base``: the folder mesh paths are relative to."""
+        if not isinstance(text, str):
+            raise ArgumentError(f"invalid `text`: the scene file's text, a str (got {type(text).__name__})", "text")
+        if base is not None and not isinstance(base, (str, Path)):
+            raise ArgumentError(f"invalid `base`: a folder path or None (got {type(base).__name__})", "base")
         return cls(_core.Scene3D.from_toml(text, None if base is None else str(base)))
 
     def __repr__(self) -> str:
@@ -53,14 +59,16 @@ class Scene3D:
         return self._core.mesh()
 
     def pad_contacts(self, pose) -> list:
-        return [np.array(p) for p in self._core.pad_contacts(list(np.asarray(pose, float)))]
+        return [np.array(p) for p in self._core.pad_contacts(list(_vec(pose, 7, "pose")))]
 
     def quasistatic_problem(self, pose, pusher: str, h: float = 1.0):
-        return self._core.quasistatic_problem(list(np.asarray(pose, float)), pusher, h)
+        return self._core.quasistatic_problem(list(_vec(pose, 7, "pose")), _name(pusher, "pusher"), _number(h, "h"))
 
     def simulate_push(self, pose, pusher: str, twist, duration: float, dt: float = 0.05) -> dict:
-        return self._core.simulate_push(list(np.asarray(pose, float)), pusher, list(np.asarray(twist, float)),
-                                        float(duration), float(dt))
+        """The pusher moves with constant body ``twist`` for ``duration`` [s] > 0 in steps of
+        ``dt`` [s] > 0 (quasi-static time stepping)."""
+        return self._core.simulate_push(list(_vec(pose, 7, "pose")), _name(pusher, "pusher"), list(_vec(twist, 6, "twist")),
+                                        _number(duration, "duration"), _number(dt, "dt"))
 
     def plan(self, start=None, goal=None, **settings) -> Plan:
         """T-RRT* over SE(3) with inverse-dynamics and rolling unit steps (thesis §4.2): the same
@@ -74,7 +82,7 @@ class Scene3D:
     def validate_path(self, path) -> list:
         """Whether each step of a 3-D plan (a :class:`~regrasp.Plan`, a plan dict or its
         ``path`` list) can be taken by its pusher (see ``regrasp::trrt3d::validate_path3``)."""
-        p = as_plan({"path": path} if isinstance(path, list) else path, self)
+        p = as_plan({"path": path} if isinstance(path, list) else path, self, "path")
         tw = p.pusher_twists
         tw = None if all(u is None for u in tw) else [[0.0] * 6 if u is None else u.tolist() for u in tw]
         return self._core.validate_path(p.poses.tolist(), p.pushers, tw)
@@ -85,6 +93,7 @@ class Scene3D:
         the object is. Returns the final pose, the error to the goal (position [m] and angle
         [rad]), success (within the task's tolerance), the poses after each step and the
         re-plans made (``feedback``: see :func:`run_plan3d`)."""
+        dt, feedback, seed = _number(dt, "dt"), _flag(feedback, "feedback"), check_seed(seed)
         path = as_plan(plan, self).path
 
         def step(a, b):
@@ -136,7 +145,7 @@ def run_plan3d(scene: "Scene3D", path: list, step, q0, feedback: bool = False, m
     pose (at most ``max_replans`` times; seeds ``seed + 1, ...``). Returns the final pose, the poses
     after each step and the number of re-plans."""
     _, goal, tol = scene.task
-    if not (isinstance(max_replans, (int, np.integer)) and max_replans >= 0):
+    if isinstance(max_replans, bool) or not (isinstance(max_replans, (int, np.integer)) and max_replans >= 0):
         raise ArgumentError("invalid `max_replans`: a non-negative whole number", "max_replans")
 
     def off(q, ref):

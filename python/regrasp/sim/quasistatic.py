@@ -15,7 +15,7 @@ import numpy as np
 from .. import _core
 from ..errors import ArgumentError
 from ..planning.plan import as_plan
-from ..scene.planar import Scene, _vec
+from ..scene.planar import Scene, _count, _flag, _name, _number, _vec
 
 #: The simulator's defaults, stated once in the Rust core (``quasistatic::Options``).
 DEFAULTS = _core.quasistatic_defaults()
@@ -25,11 +25,15 @@ SPEED = DEFAULTS["speed"]  # m/s, the thesis' pushing speed
 def support_kwargs(support: str | None = None, rings: int | None = None, points: int | None = None,
                    merge_fingers: bool | None = None) -> dict:
     """The finger support model (defaults: the core's): ``support`` "points" (pads as rings of
-    contact points) or "limit_surface" (each pad one ellipsoidal patch)."""
+    contact points) or "limit_surface" (each pad one ellipsoidal patch); ``rings`` in [1, 64] and
+    ``points`` in [0, 4096] (bounds against runaway model sizes)."""
     given = dict(support=support, rings=rings, points=points, merge_fingers=merge_fingers)
     kw = {k: DEFAULTS[k] if v is None else v for k, v in given.items()}
-    if kw["support"] not in ("points", "limit_surface"):
-        raise ArgumentError(f"invalid `support`: must be 'points' or 'limit_surface', got {kw['support']!r}", "support")
+    if not isinstance(kw["support"], str) or kw["support"] not in ("points", "limit_surface"):
+        raise ArgumentError(f"invalid `support`: must be 'points' or 'limit_surface', got {kw['support']!r:.60}", "support")
+    kw["rings"] = _count(kw["rings"], "rings", 1, 64)
+    kw["points"] = _count(kw["points"], "points", 0, 4096)
+    kw["merge_fingers"] = _flag(kw["merge_fingers"], "merge_fingers")
     return kw
 
 
@@ -37,6 +41,8 @@ def problem(scene: Scene, pose, pusher: str | None = None, h: float | None = Non
     """The instantaneous complementarity problem (``regrasp._core.MncpProblem``); ``h`` the time
     step [s] (default: the core's)."""
     kw = support_kwargs(**support)
+    h = None if h is None else _number(h, "h")
+    pusher = None if pusher is None else _name(pusher, "pusher")
     return scene._core.quasistatic_problem(list(_vec(pose, 3, "pose")), pusher, kw["support"], kw["rings"],
                                            kw["points"], kw["merge_fingers"], h, SPEED)
 
@@ -44,11 +50,9 @@ def problem(scene: Scene, pose, pusher: str | None = None, h: float | None = Non
 def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: float = 0.05, **support) -> dict:
     """Explicit time stepping of one push: the pusher moves with constant body ``twist``."""
     kw = support_kwargs(**support)
-    if not (duration > 0 and dt > 0 and np.isfinite(duration) and np.isfinite(dt)):
-        raise ArgumentError("invalid `duration`/`dt`: must be positive and finite", "duration")
-    return scene._core.simulate_push(list(_vec(pose, 3, "pose")), pusher, list(_vec(twist, 3, "twist")),
-                                     float(duration), float(dt), kw["support"], kw["rings"], kw["points"],
-                                     kw["merge_fingers"])
+    duration, dt = _number(duration, "duration"), _number(dt, "dt")
+    return scene._core.simulate_push(list(_vec(pose, 3, "pose")), _name(pusher, "pusher"), list(_vec(twist, 3, "twist")),
+                                     duration, dt, kw["support"], kw["rings"], kw["points"], kw["merge_fingers"])
 
 
 # --- plans -------------------------------------------------------------------------------------
@@ -96,6 +100,7 @@ def replay_plan(scene: Scene, plan, speed: float = SPEED, dt: float = 0.05, **su
     """Replays a plan (a :class:`~regrasp.Plan` or a plan dict) in the quasi-static simulator:
     for each step the pusher is put in contact with the object where it is now, then follows the
     planned object motion of that step (its body twist, at ``speed``)."""
+    speed, dt = _number(speed, "speed"), _number(dt, "dt")
     path = as_plan(plan, scene).path
     q = np.asarray(path[0]["pose"], float)
     ts, qs, planned = [0.0], [q.copy()], [q.copy()]

@@ -18,9 +18,12 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from ..errors import ArgumentError, RegraspError
+from ..errors import ArgumentError, RegraspError, check_seed
 from .quasistatic import SPEED
-from ..scene.planar import Scene
+from ..scene.planar import Scene, _count
+
+#: most random pushes one validation takes (a bound on its time: about 1 ms a push)
+MAX_PUSHES = 1_000_000
 
 def _random_pose(scene: Scene, rng, theta=np.pi / 6):
     out = scene.outline
@@ -189,8 +192,13 @@ def _table(pred, sim, ok, mask) -> dict:
 def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasistatic",), support: str = "points",
              workers: int | None = None, ray_address=None, progress: bool = False) -> dict:
     """Agreement of the exact motion-cone prediction with each engine (see the module notes)."""
-    if pushes < 1:
-        raise ArgumentError(f"invalid `pushes`: must be at least 1 (got {pushes})", "pushes")
+    pushes, seed = _count(pushes, "pushes", 1, MAX_PUSHES), check_seed(seed)
+    if isinstance(engines, str) or not isinstance(engines, (list, tuple)) or not engines:
+        raise ArgumentError(f"invalid `engines`: a list of engine names (got {engines!r:.60})", "engines")
+    if not isinstance(support, str) or support not in ("points", "limit_surface"):
+        raise ArgumentError(f"invalid `support`: must be 'points' or 'limit_surface' (got {support!r:.60})", "support")
+    if workers is not None:
+        workers = _count(workers, "workers", 1, 4096)
     for e in engines:
         if e not in ENGINES:
             raise ArgumentError(f"invalid `engines`: unknown engine {e!r} (available: {', '.join(ENGINES)})", "engines")
