@@ -35,8 +35,9 @@ MAX_SAMPLES = 10_000_000
 MAX_CONES = 10_000_000
 MAX_WORKERS = 1024
 MAX_HORIZON = 1000
-#: most time steps of one simulated push (`--duration` / `--dt`)
+#: most time steps of one simulated push (`--duration` / `--dt`) and its longest duration [s]
 MAX_STEPS = 1_000_000
+MAX_DURATION = 100_000.0
 #: largest --scale-* factor and largest grip force of `approx-error --forces` [N]
 MAX_SCALE = 1000.0
 MAX_FORCE = 10_000.0

@@ -9,7 +9,7 @@ import numpy as np
 from ..errors import ArgumentError
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
-from . import (CANNOT, FIGURE_SUFFIXES, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, VIDEO_SUFFIXES, add_scale_options,
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, VIDEO_SUFFIXES, add_scale_options,
                add_verbose, check_count, check_number, check_outputs, check_positive, execute3d, floats, given, load,
                load_planar, reject_flags, scales, seed_arg)
 
@@ -129,8 +129,8 @@ def _push_report(scene, a, twist, tr: dict) -> int:
 
 def _check_push(a) -> None:
     """--duration, --dt (positive, at most MAX_STEPS steps) and --plot, before any work."""
-    check_number(a, "duration", 0.0, what="duration [s]", lo_open=True)
-    check_number(a, "dt", 0.0, what="time step [s]", lo_open=True)
+    check_number(a, "duration", 0.0, MAX_DURATION, what="duration [s]", lo_open=True)
+    check_number(a, "dt", 0.0, a.duration, what="time step [s] (at most --duration)", lo_open=True)
     if a.duration / a.dt > MAX_STEPS:
         raise ArgumentError(f"invalid `--dt`: --duration / --dt is at most {MAX_STEPS} steps "
                             f"(got {a.duration / a.dt:.3g})", "--dt")
