@@ -20,3 +20,13 @@ def pytest_sessionfinish(session, exitstatus):
     out = os.environ.get("REGRASP_FUZZ_REPORT")
     if out and RECORDER.cases:
         Path(out).write_text(json.dumps(RECORDER.summary(), indent=1))
+
+
+def pytest_collection_modifyitems(config, items):
+    """Every test of this folder carries the `fuzz` marker (`-m "not fuzz"` skips the suite)."""
+    import pytest
+
+    here = Path(__file__).parent
+    for item in items:
+        if here in Path(str(item.fspath)).parents:
+            item.add_marker(pytest.mark.fuzz)

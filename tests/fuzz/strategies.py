@@ -123,7 +123,7 @@ def mutation(draw, d: dict):
     kind = draw(st.sampled_from(kinds))
     if kind in ("number", "scale") and numeric:
         p, v = draw(st.sampled_from(numeric))
-        new = draw(st.sampled_from(HOSTILE_NUMBERS)) if kind == "number" else v * draw(
+        new = draw(st.one_of(st.sampled_from(HOSTILE_NUMBERS), st.floats())) if kind == "number" else v * draw(
             st.sampled_from([-1, 1e3, 1e-3, 1e6, 1e-6, 1e12]))
         _parent(d, p)[p[-1]] = new
         bad = isinstance(new, float) and not math.isfinite(new)
@@ -232,4 +232,7 @@ def bad_values(kind: str) -> st.SearchStrategy:
         base += [-5, 0, 2**31, 2**63, 10**12, 1.5, "10"]
     elif kind == "name":
         base += ["nope", "LEFT", "left ", "\x00", "ü" * 3, "x" * 10000]
-    return st.sampled_from(base)
+    n = int(kind[3:]) if kind.startswith("vec") else 3
+    drawn = {"name": st.text(max_size=12), "count": st.integers(), "scalar": st.floats()}.get(
+        kind, st.lists(st.floats(), min_size=n - 1, max_size=n + 1))
+    return st.one_of(st.sampled_from(base), drawn)

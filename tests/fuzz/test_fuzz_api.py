@@ -183,7 +183,7 @@ def test_entry_point_works_with_its_defaults(name):
     run(f"api.defaults.{name}", f"{name}(defaults)", lambda: fn(**defaults), timeout=30)
 
 
-@fuzz_settings(250, 6000)
+@fuzz_settings(400, 6000)
 @given(case=api_case())
 def test_bad_argument(case):
     name, arg, value = case
@@ -196,7 +196,7 @@ def test_bad_argument(case):
 SAVE_PATHS = ["missing/sub/plan.json", ".", "", "x" * 300, "dir-as-file", "readonly/plan.json", None, 0, b"\xff"]
 
 
-@fuzz_settings(15, 300)
+@fuzz_settings(20, 300)
 @given(rel=st.sampled_from(SAVE_PATHS))
 def test_plan_save_to_bad_path(rel, tmp_path_factory):
     base = tmp_path_factory.mktemp("save")

@@ -79,7 +79,7 @@ def load_planar(d: dict, loader: str) -> regrasp.Scene:
     return regrasp.Scene.from_toml(to_toml(d))
 
 
-@fuzz_settings(90, 6000)
+@fuzz_settings(150, 6000)
 @given(case=mutated_scene(PLANAR), loader=st.sampled_from(["toml", "dict"]))
 def test_mutated_planar_scene(case, loader):
     name, d, what, must = case
@@ -89,7 +89,7 @@ def test_mutated_planar_scene(case, loader):
         run("scene.planar.exercise", repro, lambda: exercise_planar(scene))
 
 
-@fuzz_settings(45, 4000)
+@fuzz_settings(80, 4000)
 @given(case=mutated_scene(SPATIAL))
 def test_mutated_spatial_scene(case):
     name, d, what, must = case
@@ -99,7 +99,7 @@ def test_mutated_spatial_scene(case):
         run("scene.spatial.exercise", repro, lambda: exercise_spatial(scene))
 
 
-@fuzz_settings(20, 500)
+@fuzz_settings(40, 500)
 @given(case=mutated_scene(PLANAR + SPATIAL))
 def test_mutated_scene_file(case, tmp_path_factory):
     """`load_scene` on a mutated file (both dimensions, told apart by the file)."""
