@@ -51,20 +51,21 @@ def _vec(x, n: int, name: str) -> np.ndarray:
     return _finite(a, name)
 
 
-def _rows(x, name: str, n: int = 3) -> np.ndarray:
-    """An (m, n) array of finite numbers (one vector of ``n`` is one row), m >= 1."""
+def _rows(x, name: str, n: int = 3, finite: bool = False) -> np.ndarray:
+    """An (m, n) array (one vector of ``n`` is one row), m >= 1; of finite numbers with ``finite``
+    (batches report a non-finite row in its status instead)."""
     a = np.ascontiguousarray(_array(x, name))
     if a.ndim == 1 and a.shape == (n,):
         a = a[None, :]
     if a.ndim != 2 or a.shape[1] != n or a.shape[0] == 0:
         raise ArgumentError(f"invalid `{name}`: expected an (m, {n}) array with m >= 1, got shape {a.shape}", name)
-    return _finite(a, name)
+    return _finite(a, name) if finite else a
 
 
 def _vec_or_rows(x, name: str):
     """One 3-vector (a list for the core) or an (m, 3) array: what the cone tests take."""
     a = _array(x, name)
-    return _rows(a, name) if a.ndim == 2 else list(_vec(a, 3, name))
+    return _rows(a, name, finite=True) if a.ndim == 2 else list(_vec(a, 3, name))
 
 
 def _twists(x, name: str) -> np.ndarray:
