@@ -21,7 +21,7 @@ from regrasp.reference import approx_error
 from regrasp.sim import quasistatic, validation
 
 from .harness import fuzz_settings, run
-from .strategies import BAD_SCALARS, EXAMPLES, bad_values
+from .strategies import BAD_SCALARS, EXAMPLES, Weird, bad_values
 
 P = regrasp.load_scene(EXAMPLES / "block-low-friction.toml")
 S3 = regrasp.load_scene(EXAMPLES / "pivot-3d.toml")
@@ -160,9 +160,6 @@ def bad_for(kind: str) -> st.SearchStrategy:
     if kind == "bool":
         return st.sampled_from([None, "yes", 2, math.nan, [], Weird()])
     return bad_values(kind)
-
-
-from .strategies import Weird  # noqa: E402
 
 
 @st.composite
