@@ -4,6 +4,7 @@
 # first failure. Prints the cases run per family and the bad outcomes per kind (panics, hangs,
 # NaN/inf, exceptions outside the closed set, tracebacks, ...) with the first reproductions, and
 # exits 1 when there is any. Usage: scripts/fuzz-long.sh [REPORT.json] [pytest args...]
+# (REGRASP_FUZZ_SCALE=0.1 runs a tenth of the long counts; REGRASP_FUZZ_TIMEOUT: seconds a case may take)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 REPORT="${1:-out/fuzz-long.json}"

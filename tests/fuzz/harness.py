@@ -4,6 +4,7 @@ the closed exception set (SceneError/ArgumentError naming a field, GraspError)."
 from __future__ import annotations
 
 import dataclasses
+import faulthandler
 import math
 import os
 import signal
@@ -36,8 +37,8 @@ settings.register_profile(
 
 
 def n_examples(short: int, long: int) -> int:
-    """Examples per test in the active profile."""
-    return long if LONG else short
+    """Examples per test in the active profile (REGRASP_FUZZ_SCALE scales the long one)."""
+    return max(1, int(long * float(os.environ.get("REGRASP_FUZZ_SCALE", "1")))) if LONG else short
 
 
 def fuzz_settings(short: int, long: int) -> settings:
@@ -158,6 +159,8 @@ def run(family: str, what: str, fn, timeout: float | None = None, reject: list |
     limit = TIMEOUT if timeout is None else timeout
     old = signal.signal(signal.SIGALRM, _alarm)
     signal.setitimer(signal.ITIMER_REAL, limit)
+    # a loop that never checks signals is not interrupted by the alarm: its stack goes to stderr
+    faulthandler.dump_traceback_later(3 * limit + 5, exit=False)
     t0 = time.monotonic()
     try:
         out = fn()
@@ -169,6 +172,7 @@ def run(family: str, what: str, fn, timeout: float | None = None, reject: list |
         return None
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
+        faulthandler.cancel_dump_traceback_later()
         signal.signal(signal.SIGALRM, old)
     took = time.monotonic() - t0
     if took > limit:  # the alarm could not interrupt it (a loop that does not check signals)
