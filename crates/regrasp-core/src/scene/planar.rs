@@ -82,8 +82,15 @@ pub struct Scene {
     pub uncertainty: Option<Uncertainty>,
     /// Which motion cones the scene answers with (nominal unless made robust or fixtureless).
     pub mode: ConeMode,
+    /// What the loader changed, e.g. a measured pusher point moved onto the outline.
+    pub notes: Vec<String>,
 }
 impl Scene {
+    /// What the loader changed in the file's values (pusher points snapped onto the outline).
+    pub fn notes(&self) -> &[String] {
+        &self.notes
+    }
+
     /// Error naming the field to change when gravity alone would make the support slip at `q`.
     pub(crate) fn check_holds(&self, q: &[f64; 3], at: &str) -> Result<()> {
         let ratio = self.hold_ratio(q);
