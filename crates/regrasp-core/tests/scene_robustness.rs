@@ -441,3 +441,34 @@ fn every_example_loads_unchanged_through_the_mutation_round_trip() {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Copies with changed parameters stay within the bounds
+
+#[test]
+fn absurd_grip_forces_and_scales_are_argument_errors() {
+    let s = Scene::from_toml_str(BLOCK).unwrap();
+    for f in [1e200, 1e300, f64::NAN, -1.0, 0.0] {
+        assert!(matches!(s.try_with_grip_force(f), Err(Error::InvalidArgument { ref name, .. }) if name == "force"), "force {f}");
+    }
+    assert_eq!(s.try_with_grip_force(40.0).unwrap().grip_force(), Some(40.0));
+    use regrasp::cones::robust::ConeMode;
+    use regrasp::scene::perturb::scaled;
+    let e = scaled(&s, 1.0, 1e300, 1.0, 1.0, ConeMode::Nominal).unwrap_err();
+    assert!(matches!(e, Error::InvalidArgument { ref name, .. } if name == "grip"), "{e:?}");
+    let e = scaled(&s, 1.0, 1.0, 1e300, 1.0, ConeMode::Nominal).unwrap_err();
+    assert!(matches!(e, Error::InvalidArgument { ref name, .. } if name == "mass"), "{e:?}");
+    assert!(scaled(&s, 0.9, 1.1, 1.2, 0.8, ConeMode::Nominal).is_ok());
+}
+
+#[test]
+fn a_ten_thousand_vertex_outline_on_a_surface_loads_fast() {
+    let text = round_scene(bounds::MAX_OUTLINE_VERTICES);
+    let at = text.find("[grasp]").unwrap();
+    let (head, tail) = text.split_at(at);
+    let pushers = &tail[tail.find("[[pushers]]").unwrap()..tail.find("[task]").unwrap()];
+    let text = format!("{head}[surface]\nfriction = 0.5\n{pushers}");
+    let t = Instant::now();
+    Scene::from_toml_str(&text).expect("a round object on a surface");
+    assert!(t.elapsed() < Duration::from_secs(1), "loading took {:?}", t.elapsed());
+}

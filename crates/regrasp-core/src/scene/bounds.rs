@@ -27,6 +27,14 @@ impl Bound {
         Err(Error::scene(field, format!("must be a number in [{:e}, {:e}]{unit} (got {v})", self.lo, self.hi)))
     }
 
+    /// Like [`Self::check`] for a call argument `name` (an [`Error::InvalidArgument`]).
+    pub fn check_arg(&self, name: &str, v: f64) -> Result<f64> {
+        self.check(name, v).map_err(|e| match e {
+            Error::Scene { message, .. } => Error::arg(name, message),
+            other => other,
+        })
+    }
+
     /// Every component of `v` checked (fields `field[k]`).
     pub fn check_each<const N: usize>(&self, field: &str, v: [f64; N]) -> Result<[f64; N]> {
         for (k, x) in v.iter().enumerate() {

@@ -299,7 +299,15 @@ impl Scene {
         }
     }
 
-    /// A copy with another per-finger grip force (grasp scenes).
+    /// A copy with another per-finger grip force [N] (grasp scenes), the force checked against
+    /// [`crate::scene::bounds::FORCE`] (an error on the argument `force`).
+    pub fn try_with_grip_force(&self, force: f64) -> Result<Scene> {
+        crate::scene::bounds::FORCE.check_arg("force", force)?;
+        Ok(self.with_grip_force(force))
+    }
+
+    /// A copy with another per-finger grip force (grasp scenes; unchecked: see
+    /// [`Self::try_with_grip_force`]).
     pub fn with_grip_force(&self, force: f64) -> Scene {
         let mut s = self.clone();
         if let Support::Grasp(g) = &mut s.support {
