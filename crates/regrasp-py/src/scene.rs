@@ -57,6 +57,8 @@ impl Scene {
         }
     }
     #[getter] fn pusher_names(&self) -> Vec<String> { self.inner.pushers.iter().map(|p| p.name.clone()).collect() }
+    /// What the loader changed in the file's values (pusher points snapped onto the outline).
+    #[getter] fn notes(&self) -> Vec<String> { self.inner.notes().to_vec() }
     #[getter] fn length(&self) -> f64 { self.inner.length }
     #[getter] fn mass(&self) -> f64 { self.inner.mass }
     #[getter] fn com(&self) -> (f64, f64) { (self.inner.com.x, self.inner.com.y) }

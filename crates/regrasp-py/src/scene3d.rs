@@ -37,6 +37,8 @@ impl Scene3D {
     }
     #[getter] fn name(&self) -> String { self.inner.name.clone() }
     #[getter] fn pusher_names(&self) -> Vec<String> { self.inner.pushers.iter().map(|p| p.name.clone()).collect() }
+    /// What the loader changed in the file's values (pusher points snapped onto the surface).
+    #[getter] fn notes(&self) -> Vec<String> { self.inner.notes().to_vec() }
     #[getter] fn length(&self) -> f64 { self.inner.length }
     #[getter] fn mass(&self) -> f64 { self.inner.mass }
     #[getter] fn inertia<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> { matrix(py, &self.inner.inertia) }

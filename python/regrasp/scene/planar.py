@@ -373,6 +373,8 @@ class Scene:
     name = core_property("name")
     kind = core_property("kind", '"grasp" (object between finger pads) or "surface" (object on a plane).')
     pusher_names = core_property("pusher_names")
+    notes = core_property("notes", "What the loader changed in the file's values: measured pusher points moved onto "
+                                   "the outline (list of str, empty when nothing moved).")
 
     @property
     def pushers(self) -> list[Pusher]:

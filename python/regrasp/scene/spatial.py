@@ -46,6 +46,8 @@ class Scene3D:
 
     name = core_property("name")
     pusher_names = core_property("pusher_names")
+    notes = core_property("notes", "What the loader changed in the file's values: measured pusher points moved onto "
+                                   "the object's surface (list of str, empty when nothing moved).")
     length = core_property("length", "Characteristic length L [m] weighing rotation against translation.")
     mass = core_property("mass")
     inertia = core_property("inertia")

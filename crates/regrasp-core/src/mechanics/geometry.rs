@@ -78,6 +78,46 @@ fn segments_intersect(a: &Vec2, b: &Vec2, c: &Vec2, d: &Vec2) -> bool {
         || (d4 == 0.0 && on_seg(a, b, d))
 }
 
+/// A pair `(i, j)`, `i < j`, of non-adjacent edges of the closed outline `pts` that touch, if
+/// any. A sweep along x: the edges sorted by their left end, each tested (exactly) only against
+/// the edges still open at that x whose z-ranges overlap its own; O(n log n) when a vertical
+/// line crosses few edges (any outline a scene describes), O(n²) at worst (a comb).
+fn first_crossing(pts: &[Vec2]) -> Option<(usize, usize)> {
+    let n = pts.len();
+    let bbox = |i: usize| {
+        let (a, b) = (pts[i], pts[(i + 1) % n]);
+        (a.inf(&b), a.sup(&b))
+    };
+    let boxes: Vec<(Vec2, Vec2)> = (0..n).map(bbox).collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&i, &j| boxes[i].0.x.total_cmp(&boxes[j].0.x));
+    let mut open: Vec<usize> = Vec::new();
+    for &i in &order {
+        let (lo, hi) = boxes[i];
+        open.retain(|&j| boxes[j].1.x >= lo.x);
+        for &j in &open {
+            let (a, b) = (i.min(j), i.max(j));
+            let adjacent = b == a + 1 || (a == 0 && b == n - 1);
+            if adjacent || boxes[j].1.y < lo.y || boxes[j].0.y > hi.y {
+                continue;
+            }
+            if segments_intersect(&pts[a], &pts[(a + 1) % n], &pts[b], &pts[(b + 1) % n]) {
+                return Some((a, b));
+            }
+        }
+        open.push(i);
+    }
+    None
+}
+
+/// The point of segment `ab` nearest to `p`.
+pub fn closest_on_segment(p: &Vec2, a: &Vec2, b: &Vec2) -> Vec2 {
+    let ab = b - a;
+    let l2 = ab.norm_squared();
+    let t = if l2 > 0.0 { ((p - a).dot(&ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    a + ab * t
+}
+
 /// Distance from `p` to segment `ab`.
 pub fn point_segment_distance(p: &Vec2, a: &Vec2, b: &Vec2) -> f64 {
     let ab = b - a;
@@ -101,16 +141,8 @@ impl Polygon {
                 return Err(PolygonDefect::RepeatedVertex(i));
             }
         }
-        for i in 0..n {
-            for j in (i + 1)..n {
-                // adjacent edges share a vertex: only check non-adjacent pairs
-                if j == i + 1 || (i == 0 && j == n - 1) {
-                    continue;
-                }
-                if segments_intersect(&pts[i], &pts[(i + 1) % n], &pts[j], &pts[(j + 1) % n]) {
-                    return Err(PolygonDefect::SelfIntersecting(i, j));
-                }
-            }
+        if let Some((i, j)) = first_crossing(&pts) {
+            return Err(PolygonDefect::SelfIntersecting(i, j));
         }
         // adjacent edges folding back onto each other also make the outline non-simple
         for i in 0..n {
@@ -203,6 +235,19 @@ impl Polygon {
         } else {
             -d
         }
+    }
+
+    /// The outline point nearest to `p`, the index of its edge and its distance to `p` [m].
+    pub fn closest_point(&self, p: &Vec2) -> (Vec2, usize, f64) {
+        let mut best = (self.pts[0], 0, f64::INFINITY);
+        for (i, (a, b)) in self.edges().enumerate() {
+            let c = closest_on_segment(p, &a, &b);
+            let d = (c - p).norm();
+            if d < best.2 {
+                best = (c, i, d);
+            }
+        }
+        best
     }
 
     /// Index of the edge closest to `p`.

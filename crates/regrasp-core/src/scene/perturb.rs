@@ -5,6 +5,7 @@ use crate::cones::frame::{ConeMode, PusherModel};
 use crate::cones::robust::Uncertainty;
 use crate::error::{Error, Result};
 use crate::mechanics::friction_cone::PusherContact;
+use crate::scene::bounds;
 use crate::scene::planar::{Scene, Support};
 
 /// `ρ = μ_s N / (m g)` of a grasp scene (`N` per finger); `None` for an object on a surface.
@@ -32,13 +33,32 @@ pub fn scaled(scene: &Scene, finger_friction: f64, grip: f64, mass: f64, pusher_
         Support::Surface(sf) => sf.friction *= finger_friction,
     }
     s.mass *= mass;
+    within("mass", s.mass, bounds::MASS)?;
+    match &s.support {
+        Support::Grasp(g) => {
+            within("grip", g.force, bounds::FORCE)?;
+            within("finger_friction", g.friction, bounds::SUPPORT_FRICTION)?;
+        }
+        Support::Surface(sf) => {
+            within("finger_friction", sf.friction, bounds::SUPPORT_FRICTION)?;
+        }
+    }
     let metric = s.metric();
     for p in s.pushers.iter_mut() {
-        p.contact = PusherContact { friction: p.contact.friction * pusher_friction, ..p.contact.clone() };
+        p.contact = PusherContact { friction: within("pusher_friction", p.contact.friction * pusher_friction, bounds::PUSHER_FRICTION)?, ..p.contact.clone() };
         p.model = PusherModel::new(p.contact.clone(), metric)?;
     }
     s.mode = mode;
     Ok(s)
+}
+
+/// A scaled value: an error on argument `name` when it leaves the top of its bound (scaling
+/// down never leaves a positive value's range in a way that overflows).
+fn within(name: &str, v: f64, b: bounds::Bound) -> Result<f64> {
+    if v.is_finite() && v <= b.hi {
+        return Ok(v);
+    }
+    Err(Error::arg(name, format!("the scaled value {v:e} exceeds {:e}", b.hi)))
 }
 
 /// The worst case of a range (`ρ_min`, lowest pusher friction) with the robust cone mode.

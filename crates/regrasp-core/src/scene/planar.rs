@@ -82,8 +82,15 @@ pub struct Scene {
     pub uncertainty: Option<Uncertainty>,
     /// Which motion cones the scene answers with (nominal unless made robust or fixtureless).
     pub mode: ConeMode,
+    /// What the loader changed, e.g. a measured pusher point moved onto the outline.
+    pub notes: Vec<String>,
 }
 impl Scene {
+    /// What the loader changed in the file's values (pusher points snapped onto the outline).
+    pub fn notes(&self) -> &[String] {
+        &self.notes
+    }
+
     /// Error naming the field to change when gravity alone would make the support slip at `q`.
     pub(crate) fn check_holds(&self, q: &[f64; 3], at: &str) -> Result<()> {
         let ratio = self.hold_ratio(q);
@@ -292,7 +299,15 @@ impl Scene {
         }
     }
 
-    /// A copy with another per-finger grip force (grasp scenes).
+    /// A copy with another per-finger grip force [N] (grasp scenes), the force checked against
+    /// [`crate::scene::bounds::FORCE`] (an error on the argument `force`).
+    pub fn try_with_grip_force(&self, force: f64) -> Result<Scene> {
+        crate::scene::bounds::FORCE.check_arg("force", force)?;
+        Ok(self.with_grip_force(force))
+    }
+
+    /// A copy with another per-finger grip force (grasp scenes; unchecked: see
+    /// [`Self::try_with_grip_force`]).
     pub fn with_grip_force(&self, force: f64) -> Scene {
         let mut s = self.clone();
         if let Support::Grasp(g) = &mut s.support {

@@ -9,6 +9,7 @@ use crate::mechanics::friction_cone::PusherContact;
 use crate::mechanics::geometry::{cross2, perp, point_segment_distance, Polygon, Vec2};
 use crate::mechanics::limit_surface::{LimitSurface, Pressure, PressureDistribution};
 use crate::mechanics::metric::Metric;
+use crate::scene::{bounds, exact};
 use crate::scene::planar::{Grasp, PadShape, Pusher, Scene, Support, Surface, Task};
 use serde::{Deserialize, Serialize};
 
@@ -42,8 +43,10 @@ pub struct RawUncertainty {
 #[derive(Deserialize, Serialize, Default, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct RawObject {
+    #[serde(default, deserialize_with = "exact::opt_list::<2, _>")]
     pub outline: Option<Vec<[f64; 2]>>,
     pub mass: Option<f64>,
+    #[serde(default, deserialize_with = "exact::opt::<2, _>")]
     pub com: Option<[f64; 2]>,
     /// Documentation only: what the object is made of.
     pub material: Option<String>,
@@ -58,6 +61,7 @@ pub struct RawGrasp {
     /// `"circle"` (default) or `"rectangle"`.
     pub pad_shape: Option<String>,
     /// `[width, height]` of a rectangular pad (gripper X × Z) [m].
+    #[serde(default, deserialize_with = "exact::opt::<2, _>")]
     pub pad_size: Option<[f64; 2]>,
     /// `"uniform"` (default) or `"hertzian"` (circular pads only).
     pub pressure: Option<String>,
@@ -74,6 +78,7 @@ pub struct RawSurface {
 #[derive(Deserialize, Serialize, Default, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct RawGravity {
+    #[serde(default, deserialize_with = "exact::opt::<2, _>")]
     pub direction: Option<[f64; 2]>,
     pub g: Option<f64>,
 }
@@ -83,15 +88,20 @@ pub struct RawGravity {
 pub struct RawPusher {
     pub name: Option<String>,
     pub friction: Option<f64>,
+    #[serde(default, deserialize_with = "exact::opt_list::<2, _>")]
     pub points: Option<Vec<[f64; 2]>>,
+    #[serde(default, deserialize_with = "exact::opt::<2, _>")]
     pub normal: Option<[f64; 2]>,
 }
 
 #[derive(Deserialize, Serialize, Default, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct RawTask {
+    #[serde(default, deserialize_with = "exact::opt::<3, _>")]
     pub start: Option<[f64; 3]>,
+    #[serde(default, deserialize_with = "exact::opt::<3, _>")]
     pub goal: Option<[f64; 3]>,
+    #[serde(default, deserialize_with = "exact::opt::<3, _>")]
     pub tolerance: Option<[f64; 3]>,
 }
 
@@ -125,33 +135,8 @@ fn normal_fits(outline: &Polygon, q: &Vec2, n: &Vec2, tol: f64) -> bool {
         .any(|(i, _)| inward(i).dot(n) > 1.0 - 1e-6)
 }
 
-/// Largest values accepted for forces [N], masses [kg], friction coefficients and lengths [m]
-/// (beyond them the numbers stop meaning a gripper and a hand-held object).
-const MAX_FORCE: f64 = 1e6;
-const MAX_MASS: f64 = 1e4;
-const MAX_FRICTION: f64 = 100.0;
-
-fn bounded(field: &str, v: f64, lo: f64, hi: f64) -> Result<f64> {
-    if v < lo || v > hi {
-        return Err(Error::scene(field, format!("must be between {lo:e} and {hi:e} (got {v})")));
-    }
-    Ok(v)
-}
-
-fn positive(field: &str, v: Option<f64>) -> Result<f64> {
-    let v = v.ok_or_else(|| Error::scene(field, "is required"))?;
-    if !v.is_finite() || v <= 0.0 {
-        return Err(Error::scene(field, format!("must be a positive number (got {v})")));
-    }
-    Ok(v)
-}
-
-fn non_negative(field: &str, v: Option<f64>) -> Result<f64> {
-    let v = v.ok_or_else(|| Error::scene(field, "is required"))?;
-    if !v.is_finite() || v < 0.0 {
-        return Err(Error::scene(field, format!("must be a non-negative number (got {v})")));
-    }
-    Ok(v)
+fn req<T>(field: &str, v: Option<T>) -> Result<T> {
+    v.ok_or_else(|| Error::scene(field, "is required"))
 }
 
 fn finite2(field: &str, v: [f64; 2]) -> Result<Vec2> {
@@ -162,13 +147,25 @@ fn finite2(field: &str, v: [f64; 2]) -> Result<Vec2> {
     }
 }
 
-fn finite3(field: &str, v: Option<[f64; 3]>) -> Result<[f64; 3]> {
-    let v = v.ok_or_else(|| Error::scene(field, "is required"))?;
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(v)
-    } else {
-        Err(Error::scene(field, "has a non-finite component"))
+/// A point or position: finite, each coordinate within [`bounds::COORD`].
+fn point2(field: &str, v: [f64; 2]) -> Result<Vec2> {
+    let p = finite2(field, v)?;
+    for x in p.iter() {
+        bounds::COORD.check(field, *x)?;
     }
+    Ok(p)
+}
+
+/// A planar pose `[x, z, theta]`: positions within [`bounds::COORD`], the angle within
+/// [`bounds::ANGLE`] (errors on `field`).
+fn pose3(field: &str, v: Option<[f64; 3]>) -> Result<[f64; 3]> {
+    let v = req(field, v)?;
+    if !v.iter().all(|x| x.is_finite()) {
+        return Err(Error::scene(field, "has a non-finite component"));
+    }
+    point2(field, [v[0], v[1]])?;
+    bounds::ANGLE.check(field, v[2])?;
+    Ok(v)
 }
 
 fn unit2(field: &str, v: [f64; 2]) -> Result<Vec2> {
@@ -176,6 +173,10 @@ fn unit2(field: &str, v: [f64; 2]) -> Result<Vec2> {
     let n = v.norm();
     if n == 0.0 {
         return Err(Error::scene(field, "must be a non-zero vector"));
+    }
+    let b = bounds::DIRECTION_NORM;
+    if n < b.lo || n > b.hi {
+        return Err(Error::scene(field, format!("its norm must be in [{:e}, {:e}] (got {n:e})", b.lo, b.hi)));
     }
     Ok(v / n)
 }
@@ -231,7 +232,8 @@ impl Scene {
             (None, Some(sf)) => Support::Surface(Self::surface(sf, &outline, &com)?),
         };
         let length = outline.gyration_radius_sq(&com).sqrt();
-        let pushers = Self::pushers(raw.pushers.as_deref(), &outline, Metric::new(com, length))?;
+        let mut notes = Vec::new();
+        let pushers = Self::pushers(raw.pushers.as_deref(), &outline, Metric::new(com, length), &mut notes)?;
         let mut scene = Scene {
             name,
             description: raw.description.clone(),
@@ -246,6 +248,7 @@ impl Scene {
             length,
             uncertainty: raw.uncertainty.as_ref().map(Self::uncertainty).transpose()?,
             mode: ConeMode::Nominal,
+            notes,
         };
         scene.task = Self::task(raw.task.as_ref(), &scene)?;
         if let Support::Surface(_) = scene.support {
@@ -260,16 +263,25 @@ impl Scene {
 
     /// The object's outline, mass [kg] and centre of mass (default: the area centroid).
     fn object(obj: &RawObject) -> Result<(Polygon, f64, Vec2)> {
-        let outline_raw = obj.outline.clone().ok_or_else(|| Error::scene("object.outline", "is required"))?;
+        let outline_raw = req("object.outline", obj.outline.as_ref())?;
+        bounds::count("object.outline", outline_raw.len(), bounds::MAX_OUTLINE_VERTICES, "vertices")?;
         let pts = outline_raw
             .iter()
             .enumerate()
-            .map(|(i, p)| finite2(&format!("object.outline[{i}]"), *p))
+            .map(|(i, p)| point2(&format!("object.outline[{i}]"), *p))
             .collect::<Result<Vec<_>>>()?;
         let outline = Polygon::new(pts).map_err(|d| Error::scene("object.outline", d.to_string()))?;
-        let mass = bounded("object.mass", positive("object.mass", obj.mass)?, 1e-9, MAX_MASS)?;
+        let size = outline.bbox_diagonal();
+        if bounds::SIZE.check("object.outline", size).is_err() {
+            let b = bounds::SIZE;
+            return Err(Error::scene(
+                "object.outline",
+                format!("its size (bounding-box diagonal) must be in [{:e}, {:e}] m (got {size:e})", b.lo, b.hi),
+            ));
+        }
+        let mass = bounds::MASS.check("object.mass", req("object.mass", obj.mass)?)?;
         let com = match obj.com {
-            Some(c) => finite2("object.com", c)?,
+            Some(c) => point2("object.com", c)?,
             None => outline.centroid(),
         };
         Ok((outline, mass, com))
@@ -290,7 +302,7 @@ impl Scene {
         };
         let g = match gr.g {
             None => 9.81,
-            Some(g) => bounded("gravity.g", non_negative("gravity.g", Some(g))?, 0.0, 1e3)?,
+            Some(g) => bounds::G.check("gravity.g", g)?,
         };
         Ok((d, g))
     }
@@ -298,11 +310,11 @@ impl Scene {
     /// A surface the object lies on (incline below π/2; uniform pressure over the outline, so
     /// the centre of mass must be the centroid); its limit surface fitted to the footprint.
     fn surface(sf: &RawSurface, outline: &Polygon, com: &Vec2) -> Result<Surface> {
-        let friction = bounded("surface.friction", positive("surface.friction", sf.friction)?, 1e-6, MAX_FRICTION)?;
-        let incline = match sf.incline {
-            None => 0.0,
-            Some(a) => non_negative("surface.incline", Some(a))?,
-        };
+        let friction = bounds::SUPPORT_FRICTION.check("surface.friction", req("surface.friction", sf.friction)?)?;
+        let incline = sf.incline.unwrap_or(0.0);
+        if !(incline.is_finite() && incline >= 0.0) {
+            return Err(Error::scene("surface.incline", format!("must be a non-negative number (got {incline})")));
+        }
         if incline >= std::f64::consts::FRAC_PI_2 {
             return Err(Error::scene("surface.incline", "must be below π/2 rad"));
         }
@@ -318,12 +330,13 @@ impl Scene {
     }
 
     /// The pushers (at least one, unique names), their cones in the scene's metric.
-    fn pushers(raw: Option<&[RawPusher]>, outline: &Polygon, metric: Metric) -> Result<Vec<Pusher>> {
+    fn pushers(raw: Option<&[RawPusher]>, outline: &Polygon, metric: Metric, notes: &mut Vec<String>) -> Result<Vec<Pusher>> {
         let raw = raw.filter(|r| !r.is_empty()).ok_or_else(|| Error::scene("pushers", "at least one [[pushers]] is required"))?;
+        bounds::count("pushers", raw.len(), bounds::MAX_PUSHERS, "entries")?;
         let size = outline.bbox_diagonal();
         let mut pushers: Vec<Pusher> = Vec::new();
         for (i, p) in raw.iter().enumerate() {
-            let mut pusher = Self::pusher(&format!("pushers[{i}]"), p, outline, size)?;
+            let mut pusher = Self::pusher(&format!("pushers[{i}]"), p, outline, size, notes)?;
             if pushers.iter().any(|q| q.name == pusher.name) {
                 return Err(Error::scene(format!("pushers[{i}].name"), format!("`{}` is used twice", pusher.name)));
             }
@@ -351,13 +364,12 @@ impl Scene {
             (None, Support::Surface(_)) => return Ok(None),
             (Some(t), _) => t,
         };
-        let start = finite3("task.start", t.start)?;
-        let goal = finite3("task.goal", t.goal)?;
-        let tol = finite3("task.tolerance", t.tolerance)?;
+        let start = pose3("task.start", t.start)?;
+        let goal = pose3("task.goal", t.goal)?;
+        let tol = req("task.tolerance", t.tolerance)?;
         for (k, v) in tol.iter().enumerate() {
-            if *v <= 0.0 {
-                return Err(Error::scene(format!("task.tolerance[{k}]"), format!("must be positive (got {v})")));
-            }
+            let b = if k < 2 { bounds::TOL_POSITION } else { bounds::TOL_ANGLE };
+            b.check(&format!("task.tolerance[{k}]"), *v)?;
         }
         for (field, q) in [("task.start", start), ("task.goal", goal)] {
             if !scene.admissible(&q) {
@@ -369,8 +381,8 @@ impl Scene {
     }
 
     fn grasp(gr: &RawGrasp) -> Result<Grasp> {
-        let force = bounded("grasp.force", positive("grasp.force", gr.force)?, 1e-6, MAX_FORCE)?;
-        let friction = bounded("grasp.friction", positive("grasp.friction", gr.friction)?, 1e-6, MAX_FRICTION)?;
+        let force = bounds::FORCE.check("grasp.force", req("grasp.force", gr.force)?)?;
+        let friction = bounds::SUPPORT_FRICTION.check("grasp.friction", req("grasp.friction", gr.friction)?)?;
         let pressure = match gr.pressure.as_deref() {
             None | Some("uniform") => Pressure::Uniform,
             Some("hertzian") => Pressure::Hertzian,
@@ -379,9 +391,12 @@ impl Scene {
             }
         };
         let pad = match gr.pad_shape.as_deref() {
-            None | Some("circle") => PadShape::Circle {
-                radius: bounded("grasp.pad_radius", positive("grasp.pad_radius", gr.pad_radius)?, 1e-6, 10.0)?,
-            },
+            None | Some("circle") => {
+                if gr.pad_size.is_some() {
+                    return Err(Error::scene("grasp.pad_size", "is for pad_shape = \"rectangle\"; a circular pad is sized by grasp.pad_radius"));
+                }
+                PadShape::Circle { radius: bounds::PAD.check("grasp.pad_radius", req("grasp.pad_radius", gr.pad_radius)?)? }
+            }
             Some("rectangle") => {
                 if gr.pad_radius.is_some() {
                     return Err(Error::scene(
@@ -391,8 +406,8 @@ impl Scene {
                 }
                 let s = gr.pad_size.ok_or_else(|| Error::scene("grasp.pad_size", "is required for a rectangular pad"))?;
                 PadShape::Rectangle {
-                    width: positive("grasp.pad_size[0]", Some(s[0]))?,
-                    height: positive("grasp.pad_size[1]", Some(s[1]))?,
+                    width: bounds::PAD.check("grasp.pad_size[0]", s[0])?,
+                    height: bounds::PAD.check("grasp.pad_size[1]", s[1])?,
                 }
             }
             Some(other) => {
@@ -414,12 +429,12 @@ impl Scene {
         Ok(Grasp { force, friction, pad, pressure, limit_surface })
     }
 
-    fn pusher(field: &str, p: &RawPusher, outline: &Polygon, size: f64) -> Result<Pusher> {
+    fn pusher(field: &str, p: &RawPusher, outline: &Polygon, size: f64, notes: &mut Vec<String>) -> Result<Pusher> {
         let name = p.name.clone().ok_or_else(|| Error::scene(format!("{field}.name"), "is required"))?;
         if name.trim().is_empty() {
             return Err(Error::scene(format!("{field}.name"), "must not be empty"));
         }
-        let friction = bounded(&format!("{field}.friction"), non_negative(&format!("{field}.friction"), p.friction)?, 0.0, MAX_FRICTION)?;
+        let friction = bounds::PUSHER_FRICTION.check(&format!("{field}.friction"), req(&format!("{field}.friction"), p.friction)?)?;
         let raw_pts = p.points.clone().ok_or_else(|| Error::scene(format!("{field}.points"), "is required"))?;
         if raw_pts.is_empty() || raw_pts.len() > 2 {
             return Err(Error::scene(
@@ -435,11 +450,7 @@ impl Scene {
         let mut points = Vec::new();
         for (k, q) in raw_pts.iter().enumerate() {
             let f = format!("{field}.points[{k}]");
-            let q = finite2(&f, *q)?;
-            let d = outline.boundary_distance(&q);
-            if d > tol {
-                return Err(Error::scene(f, format!("{q:?} is not on the object outline (it is {d:.3e} m away)")));
-            }
+            let q = on_outline(&f, point2(&f, *q)?, outline, notes)?;
             if !normal_fits(outline, &q, &normal, tol) {
                 return Err(Error::scene(
                     format!("{field}.normal"),
@@ -472,4 +483,26 @@ impl Scene {
         let model = PusherModel::new(contact.clone(), Metric::new(Vec2::zeros(), size))
             .map_err(|e| Error::scene(field.to_string(), e.to_string()))?;
         Ok(Pusher { name, contact, model })
-    }}
+    }
+}
+
+/// A measured pusher point taken onto the outline: within [`bounds::SNAP_DISTANCE`] it is moved
+/// to the nearest outline point (a note says so when it moves more than 1 nm); farther, an
+/// error names the nearest outline point.
+fn on_outline(field: &str, q: Vec2, outline: &Polygon, notes: &mut Vec<String>) -> Result<Vec2> {
+    let (near, edge, d) = outline.closest_point(&q);
+    if d > bounds::SNAP_DISTANCE {
+        return Err(Error::scene(
+            field,
+            format!(
+                "[{}, {}] is not on the object outline: it is {:.1} µm away, more than the {:.1} µm a measured point may be off; the nearest outline point is [{:.6}, {:.6}] (edge {edge})",
+                q.x, q.y, d * 1e6, bounds::SNAP_DISTANCE * 1e6, near.x, near.y
+            ),
+        ));
+    }
+    if d <= 1e-9 {
+        return Ok(q);
+    }
+    notes.push(format!("{field} moved {:.1} µm onto the outline (edge {edge})", d * 1e6));
+    Ok(near)
+}

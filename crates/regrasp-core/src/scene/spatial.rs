@@ -42,6 +42,7 @@
 //! ```
 
 use crate::error::{Error, Result};
+use crate::scene::bounds;
 pub use crate::pose::spatial::{from_array as pose_from_array, to_array as pose_to_array};
 use nalgebra::{Isometry3, Matrix3, Vector3};
 
@@ -57,9 +58,24 @@ pub struct ConvexMesh {
 }
 
 impl ConvexMesh {
-    /// An icosphere of radius `r`: an icosahedron subdivided `levels` times, vertices on the
-    /// sphere (a drawing of a sphere; 20·4^levels triangles).
+    /// An icosphere of radius `r` (panics for a radius outside [`bounds::SIZE`]; scene files
+    /// go through [`Self::try_icosphere`]).
     pub fn icosphere(r: f64, levels: usize) -> Self {
+        Self::try_icosphere(r, levels).expect("an icosphere of a radius within bounds::SIZE is a convex mesh")
+    }
+
+    /// A box of full sizes `s`, centred at the origin (panics for sides outside
+    /// [`bounds::SIZE`]; scene files go through [`Self::try_cuboid`]).
+    pub fn cuboid(s: &V3) -> Self {
+        Self::try_cuboid(s).expect("a box with sides within bounds::SIZE is a convex mesh")
+    }
+
+    /// An icosphere of radius `r`: an icosahedron subdivided `levels` (at most 4) times, vertices
+    /// on the sphere (a drawing of a sphere; 20·4^levels triangles).
+    pub fn try_icosphere(r: f64, levels: usize) -> std::result::Result<Self, String> {
+        if !(r.is_finite() && r > 0.0) || levels > 4 {
+            return Err(format!("an icosphere needs a positive finite radius and at most 4 levels (got {r}, {levels})"));
+        }
         let t = (1.0 + 5f64.sqrt()) / 2.0;
         let mut v: Vec<V3> = [
             [-1.0, t, 0.0], [1.0, t, 0.0], [-1.0, -t, 0.0], [1.0, -t, 0.0], [0.0, -1.0, t], [0.0, 1.0, t],
@@ -88,11 +104,14 @@ impl ConvexMesh {
                 })
                 .collect();
         }
-        Self::new(v.into_iter().map(|x| x * r).collect(), f).expect("an icosphere is a convex mesh")
+        Self::new(v.into_iter().map(|x| x * r).collect(), f)
     }
 
     /// A box of full sizes `s`, centred at the origin.
-    pub fn cuboid(s: &V3) -> Self {
+    pub fn try_cuboid(s: &V3) -> std::result::Result<Self, String> {
+        if !s.iter().all(|x| x.is_finite() && *x > 0.0) {
+            return Err(format!("a box needs positive finite sides (got {:?})", s.as_slice()));
+        }
         let h = s / 2.0;
         let v: Vec<V3> = (0..8)
             .map(|i| V3::new(if i & 1 == 0 { -h.x } else { h.x }, if i & 2 == 0 { -h.y } else { h.y }, if i & 4 == 0 { -h.z } else { h.z }))
@@ -104,7 +123,7 @@ impl ConvexMesh {
             t.push([q[0], q[1], q[2]]);
             t.push([q[0], q[2], q[3]]);
         }
-        Self::new(v, t).expect("a box is a convex mesh")
+        Self::new(v, t)
     }
 
     /// Validates a closed convex mesh with outward-oriented triangles.
@@ -112,10 +131,22 @@ impl ConvexMesh {
         if vertices.len() < 4 || triangles.len() < 4 {
             return Err("a closed mesh needs at least 4 vertices and 4 triangles".into());
         }
+        if vertices.len() > bounds::MAX_MESH_VERTICES || triangles.len() > bounds::MAX_MESH_TRIANGLES {
+            return Err(format!(
+                "has {} vertices and {} triangles; at most {} and {} are allowed",
+                vertices.len(),
+                triangles.len(),
+                bounds::MAX_MESH_VERTICES,
+                bounds::MAX_MESH_TRIANGLES
+            ));
+        }
         if vertices.iter().any(|v| !v.iter().all(|x| x.is_finite())) {
             return Err("a vertex has a non-finite coordinate".into());
         }
-        let scale = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max).max(1e-12);
+        let scale = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err("the vertices' distances from the origin overflow or are all zero".into());
+        }
         let mut planes = Vec::with_capacity(triangles.len());
         for (k, t) in triangles.iter().enumerate() {
             if t.iter().any(|&i| i >= vertices.len()) {
@@ -131,7 +162,7 @@ impl ConvexMesh {
         }
         let m = Self { vertices, triangles, planes };
         let vol = m.mass_properties().0;
-        if !(vol > 0.0) {
+        if !(vol > 0.0 && vol.is_finite()) {
             return Err("the triangles are not oriented outwards (negative volume)".into());
         }
         for (k, (n, d)) in m.planes.iter().enumerate() {
@@ -240,6 +271,8 @@ pub struct Scene3 {
     pub tolerance: [f64; 4],
     /// Characteristic length [m] (radius of gyration).
     pub length: f64,
+    /// What the loader changed in the file's values (pusher points snapped onto the surface).
+    pub notes: Vec<String>,
 }
 
 /// Signed distance to the object's surface: the sphere's exactly, else the mesh's.
@@ -251,6 +284,11 @@ pub(crate) fn surface_distance(mesh: &ConvexMesh, sphere: Option<f64>, p: &V3) -
 }
 
 impl Scene3 {
+    /// What the loader changed in the file's values (pusher points snapped onto the surface).
+    pub fn notes(&self) -> &[String] {
+        &self.notes
+    }
+
     /// Signed distance of object-frame point `p` to the object's surface (positive outside).
     pub fn signed_distance(&self, p: &V3) -> f64 {
         surface_distance(&self.mesh, self.sphere, p)

@@ -3,6 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::pose::spatial::{from_array as pose_from_array, V3};
+use crate::scene::{bounds, exact};
 use crate::scene::spatial::{surface_distance, ConvexMesh, Pusher3, Scene3};
 use nalgebra::{Isometry3, Matrix3};
 use serde::Deserialize;
@@ -26,10 +27,12 @@ struct Raw {
 #[serde(deny_unknown_fields)]
 struct RawObject {
     shape: Option<String>,
+    #[serde(default, deserialize_with = "exact::opt::<3, _>")]
     size: Option<[f64; 3]>,
     mesh: Option<String>,
     radius: Option<f64>,
     mass: Option<f64>,
+    #[serde(default, deserialize_with = "exact::opt::<3, _>")]
     com: Option<[f64; 3]>,
     #[allow(dead_code)] // documentation only
     material: Option<String>,
@@ -46,6 +49,7 @@ struct RawGrasp {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawGravity {
+    #[serde(default, deserialize_with = "exact::opt::<3, _>")]
     direction: Option<[f64; 3]>,
     g: Option<f64>,
 }
@@ -55,7 +59,9 @@ struct RawGravity {
 struct RawPusher {
     name: Option<String>,
     friction: Option<f64>,
+    #[serde(default, deserialize_with = "exact::opt_list::<3, _>")]
     points: Option<Vec<[f64; 3]>>,
+    #[serde(default, deserialize_with = "exact::opt::<3, _>")]
     normal: Option<[f64; 3]>,
     plane: Option<bool>,
 }
@@ -63,21 +69,16 @@ struct RawPusher {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawTask {
+    #[serde(default, deserialize_with = "exact::opt::<7, _>")]
     start: Option<[f64; 7]>,
+    #[serde(default, deserialize_with = "exact::opt::<7, _>")]
     goal: Option<[f64; 7]>,
+    #[serde(default, deserialize_with = "exact::opt::<4, _>")]
     tolerance: Option<[f64; 4]>,
 }
 
 fn req<T>(field: &str, v: Option<T>) -> Result<T> {
     v.ok_or_else(|| Error::scene(field, "is required"))
-}
-
-fn pos(field: &str, v: Option<f64>) -> Result<f64> {
-    let v = req(field, v)?;
-    if !(v.is_finite() && v > 0.0) {
-        return Err(Error::scene(field, format!("must be a positive number (got {v})")));
-    }
-    Ok(v)
 }
 
 fn vec3(field: &str, v: [f64; 3]) -> Result<V3> {
@@ -86,6 +87,37 @@ fn vec3(field: &str, v: [f64; 3]) -> Result<V3> {
     } else {
         Err(Error::scene(field, "has a non-finite component"))
     }
+}
+
+/// A point or position: finite, each coordinate within [`bounds::COORD`].
+fn point3(field: &str, v: [f64; 3]) -> Result<V3> {
+    let p = vec3(field, v)?;
+    for x in p.iter() {
+        bounds::COORD.check(field, *x)?;
+    }
+    Ok(p)
+}
+
+/// A direction: finite, its norm within [`bounds::DIRECTION_NORM`]; normalized.
+fn direction3(field: &str, v: [f64; 3]) -> Result<V3> {
+    let d = vec3(field, v)?;
+    let (n, b) = (d.norm(), bounds::DIRECTION_NORM);
+    if n == 0.0 {
+        return Err(Error::scene(field, "must be non-zero"));
+    }
+    if n < b.lo || n > b.hi {
+        return Err(Error::scene(field, format!("its norm must be in [{:e}, {:e}] (got {n:e})", b.lo, b.hi)));
+    }
+    Ok(d / n)
+}
+
+/// A name: present and not blank.
+fn name(field: &str, v: Option<String>) -> Result<String> {
+    let n = req(field, v)?;
+    if n.trim().is_empty() {
+        return Err(Error::scene(field, "must not be empty"));
+    }
+    Ok(n)
 }
 
 impl Scene3 {
@@ -99,28 +131,30 @@ impl Scene3 {
         if raw.dimension != Some(3) {
             return Err(Error::scene("dimension", "a 3-D scene says `dimension = 3`"));
         }
-        let name = req("name", raw.name)?;
+        let name = name("name", raw.name)?;
         let obj = req("object", raw.object)?;
         let (mesh, sphere) = shape(&obj, base)?;
         let (mass, com, inertia) = mass_properties(&obj, &mesh, sphere)?;
         let gr = req("grasp", raw.grasp)?;
         let (start, goal, tolerance) = task(req("task", raw.task)?)?;
+        let mut notes = Vec::new();
         let s = Scene3 {
             name,
-            pushers: pushers(req("pushers", raw.pushers)?, &mesh, sphere)?,
+            pushers: pushers(req("pushers", raw.pushers)?, &mesh, sphere, &mut notes)?,
             mesh,
             sphere,
             mass,
             com,
             inertia,
-            grip_force: pos("grasp.force", gr.force)?,
-            grip_friction: pos("grasp.friction", gr.friction)?,
-            pad_radius: pos("grasp.pad_radius", gr.pad_radius)?,
+            grip_force: bounds::FORCE.check("grasp.force", req("grasp.force", gr.force)?)?,
+            grip_friction: bounds::SUPPORT_FRICTION.check("grasp.friction", req("grasp.friction", gr.friction)?)?,
+            pad_radius: bounds::PAD.check("grasp.pad_radius", req("grasp.pad_radius", gr.pad_radius)?)?,
             gravity: gravity(raw.gravity)?,
             start,
             goal,
             tolerance,
             length: (inertia.trace() / (2.0 * mass)).sqrt(),
+            notes,
         };
         for (field, p) in [("task.start", &s.start), ("task.goal", &s.goal)] {
             if s.pad_contacts(p).iter().any(|c| c.is_empty()) {
@@ -134,48 +168,61 @@ impl Scene3 {
         let text = std::fs::read_to_string(path).map_err(|e| Error::arg("path", format!("cannot read {}: {e}", path.display())))?;
         Self::from_toml_str(&text, path.parent())
     }
-
 }
 
 /// The object's surface: a box, a convex OBJ mesh (relative to `base`) or a sphere (with its
-/// radius; its mesh an icosphere for drawing and contacts).
+/// radius; its mesh an icosphere for drawing and contacts); its size within [`bounds::SIZE`].
 fn shape(obj: &RawObject, base: Option<&Path>) -> Result<(ConvexMesh, Option<f64>)> {
-    let mesh = match obj.shape.as_deref() {
-        Some("box") => {
-            let s = vec3("object.size", req("object.size", obj.size)?)?;
-            if s.iter().any(|x| !(*x > 0.0)) {
-                return Err(Error::scene("object.size", "every size must be positive"));
-            }
-            ConvexMesh::cuboid(&s)
+    let kind = match obj.shape.as_deref() {
+        Some(k @ ("box" | "mesh" | "sphere")) => k,
+        Some(other) => return Err(Error::scene("object.shape", format!("must be \"box\", \"mesh\" or \"sphere\" (got \"{other}\")"))),
+        None => return Err(Error::scene("object.shape", "is required (\"box\", \"mesh\" or \"sphere\")")),
+    };
+    for (key, given, owner) in [
+        ("object.size", obj.size.is_some(), "box"),
+        ("object.mesh", obj.mesh.is_some(), "mesh"),
+        ("object.radius", obj.radius.is_some(), "sphere"),
+    ] {
+        if given && kind != owner {
+            return Err(Error::scene(key, format!("is for shape = \"{owner}\", not \"{kind}\"")));
         }
-        Some("mesh") => {
+    }
+    match kind {
+        "box" => {
+            let s = vec3("object.size", req("object.size", obj.size)?)?;
+            bounds::SIZE.check_each("object.size", [s.x, s.y, s.z])?;
+            let m = ConvexMesh::try_cuboid(&s).map_err(|e| Error::scene("object.size", e))?;
+            Ok((m, None))
+        }
+        "mesh" => {
             let file = req("object.mesh", obj.mesh.clone())?;
             let path = base.map(|b| b.join(&file)).unwrap_or_else(|| file.clone().into());
             let text = std::fs::read_to_string(&path)
                 .map_err(|e| Error::scene("object.mesh", format!("cannot read {}: {e}", path.display())))?;
-            ConvexMesh::from_obj(&text).map_err(|e| Error::scene("object.mesh", e))?
+            let m = ConvexMesh::from_obj(&text).map_err(|e| Error::scene("object.mesh", e))?;
+            let size = m.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            if bounds::SIZE.check("object.mesh", size).is_err() {
+                let b = bounds::SIZE;
+                return Err(Error::scene(
+                    "object.mesh",
+                    format!("its size (largest distance of a vertex from the origin) must be in [{:e}, {:e}] m (got {size:e})", b.lo, b.hi),
+                ));
+            }
+            Ok((m, None))
         }
-        Some("sphere") => ConvexMesh::icosphere(pos("object.radius", obj.radius)?, 2),
-        Some(other) => return Err(Error::scene("object.shape", format!("must be \"box\", \"mesh\" or \"sphere\" (got \"{other}\")"))),
-        None => return Err(Error::scene("object.shape", "is required (\"box\", \"mesh\" or \"sphere\")")),
-    };
-    let sphere = if obj.shape.as_deref() == Some("sphere") { obj.radius } else { None };
-    if sphere.is_none() && obj.radius.is_some() {
-        return Err(Error::scene("object.radius", "is for shape = \"sphere\""));
-    }
-    if sphere.is_some() {
-        if let Some(f) = [("object.size", obj.size.is_some()), ("object.mesh", obj.mesh.is_some())].iter().find(|f| f.1) {
-            return Err(Error::scene(f.0, "is not for shape = \"sphere\" (give `radius`)"));
+        _ => {
+            let r = bounds::SIZE.check("object.radius", req("object.radius", obj.radius)?)?;
+            let m = ConvexMesh::try_icosphere(r, 2).map_err(|e| Error::scene("object.radius", e))?;
+            Ok((m, Some(r)))
         }
     }
-    Ok((mesh, sphere))
 }
 
 /// Mass [kg], centre of mass (default: the volume centroid; inside the object) and inertia about
 /// it [kg m²] of a uniform-density object (a moved centre of mass shifts the inertia by the
 /// parallel-axis rule).
 fn mass_properties(obj: &RawObject, mesh: &ConvexMesh, sphere: Option<f64>) -> Result<(f64, V3, Matrix3<f64>)> {
-    let mass = pos("object.mass", obj.mass)?;
+    let mass = bounds::MASS.check("object.mass", req("object.mass", obj.mass)?)?;
     let (centroid, inertia_unit) = match sphere {
         // a solid sphere: I = (2/5) r² per unit mass
         Some(r) => (V3::zeros(), Matrix3::identity() * 0.4 * r * r),
@@ -185,7 +232,7 @@ fn mass_properties(obj: &RawObject, mesh: &ConvexMesh, sphere: Option<f64>) -> R
         }
     };
     let com = match obj.com {
-        Some(c) => vec3("object.com", c)?,
+        Some(c) => point3("object.com", c)?,
         None => centroid,
     };
     if surface_distance(mesh, sphere, &com) > 0.0 {
@@ -203,21 +250,19 @@ fn gravity(gv: Option<RawGravity>) -> Result<V3> {
     if (d.norm() - 1.0).abs() > 1e-3 {
         return Err(Error::scene("gravity.direction", "must be a unit vector"));
     }
-    let g = gv.g.unwrap_or(9.81);
-    if !(g >= 0.0 && g.is_finite()) {
-        return Err(Error::scene("gravity.g", "must be a non-negative number"));
-    }
+    let g = bounds::G.check("gravity.g", gv.g.unwrap_or(9.81))?;
     Ok(d.normalize() * g)
 }
 
 /// The pushers (at least one, unique names): planes, or point sets on the object's surface
 /// with an inward normal.
-fn pushers(raw: Vec<RawPusher>, mesh: &ConvexMesh, sphere: Option<f64>) -> Result<Vec<Pusher3>> {
+fn pushers(raw: Vec<RawPusher>, mesh: &ConvexMesh, sphere: Option<f64>, notes: &mut Vec<String>) -> Result<Vec<Pusher3>> {
+    bounds::count("pushers", raw.len(), bounds::MAX_PUSHERS, "entries")?;
     let size = mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
     let mut out: Vec<Pusher3> = Vec::new();
     for (i, p) in raw.into_iter().enumerate() {
         let f = format!("pushers[{i}]");
-        let pusher = self::pusher(&f, p, mesh, sphere, size)?;
+        let pusher = self::pusher(&f, p, mesh, sphere, size, notes)?;
         if out.iter().any(|q| q.name == pusher.name) {
             return Err(Error::scene(format!("{f}.name"), format!("`{}` is used twice", pusher.name)));
         }
@@ -230,17 +275,10 @@ fn pushers(raw: Vec<RawPusher>, mesh: &ConvexMesh, sphere: Option<f64>) -> Resul
 }
 
 /// One pusher (`f` its field path).
-fn pusher(f: &str, p: RawPusher, mesh: &ConvexMesh, sphere: Option<f64>, size: f64) -> Result<Pusher3> {
-    let name = req(&format!("{f}.name"), p.name)?;
-    let friction = req(&format!("{f}.friction"), p.friction)?;
-    if !(friction >= 0.0 && friction.is_finite()) {
-        return Err(Error::scene(format!("{f}.friction"), "must be a non-negative number"));
-    }
-    let normal = vec3(&format!("{f}.normal"), req(&format!("{f}.normal"), p.normal)?)?;
-    if normal.norm() == 0.0 {
-        return Err(Error::scene(format!("{f}.normal"), "must be non-zero"));
-    }
-    let normal = normal.normalize();
+fn pusher(f: &str, p: RawPusher, mesh: &ConvexMesh, sphere: Option<f64>, size: f64, notes: &mut Vec<String>) -> Result<Pusher3> {
+    let name = self::name(&format!("{f}.name"), p.name)?;
+    let friction = bounds::PUSHER_FRICTION.check(&format!("{f}.friction"), req(&format!("{f}.friction"), p.friction)?)?;
+    let normal = direction3(&format!("{f}.normal"), req(&format!("{f}.normal"), p.normal)?)?;
     if p.plane == Some(true) {
         if p.points.is_some() {
             return Err(Error::scene(format!("{f}.points"), "a plane has no points (it touches the object where it is lowest)"));
@@ -251,12 +289,13 @@ fn pusher(f: &str, p: RawPusher, mesh: &ConvexMesh, sphere: Option<f64>, size: f
     if pts.is_empty() {
         return Err(Error::scene(format!("{f}.points"), "needs at least one point"));
     }
-    let mut points = Vec::new();
+    bounds::count(&format!("{f}.points"), pts.len(), bounds::MAX_PUSHER_POINTS, "points")?;
+    let mut points: Vec<V3> = Vec::new();
     for (k, q) in pts.iter().enumerate() {
-        let q = vec3(&format!("{f}.points[{k}]"), *q)?;
-        let dist = surface_distance(mesh, sphere, &q);
-        if dist.abs() > 1e-4 * size {
-            return Err(Error::scene(format!("{f}.points[{k}]"), format!("is not on the object's surface ({dist:.2e} m off)")));
+        let fk = format!("{f}.points[{k}]");
+        let q = on_surface(&fk, point3(&fk, *q)?, mesh, sphere, notes)?;
+        if let Some(j) = points.iter().position(|p| (p - q).norm() <= 1e-6 * size) {
+            return Err(Error::scene(fk, format!("coincides with {f}.points[{j}]: a pusher's points must be distinct")));
         }
         if surface_distance(mesh, sphere, &(q + normal * 1e-3 * size)) > 0.0 {
             return Err(Error::scene(format!("{f}.normal"), "must point into the object"));
@@ -266,13 +305,69 @@ fn pusher(f: &str, p: RawPusher, mesh: &ConvexMesh, sphere: Option<f64>, size: f
     Ok(Pusher3 { name, friction, points, normal, plane: false })
 }
 
+/// A measured pusher point taken onto the object's surface: within [`bounds::SNAP_DISTANCE`] it
+/// is moved onto it (a note says so when it moves more than 1 nm); farther is an error.
+fn on_surface(field: &str, q: V3, mesh: &ConvexMesh, sphere: Option<f64>, notes: &mut Vec<String>) -> Result<V3> {
+    let dist = surface_distance(mesh, sphere, &q);
+    if dist.abs() > bounds::SNAP_DISTANCE {
+        return Err(Error::scene(
+            field,
+            format!(
+                "is not on the object's surface: it is {:.1} µm {}, more than the {:.1} µm a measured point may be off",
+                dist.abs() * 1e6,
+                if dist > 0.0 { "outside" } else { "inside" },
+                bounds::SNAP_DISTANCE * 1e6
+            ),
+        ));
+    }
+    if dist.abs() <= 1e-9 {
+        return Ok(q);
+    }
+    let snapped = match sphere {
+        Some(r) if q.norm() > 0.0 => q * (r / q.norm()),
+        _ => snap_to_mesh(mesh, q),
+    };
+    let moved = (snapped - q).norm();
+    notes.push(format!("{field} moved {:.1} µm onto the object's surface", moved * 1e6));
+    Ok(snapped)
+}
+
+/// `q` (near the surface) moved onto a convex mesh: along the normal of the face plane it is
+/// farthest outside of (or, inside, nearest to), repeated for points near an edge or a corner.
+fn snap_to_mesh(mesh: &ConvexMesh, mut q: V3) -> V3 {
+    for _ in 0..8 {
+        let Some((n, d)) = mesh.planes.iter().map(|(n, d)| (n, n.dot(&q) - d)).max_by(|a, b| a.1.total_cmp(&b.1)) else { break };
+        if d.abs() <= 1e-12 {
+            break;
+        }
+        q -= n * d;
+    }
+    q
+}
+
 /// Start and goal poses and the tolerance (position components [m], then the angle [rad]).
 fn task(task: RawTask) -> Result<(Isometry3<f64>, Isometry3<f64>, [f64; 4])> {
-    let start = pose_from_array("task.start", &req("task.start", task.start)?)?;
-    let goal = pose_from_array("task.goal", &req("task.goal", task.goal)?)?;
+    let start = pose("task.start", req("task.start", task.start)?)?;
+    let goal = pose("task.goal", req("task.goal", task.goal)?)?;
     let tolerance = req("task.tolerance", task.tolerance)?;
-    if tolerance.iter().any(|t| !(*t > 0.0)) {
-        return Err(Error::scene("task.tolerance", "every component must be positive"));
+    for (k, t) in tolerance.iter().enumerate() {
+        let b = if k < 3 { bounds::TOL_POSITION } else { bounds::TOL_ANGLE };
+        b.check(&format!("task.tolerance[{k}]"), *t)?;
     }
     Ok((start, goal, tolerance))
+}
+
+/// A pose `[x, y, z, qw, qx, qy, qz]`: the position within [`bounds::COORD`], the quaternion's
+/// norm within [`bounds::DIRECTION_NORM`].
+fn pose(field: &str, a: [f64; 7]) -> Result<Isometry3<f64>> {
+    if !a.iter().all(|x| x.is_finite()) {
+        return Err(Error::scene(field, "has a non-finite component"));
+    }
+    point3(field, [a[0], a[1], a[2]])?;
+    let n = (a[3] * a[3] + a[4] * a[4] + a[5] * a[5] + a[6] * a[6]).sqrt();
+    let b = bounds::DIRECTION_NORM;
+    if n != 0.0 && !(n >= b.lo && n <= b.hi) {
+        return Err(Error::scene(field, format!("the quaternion's norm must be in [{:e}, {:e}] (got {n:e})", b.lo, b.hi)));
+    }
+    pose_from_array(field, &a)
 }

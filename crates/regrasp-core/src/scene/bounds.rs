@@ -1,0 +1,94 @@
+//! The physical ranges every scene number must lie in, stated once (`docs/scene-file.md`,
+//! "Bounds"). They are wide enough that no gripper, object or fixture a robot handles meets
+//! them by accident, and narrow enough to exclude nonsense (1e300, 1e-300) that would overflow
+//! the mechanics into inf or NaN.
+
+use crate::error::{Error, Result};
+
+/// A closed interval `[lo, hi]` of admissible values, in `unit`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bound {
+    pub lo: f64,
+    pub hi: f64,
+    pub unit: &'static str,
+}
+
+impl Bound {
+    const fn new(lo: f64, hi: f64, unit: &'static str) -> Self {
+        Bound { lo, hi, unit }
+    }
+
+    /// `v` itself when finite and within the bound, else an error naming `field` and the range.
+    pub fn check(&self, field: &str, v: f64) -> Result<f64> {
+        if v.is_finite() && v >= self.lo && v <= self.hi {
+            return Ok(v);
+        }
+        let unit = if self.unit.is_empty() { String::new() } else { format!(" {}", self.unit) };
+        Err(Error::scene(field, format!("must be a number in [{:e}, {:e}]{unit} (got {v})", self.lo, self.hi)))
+    }
+
+    /// Like [`Self::check`] for a call argument `name` (an [`Error::InvalidArgument`]).
+    pub fn check_arg(&self, name: &str, v: f64) -> Result<f64> {
+        self.check(name, v).map_err(|e| match e {
+            Error::Scene { message, .. } => Error::arg(name, message),
+            other => other,
+        })
+    }
+
+    /// Every component of `v` checked (fields `field[k]`).
+    pub fn check_each<const N: usize>(&self, field: &str, v: [f64; N]) -> Result<[f64; N]> {
+        for (k, x) in v.iter().enumerate() {
+            self.check(&format!("{field}[{k}]"), *x)?;
+        }
+        Ok(v)
+    }
+}
+
+/// Object size [m]: a planar outline's bounding-box diagonal, a box's sides, a sphere's radius,
+/// a mesh's largest distance from its origin (0.1 mm to 10 m).
+pub const SIZE: Bound = Bound::new(1e-4, 10.0, "m");
+/// Finger pad radius and rectangular pad sides [m] (1 µm to 10 m).
+pub const PAD: Bound = Bound::new(1e-6, 10.0, "m");
+/// Any coordinate of a point or a position [m] (outline vertices, centre of mass, pusher points,
+/// task positions): within 100 m of the frame's origin.
+pub const COORD: Bound = Bound::new(-100.0, 100.0, "m");
+/// Angles of planar poses [rad] (±1000 rad, about 160 turns).
+pub const ANGLE: Bound = Bound::new(-1e3, 1e3, "rad");
+/// Object mass [kg].
+pub const MASS: Bound = Bound::new(1e-9, 1e4, "kg");
+/// Grip force of each finger [N].
+pub const FORCE: Bound = Bound::new(1e-6, 1e6, "N");
+/// Coulomb coefficient of a support (finger pads, a surface).
+pub const SUPPORT_FRICTION: Bound = Bound::new(1e-6, 100.0, "");
+/// Coulomb coefficient of a pusher (0: frictionless).
+pub const PUSHER_FRICTION: Bound = Bound::new(0.0, 100.0, "");
+/// Gravitational acceleration [m/s²] (0: gravity-free).
+pub const G: Bound = Bound::new(0.0, 1e3, "m/s²");
+/// Norm of a direction given as a vector that is normalized (a pusher normal, a quaternion).
+pub const DIRECTION_NORM: Bound = Bound::new(1e-6, 1e6, "");
+/// Task tolerance on a position component [m].
+pub const TOL_POSITION: Bound = Bound::new(1e-9, 10.0, "m");
+/// Task tolerance on an angle [rad].
+pub const TOL_ANGLE: Bound = Bound::new(1e-9, std::f64::consts::TAU, "rad");
+
+/// Most vertices of a planar outline (its simplicity test is a sweep over them).
+pub const MAX_OUTLINE_VERTICES: usize = 10_000;
+/// Most vertices and triangles of a 3-D mesh (its convexity test is vertices × triangles).
+pub const MAX_MESH_VERTICES: usize = 5_000;
+pub const MAX_MESH_TRIANGLES: usize = 10_000;
+/// Most points of one 3-D pusher.
+pub const MAX_PUSHER_POINTS: usize = 1_000;
+/// Most pushers in a scene.
+pub const MAX_PUSHERS: usize = 1_000;
+
+/// How far a pusher point may lie from the object's boundary [m] and still be taken as on it
+/// (then moved onto it, with a note): scene files are measured and rounded to 0.1 mm.
+pub const SNAP_DISTANCE: f64 = 1e-4;
+
+/// An error when `n` items exceed `max`.
+pub fn count(field: &str, n: usize, max: usize, what: &str) -> Result<()> {
+    if n > max {
+        return Err(Error::scene(field, format!("has {n} {what}; at most {max} are allowed")));
+    }
+    Ok(())
+}
