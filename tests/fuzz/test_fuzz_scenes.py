@@ -105,5 +105,6 @@ def test_mutated_scene_file(case, tmp_path_factory):
     """`load_scene` on a mutated file (both dimensions, told apart by the file)."""
     name, d, what, must = case
     p = tmp_path_factory.mktemp("scene") / name
+    (p.parent / "meshes").symlink_to(EXAMPLES / "meshes")  # the examples' meshes, relative to the file
     p.write_text(to_toml(d))
     run("scene.load_scene", f"{name}: {what}", lambda: regrasp.load_scene(p), reject=must)
