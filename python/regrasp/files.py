@@ -21,8 +21,20 @@ from typing import Callable, Iterable, Mapping, Optional
 
 from .errors import ArgumentError
 
-__all__ = ["atomic_write", "write_text", "temp_path", "check_writable", "refuse_overwrite_input", "Outputs",
+__all__ = ["as_path", "atomic_write", "write_text", "temp_path", "check_writable", "refuse_overwrite_input", "Outputs",
            "same_file"]
+
+
+def as_path(v, name: str) -> Path:
+    """Argument ``name`` as a file path: a non-empty ``str`` or ``os.PathLike`` (else an
+    ArgumentError naming it)."""
+    if isinstance(v, os.PathLike):
+        v = os.fspath(v)
+    if not isinstance(v, str) or not v.strip():
+        raise ArgumentError(f"invalid `{name}`: a file path, a non-empty string (got {v!r})", name)
+    if "\0" in v:
+        raise ArgumentError(f"invalid `{name}`: a file path without NUL characters", name)
+    return Path(v)
 
 
 def same_file(a, b) -> bool:
@@ -118,13 +130,6 @@ def write_text(path, text: str) -> Path:
     return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
-def _existing_ancestor(p: Path) -> Path:
-    q = p.parent
-    while not q.exists() and q != q.parent:
-        q = q.parent
-    return q
-
-
 def check_writable(path, name: str, create_folder: bool = False) -> Path:
     """That ``path`` can be written (before a long computation): not a folder, its folder exists
     (or, with ``create_folder``, can be created) and is writable. ArgumentError naming option
@@ -138,7 +143,12 @@ def check_writable(path, name: str, create_folder: bool = False) -> Path:
         fail("not a file name")
     if p.is_dir():
         fail("is a folder")
-    folder = p.parent if p.parent.exists() or not create_folder else _existing_ancestor(p)
+    if create_folder and not p.parent.exists():
+        try:  # the folder is made now, so that a path that cannot be made fails before the work
+            p.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            fail(f"cannot make the folder {p.parent}: {e.strerror or e}")
+    folder = p.parent
     if not folder.exists():
         fail(f"no folder {folder}")
     if not folder.is_dir():

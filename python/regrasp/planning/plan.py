@@ -18,7 +18,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import ArgumentError, check_seed
-from ..files import same_file as _same_file, write_text
+from ..files import as_path, same_file as _same_file, write_text
 
 #: the keys of a plan file, in the order they are written (docs/plan-file.md), by dimension
 KEYS = {
@@ -236,7 +236,7 @@ class Plan:
     @classmethod
     def load(cls, path, scene=None) -> "Plan":
         """Reads a plan file (see :meth:`from_json`); errors name the field (``plan.path[3].pose``)."""
-        p = Path(path)
+        p = as_path(path, "plan")
         try:
             d = json.loads(p.read_text())
         except (OSError, UnicodeDecodeError) as e:
@@ -253,6 +253,8 @@ class Plan:
     def check_for(self, scene, name: str = "plan") -> None:
         """Whether the plan is for ``scene``: its dimension, its pushers; a plane pusher's 3-D step
         needs its pusher twist (a plane only rolls the object). ArgumentError naming the field."""
+        if not all(hasattr(scene, a) for a in ("dimension", "pusher_names", "_core")):
+            raise ArgumentError(f"invalid `scene`: a regrasp Scene or Scene3D (got {type(scene).__name__})", "scene")
         if scene.dimension != self.dimension:
             kind = {2: "a planar", 3: "a 3-D"}
             n = POSE_SIZE[scene.dimension]
@@ -282,7 +284,7 @@ class Plan:
     def save(self, path) -> Path:
         """Writes the plan file atomically (a temporary file in the same folder, then renamed over
         ``path``). Refuses to overwrite the scene file the plan was made from."""
-        p = Path(path)
+        p = as_path(path, "path")
         if self.scene_file is not None and same_file(p, self.scene_file):
             raise ArgumentError(f"invalid `path`: {p} is the scene file the plan was made from (not overwritten)", "path")
         text = json.dumps(self.to_json(), indent=1, allow_nan=False)
@@ -328,7 +330,7 @@ def _pose_argument(v, name: str):
         return None
     try:
         a = np.asarray(v, dtype=float)
-    except (TypeError, ValueError) as e:
+    except (TypeError, ValueError, OverflowError) as e:
         raise ArgumentError(f"invalid `{name}`: a pose, a list of numbers (got {v!r})", name) from e
     if a.ndim != 1:
         raise ArgumentError(f"invalid `{name}`: a pose, a list of numbers (got shape {a.shape})", name)

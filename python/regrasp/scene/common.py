@@ -7,12 +7,13 @@ import tomllib
 from pathlib import Path
 
 from ..errors import ArgumentError
+from ..files import as_path
 
 
 def read_scene_file(path) -> tuple[Path, str]:
     """The path and text of a scene file; an :class:`ArgumentError` naming ``path`` when it
     cannot be read."""
-    p = Path(path)
+    p = as_path(path, "path")
     try:
         return p, p.read_text()
     except (OSError, UnicodeDecodeError) as e:
