@@ -1,7 +1,7 @@
 //! Quasi-static dynamics (`regrasp::dynamics`): the `MncpProblem` of one instant, and the
 //! problems, pushes and simulated pushes of planar and 3-D scenes.
 
-use crate::convert::{Arg, arg, array1, finite, batch, dict, matrix, pose3, pose7, pusher, rows_array, twist3, twist6, vector};
+use crate::convert::{Arg, arg, array1, finite, finite_numbers, batch, dict, matrix, pose3, pose7, pusher, rows_array, twist3, twist6, vector};
 use crate::errors::{arg_err, guard, interruptible, to_py};
 use nalgebra::DVector;
 use numpy::{PyArray1, PyArray2};
@@ -22,7 +22,7 @@ pub struct MncpProblem {
 
 /// Argument `name`: a list of `n` numbers.
 fn sized(name: &str, v: &Arg<'_>, n: usize) -> PyResult<Vec<f64>> {
-    let x: Vec<f64> = arg(name, v)?;
+    let x = finite_numbers(name, v)?;
     if x.len() != n {
         return Err(arg_err(name, format!("must have {n} numbers (got {})", x.len())));
     }
@@ -89,7 +89,7 @@ impl MncpProblem {
     /// Forward problem: pusher twist given; returns the solution as a dict.
     fn solve_forward<'py>(&self, py: Python<'py>, pusher_twist: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
         guard(move || {
-            let u = DVector::from_vec(arg("pusher_twist", pusher_twist)?);
+            let u = DVector::from_vec(finite_numbers("pusher_twist", pusher_twist)?);
             let s = py.allow_threads(|| mncp::solve_forward(&self.inner, &u, &mncp::Settings::default())).map_err(to_py)?;
             solution_dict(py, &self.inner, &s)
         })
@@ -98,7 +98,7 @@ impl MncpProblem {
     /// Inverse problem: object twist given; returns the pusher motion and forces.
     fn solve_inverse<'py>(&self, py: Python<'py>, twist: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
         guard(move || {
-            let v = DVector::from_vec(arg("twist", twist)?);
+            let v = DVector::from_vec(finite_numbers("twist", twist)?);
             let s = py.allow_threads(|| mncp::solve_inverse(&self.inner, &v, &mncp::Settings::default())).map_err(to_py)?;
             solution_dict(py, &self.inner, &s)
         })

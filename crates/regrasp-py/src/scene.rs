@@ -116,7 +116,11 @@ impl Scene {
 
     fn hold_ratio(&self, pose: &Arg<'_>) -> PyResult<f64> {
         guard(move || {
-            Ok(self.inner.hold_ratio(&pose3("pose", pose)?))
+            let r = self.inner.hold_ratio(&pose3("pose", pose)?);
+            if !r.is_finite() {
+                return Err(arg_err("pose", format!("has no finite hold ratio (got {r}): the support cannot hold the object there at all")));
+            }
+            Ok(r)
         })
     }
 
