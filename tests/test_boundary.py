@@ -12,10 +12,14 @@ import numpy as np
 import pytest
 
 from regrasp import _core
-from regrasp.errors import ArgumentError, RegraspError
+from regrasp.errors import ArgumentError, InternalError, RegraspError
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-BAD = [-1, 2**70, 1.5, float("nan"), "x", None, [], [1.0, 2.0], [[1.0, 2.0, 3.0]], np.zeros((2, 2)), {}, object(), True]
+BAD = [-1, 2**70, 1.5, float("nan"), "x", None, [], [1.0, 2.0], [[1.0, 2.0, 3.0]], np.zeros((2, 2)), {}, object(), True,
+       1e300, -1e300, float("inf"), 0, 0.0, -0.0, 1e-300, [1e300, 0.0, 0.0], [0.0, 0.0, float("inf")],
+       [1e300, 0.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1e300, 0.0, 0.0, 0.0], np.full((2, 3), 1e300), ""]
+# a bad value for every setting of the planner and of the MPC
+BAD_SETTINGS = [-1, -1e300, 1e300, float("inf"), float("-inf"), float("nan"), 2**70, "x", None, [1], 1.5, True]
 
 Q = [0.0, 0.0, 0.0]
 Q3 = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
@@ -115,6 +119,108 @@ def test_every_bad_argument_is_a_regrasp_error(scene, scene3):
                 except BaseException as e:  # noqa: B036 — a panic is a BaseException
                     escaped.append(f"{label}(arg {i} = {bad!r}): {type(e).__name__}: {e}")
     assert not escaped, "\n".join(escaped)
+
+
+def _finite(x) -> bool:
+    """Whether every number in `x` (nested lists, tuples, dicts, arrays) is finite."""
+    if isinstance(x, dict):
+        return all(_finite(v) for v in x.values())
+    if isinstance(x, (list, tuple)):
+        return all(_finite(v) for v in x)
+    if isinstance(x, np.ndarray) and x.dtype.kind == "f":
+        return bool(np.isfinite(x).all())
+    if isinstance(x, float):
+        return np.isfinite(x)
+    return True
+
+
+def test_no_output_is_nan_or_infinite(scene, scene3):
+    """Whatever a call returns, with valid or bad arguments, holds no NaN or infinity."""
+    bad = []
+    for label, f, args in calls(scene, scene3):
+        for i in range(-1, len(args)):
+            for v in BAD if i >= 0 else [None]:
+                a = list(args)
+                if i >= 0:
+                    a[i] = v
+                try:
+                    r = f(*a)
+                except RegraspError:
+                    continue
+                if label == "cone.grip_force_range" and r is not None:
+                    r = r[0] if r[1] == float("inf") else r  # documented: max = inf when no force is too high
+                if label == "planner_defaults":
+                    r = {k: x for k, x in r.items() if k != "cost_threshold"}  # documented default: inf, the first path
+                if not _finite(r if not hasattr(r, "generators") else r.generators):
+                    bad.append(f"{label}(arg {i} = {v!r}) returned {r!r}"[:300])
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_every_bad_setting_is_an_argument_error_naming_it(scene, scene3, dimension):
+    plan = scene.plan if dimension == 2 else scene3.plan
+    escaped = []
+    for key in _core.planner_defaults(dimension):
+        for bad in BAD_SETTINGS:
+            try:
+                plan(None, None, {"time_limit": 0.05, "max_nodes": 30, key: bad})
+            except ArgumentError as e:
+                if e.field != key:
+                    escaped.append(f"{key} = {bad!r}: field {e.field!r}: {e}")
+            except RegraspError:
+                pass
+            except BaseException as e:  # noqa: B036
+                escaped.append(f"{key} = {bad!r}: {type(e).__name__}: {e}")
+    assert not escaped, "\n".join(escaped)
+
+
+def test_every_bad_mpc_setting_is_an_argument_error(scene):
+    path = ([Q, [0.001, 0.0, 0.0]], [None, "left"])
+    escaped = []
+    for key in _core.mpc_defaults():
+        for bad in BAD_SETTINGS:
+            try:
+                _core.Mpc(scene, *path, **{key: bad}).step(Q)
+            except RegraspError:
+                pass
+            except BaseException as e:  # noqa: B036
+                escaped.append(f"{key} = {bad!r}: {type(e).__name__}: {e}")
+    assert not escaped, "\n".join(escaped)
+
+
+def test_magnitudes_are_bounded(scene, scene3):
+    """Physically absurd magnitudes are errors naming the argument, not NaN, inf or a long run."""
+    s3 = scene3.task[0]
+    cases = [
+        (lambda: scene.with_grip_force(1e200), "force"),
+        (lambda: scene.with_grip_force(1e300), "force"),
+        (lambda: scene.scaled(1.0, 1e300, 1.0, 1.0, None), "grip"),
+        (lambda: scene.simulate_push(Q, "left", [1e6, 0.0, 0.0], 0.05, 0.05), "twist"),
+        (lambda: scene.simulate_push(Q, "left", [0.01, 0.0, 0.0], 0.0, 0.05), "duration"),
+        (lambda: scene.simulate_push(Q, "left", [0.01, 0.0, 0.0], 0.05, 0.0), "dt"),
+        (lambda: scene.simulate_push(Q, "left", [0.01, 0.0, 0.0], 0.05, 0.1), "dt"),
+        (lambda: scene.simulate_push(Q, "left", [0.01, 0.0, 0.0], 1e9, 1e-3), "dt"),
+        (lambda: scene.simulate_push(Q, "left", [0.01, 0.0, 0.0], float("inf"), 0.05), "duration"),
+        (lambda: scene3.simulate_push(s3, "left", [1e300, 0, 0, 0, 0, 0], 0.02, 0.02), "twist"),
+        (lambda: scene3.simulate_push(s3, "left", [0.01, 0, 0, 0, 0, 0], 0.0, 0.02), "duration"),
+        (lambda: scene3.simulate_push(s3, "left", [0.01, 0, 0, 0, 0, 0], 0.02, 0.0), "dt"),
+        (lambda: scene.quasistatic_problem(Q, "left", "points", 10**6, 4), "rings"),
+        (lambda: scene.quasistatic_problem(Q, "left", "points", 2, 10**9), "points"),
+        (lambda: scene.validate_path([Q, Q], [None, "left"], 10**12), "checks"),
+    ]
+    for f, field in cases:
+        with pytest.raises(ArgumentError) as e:
+            f()
+        assert e.value.field == field, (field, str(e.value))
+    # an instantaneous push of a huge twist is reported per entry, at once
+    sticks, twists, residuals, errors = scene.push_outcomes(POSES, "left", TWISTS * 1e300, "limit_surface", 1, 0, True)
+    assert all(e is not None and "twist" in e for e in errors)
+    assert np.isfinite(twists).all() and np.isfinite(residuals).all()
+
+
+def test_internal_error_is_in_the_closed_set():
+    assert issubclass(InternalError, RegraspError) and issubclass(InternalError, RuntimeError)
+    assert "report" in InternalError.__doc__
 
 
 def test_errors_name_the_argument(scene):

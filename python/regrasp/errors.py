@@ -23,6 +23,11 @@ class GraspError(RegraspError, RuntimeError):
     """The grasp cannot hold the object against gravity at the requested pose."""
 
 
+class InternalError(RegraspError, RuntimeError):
+    """A bug in regrasp: please report it with the input. (A Rust panic caught at the boundary;
+    the message carries the panic's message and location.)"""
+
+
 def check_seed(seed) -> int:
     """A random seed: a whole number >= 0 (the core's generators take an unsigned 64-bit seed)."""
     import numbers

@@ -19,6 +19,10 @@ pub enum Error {
         pose[0], pose[1], pose[2]
     )]
     GraspCannotHold { pose: [f64; 3], ratio: f64 },
+
+    /// The caller's interrupt poll asked to stop (Ctrl-C; see [`crate::interrupt`]).
+    #[error("interrupted")]
+    Interrupted,
 }
 
 impl Error {

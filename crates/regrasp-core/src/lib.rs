@@ -8,6 +8,7 @@ pub mod cones;
 pub mod control;
 pub mod dynamics;
 pub mod error;
+pub mod interrupt;
 pub mod mechanics;
 pub mod planning;
 pub mod pose;

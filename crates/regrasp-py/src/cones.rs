@@ -3,7 +3,7 @@
 //! (`regrasp::cones::batch`).
 
 use crate::convert::{Arg, arg, array1, batch, dict, matrix, matrix_rows, numbers, one_or_array, opt, pusher, rows, rows_array, twist3, vector};
-use crate::errors::{arg_err, to_py};
+use crate::errors::{arg_err, guard, interruptible, to_py};
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
@@ -47,7 +47,9 @@ impl MotionCone {
     /// Generators of the polyhedral approximation, one unit twist a row.
     #[getter]
     fn generators<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        Ok(matrix_rows(py, &self.push.generators().map_err(to_py)?))
+        guard(move || {
+            Ok(matrix_rows(py, &self.push.generators().map_err(to_py)?))
+        })
     }
     #[getter]
     fn gravity_free_generators<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
@@ -70,76 +72,96 @@ impl MotionCone {
 
     /// Motion-cone ray (unit twist) produced by pusher wrench `wrench`, or None.
     fn ray<'py>(&self, py: Python<'py>, wrench: &Arg<'py>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
-        let w = Vec3::from(numbers("wrench", wrench, "[fx, fz, τ]")?);
-        Ok(self.push.ray(&w).map(|v| vector(py, &v)))
+        guard(move || {
+            let w = Vec3::from(numbers("wrench", wrench, "[fx, fz, τ]")?);
+            Ok(self.push.ray(&w).map(|v| vector(py, &v)))
+        })
     }
 
     /// Exact test of one twist: dict(feasible, margin, active_limit, pusher_wrench, support_wrench).
     fn classify<'py>(&self, py: Python<'py>, twist: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let c = self.push.classify(&twist3("twist", twist)?).map_err(to_py)?;
-        Ok(dict!(py; "feasible" => c.feasible, "margin" => c.margin, "active_limit" => c.limit.label(),
-                     "pusher_wrench" => c.pusher_wrench.as_slice().to_vec(),
-                     "support_wrench" => c.support_wrench.as_slice().to_vec()))
+        guard(move || {
+            let c = self.push.classify(&twist3("twist", twist)?).map_err(to_py)?;
+            Ok(dict!(py; "feasible" => c.feasible, "margin" => c.margin, "active_limit" => c.limit.label(),
+                         "pusher_wrench" => c.pusher_wrench.as_slice().to_vec(),
+                         "support_wrench" => c.support_wrench.as_slice().to_vec()))
+        })
     }
 
     /// Signed margins of one twist or of an (n, 3) array of twists.
     fn margin(&self, py: Python<'_>, twist: &Arg<'_>) -> PyResult<PyObject> {
-        let (ts, many) = twists(twist)?;
-        let m = ts.iter().map(|t| self.push.classify(t).map(|c| c.margin)).collect::<Result<_, _>>().map_err(to_py)?;
-        one_or_array(py, m, many)
+        guard(move || {
+            let (ts, many) = twists(twist)?;
+            let m = ts.iter().map(|t| self.push.classify(t).map(|c| c.margin)).collect::<Result<_, _>>().map_err(to_py)?;
+            one_or_array(py, m, many)
+        })
     }
 
     /// Exact membership of one twist or of an (n, 3) array of twists.
     fn contains(&self, py: Python<'_>, twist: &Arg<'_>) -> PyResult<PyObject> {
-        let (ts, many) = twists(twist)?;
-        let m = ts.iter().map(|t| self.push.contains(t)).collect::<Result<_, _>>().map_err(to_py)?;
-        one_or_array(py, m, many)
+        guard(move || {
+            let (ts, many) = twists(twist)?;
+            let m = ts.iter().map(|t| self.push.contains(t)).collect::<Result<_, _>>().map_err(to_py)?;
+            one_or_array(py, m, many)
+        })
     }
 
     /// Membership in the polyhedral approximation, of one twist or an (n, 3) array.
     fn contains_polyhedral(&self, py: Python<'_>, twist: &Arg<'_>) -> PyResult<PyObject> {
-        let (ts, many) = twists(twist)?;
-        one_or_array(py, polyhedral::contains(&self.push, &ts).map_err(to_py)?, many)
+        guard(move || {
+            let (ts, many) = twists(twist)?;
+            one_or_array(py, polyhedral::contains(&self.push, &ts).map_err(to_py)?, many)
+        })
     }
 
     /// Margin of a twist in the gravity-free cone (exact, polyhedral).
     fn gravity_free_margin(&self, twist: &Arg<'_>) -> PyResult<f64> {
-        self.push.gravity_free_margin(&twist3("twist", twist)?).map_err(to_py)
+        guard(move || {
+            self.push.gravity_free_margin(&twist3("twist", twist)?).map_err(to_py)
+        })
     }
 
     /// Closest feasible twist (metric diag(1, 1, L²)), exact cone.
     fn project(&self, py: Python<'_>, twist: &Arg<'_>) -> PyResult<PyObject> {
-        let (ts, many) = twists(twist)?;
-        let p: Vec<Vec3> = ts.iter().map(|t| self.push.project(t)).collect::<Result<_, _>>().map_err(to_py)?;
-        match p[..] {
-            [one] if !many => vector(py, &one).into_py_any(py),
-            _ => matrix_rows(py, &p).into_py_any(py),
-        }
+        guard(move || {
+            let (ts, many) = twists(twist)?;
+            let p: Vec<Vec3> = ts.iter().map(|t| self.push.project(t)).collect::<Result<_, _>>().map_err(to_py)?;
+            match p[..] {
+                [one] if !many => vector(py, &one).into_py_any(py),
+                _ => matrix_rows(py, &p).into_py_any(py),
+            }
+        })
     }
 
     /// Closest twist in a polyhedral cone: `which` "approx" (default) or "gravity_free".
     #[pyo3(signature = (twist, which=None))]
     fn project_polyhedral<'py>(&self, py: Python<'py>, twist: &Arg<'py>, which: Option<&Arg<'py>>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let which = match opt::<String>("which", which)? {
-            Some(w) => Generators::parse(&w).map_err(to_py)?,
-            None => Generators::Approx,
-        };
-        Ok(vector(py, &polyhedral::project(&self.push, &twist3("twist", twist)?, which).map_err(to_py)?))
+        guard(move || {
+            let which = match opt::<String>("which", which)? {
+                Some(w) => Generators::parse(&w).map_err(to_py)?,
+                None => Generators::Approx,
+            };
+            Ok(vector(py, &polyhedral::project(&self.push, &twist3("twist", twist)?, which).map_err(to_py)?))
+        })
     }
 
     /// Per-finger grip-force range [min, max] for which the pusher motion of `twist` sticks.
     fn grip_force_range(&self, twist: &Arg<'_>) -> PyResult<Option<(f64, f64)>> {
-        let r = self.push.grip_force_range(&twist3("twist", twist)?).map_err(to_py)?;
-        Ok(r.map(|r| (r.min, r.max)))
+        guard(move || {
+            let r = self.push.grip_force_range(&twist3("twist", twist)?).map_err(to_py)?;
+            Ok(r.map(|r| (r.min, r.max)))
+        })
     }
 
     /// Point pushers: object twist when the contact point moves with velocity `u` (object frame).
     fn point_pusher_twist<'py>(&self, py: Python<'py>, u: &Arg<'py>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
-        let u = Vec2::from(numbers("u", u, "[ux, uz]")?);
-        if self.push.spec().pusher.is_line() {
-            return Err(arg_err("pusher", "point_pusher_twist needs a point pusher"));
-        }
-        Ok(self.push.point_pusher_twist(&u, self.push.spec().friction_scale).map(|v| vector(py, &v)))
+        guard(move || {
+            let u = Vec2::from(numbers("u", u, "[ux, uz]")?);
+            if self.push.spec().pusher.is_line() {
+                return Err(arg_err("pusher", "point_pusher_twist needs a point pusher"));
+            }
+            Ok(self.push.point_pusher_twist(&u, self.push.spec().friction_scale).map(|v| vector(py, &v)))
+        })
     }
 
     /// Shape of the pusher's friction cone: "solid", "fan", "ray" or "full".
@@ -165,6 +187,18 @@ pub type Classified<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>
 /// `Scene.project_many`'s result: projections (n, 3) and status (n,).
 pub type Projected<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>);
 
+/// Entries of a batch computed between two interrupt checks.
+const CHUNK: usize = 1024;
+
+/// `f` on the ranges of `0..n`, [`CHUNK`] entries each, checking for an interrupt before each.
+fn chunked(n: usize, mut f: impl FnMut(std::ops::Range<usize>)) -> regrasp::Result<()> {
+    for start in (0..n).step_by(CHUNK) {
+        regrasp::interrupt::check()?;
+        f(start..(start + CHUNK).min(n));
+    }
+    Ok(())
+}
+
 /// `Scene.generators_many`: the polyhedral (or gravity-free) generators of pusher `name` at
 /// each pose.
 pub fn generators_many<'py>(py: Python<'py>, scene: &Scene, poses: &Arg<'py>, name: &Arg<'py>, gravity_free: &Arg<'py>) -> PyResult<Generated<'py>> {
@@ -172,7 +206,8 @@ pub fn generators_many<'py>(py: Python<'py>, scene: &Scene, poses: &Arg<'py>, na
     let (n, k) = (q.len(), scene.pushers[i].model.edges.len());
     let mut out = vec![0.0; n * k * 3];
     let mut st = vec![Status::Ok; n];
-    py.allow_threads(|| batches::generators_into(scene, &q, i, gravity_free, &mut out, &mut st));
+    let (g, s) = (k * 3, &mut st);
+    interruptible(py, || chunked(q.len(), |r| batches::generators_into(scene, &q[r.clone()], i, gravity_free, &mut out[r.start * g..r.end * g], &mut s[r])))?;
     let g = Array3::from_shape_fn((n, k, 3), |(a, b, c)| out[(a * k + b) * 3 + c]);
     Ok((g.into_pyarray(py), status_array(py, &st)))
 }
@@ -182,7 +217,9 @@ pub fn classify_many<'py>(py: Python<'py>, scene: &Scene, poses: &Arg<'py>, twis
     let (q, t, i) = batch(poses, twists, name, |n| scene.pusher_index(n))?;
     let n = q.len();
     let (mut fe, mut ma, mut li, mut st) = (vec![false; n], vec![0.0; n], vec![ContactLimit::Torque; n], vec![Status::Ok; n]);
-    py.allow_threads(|| batches::classify_into(scene, &q, &t, i, &mut fe, &mut ma, &mut li, &mut st));
+    interruptible(py, || {
+        chunked(n, |r| batches::classify_into(scene, &q[r.clone()], &t[r.clone()], i, &mut fe[r.clone()], &mut ma[r.clone()], &mut li[r.clone()], &mut st[r]))
+    })?;
     let codes = li.iter().map(|l| l.code()).collect();
     Ok((array1(py, fe), array1(py, ma), array1(py, codes), status_array(py, &st)))
 }
@@ -191,7 +228,7 @@ pub fn classify_many<'py>(py: Python<'py>, scene: &Scene, poses: &Arg<'py>, twis
 pub fn project_many<'py>(py: Python<'py>, scene: &Scene, poses: &Arg<'py>, twists: &Arg<'py>, name: &Arg<'py>) -> PyResult<Projected<'py>> {
     let (q, t, i) = batch(poses, twists, name, |n| scene.pusher_index(n))?;
     let (mut out, mut st) = (vec![0.0; 3 * q.len()], vec![Status::Ok; q.len()]);
-    py.allow_threads(|| batches::project_into(scene, &q, &t, i, &mut out, &mut st));
+    interruptible(py, || chunked(q.len(), |r| batches::project_into(scene, &q[r.clone()], &t[r.clone()], i, &mut out[3 * r.start..3 * r.end], &mut st[r])))?;
     Ok((rows_array(py, out.as_chunks::<3>().0.to_vec()), status_array(py, &st)))
 }
 

@@ -2,7 +2,7 @@
 //! scene's motion cones, re-planning when it stalls.
 
 use crate::convert::{Arg, arg, dict, matrix_rows, optional, path, pose3, rows_array};
-use crate::errors::{arg_err, to_py};
+use crate::errors::{arg_err, guard, interruptible, to_py};
 use crate::scene::Scene;
 use crate::settings;
 use numpy::PyArray2;
@@ -49,43 +49,49 @@ impl Mpc {
         seed: Option<Arg<'py>>,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Self> {
-        let named = [("dt", dt), ("horizon", horizon), ("speed", speed), ("stage_weight", stage_weight),
-                     ("terminal_weight", terminal_weight), ("effort_weight", effort_weight), ("margin", margin),
-                     ("stall_steps", stall_steps), ("max_replans", max_replans),
-                     ("replan_time_limit", replan_time_limit), ("seed", seed)];
-        let mut given: Vec<(String, Arg<'py>)> =
-            named.into_iter().filter_map(|(k, v)| v.map(|v| (k.to_string(), v))).collect();
-        given.extend(settings::items(settings.map(|d| d.as_any()))?);
-        let scene = scene.downcast::<Scene>().map_err(|_| arg_err("scene", "must be a regrasp._core.Scene"))?.get();
-        let path = path("plan.path", poses, pushers, pose3, |n| scene.inner.pusher_index(n))?;
-        let goal = optional(goal, |g| pose3("goal", g))?;
-        let inner = regrasp::control::mpc::Mpc::new(&scene.inner, &path, goal, settings::mpc(&given)?).map_err(to_py)?;
-        Ok(Self { inner, names: scene.inner.pushers.iter().map(|p| p.name.clone()).collect() })
+        guard(move || {
+            let named = [("dt", dt), ("horizon", horizon), ("speed", speed), ("stage_weight", stage_weight),
+                         ("terminal_weight", terminal_weight), ("effort_weight", effort_weight), ("margin", margin),
+                         ("stall_steps", stall_steps), ("max_replans", max_replans),
+                         ("replan_time_limit", replan_time_limit), ("seed", seed)];
+            let mut given: Vec<(String, Arg<'py>)> =
+                named.into_iter().filter_map(|(k, v)| v.map(|v| (k.to_string(), v))).collect();
+            given.extend(settings::items(settings.map(|d| d.as_any()))?);
+            let scene = scene.downcast::<Scene>().map_err(|_| arg_err("scene", "must be a regrasp._core.Scene"))?.get();
+            let path = path("plan.path", poses, pushers, pose3, |n| scene.inner.pusher_index(n))?;
+            let goal = optional(goal, |g| pose3("goal", g))?;
+            let inner = regrasp::control::mpc::Mpc::new(&scene.inner, &path, goal, settings::mpc(&given)?).map_err(to_py)?;
+            Ok(Self { inner, names: scene.inner.pushers.iter().map(|p| p.name.clone()).collect() })
+        })
     }
 
     /// One control step from the measured pose: a dict with status, pusher, twist, knot,
     /// tracking_error, projected, solve_time_s, replan_time_s.
     fn step<'py>(&mut self, py: Python<'py>, pose: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let q = pose3("pose", pose)?;
-        let inner = &mut self.inner;
-        // a step may re-plan (up to the re-planning time limit): other Python threads run meanwhile
-        let c = py.allow_threads(|| inner.step(&q)).map_err(to_py)?;
-        Ok(dict!(py;
-            "status" => c.status.label(), "pusher" => self.name(c.pusher), "twist" => c.twist.as_slice().to_vec(),
-            "knot" => c.knot, "tracking_error" => c.tracking_error, "projected" => c.projected,
-            "solve_time_s" => c.solve_time_s, "replan_time_s" => c.replan_time_s,
-        ))
+        guard(move || {
+            let q = pose3("pose", pose)?;
+            let inner = &mut self.inner;
+            // a step may re-plan (up to the re-planning time limit): other Python threads run meanwhile
+            let c = interruptible(py, || inner.step(&q))?;
+            Ok(dict!(py;
+                "status" => c.status.label(), "pusher" => self.name(c.pusher), "twist" => c.twist.as_slice().to_vec(),
+                "knot" => c.knot, "tracking_error" => c.tracking_error, "projected" => c.projected,
+                "solve_time_s" => c.solve_time_s, "replan_time_s" => c.replan_time_s,
+            ))
+        })
     }
 
     /// The QP at pose `pose` with the reference after knot `knot`: per horizon step a dict with
     /// the pusher, generators (k, 3) and weights (k,); and whether clarabel solved it.
     fn solve_qp<'py>(&self, py: Python<'py>, pose: &Arg<'py>, knot: &Arg<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        let sol = self.inner.solve_qp(&pose3("pose", pose)?, arg("knot", knot)?).map_err(to_py)?;
-        let step = |(p, g, w): &(usize, Vec<_>, Vec<f64>)| -> PyResult<_> {
-            Ok(dict!(py; "pusher" => self.name(Some(*p)), "generators" => matrix_rows(py, g), "weights" => w.clone()))
-        };
-        let steps = sol.steps.iter().map(step).collect::<PyResult<Vec<_>>>()?;
-        (steps, sol.status_ok).into_pyobject(py)
+        guard(move || {
+            let sol = self.inner.solve_qp(&pose3("pose", pose)?, arg("knot", knot)?).map_err(to_py)?;
+            let step = |(p, g, w): &(usize, Vec<_>, Vec<f64>)| -> PyResult<_> {
+                Ok(dict!(py; "pusher" => self.name(Some(*p)), "generators" => matrix_rows(py, g), "weights" => w.clone()))
+            };
+            let steps = sol.steps.iter().map(step).collect::<PyResult<Vec<_>>>()?;
+            (steps, sol.status_ok).into_pyobject(py)
+        })
     }
 
     /// Reference knots (n, 3).

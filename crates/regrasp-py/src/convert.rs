@@ -14,6 +14,22 @@ use pyo3::IntoPyObjectExt;
 use regrasp::mechanics::geometry::Vec3;
 use regrasp::Error;
 
+/// Largest magnitude of a number argument (a coordinate [m], an angle [rad], a velocity [m/s],
+/// a time [s], ...): far beyond any physical value, and where squares and products of a few of
+/// them stay finite.
+pub const MAX_MAGNITUDE: f64 = 1e9;
+
+/// `x` unless it is not finite or its magnitude exceeds [`MAX_MAGNITUDE`] (an error naming `name`).
+fn bounded(name: &str, x: f64) -> PyResult<f64> {
+    if !x.is_finite() {
+        return Err(arg_err(name, format!("must be finite (got {x})")));
+    }
+    if x.abs() > MAX_MAGNITUDE {
+        return Err(arg_err(name, format!("must be at most {MAX_MAGNITUDE:e} in magnitude (got {x:e})")));
+    }
+    Ok(x)
+}
+
 /// A Python argument, as every binding takes it (converted by the functions below).
 pub type Arg<'py> = Bound<'py, PyAny>;
 
@@ -65,16 +81,21 @@ pub fn numbers<const N: usize>(name: &str, v: &Arg<'_>, layout: &str) -> PyResul
     if !a.iter().all(|x| x.is_finite()) {
         return Err(arg_err(name, "has a non-finite component"));
     }
+    for x in a {
+        bounded(name, x)?;
+    }
     Ok(a)
 }
 
-/// A finite number.
+/// A finite number of magnitude at most [`MAX_MAGNITUDE`].
 pub fn finite(name: &str, v: &Arg<'_>) -> PyResult<f64> {
-    let x: f64 = arg(name, v)?;
-    if !x.is_finite() {
-        return Err(arg_err(name, format!("must be finite (got {x})")));
-    }
-    Ok(x)
+    bounded(name, arg(name, v)?)
+}
+
+/// Finite numbers, each of magnitude at most [`MAX_MAGNITUDE`].
+pub fn finite_numbers(name: &str, v: &Arg<'_>) -> PyResult<Vec<f64>> {
+    let xs: Vec<f64> = arg(name, v)?;
+    xs.into_iter().map(|x| bounded(name, x)).collect()
 }
 
 /// A positive, finite number.

@@ -1,8 +1,8 @@
 //! Quasi-static dynamics (`regrasp::dynamics`): the `MncpProblem` of one instant, and the
 //! problems, pushes and simulated pushes of planar and 3-D scenes.
 
-use crate::convert::{Arg, arg, array1, batch, dict, matrix, pose3, pose7, pusher, rows_array, twist3, twist6, vector};
-use crate::errors::{arg_err, to_py};
+use crate::convert::{Arg, arg, array1, finite, finite_numbers, batch, dict, matrix, pose3, pose7, pusher, rows_array, twist3, twist6, vector};
+use crate::errors::{arg_err, guard, interruptible, to_py};
 use nalgebra::DVector;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -22,7 +22,7 @@ pub struct MncpProblem {
 
 /// Argument `name`: a list of `n` numbers.
 fn sized(name: &str, v: &Arg<'_>, n: usize) -> PyResult<Vec<f64>> {
-    let x: Vec<f64> = arg(name, v)?;
+    let x = finite_numbers(name, v)?;
     if x.len() != n {
         return Err(arg_err(name, format!("must have {n} numbers (got {})", x.len())));
     }
@@ -88,36 +88,44 @@ impl MncpProblem {
 
     /// Forward problem: pusher twist given; returns the solution as a dict.
     fn solve_forward<'py>(&self, py: Python<'py>, pusher_twist: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let u = DVector::from_vec(arg("pusher_twist", pusher_twist)?);
-        let s = py.allow_threads(|| mncp::solve_forward(&self.inner, &u, &mncp::Settings::default())).map_err(to_py)?;
-        solution_dict(py, &self.inner, &s)
+        guard(move || {
+            let u = DVector::from_vec(finite_numbers("pusher_twist", pusher_twist)?);
+            let s = py.allow_threads(|| mncp::solve_forward(&self.inner, &u, &mncp::Settings::default())).map_err(to_py)?;
+            solution_dict(py, &self.inner, &s)
+        })
     }
 
     /// Inverse problem: object twist given; returns the pusher motion and forces.
     fn solve_inverse<'py>(&self, py: Python<'py>, twist: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let v = DVector::from_vec(arg("twist", twist)?);
-        let s = py.allow_threads(|| mncp::solve_inverse(&self.inner, &v, &mncp::Settings::default())).map_err(to_py)?;
-        solution_dict(py, &self.inner, &s)
+        guard(move || {
+            let v = DVector::from_vec(finite_numbers("twist", twist)?);
+            let s = py.allow_threads(|| mncp::solve_inverse(&self.inner, &v, &mncp::Settings::default())).map_err(to_py)?;
+            solution_dict(py, &self.inner, &s)
+        })
     }
 
     /// Scaled violation of every constraint for a candidate solution (e.g. the reference's).
     fn residuals<'py>(
         &self, py: Python<'py>, twist: &Arg<'py>, pusher_twist: &Arg<'py>, normal_forces: &Arg<'py>, friction_forces: &Arg<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let p = &self.inner;
-        let v = DVector::from_vec(sized("twist", twist, p.dim)?);
-        let u = DVector::from_vec(sized("pusher_twist", pusher_twist, p.dim)?);
-        let f_n = sized("normal_forces", normal_forces, p.contacts.len())?;
-        let f_t = self::friction_forces(p, friction_forces)?;
-        residuals_dict(py, &mncp::residuals(p, &v, &u, &f_n, &f_t))
+        guard(move || {
+            let p = &self.inner;
+            let v = DVector::from_vec(sized("twist", twist, p.dim)?);
+            let u = DVector::from_vec(sized("pusher_twist", pusher_twist, p.dim)?);
+            let f_n = sized("normal_forces", normal_forces, p.contacts.len())?;
+            let f_t = self::friction_forces(p, friction_forces)?;
+            residuals_dict(py, &mncp::residuals(p, &v, &u, &f_n, &f_t))
+        })
     }
 
     /// The problem's data (for the reference solver and for inspection).
     fn data<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let p = &self.inner;
-        let contacts = p.contacts.iter().map(|c| contact_dict(py, c)).collect::<PyResult<Vec<_>>>()?;
-        Ok(dict!(py; "dim" => p.dim, "mass" => matrix(py, &p.mass), "wrench" => vector(py, &p.wrench), "h" => p.h,
-                     "force_scale" => p.force_scale, "velocity_scale" => p.velocity_scale, "contacts" => contacts))
+        guard(move || {
+            let p = &self.inner;
+            let contacts = p.contacts.iter().map(|c| contact_dict(py, c)).collect::<PyResult<Vec<_>>>()?;
+            Ok(dict!(py; "dim" => p.dim, "mass" => matrix(py, &p.mass), "wrench" => vector(py, &p.wrench), "h" => p.h,
+                         "force_scale" => p.force_scale, "velocity_scale" => p.velocity_scale, "contacts" => contacts))
+        })
     }
 }
 
@@ -141,17 +149,27 @@ pub fn spatial_problem(scene: &Scene3, pose: &Arg<'_>, name: &Arg<'_>, h: f64) -
 /// The results of `Scene.push_outcomes`: sticks, object twists, max residuals, errors.
 pub type Outcomes<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Vec<Option<String>>);
 
-/// `Scene.push_outcomes`: instantaneous pushes of pusher `name`, twist i at pose i.
+/// Pushes of a batch solved between two interrupt checks.
+const CHUNK: usize = 64;
+
+/// `Scene.push_outcomes`: instantaneous pushes of pusher `name`, twist i at pose i (zero twist
+/// and residual where `errors[i]` is set).
 pub fn push_outcomes<'py>(py: Python<'py>, scene: &Scene, poses: &Arg<'py>, name: &Arg<'py>, twists: &Arg<'py>, opts: &Options) -> PyResult<Outcomes<'py>> {
     let (q, t, i) = batch(poses, twists, name, |n| scene.pusher_index(n))?;
-    let res: Vec<_> = py.allow_threads(|| {
-        q.par_iter().zip(t.par_iter()).with_min_len(4).map(|(q, t)| quasistatic::push_outcome(scene, q, i, &(*t).into(), opts)).collect()
-    });
+    // in chunks, the interrupt checked between them (rayon's workers see no poll)
+    let res: Vec<_> = interruptible(py, || {
+        let mut out = Vec::with_capacity(q.len());
+        for (q, t) in q.chunks(CHUNK).zip(t.chunks(CHUNK)) {
+            regrasp::interrupt::check()?;
+            out.par_extend(q.par_iter().zip(t.par_iter()).with_min_len(4).map(|(q, t)| quasistatic::push_outcome(scene, q, i, &(*t).into(), opts)));
+        }
+        Ok(out)
+    })?;
     let (mut sticks, mut tw, mut resid, mut errors) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for r in res {
         let (s, v, m, e) = match r {
-            Ok(o) => (o.sticks, std::array::from_fn(|c| o.solution.twist.get(c).copied().unwrap_or(f64::NAN)), o.solution.residuals.max(), None),
-            Err(e) => (false, [0.0; 3], f64::NAN, Some(e.to_string())),
+            Ok(o) => (o.sticks, std::array::from_fn(|c| o.solution.twist.get(c).copied().unwrap_or(0.0)), o.solution.residuals.max(), None),
+            Err(e) => (false, [0.0; 3], 0.0, Some(e.to_string())),
         };
         sticks.push(s);
         tw.push(v);
@@ -190,8 +208,8 @@ pub struct PushArgs<'a, 'py> {
 pub fn simulate_planar<'py>(py: Python<'py>, scene: &Scene, a: PushArgs<'_, 'py>, opts: &Options) -> PyResult<Bound<'py, PyDict>> {
     let (q, u) = (pose3("pose", a.pose)?, twist3("twist", a.twist)?);
     let i = pusher(a.pusher, |n| scene.pusher_index(n))?;
-    let (duration, dt) = (arg("duration", a.duration)?, arg("dt", a.dt)?);
-    let tr = py.allow_threads(|| quasistatic::simulate_push(scene, &q, i, &u, duration, dt, opts)).map_err(to_py)?;
+    let (duration, dt) = (finite("duration", a.duration)?, finite("dt", a.dt)?);
+    let tr = interruptible(py, || quasistatic::simulate_push(scene, &q, i, &u, duration, dt, opts))?;
     let d = trajectory_dict!(py, tr);
     d.set_item("pusher_pose", rows_array(py, tr.pusher_pose))?;
     d.set_item("pusher_wrench", rows_array(py, tr.pusher_wrench))?;
@@ -203,9 +221,7 @@ pub fn simulate_planar<'py>(py: Python<'py>, scene: &Scene, a: PushArgs<'_, 'py>
 pub fn simulate_spatial<'py>(py: Python<'py>, scene: &Scene3, a: PushArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
     let (p, u) = (pose7("pose", a.pose)?, twist6("twist", a.twist)?);
     let i = pusher(a.pusher, |n| scene.pusher_index(n))?;
-    let (duration, dt) = (arg("duration", a.duration)?, arg("dt", a.dt)?);
-    let tr = py
-        .allow_threads(|| quasistatic3d::simulate_push(scene, &p, i, &u, duration, dt, &mncp::Settings::default()))
-        .map_err(to_py)?;
+    let (duration, dt) = (finite("duration", a.duration)?, finite("dt", a.dt)?);
+    let tr = interruptible(py, || quasistatic3d::simulate_push(scene, &p, i, &u, duration, dt, &mncp::Settings::default()))?;
     Ok(trajectory_dict!(py, tr))
 }

@@ -20,6 +20,7 @@ use pyo3::prelude::*;
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    errors::quiet_panic_hook();
     m.add_class::<scene::Scene>()?;
     m.add_class::<cones::MotionCone>()?;
     m.add_class::<dynamics::MncpProblem>()?;

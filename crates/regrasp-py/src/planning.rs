@@ -2,13 +2,13 @@
 //! checks of a given path.
 
 use crate::convert::{Arg, arg, dict, optional, path, pose3, pose7, twist6};
-use crate::errors::to_py;
+use crate::errors::{interruptible, to_py};
 use crate::settings;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use regrasp::planning::planar::{self as trrt, PlanarSettings};
 use regrasp::planning::spatial::{plan3, validate_path3};
-use regrasp::planning::trrt::Plan;
+use regrasp::planning::trrt::{Plan, SearchSettings};
 use regrasp::pose::spatial::to_array;
 use regrasp::scene::spatial::Scene3;
 use regrasp::Scene;
@@ -63,7 +63,7 @@ fn plan_dict<'py, Q, E>(
 /// overriding `planner_defaults(2)`.
 pub fn plan_planar<'py>(py: Python<'py>, scene: &Scene, r: Request<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
     let ((start, goal), s) = (r.ends(pose3)?, settings::planar(r.settings)?);
-    let plan = py.allow_threads(|| trrt::plan(scene, start, goal, &s)).map_err(to_py)?;
+    let plan = interruptible(py, || trrt::plan(scene, start, goal, &s))?;
     let pushers = scene.pushers.iter().map(|p| p.name.clone()).collect();
     let about = About { scene: &scene.name, pushers, propagation: s.propagation.label(), seed: s.search.seed };
     plan_dict(py, about, &plan, |k, q, _, _| k.set_item("pose", q.to_vec()))
@@ -73,7 +73,7 @@ pub fn plan_planar<'py>(py: Python<'py>, scene: &Scene, r: Request<'_, 'py>) -> 
 /// `settings` overriding `planner_defaults(3)`; the dict also gives the number of solves.
 pub fn plan_spatial<'py>(py: Python<'py>, scene: &Scene3, r: Request<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
     let ((start, goal), s) = (r.ends(pose7)?, settings::spatial(r.settings)?);
-    let r = py.allow_threads(|| plan3(scene, start, goal, &s)).map_err(to_py)?;
+    let r = interruptible(py, || plan3(scene, start, goal, &s))?;
     let about = About {
         scene: &scene.name,
         pushers: scene.pushers.iter().map(|p| p.name.clone()).collect(),
@@ -93,19 +93,20 @@ pub fn plan_spatial<'py>(py: Python<'py>, scene: &Scene3, r: Request<'_, 'py>) -
 
 /// `Scene.validate_path`: the smallest exact-test margin along each step of a path, checked
 /// at `checks` poses a step (default: the planner's).
-pub fn validate_planar(scene: &Scene, poses: &Arg<'_>, pushers: &Arg<'_>, checks: Option<&Arg<'_>>) -> PyResult<Vec<f64>> {
+pub fn validate_planar(py: Python<'_>, scene: &Scene, poses: &Arg<'_>, pushers: &Arg<'_>, checks: Option<&Arg<'_>>) -> PyResult<Vec<f64>> {
     let path = path("path", poses, pushers, pose3, |n| scene.pusher_index(n))?;
     let checks = optional(checks, |v| arg("checks", v))?.unwrap_or(PlanarSettings::default().search.checks);
-    trrt::validate_path(scene, &path, checks).map_err(to_py)
+    SearchSettings { checks, ..SearchSettings::default() }.check().map_err(to_py)?;
+    interruptible(py, || trrt::validate_path(scene, &path, checks))
 }
 
 /// `Scene3D.validate_path`: whether each step of a path can be taken by its pusher (with
 /// the steps' pusher twists `twists`, when given).
-pub fn validate_spatial(scene: &Scene3, poses: &Arg<'_>, pushers: &Arg<'_>, twists: Option<&Arg<'_>>) -> PyResult<Vec<bool>> {
+pub fn validate_spatial(py: Python<'_>, scene: &Scene3, poses: &Arg<'_>, pushers: &Arg<'_>, twists: Option<&Arg<'_>>) -> PyResult<Vec<bool>> {
     let twists = optional(twists, |t| {
         let t: Vec<Arg<'_>> = arg("twists", t)?;
         t.iter().enumerate().map(|(i, v)| twist6(&format!("path[{i}].pusher_twist"), v)).collect::<PyResult<Vec<_>>>()
     })?;
     let path = path("path", poses, pushers, pose7, |n| scene.pusher_index(n))?;
-    validate_path3(scene, &path, twists.as_deref()).map_err(to_py)
+    interruptible(py, || validate_path3(scene, &path, twists.as_deref()))
 }

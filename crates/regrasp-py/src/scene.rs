@@ -5,12 +5,13 @@
 use crate::cones::{self, Classified, Generated, MotionCone, Projected};
 use crate::convert::{Arg, arg, array1, opt, pose3, positive, pusher, rows, rows_array};
 use crate::dynamics::{self, MncpProblem, Outcomes, PushArgs};
-use crate::errors::{arg_err, to_py};
+use crate::errors::{arg_err, guard, to_py};
 use crate::{planning, settings};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use regrasp::cones::robust::ConeMode;
+use regrasp::mechanics::limit_surface::MAX_NORMAL_FORCE;
 use regrasp::scene::perturb;
 use regrasp::scene::planar::{PadShape, Support};
 use std::collections::HashMap;
@@ -39,13 +40,17 @@ impl Scene {
     /// Parse and validate a scene from TOML text.
     #[staticmethod]
     fn from_toml(text: &Arg<'_>) -> PyResult<Self> {
-        regrasp::Scene::from_toml_str(&arg::<String>("text", text)?).map(|inner| Self { inner }).map_err(to_py)
+        guard(move || {
+            regrasp::Scene::from_toml_str(&arg::<String>("text", text)?).map(|inner| Self { inner }).map_err(to_py)
+        })
     }
 
     /// Parse and validate a scene from JSON text (same layout as the TOML file).
     #[staticmethod]
     fn from_json(text: &Arg<'_>) -> PyResult<Self> {
-        regrasp::Scene::from_json_str(&arg::<String>("text", text)?).map(|inner| Self { inner }).map_err(to_py)
+        guard(move || {
+            regrasp::Scene::from_json_str(&arg::<String>("text", text)?).map(|inner| Self { inner }).map_err(to_py)
+        })
     }
 
     #[getter] fn name(&self) -> String { self.inner.name.clone() }
@@ -90,61 +95,86 @@ impl Scene {
     }
     /// Pusher `name`: (points (k, 2), normal (2,), friction).
     fn pusher<'py>(&self, py: Python<'py>, name: &Arg<'py>) -> PyResult<PusherSpec<'py>> {
-        let c = &self.inner.pushers[pusher(name, |n| self.inner.pusher_index(n))?].contact;
-        Ok((rows_array(py, c.points.iter().map(|p| [p.x, p.y]).collect()), (c.normal.x, c.normal.y), c.friction))
+        guard(move || {
+            let c = &self.inner.pushers[pusher(name, |n| self.inner.pusher_index(n))?].contact;
+            Ok((rows_array(py, c.points.iter().map(|p| [p.x, p.y]).collect()), (c.normal.x, c.normal.y), c.friction))
+        })
     }
     /// (start, goal, tolerance) or None.
     #[getter] fn task(&self) -> Option<([f64; 3], [f64; 3], [f64; 3])> { self.inner.task.map(|t| (t.start, t.goal, t.tolerance)) }
 
     fn admissible(&self, pose: &Arg<'_>) -> PyResult<bool> {
-        Ok(self.inner.admissible(&pose3("pose", pose)?))
+        guard(move || {
+            Ok(self.inner.admissible(&pose3("pose", pose)?))
+        })
     }
 
     fn admissible_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>) -> PyResult<Bound<'py, PyArray1<bool>>> {
-        let q = rows::<3>("poses", poses)?;
-        Ok(array1(py, py.allow_threads(|| q.iter().map(|p| self.inner.admissible(p)).collect())))
+        guard(move || {
+            let q = rows::<3>("poses", poses)?;
+            Ok(array1(py, py.allow_threads(|| q.iter().map(|p| self.inner.admissible(p)).collect())))
+        })
     }
 
     fn hold_ratio(&self, pose: &Arg<'_>) -> PyResult<f64> {
-        Ok(self.inner.hold_ratio(&pose3("pose", pose)?))
+        guard(move || {
+            let r = self.inner.hold_ratio(&pose3("pose", pose)?);
+            if !r.is_finite() {
+                return Err(arg_err("pose", format!("has no finite hold ratio (got {r}): the support cannot hold the object there at all")));
+            }
+            Ok(r)
+        })
     }
 
     fn with_grip_force(&self, force: &Arg<'_>) -> PyResult<Self> {
-        let force = positive("force", force)?;
-        if self.inner.grip_force().is_none() {
-            return Err(arg_err("force", "only a grasp scene has a grip force"));
-        }
-        Ok(Self { inner: self.inner.with_grip_force(force) })
+        guard(move || {
+            let force = positive("force", force)?;
+            if force > MAX_NORMAL_FORCE {
+                return Err(arg_err("force", format!("must be at most {MAX_NORMAL_FORCE:e} N (got {force:e})")));
+            }
+            if self.inner.grip_force().is_none() {
+                return Err(arg_err("force", "only a grasp scene has a grip force"));
+            }
+            Ok(Self { inner: self.inner.with_grip_force(force) })
+        })
     }
 
     /// The motion cone of pusher `pusher` at `pose` (raises GraspError if the grasp cannot
     /// hold, unless `check_hold` is False).
     #[pyo3(signature = (pose, pusher, check_hold=None))]
     fn motion_cone(&self, pose: &Arg<'_>, pusher: &Arg<'_>, check_hold: Option<&Arg<'_>>) -> PyResult<MotionCone> {
-        let q = pose3("pose", pose)?;
-        let name: String = arg("pusher", pusher)?;
-        let i = self.inner.pusher_index(&name).map_err(to_py)?;
-        let push = match opt("check_hold", check_hold)?.unwrap_or(true) {
-            true => self.inner.push(&q, i),
-            false => self.inner.push_unchecked(&q, i),
-        };
-        Ok(MotionCone::new(push.map_err(to_py)?, name))
+        guard(move || {
+            let q = pose3("pose", pose)?;
+            let name: String = arg("pusher", pusher)?;
+            let i = self.inner.pusher_index(&name).map_err(to_py)?;
+            let push = match opt("check_hold", check_hold)?.unwrap_or(true) {
+                true => self.inner.push(&q, i),
+                false => self.inner.push_unchecked(&q, i),
+            };
+            Ok(MotionCone::new(push.map_err(to_py)?, name))
+        })
     }
 
     /// Polyhedral (or gravity-free) generators at many poses: (generators (n, k, 3),
     /// status (n,) uint8; 0 = ok, see `status_messages`).
     fn generators_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>, pusher: &Arg<'py>, gravity_free: &Arg<'py>) -> PyResult<Generated<'py>> {
-        cones::generators_many(py, &self.inner, poses, pusher, gravity_free)
+        guard(move || {
+            cones::generators_many(py, &self.inner, poses, pusher, gravity_free)
+        })
     }
 
     /// Exact test of twist i at pose i: (feasible, margin, active-limit codes, status).
     fn classify_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>, twists: &Arg<'py>, pusher: &Arg<'py>) -> PyResult<Classified<'py>> {
-        cones::classify_many(py, &self.inner, poses, twists, pusher)
+        guard(move || {
+            cones::classify_many(py, &self.inner, poses, twists, pusher)
+        })
     }
 
     /// Closest feasible twist to twist i at pose i: (projections (n, 3), status).
     fn project_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>, twists: &Arg<'py>, pusher: &Arg<'py>) -> PyResult<Projected<'py>> {
-        cones::project_many(py, &self.inner, poses, twists, pusher)
+        guard(move || {
+            cones::project_many(py, &self.inner, poses, twists, pusher)
+        })
     }
 
     /// Labels of the contact-limit codes returned by `classify_many`.
@@ -168,9 +198,11 @@ impl Scene {
         support: Option<&Arg<'_>>, rings: Option<&Arg<'_>>, points: Option<&Arg<'_>>, merge_fingers: Option<&Arg<'_>>,
         h: Option<&Arg<'_>>, speed: Option<&Arg<'_>>,
     ) -> PyResult<MncpProblem> {
-        let [a, b, c, d] = self::support(support, rings, points, merge_fingers);
-        let opts = settings::quasistatic(&[a, b, c, d, ("h", h), ("speed", speed)])?;
-        dynamics::planar_problem(&self.inner, pose, pusher, &opts)
+        guard(move || {
+            let [a, b, c, d] = self::support(support, rings, points, merge_fingers);
+            let opts = settings::quasistatic(&[a, b, c, d, ("h", h), ("speed", speed)])?;
+            dynamics::planar_problem(&self.inner, pose, pusher, &opts)
+        })
     }
 
     /// Instantaneous pushes: pusher `pusher` at pose i moving with twist i (object frame).
@@ -181,8 +213,10 @@ impl Scene {
         &self, py: Python<'py>, poses: &Arg<'py>, pusher: &Arg<'py>, twists: &Arg<'py>,
         support: Option<&Arg<'py>>, rings: Option<&Arg<'py>>, points: Option<&Arg<'py>>, merge_fingers: Option<&Arg<'py>>,
     ) -> PyResult<Outcomes<'py>> {
-        let opts = settings::quasistatic(&self::support(support, rings, points, merge_fingers))?;
-        dynamics::push_outcomes(py, &self.inner, poses, pusher, twists, &opts)
+        guard(move || {
+            let opts = settings::quasistatic(&self::support(support, rings, points, merge_fingers))?;
+            dynamics::push_outcomes(py, &self.inner, poses, pusher, twists, &opts)
+        })
     }
 
     /// Explicit time stepping of one push (pusher body twist constant, object frame at t = 0).
@@ -192,22 +226,28 @@ impl Scene {
         &self, py: Python<'py>, pose: &Arg<'py>, pusher: &Arg<'py>, twist: &Arg<'py>, duration: &Arg<'py>, dt: &Arg<'py>,
         support: Option<&Arg<'py>>, rings: Option<&Arg<'py>>, points: Option<&Arg<'py>>, merge_fingers: Option<&Arg<'py>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let opts = settings::quasistatic(&self::support(support, rings, points, merge_fingers))?;
-        dynamics::simulate_planar(py, &self.inner, PushArgs { pose, pusher, twist, duration, dt }, &opts)
+        guard(move || {
+            let opts = settings::quasistatic(&self::support(support, rings, points, merge_fingers))?;
+            dynamics::simulate_planar(py, &self.inner, PushArgs { pose, pusher, twist, duration, dt }, &opts)
+        })
     }
 
     /// T-RRT* regrasp plan (see `regrasp.plan`): `settings` overrides the defaults of
     /// `planner_defaults(2)`. Returns a dict.
     #[pyo3(signature = (start=None, goal=None, settings=None))]
     fn plan<'py>(&self, py: Python<'py>, start: Option<&Arg<'py>>, goal: Option<&Arg<'py>>, settings: Option<&Arg<'py>>) -> PyResult<Bound<'py, PyDict>> {
-        planning::plan_planar(py, &self.inner, planning::Request { start, goal, settings })
+        guard(move || {
+            planning::plan_planar(py, &self.inner, planning::Request { start, goal, settings })
+        })
     }
 
     /// Smallest exact-test margin along each step of a path (poses, pusher names), checked at
     /// `checks` poses a step (default: the planner's `checks`).
     #[pyo3(signature = (poses, pushers, checks=None))]
-    fn validate_path(&self, poses: &Arg<'_>, pushers: &Arg<'_>, checks: Option<&Arg<'_>>) -> PyResult<Vec<f64>> {
-        planning::validate_planar(&self.inner, poses, pushers, checks)
+    fn validate_path(&self, py: Python<'_>, poses: &Arg<'_>, pushers: &Arg<'_>, checks: Option<&Arg<'_>>) -> PyResult<Vec<f64>> {
+        guard(move || {
+            planning::validate_planar(py, &self.inner, poses, pushers, checks)
+        })
     }
 
     /// The cone mode: "nominal", "robust" or "fixtureless".
@@ -235,16 +275,24 @@ impl Scene {
         pusher_friction: Option<&Arg<'_>>,
         mode: Option<&Arg<'_>>,
     ) -> PyResult<Self> {
-        let factor = |name: &str, v: Option<&Arg<'_>>| opt::<f64>(name, v).map(|f| f.unwrap_or(1.0));
-        let (f, g) = (factor("finger_friction", finger_friction)?, factor("grip", grip)?);
-        let (m, p) = (factor("mass", mass)?, factor("pusher_friction", pusher_friction)?);
-        let mode = opt::<String>("mode", mode)?.map(|m| ConeMode::parse(&m)).transpose().map_err(to_py)?.unwrap_or_default();
-        perturb::scaled(&self.inner, f, g, m, p, mode).map(|inner| Self { inner }).map_err(to_py)
+        guard(move || {
+            let factor = |name: &str, v: Option<&Arg<'_>>| opt::<f64>(name, v).map(|f| f.unwrap_or(1.0));
+            let (f, g) = (factor("finger_friction", finger_friction)?, factor("grip", grip)?);
+            let (m, p) = (factor("mass", mass)?, factor("pusher_friction", pusher_friction)?);
+            let mode = opt::<String>("mode", mode)?.map(|m| ConeMode::parse(&m)).transpose().map_err(to_py)?.unwrap_or_default();
+            let inner = perturb::scaled(&self.inner, f, g, m, p, mode).map_err(to_py)?;
+            if inner.grip_force().is_some_and(|n| !(n <= MAX_NORMAL_FORCE)) {
+                return Err(arg_err("grip", format!("scales the grip force beyond {MAX_NORMAL_FORCE:e} N")));
+            }
+            Ok(Self { inner })
+        })
     }
 
     /// Whether pusher `pusher` alone can carry the object's weight at pose `q` (the invariant case).
     fn carries_weight(&self, q: &Arg<'_>, pusher: &Arg<'_>) -> PyResult<bool> {
-        let (q, p) = (pose3("pose", q)?, self::pusher(pusher, |n| self.inner.pusher_index(n))?);
-        Ok(self.inner.push_unchecked(&q, p).map_err(to_py)?.carries_weight())
+        guard(move || {
+            let (q, p) = (pose3("pose", q)?, self::pusher(pusher, |n| self.inner.pusher_index(n))?);
+            Ok(self.inner.push_unchecked(&q, p).map_err(to_py)?.carries_weight())
+        })
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::convert::{Arg, arg, matrix, optional, pose7, pusher, rows_array};
 use crate::dynamics::{self, MncpProblem, PushArgs};
-use crate::errors::to_py;
+use crate::errors::{guard, to_py};
 use crate::planning;
 use numpy::PyArray2;
 use pyo3::prelude::*;
@@ -30,10 +30,12 @@ impl Scene3D {
     #[staticmethod]
     #[pyo3(signature = (text, base=None))]
     fn from_toml(text: &Arg<'_>, base: Option<&Arg<'_>>) -> PyResult<Self> {
-        let base: Option<String> = optional(base, |b| arg("base", b))?;
-        Scene3::from_toml_str(&arg::<String>("text", text)?, base.as_deref().map(std::path::Path::new))
-            .map(|inner| Self { inner })
-            .map_err(to_py)
+        guard(move || {
+            let base: Option<String> = optional(base, |b| arg("base", b))?;
+            Scene3::from_toml_str(&arg::<String>("text", text)?, base.as_deref().map(std::path::Path::new))
+                .map(|inner| Self { inner })
+                .map_err(to_py)
+        })
     }
     #[getter] fn name(&self) -> String { self.inner.name.clone() }
     #[getter] fn pusher_names(&self) -> Vec<String> { self.inner.pushers.iter().map(|p| p.name.clone()).collect() }
@@ -56,18 +58,24 @@ impl Scene3D {
     #[pyo3(signature = (name, pose=None))]
     #[allow(clippy::type_complexity)]
     fn pusher_spec(&self, name: &Arg<'_>, pose: Option<&Arg<'_>>) -> PyResult<(Vec<[f64; 3]>, [f64; 3], f64)> {
-        let i = self.index(name)?;
-        let q = optional(pose, |v| pose7("pose", v))?.unwrap_or(self.inner.start);
-        let (pts, n) = self.inner.pusher_contacts(i, &q);
-        Ok((pts.into_iter().map(Into::into).collect(), n.into(), self.inner.pushers[i].friction))
+        guard(move || {
+            let i = self.index(name)?;
+            let q = optional(pose, |v| pose7("pose", v))?.unwrap_or(self.inner.start);
+            let (pts, n) = self.inner.pusher_contacts(i, &q);
+            Ok((pts.into_iter().map(Into::into).collect(), n.into(), self.inner.pushers[i].friction))
+        })
     }
     /// Pusher `name`'s normal as the scene gives it (object frame; a plane's: gripper frame).
     fn pusher_normal(&self, name: &Arg<'_>) -> PyResult<[f64; 3]> {
-        Ok(self.inner.pushers[self.index(name)?].normal.into())
+        guard(move || {
+            Ok(self.inner.pushers[self.index(name)?].normal.into())
+        })
     }
     /// Whether pusher `name` is a plane (its normal fixed in the gripper frame).
     fn is_plane(&self, name: &Arg<'_>) -> PyResult<bool> {
-        Ok(self.inner.pushers[self.index(name)?].plane)
+        guard(move || {
+            Ok(self.inner.pushers[self.index(name)?].plane)
+        })
     }
     /// The sphere's radius, for a spherical object (else None).
     #[getter] fn sphere(&self) -> Option<f64> { self.inner.sphere }
@@ -76,20 +84,26 @@ impl Scene3D {
     /// planar plan (poses as [x, y, z, qw, qx, qy, qz]) plus the number of solves.
     #[pyo3(signature = (start=None, goal=None, settings=None))]
     fn plan<'py>(&self, py: Python<'py>, start: Option<&Arg<'py>>, goal: Option<&Arg<'py>>, settings: Option<&Arg<'py>>) -> PyResult<Bound<'py, PyDict>> {
-        planning::plan_spatial(py, &self.inner, planning::Request { start, goal, settings })
+        guard(move || {
+            planning::plan_spatial(py, &self.inner, planning::Request { start, goal, settings })
+        })
     }
 
     /// Whether each step of a path (poses, pusher names) can be taken by its pusher (inverse
     /// dynamics at 8 poses along it, pads on the object).
     #[pyo3(signature = (poses, pushers, twists=None))]
-    fn validate_path(&self, poses: &Arg<'_>, pushers: &Arg<'_>, twists: Option<&Arg<'_>>) -> PyResult<Vec<bool>> {
-        planning::validate_spatial(&self.inner, poses, pushers, twists)
+    fn validate_path(&self, py: Python<'_>, poses: &Arg<'_>, pushers: &Arg<'_>, twists: Option<&Arg<'_>>) -> PyResult<Vec<bool>> {
+        guard(move || {
+            planning::validate_spatial(py, &self.inner, poses, pushers, twists)
+        })
     }
 
     /// Contact points (object frame) of pusher `name` at `pose` (default: the task's start).
     #[pyo3(signature = (name, pose=None))]
     fn pusher_points(&self, name: &Arg<'_>, pose: Option<&Arg<'_>>) -> PyResult<Vec<[f64; 3]>> {
-        Ok(self.pusher_spec(name, pose)?.0)
+        guard(move || {
+            Ok(self.pusher_spec(name, pose)?.0)
+        })
     }
 
     #[getter] fn pad_radius(&self) -> f64 { self.inner.pad_radius }
@@ -101,15 +115,19 @@ impl Scene3D {
     }
     /// Contact points (object frame) of the two finger pads at `pose`.
     fn pad_contacts(&self, pose: &Arg<'_>) -> PyResult<Vec<Vec<[f64; 3]>>> {
-        let pads = self.inner.pad_contacts(&pose7("pose", pose)?);
-        Ok(pads.iter().map(|s| s.iter().map(|&v| v.into()).collect()).collect())
+        guard(move || {
+            let pads = self.inner.pad_contacts(&pose7("pose", pose)?);
+            Ok(pads.iter().map(|s| s.iter().map(|&v| v.into()).collect()).collect())
+        })
     }
     /// The quasi-static problem of `pusher` in contact at its points, at `pose`, with time
     /// step `h` (default: the quasi-static model's, `quasistatic_defaults()["h"]`).
     #[pyo3(signature = (pose, pusher, h=None))]
     fn quasistatic_problem(&self, pose: &Arg<'_>, pusher: &Arg<'_>, h: Option<&Arg<'_>>) -> PyResult<MncpProblem> {
-        let h = optional(h, |v| arg("h", v))?.unwrap_or(Options::default().h);
-        dynamics::spatial_problem(&self.inner, pose, pusher, h)
+        guard(move || {
+            let h = optional(h, |v| arg("h", v))?.unwrap_or(Options::default().h);
+            dynamics::spatial_problem(&self.inner, pose, pusher, h)
+        })
     }
     /// Time stepping of one push (pusher body twist [v, ω] constant, object frame at t = 0).
     fn simulate_push<'py>(
@@ -121,6 +139,8 @@ impl Scene3D {
         duration: &Arg<'py>,
         dt: &Arg<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        dynamics::simulate_spatial(py, &self.inner, PushArgs { pose, pusher, twist, duration, dt })
+        guard(move || {
+            dynamics::simulate_spatial(py, &self.inner, PushArgs { pose, pusher, twist, duration, dt })
+        })
     }
 }

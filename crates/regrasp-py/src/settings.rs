@@ -3,7 +3,7 @@
 //! overrides applied onto them, each key checked (an unknown key is an `ArgumentError`).
 
 use crate::convert::{Arg, arg, dict, positive};
-use crate::errors::{arg_err, to_py};
+use crate::errors::{arg_err, guard, to_py};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use regrasp::control::mpc::MpcSettings;
@@ -87,25 +87,29 @@ pub fn spatial(overrides: Option<&Arg<'_>>) -> PyResult<SpatialSettings> {
 /// The planner's default settings for scenes of `dimension` 2 or 3 (the Rust `Default`s).
 #[pyfunction]
 pub fn planner_defaults<'py>(py: Python<'py>, dimension: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
-    match arg::<usize>("dimension", dimension)? {
-        2 => planar_dict(py, &PlanarSettings::default()),
-        3 => {
-            let d = PyDict::new(py);
-            search_dict(&SpatialSettings::default().search, &d)?;
-            Ok(d)
+    guard(move || {
+        match arg::<usize>("dimension", dimension)? {
+            2 => planar_dict(py, &PlanarSettings::default()),
+            3 => {
+                let d = PyDict::new(py);
+                search_dict(&SpatialSettings::default().search, &d)?;
+                Ok(d)
+            }
+            _ => Err(arg_err("dimension", "must be 2 or 3")),
         }
-        _ => Err(arg_err("dimension", "must be 2 or 3")),
-    }
+    })
 }
 
 /// The MPC's default settings (`regrasp::control::mpc::MpcSettings::default()`): the keywords
 /// `_core.Mpc` takes, `replan_time_limit` and `seed` being those of its re-planning.
 #[pyfunction]
 pub fn mpc_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
-    let s = MpcSettings::default();
-    let d = dict!(py; "replan_time_limit" => s.planner.search.time_limit, "seed" => s.planner.search.seed);
-    mpc_dict(&s, &d)?;
-    Ok(d)
+    guard(move || {
+        let s = MpcSettings::default();
+        let d = dict!(py; "replan_time_limit" => s.planner.search.time_limit, "seed" => s.planner.search.seed);
+        mpc_dict(&s, &d)?;
+        Ok(d)
+    })
 }
 
 /// The MPC's settings: the defaults with `overrides` applied (None values are skipped); checked
@@ -137,11 +141,17 @@ fn support_parts(m: SupportModel) -> (&'static str, usize, usize, bool) {
 /// the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`.
 #[pyfunction]
 pub fn quasistatic_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
-    let o = Options::default();
-    let (support, rings, points, merge_fingers) = support_parts(o.support);
-    Ok(dict!(py; "support" => support, "rings" => rings, "points" => points, "merge_fingers" => merge_fingers,
-                 "h" => o.h, "speed" => o.speed))
+    guard(move || {
+        let o = Options::default();
+        let (support, rings, points, merge_fingers) = support_parts(o.support);
+        Ok(dict!(py; "support" => support, "rings" => rings, "points" => points, "merge_fingers" => merge_fingers,
+                     "h" => o.h, "speed" => o.speed))
+    })
 }
+
+/// Most rings and points a pad's support model may take (each point is a contact of the problem).
+const MAX_RINGS: usize = 64;
+const MAX_POINTS: usize = 1024;
 
 /// The quasi-static model's options: the defaults with the `given` ones (None: the default).
 pub fn quasistatic(given: &[(&str, Option<&Arg<'_>>)]) -> PyResult<Options> {
@@ -157,6 +167,11 @@ pub fn quasistatic(given: &[(&str, Option<&Arg<'_>>)]) -> PyResult<Options> {
             "h" => o.h = positive(k, v)?,
             "speed" => o.speed = positive(k, v)?,
             _ => return Err(arg_err(k, "is not an option of the quasi-static model")),
+        }
+    }
+    for (name, v, hi) in [("rings", rings, MAX_RINGS), ("points", points, MAX_POINTS)] {
+        if v > hi {
+            return Err(arg_err(name, format!("must be at most {hi} (got {v})")));
         }
     }
     o.support = match support.as_str() {

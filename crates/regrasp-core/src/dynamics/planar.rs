@@ -9,7 +9,7 @@
 
 use crate::cones::frame::SupportFrame;
 use crate::dynamics::mncp::{self, Contact, ContactState, FrictionLaw, NormalLaw, Problem, Settings, Side, Solution};
-use crate::dynamics::stepping::{march, pusher_at, solve_step, step_count, within_reach, PusherContacts};
+use crate::dynamics::stepping::{check_speed, check_step_motion, finite_solution, march, pusher_at, solve_step, step_count, within_reach, PusherContacts};
 use crate::error::{Error, Result};
 use crate::mechanics::geometry::{cross2, perp, rot, Vec2, Vec3};
 use crate::mechanics::limit_surface::{Pressure, PressureDistribution};
@@ -228,8 +228,10 @@ fn pusher_states(p: &Problem, s: &Solution) -> Vec<ContactState> {
 
 /// One instantaneous push: pusher `pusher` at pose `q` moving with twist `u` (object frame).
 pub fn push_outcome(scene: &Scene, q: &[f64; 3], pusher: usize, u: &Vec3, opts: &Options) -> Result<PushOutcome> {
+    check_speed("twist", Vec2::new(u.x, u.y).norm() + u.z.abs() * scene.length)?;
     let p = push_problem(scene, q, pusher, opts)?;
     let sol = mncp::solve_forward(&p, &DVector::from_row_slice(u.as_slice()), &opts.settings)?;
+    finite_solution(&sol)?;
     let sticks = pusher_states(&p, &sol).iter().all(|s| *s == ContactState::Stick);
     Ok(PushOutcome { sticks, solution: sol })
 }
@@ -274,7 +276,9 @@ pub fn simulate_push(
     let pz = pusher_at(&scene.pushers, pusher)?;
     let opts = Options { h: dt, ..*opts };
     let mut traj = Trajectory::default();
-    let reach = 0.002 + 2.0 * dt * (Vec2::new(u.x, u.y).norm() + u.z.abs() * scene.length);
+    let speed = Vec2::new(u.x, u.y).norm() + u.z.abs() * scene.length;
+    check_step_motion(speed, dt, scene.length)?;
+    let reach = 0.002 + 2.0 * dt * speed;
     march(steps, dt, *q0, u, integrate, |t, q, qp| {
         // pusher points and normal in the object frame
         let rel = relative(q, qp);

@@ -9,7 +9,7 @@
 //! (the contact point moves over the object as it rolls).
 
 use crate::dynamics::mncp::{Contact, Problem, Settings, Side};
-use crate::dynamics::stepping::{march, pusher_at, solve_step, step_count, within_reach, PusherContacts};
+use crate::dynamics::stepping::{check_step_motion, march, pusher_at, solve_step, step_count, within_reach, PusherContacts};
 use crate::error::{Error, Result};
 pub use crate::pose::spatial::integrate;
 use crate::pose::spatial::{skew, twist_in};
@@ -145,6 +145,7 @@ pub fn simulate_push(
     let steps = step_count(duration, dt)?;
     let pz = pusher_at(&scene.pushers, pusher)?;
     let speed = V3::new(u[0], u[1], u[2]).norm() + V3::new(u[3], u[4], u[5]).norm() * scene.length;
+    check_step_motion(speed, dt, scene.length)?;
     let reach = 0.002 + 2.0 * dt * speed;
     let mut tr = Trajectory3::default();
     // in the pusher's frame (the object frame at the start): its points (or a point of the

@@ -10,15 +10,46 @@ use nalgebra::DVector;
 /// Most time steps one simulated push may take (a typo in `dt` must not run for hours).
 pub const MAX_STEPS: f64 = 1e6;
 
-/// The number of steps of `dt` in `duration`, both checked.
+/// The number of steps of `dt` in `duration`, both checked: `duration` positive and finite,
+/// `dt` in (0, duration], at most [`MAX_STEPS`] steps.
 pub(super) fn step_count(duration: f64, dt: f64) -> Result<usize> {
-    if !(dt > 0.0) || !(duration >= 0.0) || !duration.is_finite() {
-        return Err(Error::arg("dt", "time step and duration must be positive and finite"));
+    if !(duration > 0.0 && duration.is_finite()) {
+        return Err(Error::arg("duration", format!("must be a positive, finite number of seconds (got {duration})")));
+    }
+    if !(dt > 0.0 && dt <= duration) {
+        return Err(Error::arg("dt", format!("must be a time step in (0, duration = {duration}] s (got {dt})")));
     }
     if duration / dt > MAX_STEPS {
         return Err(Error::arg("dt", format!("{:.0} time steps asked for (duration / dt); at most {MAX_STEPS:.0}", duration / dt)));
     }
     Ok((duration / dt).round() as usize)
+}
+
+/// Fastest pusher motion the quasi-static model takes [m/s] (metric: |v| + L |ω|): far beyond
+/// any gripper's, and where the solver's work stays bounded.
+pub const MAX_SPEED: f64 = 100.0;
+
+/// Checks a pusher speed `speed` [m/s] (metric: |v| + L |ω|): finite and at most
+/// [`MAX_SPEED`]. Errors name `name`.
+pub fn check_speed(name: &str, speed: f64) -> Result<()> {
+    if !(speed.is_finite() && speed <= MAX_SPEED) {
+        return Err(Error::arg(name, format!("moves the pusher at {speed:.3e} m/s (|v| + L |ω|); at most {MAX_SPEED} m/s")));
+    }
+    Ok(())
+}
+
+/// Checks that a pusher moving at `speed` [m/s] (metric: |v| + L |ω|; see [`check_speed`])
+/// moves at most the object's characteristic length `length` [m] in one time step `dt` [s]:
+/// a quasi-static step cannot resolve more. Errors name `twist`.
+pub fn check_step_motion(speed: f64, dt: f64, length: f64) -> Result<()> {
+    check_speed("twist", speed)?;
+    if speed * dt > length {
+        return Err(Error::arg(
+            "twist",
+            format!("moves the pusher {:.3e} m in one time step of {dt} s, more than the object's size ({length:.3e} m): slow it down or shorten the step", speed * dt),
+        ));
+    }
+    Ok(())
 }
 
 /// Pusher `i` of a scene's pushers.
@@ -35,7 +66,7 @@ pub(super) fn within_reach<P>(candidates: impl IntoIterator<Item = (P, f64)>, re
 /// Steps `k = 0..=steps` of a push at times `k dt`: `step(t, q, qp)` solves the step with the
 /// object at pose `q` and the pusher at `qp` and returns the object's twist; then, but for the
 /// last step, the object moves with that twist and the pusher with `u`, both over `dt`
-/// (`integrate`: the exponential map of the pose space).
+/// (`integrate`: the exponential map of the pose space). Checks for an interrupt every step.
 pub(super) fn march<Q: Copy, V>(
     steps: usize,
     dt: f64,
@@ -46,6 +77,7 @@ pub(super) fn march<Q: Copy, V>(
 ) -> Result<()> {
     let (mut q, mut qp) = (q0, q0);
     for k in 0..=steps {
+        crate::interrupt::check()?;
         let v = step(k as f64 * dt, &q, &qp)?;
         if k < steps {
             q = integrate(&q, &v, dt);
@@ -56,8 +88,18 @@ pub(super) fn march<Q: Copy, V>(
 }
 
 /// The forward problem of the step at time `t` with pusher twist `u` (object frame).
+/// A solution whose velocities or forces are not all finite is an error naming `twist`.
 pub(super) fn solve_step(p: &Problem, u: &[f64], settings: &Settings, t: f64) -> Result<Solution> {
-    mncp::solve_forward(p, &DVector::from_row_slice(u), settings).map_err(|e| Error::arg("push", format!("at t = {t:.3} s: {e}")))
+    let s = mncp::solve_forward(p, &DVector::from_row_slice(u), settings).map_err(|e| Error::arg("push", format!("at t = {t:.3} s: {e}")))?;
+    finite_solution(&s).map_err(|e| Error::arg("twist", format!("at t = {t:.3} s: {e}")))?;
+    Ok(s)
+}
+
+/// `Ok` when every velocity and force of `s` is finite.
+pub fn finite_solution(s: &Solution) -> Result<()> {
+    let vectors = s.tangent_velocities.iter().chain(&s.friction_forces).chain([&s.twist, &s.pusher_twist]);
+    let finite = vectors.flat_map(|v| v.iter()).chain(&s.normal_forces).chain(&s.normal_velocities).all(|x| x.is_finite());
+    if finite && s.residuals.max().is_finite() { Ok(()) } else { Err(Error::arg("twist", "the solution has non-finite velocities or forces")) }
 }
 
 /// What a step records about the pusher's contacts.

@@ -13,6 +13,10 @@
 use crate::mechanics::geometry::{cross2, perp, Mat3, Polygon, Vec2, Vec3};
 use nalgebra::{DMatrix, DVector};
 
+/// Largest normal (grip) force a support may press with [N]: far beyond any gripper, and where
+/// the cones' computations (squares of forces, `A = B / (μ N)²`) stay finite.
+pub const MAX_NORMAL_FORCE: f64 = 1e6;
+
 /// The integration constant `k` for a circular pad of radius `r` under uniform pressure.
 pub fn circular_pad_k(radius: f64) -> f64 {
     0.6 * radius

@@ -352,7 +352,7 @@ pub fn plan_tree(
     let goal = goal.or(task.map(|t| t.goal)).ok_or_else(|| Error::arg("goal", "the scene has no task: give a goal"))?;
     let tol = task.map(|t| t.tolerance).unwrap_or([1e-3, 1e-3, 0.0175]);
     let space = PlanarSpace::new(scene, start, goal, tol, settings)?;
-    Ok(trrt::plan_tree(&space, start))
+    trrt::plan_tree(&space, start)
 }
 
 /// ICRA 2018 "stable check": is there a pusher force in its friction cone that, with the
@@ -401,6 +401,7 @@ pub fn stable_push_lp(scene: &Scene, q: &[f64; 3], pusher: usize, tw: &Vec3) -> 
 pub fn validate_path(scene: &Scene, path: &[([f64; 3], Option<usize>)], checks: usize) -> Result<Vec<f64>> {
     let mut out = Vec::new();
     for (i, w) in path.windows(2).enumerate() {
+        crate::interrupt::check()?;
         let (a, b) = (w[0].0, w[1].0);
         let p = w[1].1.ok_or_else(|| Error::arg(format!("path[{}].pusher", i + 1), "is missing"))?;
         if p >= scene.pushers.len() {

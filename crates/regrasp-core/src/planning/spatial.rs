@@ -168,9 +168,22 @@ impl<'a> SpatialSpace<'a> {
         self.s.search.checks
     }
 
-    /// Whether `u` is an exact step of pusher `p` (inverse problem along it), counting solves.
-    fn exact(&self, q: &Isometry3<f64>, u: &Twist6, p: usize) -> bool {
-        step_feasible(self.scene, q, u, p, self.checks(), Some(&self.solves))
+    /// Whether `u` is an exact step of pusher `p` (inverse problem along it), counting solves
+    /// in `solves`.
+    fn exact(&self, q: &Isometry3<f64>, u: &Twist6, p: usize, solves: &AtomicUsize) -> bool {
+        step_feasible(self.scene, q, u, p, self.checks(), Some(solves))
+    }
+
+    /// `f(p, solves)` of the pushers `order`, evaluated in parallel: the first (in `order`) that
+    /// gives `Some`. The solves counted are those of the pushers up to that one (all of them
+    /// when none does), as a sequential search would make: whatever work the parallel search
+    /// did beyond it is not counted, so the count depends on the seed only.
+    fn first_pusher<T: Send>(&self, order: &[usize], f: impl Fn(usize, &AtomicUsize) -> Option<T> + Sync) -> Option<T> {
+        let counts: Vec<AtomicUsize> = order.iter().map(|_| AtomicUsize::new(0)).collect();
+        let found = order.par_iter().enumerate().find_map_first(|(i, &p)| f(p, &counts[i]).map(|t| (i, t)));
+        let upto = found.as_ref().map_or(order.len(), |(i, _)| i + 1);
+        self.solves.fetch_add(counts[..upto].iter().map(|c| c.load(Ordering::Relaxed)).sum(), Ordering::Relaxed);
+        found.map(|(_, t)| t)
     }
 
     /// The first pusher (in `order`) that can take step `u` from `q`, pushers evaluated in
@@ -183,12 +196,12 @@ impl<'a> SpatialSpace<'a> {
     fn feasible_pusher(&self, q: &Isometry3<f64>, u: &Twist6, order: &[usize]) -> Option<Step<Isometry3<f64>, Twist6>> {
         let l = self.l();
         let len = twist_length(l, u);
-        order.par_iter().find_map_first(|&p| {
-            if self.exact(q, u, p) {
+        self.first_pusher(order, |p, solves| {
+            if self.exact(q, u, p, solves) {
                 let end = integrate(q, u, 1.0);
                 return Some(Step { length: distance(l, q, &end), q: end, pusher: p, edge: *u });
             }
-            self.solves.fetch_add(FORWARD_STEPS + 1, Ordering::Relaxed);
+            solves.fetch_add(FORWARD_STEPS + 1, Ordering::Relaxed);
             let up = pusher_motion(self.scene, q, p, u);
             let end = simulate_step(self.scene, q, &up, p, FORWARD_STEPS)?;
             let v = se3_log(q, &end);
@@ -232,7 +245,7 @@ impl<'a> SpatialSpace<'a> {
     /// rolling moves the object's centre as a side effect).
     fn connect_rolling(&self, q0: &Isometry3<f64>, pusher: Option<usize>, n: usize) -> Option<(usize, Vec<(Isometry3<f64>, Twist6, f64)>)> {
         let planes: Vec<usize> = pusher_order(self.scene.pushers.len(), pusher).into_iter().filter(|&p| self.scene.pushers[p].plane).collect();
-        planes.par_iter().find_map_first(|&p| {
+        self.first_pusher(&planes, |p, solves| {
             let (mut q, mut steps) = (*q0, Vec::new());
             for _ in 0..n + 4 {
                 let aim = if self.within_position(&q) { Isometry3::from_parts(q.translation, self.core.goal.rotation) } else { self.core.goal };
@@ -240,7 +253,7 @@ impl<'a> SpatialSpace<'a> {
                 let len = twist_length(self.l(), &xi);
                 let u: Twist6 = xi.map(|x| x * self.core.step.min(len) / len.max(1e-300));
                 let up = pusher_motion(self.scene, &q, p, &u);
-                self.solves.fetch_add(FORWARD_STEPS + 1, Ordering::Relaxed);
+                solves.fetch_add(FORWARD_STEPS + 1, Ordering::Relaxed);
                 let end = simulate_step(self.scene, &q, &up, p, FORWARD_STEPS)?;
                 if self.dist(&end, &self.core.goal) >= self.dist(&q, &self.core.goal) {
                     return None;
@@ -315,7 +328,7 @@ impl Space<7> for SpatialSpace<'_> {
         (u, twist_length(self.l(), &u))
     }
     fn take(&self, a: &Isometry3<f64>, u: &Twist6, p: usize) -> Option<Twist6> {
-        self.exact(a, u, p).then_some(*u)
+        self.exact(a, u, p, &self.solves).then_some(*u)
     }
     /// Straight push to the goal (unit steps of one constant twist, one pusher, at most 100);
     /// when no pusher can take it (and it is at most 20 steps), rolling with a plane.
@@ -334,7 +347,7 @@ impl Space<7> for SpatialSpace<'_> {
         let order = pusher_order(self.scene.pushers.len(), pusher);
         let ok: Vec<bool> = order
             .par_iter()
-            .map(|&p| std::iter::once(q).chain(poses.iter().take(n - 1)).all(|qk| self.exact(qk, &u, p)))
+            .map(|&p| std::iter::once(q).chain(poses.iter().take(n - 1)).all(|qk| self.exact(qk, &u, p, &self.solves)))
             .collect();
         let Some(p) = order.iter().zip(ok).find(|(_, o)| *o).map(|(p, _)| *p) else {
             return if n <= 20 { self.connect_rolling(q, pusher, n) } else { None };
@@ -366,7 +379,7 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
     let step = settings.search.step.unwrap_or(0.2 * scene.length);
     let core = SpaceCore { search: settings.search.clone(), length: scene.length, step, pushers: scene.pushers.len(), goal };
     let space = SpatialSpace { core, scene, s: settings, solves: AtomicUsize::new(0) };
-    let plan = trrt::plan(&space, start);
+    let plan = trrt::plan(&space, start)?;
     Ok(SpatialPlan { plan, solves: space.solves.load(Ordering::Relaxed) })
 }
 
@@ -378,6 +391,7 @@ pub fn validate_path3(scene: &Scene3, path: &[(Isometry3<f64>, Option<usize>)], 
     path.windows(2)
         .enumerate()
         .map(|(i, w)| {
+            crate::interrupt::check()?;
             let p = w[1].1.ok_or_else(|| Error::arg(format!("path[{}].pusher", i + 1), "is missing"))?;
             if p >= scene.pushers.len() {
                 return Err(Error::arg(format!("path[{}].pusher", i + 1), "is not a pusher of the scene"));

@@ -493,12 +493,15 @@ pub fn gauss<R: Rng>(rng: &mut R) -> f64 {
 }
 
 /// Plans from `start` to the space's goal.
-pub fn plan<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Plan<S::Q, S::Edge> {
-    plan_tree(space, start).0
+pub fn plan<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<Plan<S::Q, S::Edge>> {
+    plan_tree(space, start).map(|r| r.0)
 }
 
-/// [`plan`], also returning the search tree.
-pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> (Plan<S::Q, S::Edge>, Vec<TreeNode<S::Q, S::Edge>>) {
+/// The search tree of a plan.
+pub type Nodes<S, const K: usize> = Vec<TreeNode<<S as Space<K>>::Q, <S as Space<K>>::Edge>>;
+
+/// [`plan`], also returning the search tree; [`crate::interrupt::check`]ed every iteration.
+pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<(Plan<S::Q, S::Edge>, Nodes<S, K>)> {
     let s = space.search();
     let mut search = Search::new(space, start);
     let t0 = Instant::now();
@@ -512,6 +515,7 @@ pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> (Plan<S
         if let Some(r) = stop_reason(s, best.map(|g| search.nodes[g].cost), &t0, search.nodes.len(), iterations) {
             break r;
         }
+        crate::interrupt::check()?;
         iterations += 1;
         let Some(i) = search.grow() else { continue };
         if search.cost_to_go(&search.nodes[i].q) < search.cost_to_go(&search.nodes[closest].q) {
@@ -532,7 +536,7 @@ pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> (Plan<S
     let plan = Plan {
         found: best.is_some(),
         stop_reason: if best.is_some() { StopReason::GoalReached } else { stop },
-        goal_distance: space.dist(&path.last().expect("path").0, space.goal()),
+        goal_distance: path.last().map_or(f64::INFINITY, |p| space.dist(&p.0, space.goal())),
         cost: search.nodes[end].cost,
         switch_overs: switch_overs(&path),
         path,
@@ -540,7 +544,7 @@ pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> (Plan<S
         iterations,
         planning_time_s: t0.elapsed().as_secs_f64(),
     };
-    (plan, search.nodes.into_nodes())
+    Ok((plan, search.nodes.into_nodes()))
 }
 
 #[cfg(test)]

@@ -1,0 +1,67 @@
+"""Ctrl-C: the core's long loops (T-RRT* search, quasi-static stepping, batches, path checks)
+poll Python's signal handlers, so SIGINT stops them within a fraction of a second with
+KeyboardInterrupt, whatever the remaining budget. Each case runs in a subprocess that would take
+far longer than the test waits; SIGINT comes once the subprocess says it started the call.
+"""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from .conftest import EXAMPLES, ROOT
+
+pytestmark = pytest.mark.skipif(os.name != "posix", reason="SIGINT to a subprocess")
+
+PRELUDE = f"""
+import sys, numpy as np, regrasp
+from regrasp import _core
+from pathlib import Path
+E = Path({str(EXAMPLES)!r})
+planar = _core.Scene.from_toml((E / "block-low-friction.toml").read_text())
+s3 = _core.Scene3D.from_toml((E / "pivot-3d.toml").read_text(), str(E))
+print("started", flush=True)
+"""
+
+# each call would run for minutes (a goal that cannot be reached, a tiny step, no node limit)
+LONG = {
+    "planar plan": "planar.plan(None, None, {'time_limit': 600, 'max_nodes': 10**8, 'max_iterations': 10**12, 'cost_threshold': -1.0})",
+    "python plan": "regrasp.plan(regrasp.load_scene(E / 'block-low-friction.toml'), time_limit=600, max_nodes=10**8,"
+                   " max_iterations=10**12, cost_threshold=-1.0)",
+    "3-d plan": "s3.plan(None, None, {'time_limit': 600, 'max_nodes': 10**8, 'max_iterations': 10**12, 'cost_threshold': -1.0})",
+    "planar simulate_push": "planar.simulate_push([0, 0, 0], 'left', [1e-9, 0, 0], 1e5, 0.1)",
+    "push_outcomes": "planar.push_outcomes(np.zeros((10**6, 3)), 'left', np.tile([0.01, 0, 0], (10**6, 1)))",
+    "validate_path": "planar.validate_path([[0, 0, 0], [1e-6, 0, 0]] * 20000, [None] + ['left'] * 39999, 10000)",
+}
+
+
+def interrupted(call: str, wait: float = 1.0):
+    """Runs `call` in a subprocess, sends SIGINT `wait` s after it starts: (seconds from SIGINT
+    to exit, return code, stderr)."""
+    code = PRELUDE + call + "\nprint('finished', flush=True)\n"
+    p = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert p.stdout.readline().strip() == "started", p.stderr.read()
+        time.sleep(wait)
+        assert p.poll() is None, f"the call ended before the signal: {p.communicate()}"
+        p.send_signal(signal.SIGINT)
+        t0 = time.monotonic()
+        out, err = p.communicate(timeout=30)
+        return time.monotonic() - t0, p.returncode, out, err
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+
+
+@pytest.mark.parametrize("name", list(LONG))
+def test_ctrl_c_stops_a_long_call_within_a_second(name):
+    dt, rc, out, err = interrupted(LONG[name])
+    assert "KeyboardInterrupt" in err, (name, err[-2000:])
+    assert "finished" not in out
+    assert rc != 0
+    assert dt < 1.0, f"{name}: {dt:.2f} s from SIGINT to exit"
+    assert "PanicException" not in err and "panicked" not in err
