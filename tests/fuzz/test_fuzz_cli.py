@@ -200,7 +200,7 @@ OUTPUT_CASES = [
 ]
 #: output paths that cannot be written (a missing folder may be made: the CLI's choice, not an error)
 BAD_OUTPUTS = {"missing-folder": "{base}/missing/x.out", "folder": "{base}", "proc": "/proc/regrasp-fuzz/x",
-               "scene-itself": "{scene}", "empty": ""}
+               "scene-itself": "{self}", "empty": ""}
 MAY_WORK = ("missing-folder", "scene-itself")
 
 
@@ -209,7 +209,8 @@ MAY_WORK = ("missing-folder", "scene-itself")
 def test_unwritable_output(argv, which, tmp_path_factory):
     files = _files(tmp_path_factory.mktemp("cli"))
     scene_before = {k: Path(files[k]).read_bytes() for k in ("scene", "scene3")}
-    argv = [a.replace("{o}", BAD_OUTPUTS[which]) for a in argv]
+    bad = BAD_OUTPUTS[which].replace("{self}", argv[1])  # the command's own scene file
+    argv = [a.replace("{o}", bad) for a in argv]
     argv = fill(argv, files)
     what = "regrasp " + " ".join(argv)
     r = run("cli.output", what, lambda: run_main(argv), timeout=30)

@@ -11,7 +11,6 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use regrasp::cones::robust::ConeMode;
-use regrasp::mechanics::limit_surface::MAX_NORMAL_FORCE;
 use regrasp::scene::perturb;
 use regrasp::scene::planar::{PadShape, Support};
 use std::collections::HashMap;
@@ -129,13 +128,10 @@ impl Scene {
     fn with_grip_force(&self, force: &Arg<'_>) -> PyResult<Self> {
         guard(move || {
             let force = positive("force", force)?;
-            if force > MAX_NORMAL_FORCE {
-                return Err(arg_err("force", format!("must be at most {MAX_NORMAL_FORCE:e} N (got {force:e})")));
-            }
             if self.inner.grip_force().is_none() {
                 return Err(arg_err("force", "only a grasp scene has a grip force"));
             }
-            Ok(Self { inner: self.inner.with_grip_force(force) })
+            Ok(Self { inner: self.inner.try_with_grip_force(force).map_err(to_py)? })
         })
     }
 
@@ -280,11 +276,7 @@ impl Scene {
             let (f, g) = (factor("finger_friction", finger_friction)?, factor("grip", grip)?);
             let (m, p) = (factor("mass", mass)?, factor("pusher_friction", pusher_friction)?);
             let mode = opt::<String>("mode", mode)?.map(|m| ConeMode::parse(&m)).transpose().map_err(to_py)?.unwrap_or_default();
-            let inner = perturb::scaled(&self.inner, f, g, m, p, mode).map_err(to_py)?;
-            if inner.grip_force().is_some_and(|n| !(n <= MAX_NORMAL_FORCE)) {
-                return Err(arg_err("grip", format!("scales the grip force beyond {MAX_NORMAL_FORCE:e} N")));
-            }
-            Ok(Self { inner })
+            Ok(Self { inner: perturb::scaled(&self.inner, f, g, m, p, mode).map_err(to_py)? })
         })
     }
 

@@ -56,8 +56,8 @@ pub const COORD: Bound = Bound::new(-100.0, 100.0, "m");
 pub const ANGLE: Bound = Bound::new(-1e3, 1e3, "rad");
 /// Object mass [kg].
 pub const MASS: Bound = Bound::new(1e-9, 1e4, "kg");
-/// Grip force of each finger [N].
-pub const FORCE: Bound = Bound::new(1e-6, 1e6, "N");
+/// Grip force of each finger [N]: up to the mechanics' largest normal force.
+pub const FORCE: Bound = Bound::new(1e-6, crate::mechanics::limit_surface::MAX_NORMAL_FORCE, "N");
 /// Coulomb coefficient of a support (finger pads, a surface).
 pub const SUPPORT_FRICTION: Bound = Bound::new(1e-6, 100.0, "");
 /// Coulomb coefficient of a pusher (0: frictionless).
