@@ -32,6 +32,7 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
     // 3. Smoothing Newton from each start, then plain semismooth Newton from the same start.
     let starts = starts(p, u, &nw, settings);
     for x0 in &starts {
+        crate::interrupt::check()?;
         let (x, its) = smooth_then_exact(&nw, x0.clone(), 0.1, settings);
         if let Some(s) = tries.consider(&nw, &x, its) {
             return Ok(s);
@@ -47,6 +48,7 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
         let nr = Newton::with_rho(p, u, rho_scale);
         let best = tries.best().map(|b| nr.pack(b));
         for x0 in best.into_iter().chain(starts.iter().cloned()) {
+            crate::interrupt::check()?;
             let (x, its) = smooth_then_exact(&nr, x0, 0.3, settings);
             if let Some(s) = tries.consider(&nr, &x, its) {
                 return Ok(s);
