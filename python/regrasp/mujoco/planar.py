@@ -23,8 +23,9 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import ArgumentError
-from ..scene.planar import Scene
+from ..scene.planar import Scene, _number
 from ..sim.quasistatic import Replay, body_twist, integrate_pose
+from .push import MAX_DURATION
 from .model import (Contact, Driver, Rig, add_driven_body, add_feature, add_grip_motors, add_object, add_planar_pads,
                     compose, inverse, plan_dict, planar_pose, planar_spec, put_object, quat_y, rotate)
 
@@ -244,7 +245,10 @@ class PlanarExecution(GripperRig):
 def execute_plan(scene: Scene, plan, perturb: Perturbation = Perturbation(), speed: float = 0.01,
                  record_dt: float = 0.02, contact: Contact = Contact(), settle: float = 0.2) -> Replay:
     """Executes ``plan`` (a ``regrasp.Plan`` or its dict) open loop in MuJoCo; returns the
-    recorded object pose in the grasp (:class:`PlanarExecution`)."""
+    recorded object pose in the grasp (:class:`PlanarExecution`). ``speed`` [m/s] at most 100 m/s
+    (the core's bound on a pusher's speed), ``record_dt`` and ``settle`` [s] at most 60 s."""
+    speed = _number(speed, "speed", high=100.0)
+    record_dt, settle = _number(record_dt, "record_dt", high=MAX_DURATION), _number(settle, "settle", 0.0, False, MAX_DURATION)
     return PlanarExecution(scene, plan, perturb, contact, speed, record_dt).run(settle)
 
 

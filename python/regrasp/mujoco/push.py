@@ -135,7 +135,7 @@ def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, recor
     ``twist`` (object frame at the start). Returns times and object poses (gripper frame)."""
     pose, twist, pusher = _vec(pose, 3, "pose"), _vec(twist, 3, "twist"), _name(pusher, "pusher")
     duration = _number(duration, "duration", high=MAX_DURATION)
-    record_dt = _number(record_dt, "record_dt")
+    record_dt = _number(record_dt, "record_dt", high=MAX_DURATION)
     rig = PushRig(scene, pusher, settings)
     r = rig.push(pose, twist, duration, settle=0.3, record_dt=record_dt)
     return {"t": r["t"], "pose": r["pose"], "settled_pose": r["pose"][0]}
