@@ -6,11 +6,13 @@
 //! The poll is scoped to the calling thread (a thread-local set for the duration of
 //! [`within`]), so no signature carries it and a computation without one never stops early.
 //! Calls are rate limited: the poll runs at most once every [`POLL_INTERVAL`], so a loop may
-//! call [`check`] as often as it likes. Parallel batches (rayon) check between their chunks on
-//! the calling thread; worker threads see no poll.
+//! call [`check`] as often as it likes. Parallel work runs through [`parallel`]: the calling
+//! thread keeps polling while the work runs on other threads, and each item of the work runs
+//! [`Shared::within`] a poll that reads the caller's answer, so an item stops at its next check.
 
 use crate::error::{Error, Result};
 use std::cell::RefCell;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Least time between two polls (a check in between answers from the last poll).
@@ -60,6 +62,42 @@ pub fn check() -> Result<()> {
     if stopped { Err(Error::Interrupted) } else { Ok(()) }
 }
 
+/// The stop flag that [`parallel`] shares with the threads doing its work.
+pub struct Shared(AtomicBool);
+
+impl Shared {
+    /// Runs `f` (one item of parallel work, on any thread) with a poll that says stop once the
+    /// caller of [`parallel`] has been asked to stop; an item not yet started then does not start.
+    pub fn within<R>(&self, f: impl FnOnce() -> Result<R>) -> Result<R> {
+        if self.0.load(Ordering::Relaxed) {
+            return Err(Error::Interrupted);
+        }
+        within(&|| self.0.load(Ordering::Relaxed), f)
+    }
+}
+
+/// Runs `work` (e.g. a rayon iterator whose items use [`Shared::within`]) on a helper thread
+/// while this thread keeps polling every few milliseconds; `Err(Error::Interrupted)` when this
+/// thread's poll said stop (the work then stops at its items' next [`check`]). Without a poll on
+/// this thread, `work` simply runs here. A panic in `work` is resumed on this thread.
+pub fn parallel<T: Send>(work: impl FnOnce(&Shared) -> T + Send) -> Result<T> {
+    let shared = Shared(AtomicBool::new(false));
+    if ACTIVE.with(|a| a.borrow().is_none()) {
+        return Ok(work(&shared));
+    }
+    let out = std::thread::scope(|s| {
+        let handle = s.spawn(|| work(&shared));
+        while !handle.is_finished() {
+            std::thread::sleep(Duration::from_millis(5));
+            if check().is_err() {
+                shared.0.store(true, Ordering::Relaxed);
+            }
+        }
+        handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    });
+    if shared.0.load(Ordering::Relaxed) { Err(Error::Interrupted) } else { Ok(out) }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -96,5 +134,27 @@ mod tests {
             std::thread::sleep(POLL_INTERVAL);
             assert!(check().is_ok(), "the outer poll is back");
         });
+    }
+
+    #[test]
+    fn parallel_work_stops_when_the_caller_is_asked_to() {
+        let t0 = Instant::now();
+        let stop = || t0.elapsed() > Duration::from_millis(100);
+        let r = within(&stop, || {
+            parallel(|s| {
+                std::thread::scope(|sc| {
+                    let item = || s.within(|| loop {
+                        check()?;
+                    });
+                    let a = sc.spawn(item);
+                    assert_eq!(item(), Err::<(), _>(Error::Interrupted));
+                    assert_eq!(a.join().unwrap(), Err(Error::Interrupted));
+                    assert_eq!(s.within(|| Ok(1)), Err(Error::Interrupted), "a later item does not start");
+                })
+            })
+        });
+        assert_eq!(r, Err(Error::Interrupted));
+        assert!(t0.elapsed() < Duration::from_secs(2), "stopped in {:?}", t0.elapsed());
+        assert_eq!(parallel(|_| 7), Ok(7), "without a poll the work runs to its end");
     }
 }

@@ -7,7 +7,6 @@ use nalgebra::DVector;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use rayon::prelude::*;
 use regrasp::dynamics::mncp::{self, Contact, FrictionLaw, NormalLaw, Side};
 use regrasp::dynamics::planar::{self as quasistatic, Options};
 use regrasp::dynamics::spatial as quasistatic3d;
@@ -149,22 +148,11 @@ pub fn spatial_problem(scene: &Scene3, pose: &Arg<'_>, name: &Arg<'_>, h: f64) -
 /// The results of `Scene.push_outcomes`: sticks, object twists, max residuals, errors.
 pub type Outcomes<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Vec<Option<String>>);
 
-/// Pushes of a batch solved between two interrupt checks.
-const CHUNK: usize = 64;
-
 /// `Scene.push_outcomes`: instantaneous pushes of pusher `name`, twist i at pose i (zero twist
 /// and residual where `errors[i]` is set).
 pub fn push_outcomes<'py>(py: Python<'py>, scene: &Scene, poses: &Arg<'py>, name: &Arg<'py>, twists: &Arg<'py>, opts: &Options) -> PyResult<Outcomes<'py>> {
     let (q, t, i) = batch(poses, twists, name, |n| scene.pusher_index(n))?;
-    // in chunks, the interrupt checked between them (rayon's workers see no poll)
-    let res: Vec<_> = interruptible(py, || {
-        let mut out = Vec::with_capacity(q.len());
-        for (q, t) in q.chunks(CHUNK).zip(t.chunks(CHUNK)) {
-            regrasp::interrupt::check()?;
-            out.par_extend(q.par_iter().zip(t.par_iter()).with_min_len(4).map(|(q, t)| quasistatic::push_outcome(scene, q, i, &(*t).into(), opts)));
-        }
-        Ok(out)
-    })?;
+    let res = interruptible(py, || quasistatic::push_outcomes(scene, &q, i, &t, opts))?;
     let (mut sticks, mut tw, mut resid, mut errors) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for r in res {
         let (s, v, m, e) = match r {

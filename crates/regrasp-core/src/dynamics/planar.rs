@@ -236,6 +236,20 @@ pub fn push_outcome(scene: &Scene, q: &[f64; 3], pusher: usize, u: &Vec3, opts: 
     Ok(PushOutcome { sticks, solution: sol })
 }
 
+/// Instantaneous pushes of pusher `pusher`: pose `qs[i]` with twist `twists[i]` (object frame),
+/// in parallel, an outcome or an error each; the batch stops on an interrupt
+/// ([`crate::interrupt::parallel`]).
+pub fn push_outcomes(scene: &Scene, qs: &[[f64; 3]], pusher: usize, twists: &[[f64; 3]], opts: &Options) -> Result<Vec<Result<PushOutcome>>> {
+    use rayon::prelude::*;
+    if qs.len() != twists.len() {
+        return Err(Error::arg("twists", format!("one twist per pose ({}), got {}", qs.len(), twists.len())));
+    }
+    crate::interrupt::parallel(|stop| {
+        let one = |(q, u): (&[f64; 3], &[f64; 3])| stop.within(|| push_outcome(scene, q, pusher, &Vec3::from(*u), opts));
+        qs.par_iter().zip(twists.par_iter()).with_min_len(4).map(one).collect()
+    })
+}
+
 /// A recorded push, one row per step.
 #[derive(Clone, Debug, Default)]
 pub struct Trajectory {

@@ -55,6 +55,7 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
             }
         }
     }
+    crate::interrupt::check()?; // an interrupt that cut the last attempt short is not a failure to converge
     Err(tries.failure())
 }
 

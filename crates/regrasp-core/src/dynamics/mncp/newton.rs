@@ -282,13 +282,14 @@ impl<'a> Newton<'a> {
         }
     }
 
-    /// Damped Newton on `F_e = 0` until `|F_e|∞ ≤ tol`.
+    /// Damped Newton on `F_e = 0` until `|F_e|∞ ≤ tol` (or an interrupt, see [`crate::interrupt`]).
     pub(super) fn solve(&self, x0: DVector<f64>, e: f64, tol: f64, max_it: usize) -> (DVector<f64>, f64, usize) {
         let mut x = x0;
         let (mut fx, _) = self.eval(&x, false, e);
         let mut phi = 0.5 * fx.norm_squared();
         let mut it = 0;
-        while it < max_it && fx.amax() > tol {
+        // an interrupt ends the iterations; it stays raised for the caller's next check
+        while it < max_it && fx.amax() > tol && crate::interrupt::check().is_ok() {
             it += 1;
             if std::env::var("MNCP_TRACE").is_ok() {
                 eprintln!("it {it}: |F| = {:.3e}  v = {:?}", fx.amax(), x.rows(0, self.p.dim).as_slice());
@@ -311,6 +312,9 @@ impl<'a> Newton<'a> {
             let mut t = 1.0;
             let mut accepted = false;
             for _ in 0..30 {
+                if crate::interrupt::check().is_err() {
+                    break;
+                }
                 let xn = &x + &step * t;
                 let (fn_, _) = self.eval(&xn, false, e);
                 let phin = 0.5 * fn_.norm_squared();
