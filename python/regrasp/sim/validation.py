@@ -13,8 +13,10 @@ MuJoCo pushes are spread over local processes
 
 from __future__ import annotations
 
+import multiprocessing
 import os
-from concurrent.futures import ProcessPoolExecutor
+import signal
+import socket
 
 import numpy as np
 
@@ -134,6 +136,54 @@ def _mujoco_chunk(scene: Scene, chunk: list) -> list:
     return out
 
 
+def _mujoco_job(job: tuple) -> list:
+    return _mujoco_chunk(*job)
+
+
+def _ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _check_reachable(address: str, timeout: float = 5.0) -> None:
+    """An ArgumentError naming ``--ray`` when a Ray head ``[ray://]HOST:PORT`` does not answer a
+    TCP connection within ``timeout`` seconds (Ray itself would keep retrying)."""
+    if address in ("local", "auto"):
+        return
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    try:
+        socket.create_connection((host, int(port)), timeout=timeout).close()
+    except (OSError, ValueError) as e:
+        raise ArgumentError(f"invalid `--ray`: no Ray cluster answers at {address!r} ({e})", "--ray") from e
+
+
+def _each_chunk(scene: Scene, chunks: list, workers: int, ray_address, take) -> None:
+    """``take(outcomes)`` of every chunk, run on Ray (``ray_address``), here (one worker) or in a
+    process pool."""
+    if ray_address is not None:
+        try:
+            import ray
+        except ImportError as e:
+            raise ArgumentError("invalid `--ray`: the `ray` package is not installed (pip install ray)", "--ray") from e
+        if not ray.is_initialized():
+            _check_reachable(ray_address)
+            ray.init(address=None if ray_address == "local" else ray_address, include_dashboard=False,
+                     log_to_driver=False, num_cpus=workers if ray_address == "local" else None)
+        remote = ray.remote(_mujoco_chunk)
+        pending = [remote.remote(scene, c) for c in chunks]
+        while pending:
+            done, pending = ray.wait(pending, num_returns=1)
+            take(ray.get(done[0]))
+    elif workers <= 1:
+        for c in chunks:
+            take(_mujoco_chunk(scene, c))
+    else:
+        # a Pool's exit terminates its workers at once (Ctrl-C does not wait for running chunks);
+        # the workers ignore SIGINT, the parent ends them
+        with multiprocessing.Pool(workers, initializer=_ignore_sigint) as pool:
+            for part in pool.imap_unordered(_mujoco_job, [(scene, c) for c in chunks]):
+                take(part)
+
+
 def _run_mujoco(scene: Scene, rows: list, workers: int, ray_address, progress: bool) -> np.ndarray:
     jobs = [(i, r[0], r[2], r[3]) for i, r in enumerate(rows)]
     size = max(1, min(50, len(jobs) // max(4 * workers, 1) or 1))
@@ -154,28 +204,11 @@ def _run_mujoco(scene: Scene, rows: list, workers: int, ray_address, progress: b
         if bar is not None:
             bar.update(len(part))
 
-    if ray_address is not None:
-        try:
-            import ray
-        except ImportError as e:
-            raise ArgumentError("invalid `--ray`: the `ray` package is not installed (pip install ray)", "--ray") from e
-        if not ray.is_initialized():
-            ray.init(address=None if ray_address == "local" else ray_address, include_dashboard=False,
-                     log_to_driver=False, num_cpus=workers if ray_address == "local" else None)
-        remote = ray.remote(_mujoco_chunk)
-        pending = [remote.remote(scene, c) for c in chunks]
-        while pending:
-            done, pending = ray.wait(pending, num_returns=1)
-            take(ray.get(done[0]))
-    elif workers <= 1:
-        for c in chunks:
-            take(_mujoco_chunk(scene, c))
-    else:
-        with ProcessPoolExecutor(max_workers=workers) as ex:
-            for part in ex.map(_mujoco_chunk, [scene] * len(chunks), chunks):
-                take(part)
-    if bar is not None:
-        bar.close()
+    try:
+        _each_chunk(scene, chunks, workers, ray_address, take)
+    finally:  # the bar ends before any message (Ctrl-C included)
+        if bar is not None:
+            bar.close()
     return result
 
 
