@@ -56,7 +56,8 @@ def _bad_plans(good: dict) -> list:
 ENTRIES = {
     "Scene.motion_cone": (lambda pose, pusher, check_hold: P.motion_cone(pose, pusher, check_hold).generators,
                           dict(pose=Z3, pusher="left", check_hold=True), dict(pose="vec3", pusher="name", check_hold="bool")),
-    "Scene.motion_cones": (lambda poses, pusher, strict: vars(P.motion_cones(poses, pusher, strict)) | {"scene": None},
+    # the batch's outputs (its `poses` are the input as given, bad rows marked by `status`)
+    "Scene.motion_cones": (lambda poses, pusher, strict: vars(P.motion_cones(poses, pusher, strict)) | {"scene": None, "poses": None},
                            dict(poses=np.zeros((2, 3)), pusher="left", strict=False),
                            dict(poses="rows3", pusher="name", strict="bool")),
     "Scene.admissible": (lambda pose: P.admissible(pose), dict(pose=Z3), dict(pose="vec3")),
