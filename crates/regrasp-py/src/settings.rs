@@ -44,7 +44,11 @@ fields!(mpc_dict, set_mpc, MpcSettings;
 pub fn items<'py>(settings: Option<&Arg<'py>>) -> PyResult<Vec<(String, Arg<'py>)>> {
     let Some(s) = settings.filter(|s| !s.is_none()) else { return Ok(Vec::new()) };
     let d = s.downcast::<PyDict>().map_err(|_| arg_err("settings", format!("must be a dict (got {s})")))?;
-    d.iter().map(|(k, v)| Ok((k.extract::<String>().map_err(|_| arg_err("settings", "keys must be strings"))?, v))).collect()
+    let key = |k: Bound<'py, PyAny>| match k.extract::<String>() {
+        Ok(k) if !k.trim().is_empty() => Ok(k),
+        _ => Err(arg_err("settings", format!("keys must be setting names (got {k:?})"))),
+    };
+    d.iter().map(|(k, v)| Ok((key(k)?, v))).collect()
 }
 
 /// The planar planner's settings as a dict.

@@ -437,7 +437,7 @@ class Scene:
     mode = core_property("mode", 'Which motion cones this scene answers with: "nominal", "robust" or "fixtureless".')
     uncertainty = core_property("uncertainty", "The ``[uncertainty]`` table (relative spreads), or None.")
     rho = core_property("rho", "ρ = μ_s N / (m g), the one number mass, grip force and finger friction enter the "
-                               "planar motion cone through (grasp scenes).")
+                               "planar motion cone through (grasp scenes with gravity; None otherwise).")
 
     def scaled(self, finger_friction: float = 1.0, grip: float = 1.0, mass: float = 1.0,
                pusher_friction: float = 1.0, mode: str = "nominal") -> "Scene":

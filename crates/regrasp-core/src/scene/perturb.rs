@@ -8,11 +8,12 @@ use crate::mechanics::friction_cone::PusherContact;
 use crate::scene::bounds;
 use crate::scene::planar::{Scene, Support};
 
-/// `ρ = μ_s N / (m g)` of a grasp scene (`N` per finger); `None` for an object on a surface.
+/// `ρ = μ_s N / (m g)` of a grasp scene (`N` per finger); `None` for an object on a surface or
+/// without gravity (where no weight is to be held).
 pub fn rho(scene: &Scene) -> Option<f64> {
     match &scene.support {
-        Support::Grasp(g) => Some(g.friction * g.force / (scene.mass * scene.g)),
-        Support::Surface(_) => None,
+        Support::Grasp(g) if scene.g > 0.0 => Some(g.friction * g.force / (scene.mass * scene.g)),
+        _ => None,
     }
 }
 
