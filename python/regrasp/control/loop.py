@@ -118,10 +118,12 @@ def _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error, 
         raise ArgumentError(f"invalid `engine`: must be one of {ENGINES} (got {engine!r})", "engine")
     if not isinstance(policy, str) or policy not in POLICIES:
         raise ArgumentError(f"invalid `policy`: must be one of {POLICIES} (got {policy!r})", "policy")
-    _number(dt, "dt"), _number(speed, "speed"), _count(horizon, "horizon", 1, 10_000)
+    # bounds: a control period up to 10 s, the core's pusher speed limit (100 m/s), a day of
+    # control, measurement noise up to 1 m
+    _number(dt, "dt", high=10.0), _number(speed, "speed", high=100.0), _count(horizon, "horizon", 1, 10_000)
     if max_time is not None:
-        _number(max_time, "max_time")
-    _number(noise, "noise", strict=False)
+        _number(max_time, "max_time", high=86_400.0)
+    _number(noise, "noise", strict=False, high=1.0)
     check_seed(seed)
     if not all(isinstance(p, Poke) for p in _iterable(pokes, "pokes")):
         raise ArgumentError("invalid `pokes`: a list of Poke (Poke.parse('T,dx,dz,dtheta'))", "pokes")
