@@ -33,6 +33,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(pose::se3_integrate, m)?)?;
     m.add_function(wrap_pyfunction!(pose::se3_compose, m)?)?;
     m.add_function(wrap_pyfunction!(pose::se3_inverse, m)?)?;
+    m.add("MAX_MAGNITUDE", convert::MAX_MAGNITUDE)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

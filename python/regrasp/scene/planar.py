@@ -38,8 +38,12 @@ def _array(x, name: str) -> np.ndarray:
 
 
 def _finite(a: np.ndarray, name: str) -> np.ndarray:
+    """``a`` when every component is finite and at most ``_core.MAX_MAGNITUDE`` (1e9) in
+    magnitude, the bound the core puts on every number argument."""
     if not np.all(np.isfinite(a)):
         raise ArgumentError(f"invalid `{name}`: has a non-finite component", name)
+    if a.size and np.max(np.abs(a)) > _core.MAX_MAGNITUDE:
+        raise ArgumentError(f"invalid `{name}`: components must be at most {_core.MAX_MAGNITUDE:g} in magnitude", name)
     return a
 
 
