@@ -257,3 +257,30 @@ def test_defaults_come_from_rust(scene):
     q = scene.quasistatic_problem(Q, "left")
     assert p.data()["h"] == q.data()["h"] == qs["h"]
     assert len(p.labels) == len(q.labels)
+
+
+def test_the_controller_may_be_used_from_any_thread_one_at_a_time(scene):
+    """`_core.Mpc` holds its state behind a lock: another thread may use it (no panic about an
+    unsendable object), and a call while another thread's runs is an ArgumentError, not a wait."""
+    import threading
+
+    m = _core.Mpc(scene, [Q, [0.001, 0.0, 0.0]], [None, "left"])
+    outcomes = []
+
+    def steps():
+        for _ in range(5):
+            try:
+                outcomes.append(m.step(Q)["status"])
+            except ArgumentError as e:
+                outcomes.append(e.field)
+            except BaseException as e:  # noqa: BLE001 - anything else is the failure under test
+                outcomes.append(repr(e))
+
+    threads = [threading.Thread(target=steps) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(outcomes) == 20
+    assert all(o == "self" or o in ("tracking", "at_goal", "replanned", "stuck") for o in outcomes), outcomes
+    assert any(o != "self" for o in outcomes)

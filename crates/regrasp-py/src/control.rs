@@ -8,17 +8,28 @@ use crate::settings;
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
+use std::sync::{Mutex, MutexGuard, TryLockError};
 
 /// The MPC controller (Rust `regrasp::control::mpc`): a plan's reference, the scene's cones.
-#[pyclass(module = "regrasp._core", unsendable)]
+/// Its state is behind a mutex: any thread may use it, one at a time (a call while another
+/// thread's is running is an `ArgumentError`, never a wait that could hold the GIL).
+#[pyclass(module = "regrasp._core", frozen)]
 pub struct Mpc {
-    inner: regrasp::control::mpc::Mpc,
+    inner: Mutex<regrasp::control::mpc::Mpc>,
     names: Vec<String>,
 }
 
 impl Mpc {
     fn name(&self, i: Option<usize>) -> Option<String> {
         i.and_then(|i| self.names.get(i)).cloned()
+    }
+
+    /// The controller's state, or an error when another thread is using it.
+    fn state(&self) -> PyResult<MutexGuard<'_, regrasp::control::mpc::Mpc>> {
+        self.inner.try_lock().map_err(|e| match e {
+            TryLockError::WouldBlock => arg_err("self", "the controller is in use by another thread"),
+            TryLockError::Poisoned(_) => arg_err("self", "the controller failed in an earlier call (make a new one)"),
+        })
     }
 }
 
@@ -61,16 +72,17 @@ impl Mpc {
             let path = path("plan.path", poses, pushers, pose3, |n| scene.inner.pusher_index(n))?;
             let goal = optional(goal, |g| pose3("goal", g))?;
             let inner = regrasp::control::mpc::Mpc::new(&scene.inner, &path, goal, settings::mpc(&given)?).map_err(to_py)?;
-            Ok(Self { inner, names: scene.inner.pushers.iter().map(|p| p.name.clone()).collect() })
+            Ok(Self { inner: Mutex::new(inner), names: scene.inner.pushers.iter().map(|p| p.name.clone()).collect() })
         })
     }
 
     /// One control step from the measured pose: a dict with status, pusher, twist, knot,
     /// tracking_error, projected, solve_time_s, replan_time_s.
-    fn step<'py>(&mut self, py: Python<'py>, pose: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
+    fn step<'py>(&self, py: Python<'py>, pose: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
         guard(move || {
             let q = pose3("pose", pose)?;
-            let inner = &mut self.inner;
+            let mut state = self.state()?;
+            let inner = &mut *state;
             // a step may re-plan (up to the re-planning time limit): other Python threads run meanwhile
             let c = interruptible(py, || inner.step(&q))?;
             Ok(dict!(py;
@@ -85,7 +97,7 @@ impl Mpc {
     /// the pusher, generators (k, 3) and weights (k,); and whether clarabel solved it.
     fn solve_qp<'py>(&self, py: Python<'py>, pose: &Arg<'py>, knot: &Arg<'py>) -> PyResult<Bound<'py, PyTuple>> {
         guard(move || {
-            let sol = self.inner.solve_qp(&pose3("pose", pose)?, arg("knot", knot)?).map_err(to_py)?;
+            let sol = self.state()?.solve_qp(&pose3("pose", pose)?, arg("knot", knot)?).map_err(to_py)?;
             let step = |(p, g, w): &(usize, Vec<_>, Vec<f64>)| -> PyResult<_> {
                 Ok(dict!(py; "pusher" => self.name(Some(*p)), "generators" => matrix_rows(py, g), "weights" => w.clone()))
             };
@@ -95,10 +107,10 @@ impl Mpc {
     }
 
     /// Reference knots (n, 3).
-    #[getter] fn knots<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> { rows_array(py, self.inner.knots().to_vec()) }
+    #[getter] fn knots<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> { Ok(rows_array(py, self.state()?.knots().to_vec())) }
     /// The pusher reaching each knot.
-    #[getter] fn knot_pushers(&self) -> Vec<Option<String>> { self.inner.knot_pushers().iter().map(|&p| self.name(p)).collect() }
-    #[getter] fn replans(&self) -> usize { self.inner.replans }
+    #[getter] fn knot_pushers(&self) -> PyResult<Vec<Option<String>>> { Ok(self.state()?.knot_pushers().iter().map(|&p| self.name(p)).collect()) }
+    #[getter] fn replans(&self) -> PyResult<usize> { Ok(self.state()?.replans) }
     /// Why the last re-planning failed (None if it did not).
-    #[getter] fn replan_error(&self) -> Option<String> { self.inner.last_replan_error.clone() }
+    #[getter] fn replan_error(&self) -> PyResult<Option<String>> { Ok(self.state()?.last_replan_error.clone()) }
 }
