@@ -9,10 +9,10 @@ use crate::scene::bounds;
 use crate::scene::planar::{Scene, Support};
 
 /// `ρ = μ_s N / (m g)` of a grasp scene (`N` per finger); `None` for an object on a surface or
-/// without gravity (where no weight is to be held).
+/// where no weight is to be held (no gravity, or so little that ρ is not a finite number).
 pub fn rho(scene: &Scene) -> Option<f64> {
     match &scene.support {
-        Support::Grasp(g) if scene.g > 0.0 => Some(g.friction * g.force / (scene.mass * scene.g)),
+        Support::Grasp(g) => Some(g.friction * g.force / (scene.mass * scene.g)).filter(|r| r.is_finite()),
         _ => None,
     }
 }
