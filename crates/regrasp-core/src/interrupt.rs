@@ -13,6 +13,7 @@
 use crate::error::{Error, Result};
 use std::cell::RefCell;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::RecvTimeoutError;
 use std::time::{Duration, Instant};
 
 /// Least time between two polls (a check in between answers from the last poll).
@@ -86,9 +87,15 @@ pub fn parallel<T: Send>(work: impl FnOnce(&Shared) -> T + Send) -> Result<T> {
         return Ok(work(&shared));
     }
     let out = std::thread::scope(|s| {
-        let handle = s.spawn(|| work(&shared));
-        while !handle.is_finished() {
-            std::thread::sleep(Duration::from_millis(5));
+        let (done, finished) = std::sync::mpsc::channel();
+        let shared = &shared;
+        let handle = s.spawn(move || {
+            let out = work(shared);
+            let _ = done.send(()); // wakes the caller at once (a panic drops `done` instead)
+            out
+        });
+        // wait for the work, polling every few milliseconds meanwhile
+        while let Err(RecvTimeoutError::Timeout) = finished.recv_timeout(Duration::from_millis(5)) {
             if check().is_err() {
                 shared.0.store(true, Ordering::Relaxed);
             }
