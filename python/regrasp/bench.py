@@ -280,7 +280,8 @@ PLANNED = ("block-low-friction", "block-high-friction", "block-xztheta", "t-shap
 
 
 def run_planner(seeds: int = 10, time_limit: float = 30.0, examples=PLANNED) -> dict:
-    """The planner table (thesis Table 4.2): median planning time over ``seeds`` seeds for each
+    """The planner table (thesis Table 4.2): median planning time [s] over ``seeds`` seeds (each
+    run stopped at ``time_limit`` [s]) for each
     example and each propagation, measured in the same run, with the baselines' ratios."""
     from .planning.plan import plan
 
@@ -343,6 +344,8 @@ def run_mncp(reps: int = 11, ref_reps: int = 3) -> dict:
 
 
 def format_results(res: dict) -> str:
+    """The benchmark results of :func:`run` as a table: one row per benchmark, with regrasp's time,
+    the baseline's and their ratio."""
     lines = [f"{'benchmark':42s} {'regrasp':>12s} {'baseline':>12s} {'ratio':>9s}  baseline"]
     for name, r in res.items():
         lines.append(

@@ -35,6 +35,8 @@ class Poke:
 
     @classmethod
     def parse(cls, text: str) -> "Poke":
+        """A poke from the CLI's text ``"t,dx,dz,dtheta"`` (s, m, m, rad); ArgumentError when
+        malformed."""
         try:
             v = [float(x) for x in text.split(",")]
         except ValueError as e:
@@ -46,6 +48,8 @@ class Poke:
 
 @dataclass
 class ControlResult:
+    """The outcome of one :func:`control` run: success, final pose and its error to the goal
+    ``[x, z, theta]`` (m, m, rad), re-plans, the median MPC step time [s] and the recorded traces."""
     engine: str
     policy: str
     success: bool
@@ -62,6 +66,7 @@ class ControlResult:
     failure: str = ""
 
     def to_json(self) -> dict:
+        """The result as a JSON-ready dict (lists, not arrays)."""
         return {
             "engine": self.engine,
             "policy": self.policy,
@@ -84,16 +89,21 @@ class QuasistaticPlant:
         self.q = np.asarray(q0, float)
 
     def pose(self) -> np.ndarray:
+        """The object's pose ``[x, z, theta]`` (m, m, rad) in the grasp now (a copy)."""
         return self.q.copy()
 
     def push(self, pusher: str, twist, duration: float, belief=None):
+        """Pushes with ``pusher`` at body ``twist`` ``[vx, vz, omega]`` (m/s, m/s, rad/s) for ``duration``
+        [s] (one quasi-static step; ``belief`` is unused by this plant)."""
         r = simulate_push(self.scene, self.q, pusher, twist, duration, dt=duration / 2)
         self.q = np.asarray(r["pose"][-1], float)
 
     def idle(self, duration: float):
+        """Waits ``duration`` [s]: the quasi-static object does not move."""
         pass
 
     def poke(self, delta):
+        """Displaces the object in the grasp by ``delta`` ``[dx, dz, dtheta]`` (m, m, rad)."""
         self.q = self.q + np.asarray(delta, float)
 
 
@@ -141,7 +151,7 @@ def _iterable(x, name: str) -> list:
 
 class ControlRun:
     """One run of :func:`control`: the plant (the simulated world), the MPC, the pokes still to
-    come and what was recorded. :meth:`tick` is one control period."""
+    come and what was recorded. :meth:`tick` is one control period of ``dt`` [s]."""
 
     def __init__(self, scene: Scene, plan, engine: str, policy: str, pokes, start_error, perturb: Perturbation,
                  controller_scene: Scene | None, noise: float, seed: int, dt: float, speed: float, horizon: int,
@@ -209,6 +219,8 @@ class ControlRun:
         return True
 
     def mpc_tick(self, meas) -> bool:
+        """One MPC step from the measured pose ``meas`` ``[x, z, theta]`` (m, m, rad), the command sent to
+        the plant; False when the controller stops (at the goal or stuck)."""
         c = self.ctrl.step(meas.tolist())
         status = c["status"]
         if status in ("tracking", "replanned"):  # steps that solved the QP (not at goal or stuck)
@@ -246,6 +258,7 @@ class ControlRun:
         return self.mpc_tick(meas) if self.policy == "mpc" else self.open_loop_tick()
 
     def result(self) -> ControlResult:
+        """What the run recorded, as a :class:`ControlResult`."""
         q = self.plant.pose()
         if not self.ts or self.ts[-1] != self.t:
             self.ts.append(self.t)

@@ -73,6 +73,7 @@ def compose(a, b) -> np.ndarray:
 
 
 def inverse(a) -> np.ndarray:
+    """The inverse of a planar pose ``a`` ``[x, z, theta]`` (m, m, rad)."""
     c, s = np.cos(a[2]), np.sin(a[2])
     return np.array([-(c * a[0] + s * a[1]), -(-s * a[0] + c * a[1]), -a[2]])
 
@@ -290,7 +291,8 @@ def planar_spec(scene: Scene, name: str, contact: Contact = Contact()):
 
 
 def add_object(spec, scene: Scene, pose, friction: float = 0.0, mass_scale: float = 1.0):
-    """The object at planar ``pose`` on a free joint; the body frame is the object frame."""
+    """The object at planar ``pose`` ``[x, z, theta]`` (m, m, rad) on a free joint; the body frame
+    is the object frame."""
     o = scene.outline
     q = np.asarray(pose, float)
     body = spec.worldbody.add_body(name="object", pos=[q[0], 0.0, q[1]], quat=quat_y(q[2]))
@@ -379,13 +381,15 @@ class Driver:
         self.pose = np.r_[0.0, 0, 0, 1, 0, 0, 0] if self.spatial else np.zeros(3)
 
     def set(self, data, pose, velocity=None):
+        """Puts the body at ``pose`` (m, rad) with ``velocity`` (m/s, rad/s; default zero) in
+        ``data``."""
         pose = np.asarray(pose, float)
         data.qpos[self.qadr] = pose
         data.qvel[self.dadr] = 0.0 if velocity is None else velocity
         self.pose = pose
 
     def velocity(self, pose, dt: float) -> np.ndarray:
-        """The constant velocity from the current pose to ``pose`` over ``dt`` (the spatial
+        """The constant velocity (m/s, rad/s) from the current pose to ``pose`` over ``dt`` [s] (the spatial
         angular velocity: the SO(3) log of the relative rotation, in the body frame, as the ball
         joint's qvel)."""
         if not self.spatial:
@@ -396,14 +400,14 @@ class Driver:
         return np.r_[(pose[:3] - self.pose[:3]) / dt, w]
 
     def move(self, data, pose, dt: float):
-        """Moves to ``pose`` over the next step of length ``dt``."""
+        """Moves to ``pose`` (m, rad) over the next step of length ``dt`` [s]."""
         pose = np.asarray(pose, float)
         self.set(data, self.pose, self.velocity(pose, dt))
         self.pose = pose
 
 
 class Rig:
-    """A compiled model with its data, the pads squeezed with ``grip_force``."""
+    """A compiled model with its data, the pads squeezed with ``grip_force`` [N] each."""
 
     def __init__(self, spec, contact: Contact, grip_force: float):
         import mujoco
@@ -415,19 +419,23 @@ class Rig:
         self.data.ctrl[:] = grip_force
 
     def step(self):
+        """One MuJoCo time step (``mj_step``)."""
         import mujoco
 
         mujoco.mj_step(self.model, self.data)
 
     def forward(self):
+        """Recomputes the derived quantities without stepping (``mj_forward``)."""
         import mujoco
 
         mujoco.mj_forward(self.model, self.data)
 
     def mocap(self, body: str) -> int:
+        """The mocap index of body ``body``."""
         return int(self.model.body_mocapid[self.model.body(body).id])
 
     def geoms(self, body: str) -> set:
+        """The ids of the geoms of body ``body``."""
         bid = self.model.body(body).id
         return {i for i in range(self.model.ngeom) if self.model.geom_bodyid[i] == bid}
 

@@ -45,6 +45,7 @@ class Perturbation:
 
     @property
     def pusher(self) -> float:
+        """The pusher's friction scale factor (the common ``friction`` one when none is given)."""
         return self.friction if self.pusher_friction is None else self.pusher_friction
 
     @classmethod
@@ -115,12 +116,13 @@ class GripperRig(Rig):
         self.step()
 
     def move(self, path, duration: float):
-        """Moves the gripper along ``path(u)``, u in (0, 1], over ``duration`` (whole time steps)."""
+        """Moves the gripper along ``path(u)``, u in (0, 1], over ``duration`` [s] (whole time steps)."""
         n = max(1, int(np.ceil(duration / self.dt)))
         for i in range(1, n + 1):
             self.step_to(path(i / n))
 
     def idle(self, duration: float):
+        """Holds the gripper still for ``duration`` [s] (whole time steps)."""
         for _ in range(max(1, int(round(duration / self.dt)))):
             self.step_to(self.g)
 
@@ -153,7 +155,7 @@ class GripperRig(Rig):
 
 class PlanarExecution(GripperRig):
     """One open-loop execution of a plan in the world's view (see the module), recorded: the
-    object's pose in the grasp and the planned one every ``record_dt``, and per push its slip."""
+    object's pose in the grasp and the planned one every ``record_dt`` [s], and per push its slip."""
 
     def __init__(self, scene: Scene, plan, perturb: Perturbation = Perturbation(), contact: Contact = Contact(),
                  speed: float = 0.01, record_dt: float = 0.02):
@@ -321,7 +323,7 @@ class WorldRig(GripperRig):
             self.step_to(self.g - d)
 
     def push(self, pusher: str, twist, duration: float, belief=None):
-        """The object (believed at ``belief``) pushed with body twist ``twist`` for ``duration``
+        """The object (believed at ``belief``) pushed with body twist ``twist`` (m/s, m/s, rad/s) for ``duration`` [s]
         against ``pusher``'s feature: the gripper moves so that the feature, seen from the
         gripper, follows the object's intended motion."""
         belief = self.pose() if belief is None else np.asarray(belief, float)

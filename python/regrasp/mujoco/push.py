@@ -41,6 +41,7 @@ class PushRig(Rig):
         self.driver = Driver(self.model, "pusher")
 
     def reset(self, pose):
+        """Resets the simulation with the object at ``pose`` ``[x, z, theta]`` (m, m, rad)."""
         import mujoco
 
         mujoco.mj_resetData(self.model, self.data)
@@ -50,8 +51,9 @@ class PushRig(Rig):
         self.forward()
 
     def push(self, pose, twist, duration: float, settle: float = 0.1, record_dt: float = 0.02) -> dict:
-        """The pusher starts in contact at the object's pose and moves with constant body
-        ``twist``; returns times, object poses (gripper frame) and pusher poses."""
+        """The pusher starts in contact at the object's ``pose`` (m, m, rad) and moves with constant
+        body ``twist`` (m/s, m/s, rad/s) for ``duration`` [s], recorded every ``record_dt`` [s];
+        returns times, object poses (gripper frame) and pusher poses."""
         self.reset(pose)
         dt = self.dt
         m, d = self.model, self.data
@@ -73,7 +75,8 @@ class PushRig(Rig):
         return {"t": np.array(t), "pose": np.array(poses), "pusher_pose": np.array(pushers)}
 
     def slip_fraction(self, pose, twist, distance: float = 0.003, speed: float = 0.01) -> float:
-        """How far the pusher and the object move apart at the contact over a short push, as a
+        """How far the pusher and the object move apart at the contact over a short push of
+        ``twist`` (m/s, m/s, rad/s) from ``pose`` (m, m, rad), as a
         share of the push: for a line pusher, the largest motion of the object relative to the
         pusher at either end of the line — its slide along the contact and its lift-off (a roll
         about the other end), pressing in by the soft contact's compliance left out; for a point
@@ -120,7 +123,8 @@ class PushRig(Rig):
         return float(slide / distance)
 
     def sticks(self, pose, twist, distance: float = 0.003, speed: float = 0.01, ratio: float = 0.02) -> bool:
-        """Whether the pusher and the object move together over a short push: they move apart at
+        """Whether the pusher and the object move together over a short push of ``twist``
+        (m/s, m/s, rad/s) from ``pose`` (m, m, rad): they move apart at
         the contact by less than ``ratio`` of the push (:meth:`slip_fraction`; soft contacts creep
         by about 1% of a push when the pusher sticks)."""
         f = self.slip_fraction(pose, twist, distance, speed)
@@ -132,7 +136,8 @@ class PushRig(Rig):
 def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, record_dt: float = 0.02,
                   settings: Contact = Contact()) -> dict:
     """A push in MuJoCo: the pads squeeze for 0.3 s, then the pusher moves with constant body
-    ``twist`` (object frame at the start). Returns times and object poses (gripper frame)."""
+    ``twist`` (m/s, m/s, rad/s; object frame at the start) from ``pose`` (m, m, rad) for ``duration``
+    [s], recorded every ``record_dt`` [s]. Returns times and object poses (gripper frame)."""
     pose, twist, pusher = _vec(pose, 3, "pose"), _vec(twist, 3, "twist"), _name(pusher, "pusher")
     duration = _number(duration, "duration", high=MAX_DURATION)
     record_dt = _number(record_dt, "record_dt", high=MAX_DURATION)

@@ -47,6 +47,7 @@ def compose(a, b) -> np.ndarray:
 
 
 def inverse(a) -> np.ndarray:
+    """The inverse of a pose ``a`` ``[x, y, z, qw, qx, qy, qz]`` (m, unit quaternion)."""
     return np.array(_core.se3_inverse(list(map(float, a))))
 
 
@@ -77,7 +78,7 @@ def _quat(t1, t2, n) -> np.ndarray:
 
 
 def plane_frame(scene, name: str, pose) -> np.ndarray:
-    """For a plane pusher brought against the object at ``pose``: the pose, in the pusher's frame
+    """For a plane pusher brought against the object at ``pose`` (m, unit quaternion): the pose, in the pusher's frame
     (the object frame then), of the plane's own frame (origin at the contact, +Z its normal)."""
     pts, n, _ = scene._core.pusher_spec(name, list(map(float, pose)))
     n = np.asarray(n, float) / np.linalg.norm(n)
@@ -225,12 +226,14 @@ class SpatialExecution(Rig):
         return self.geoms(f"feature_{p}")
 
     def park(self, p: str):
+        """Moves pusher ``p``'s feature out of the way (far from the object)."""
         if self.world:
             self.data.mocap_pos[self.mocap(f"feature_{p}")] = PARK
         else:
             self.drivers[p].set(self.data, np.r_[PARK, 1, 0, 0, 0])
 
     def settle(self, duration: float):
+        """Lets the object settle in the grasp for ``duration`` [s], no pusher in contact."""
         for _ in range(int(duration / self.dt)):
             self.place(None)
 

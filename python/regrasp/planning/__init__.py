@@ -1,0 +1,1 @@
+"""Regrasp planning: the T-RRT* planner's entry point and the plan files (``plan``)."""

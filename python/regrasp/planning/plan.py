@@ -122,12 +122,14 @@ def _entry(k, i: int, dim: int, name: str):
 
 @dataclass(eq=False, repr=False)
 class Plan:
-    """A regrasp plan, planar (``dimension`` 2, poses ``[x, z, theta]``) or 3-D (``dimension`` 3,
-    poses ``[x, y, z, qw, qx, qy, qz]``), with the planner's statistics.
+    """A regrasp plan, planar (``dimension`` 2, poses ``[x, z, theta]`` (m, m, rad)) or 3-D
+    (``dimension`` 3, poses ``[x, y, z, qw, qx, qy, qz]`` (m, m, m, unit quaternion)), with the
+    planner's statistics.
 
     ``poses``: (n, 3) or (n, 7) array, ``poses[0]`` the start. ``pushers[i]``: the pusher that
     moves the object from ``poses[i-1]`` to ``poses[i]`` (``pushers[0]`` is None). 3-D:
-    ``pusher_twists[i]``, the pusher's body twist over step i (None for the start, or where a
+    ``pusher_twists[i]``, the pusher's body twist ``[vx, vy, vz, wx, wy, wz]`` (m/s, rad/s) over step i
+    (None for the start, or where a
     plan file gives none). A statistic is None when the plan was read from a file without it.
 
     ``plan[key]`` reads the key of :meth:`to_json` (kept for compatibility with code written for
@@ -208,6 +210,7 @@ class Plan:
         return key in self.to_json()
 
     def get(self, key: str, default=None):
+        """The value of ``key`` in :meth:`to_json`, or ``default`` (as ``dict.get``)."""
         return self.to_json().get(key, default)
 
     # -- reading -------------------------------------------------------------------------------

@@ -43,7 +43,8 @@ def _cap(axis: np.ndarray, radius: float, n: int, rng) -> np.ndarray:
 
 
 def approximation_error(scene: Scene, pusher: str, pose=None, samples: int = 20000, seed: int = 0) -> dict:
-    """Misclassification shares of the polyhedral approximation for one pusher at one pose."""
+    """Misclassification shares of the polyhedral approximation for one pusher at one ``pose``
+    ``[x, z, theta]`` (m, m, rad; default: the task's start)."""
     if pose is None and scene.task is None:
         raise ArgumentError("invalid `pose`: the scene has no [task]; give the pose", "pose")
     pose = scene.task.start if pose is None else _vec(pose, 3, "pose")
@@ -97,6 +98,8 @@ def approximation_error(scene: Scene, pusher: str, pose=None, samples: int = 200
 
 
 def approximation_report(scenes: list[Scene], forces=(5.0, 20.0, 80.0), samples: int = 20000, seed: int = 0) -> list[dict]:
+    """The approximation error of every pusher of each grasp scene, at its task's start pose, for
+    each grip force in ``forces`` [N]: one dict a row (see :func:`format_report`)."""
     rows = []
     for sc in scenes:
         if sc.kind != "grasp":
@@ -111,6 +114,7 @@ def approximation_report(scenes: list[Scene], forces=(5.0, 20.0, 80.0), samples:
 
 
 def format_report(rows: list[dict]) -> str:
+    """The rows of :func:`approximation_report` as a text table."""
     lines = [
         f"{'scene':22s} {'grip N':>6s} {'pusher':12s} {'kind':5s} {'cap deg':>7s} {'in cone':>8s} "
         f"{'false in':>9s} {'false out':>9s} {'(of cone)':>10s}"

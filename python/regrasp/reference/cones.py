@@ -17,6 +17,8 @@ from ..scene.planar import Scene
 
 @dataclass(frozen=True)
 class RefParams:
+    """The parameters of a grasp and a line pusher as the numpy reference takes them: mass [kg],
+    COM [m], g [m/s²] and its direction, the pads' friction capacity and the pusher's contact."""
     mass: float
     com: np.ndarray
     g: float
@@ -30,6 +32,8 @@ class RefParams:
 
     @classmethod
     def from_scene(cls, scene: Scene, pusher: str) -> "RefParams":
+        """The parameters of ``pusher`` in a grasp ``scene`` with circular pads (ValueError
+        otherwise)."""
         if scene.kind != "grasp" or scene.pad is None or scene.pad[0] != "circle":
             raise ValueError("the numpy reference handles grasps with circular pads only")
         p = scene.pusher(pusher)
@@ -66,7 +70,8 @@ def _metric_norm(p: RefParams, v: np.ndarray) -> np.ndarray:
 
 
 def generators_numpy(p: RefParams, pose) -> np.ndarray:
-    """Polyhedral motion-cone generators at one pose (unit twists in the COM metric)."""
+    """Polyhedral motion-cone generators at one ``pose`` ``[x, z, theta]`` (m, m, rad): unit twists
+    in the COM metric (m/s, m/s, m/s)."""
     x, z, th = pose
     c, s = np.cos(th), np.sin(th)
     R = np.array([[c, -s], [s, c]])
@@ -113,7 +118,7 @@ def _batch_frames(p: RefParams, poses: np.ndarray):
 
 
 def generators_numpy_batch(p: RefParams, poses: np.ndarray) -> np.ndarray:
-    """Vectorized :func:`generators_numpy` over an (n, 3) array of poses: (n, 2m, 3)."""
+    """Vectorized :func:`generators_numpy` over an (n, 3) array of poses (m, m, rad): (n, 2m, 3)."""
     poses = np.asarray(poses, dtype=float)
     _, Jinv, wg = _batch_frames(p, poses)
     Ad = np.array([1.0, 1.0, 1.0 / p.k**2]) / p.s**2
@@ -130,7 +135,8 @@ def generators_numpy_batch(p: RefParams, poses: np.ndarray) -> np.ndarray:
 
 
 def classify_numpy_batch(p: RefParams, poses: np.ndarray, twists: np.ndarray) -> np.ndarray:
-    """Exact membership (line pushers) of twist i at pose i, vectorized: bool (n,)."""
+    """Exact membership (line pushers) of twist i (m/s, m/s, rad/s) at pose i (m, m, rad),
+    vectorized: bool (n,)."""
     poses = np.asarray(poses, dtype=float)
     Js, _, wg = _batch_frames(p, poses)
     Ad = np.array([1.0, 1.0, 1.0 / p.k**2]) / p.s**2

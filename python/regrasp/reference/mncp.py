@@ -36,6 +36,8 @@ class ReferenceSolverError(RegraspError):
 
 @dataclass
 class ReferenceSolution:
+    """The IPOPT solution of a quasi-static problem: object and pusher twists (m/s, rad/s), normal
+    and friction forces [N], the objective and the residuals."""
     twist: np.ndarray
     pusher_twist: np.ndarray
     normal_forces: np.ndarray
@@ -167,7 +169,8 @@ def _solve_relaxed(prog: _Program, newton_euler, dim: int, tol: float, max_iter:
 
 def solve(problem, pusher_twist=None, twist=None, tol: float = 1e-10, accept: float = 1e-6,
           x0: dict | None = None, max_iter: int = 500) -> ReferenceSolution:
-    """Forward problem (give ``pusher_twist``) or inverse problem (give ``twist``) with IPOPT.
+    """Forward problem (give ``pusher_twist``) or inverse problem (give ``twist``), twists in
+    (m/s, rad/s), with IPOPT.
 
     ``problem`` is a :class:`regrasp._core.MncpProblem`. Raises :class:`ReferenceSolverError`
     when IPOPT fails or the solution's largest scaled constraint residual exceeds ``accept``.

@@ -113,6 +113,9 @@ def _flag(x, name: str) -> bool:
 
 @dataclass(frozen=True)
 class Pusher:
+    """A pusher of a planar scene: its contact points (1, 2) (a point pusher) or (2, 2) (a line
+    pusher) in the object frame [m], its unit normal (2,) (the direction it pushes the object) and
+    its friction coefficient (dimensionless)."""
     name: str
     points: np.ndarray  # (1, 2) point pusher or (2, 2) line pusher, object frame [m]
     normal: np.ndarray  # (2,) unit, the direction the pusher pushes the object
@@ -121,6 +124,8 @@ class Pusher:
 
 @dataclass(frozen=True)
 class Task:
+    """A planar regrasp task: ``start`` and ``goal`` poses ``[x, z, theta]`` (m, m, rad) and the
+    goal ``tolerance`` per coordinate (m, m, rad)."""
     start: np.ndarray
     goal: np.ndarray
     tolerance: np.ndarray
@@ -145,15 +150,23 @@ class GravityFreeCone:
 
     @property
     def generators(self) -> np.ndarray:
+        """Generators of the gravity-free cone, one unit twist ``[vx, vz, omega]`` (m/s, m/s, rad/s) a
+        row, shape (k, 3)."""
         return self._cone._core.gravity_free_generators
 
     def margin(self, twist: ArrayLike) -> float:
+        """Signed margin of ``twist`` ``[vx, vz, omega]`` (m/s, m/s, rad/s) in the gravity-free cone
+        (>= 0 inside, exact: the cone is polyhedral)."""
         return self._cone._core.gravity_free_margin(list(_vec(twist, 3, "twist")))
 
     def contains(self, twist: ArrayLike, tol: float = 1e-9) -> bool:
+        """Whether ``twist`` ``[vx, vz, omega]`` (m/s, m/s, rad/s) lies in the gravity-free cone, up to
+        ``tol`` on the margin."""
         return self.margin(twist) >= -tol
 
     def project(self, twist: ArrayLike) -> np.ndarray:
+        """Closest twist of the gravity-free cone to ``twist`` ``[vx, vz, omega]`` (m/s, m/s, rad/s), in
+        the metric of :meth:`Scene.metric_twist`."""
         return self._cone._core.project_polyhedral(list(_vec(twist, 3, "twist")), "gravity_free")
 
 
@@ -174,26 +187,34 @@ class MotionCone:
     def __repr__(self) -> str:
         return f"MotionCone(pusher={self.pusher!r}, pose={list(self.pose)}, shape={self._core.pusher_cone_shape})"
 
-    pusher = core_property("pusher")
-    pose = core_property("pose", wrap=np.array)
-    generators = core_property("generators")
-    gravity_free_generators = core_property("gravity_free_generators")
+    pusher = core_property("pusher", "Name of the pusher this cone belongs to.")
+    pose = core_property("pose", "The pose ``[x, z, theta]`` (m, m, rad) of the cone, shape (3,).", wrap=np.array)
+    generators = core_property("generators", "Generators of the polyhedral approximation, one unit twist "
+                                             "``[vx, vz, omega]`` (m/s, m/s, rad/s) a row, shape (k, 3).")
+    gravity_free_generators = core_property("gravity_free_generators", "Generators of the gravity-free "
+                                            "cone, one unit twist (m/s, m/s, rad/s) a row, shape (k, 3).")
 
     @property
     def gravity_free(self) -> GravityFreeCone:
+        """The gravity-free cone of this pusher at this pose (no gravity wrench)."""
         return GravityFreeCone(self)
 
     hold_ratio = core_property("hold_ratio", "Share of the pads' friction that gravity alone uses (< 1 holds).")
     is_line_pusher = core_property("line", "A line pusher (two rigidly connected points) rather than a point pusher.")
 
     def contains(self, twist):
-        """Exact test for one twist (bool) or an (n, 3) array (bool array)."""
+        """Exact test of one twist ``[vx, vz, omega]`` (m/s, m/s, rad/s) (a bool) or of each row of an
+        (n, 3) array (a bool array): can the pusher produce it while sticking?"""
         return self._core.contains(_vec_or_rows(twist, "twist"))
 
     def margin(self, twist):
+        """Signed margin of a twist ``[vx, vz, omega]`` (m/s, m/s, rad/s) in the exact cone: a float
+        for one twist, an array for an (n, 3) array (>= 0 inside)."""
         return self._core.margin(_vec_or_rows(twist, "twist"))
 
     def classify(self, twist: ArrayLike) -> Classification:
+        """Exact test of one twist ``[vx, vz, omega]`` (m/s, m/s, rad/s), with the wrenches (N, N, N·m)
+        that produce it."""
         d = self._core.classify(list(_vec(twist, 3, "twist")))
         return Classification(
             feasible=d["feasible"],
@@ -204,16 +225,18 @@ class MotionCone:
         )
 
     def project(self, twist):
-        """Closest feasible twist (exact cone) to one twist or to each row of an (n, 3) array,
-        in the metric of :meth:`Scene.metric_twist`."""
+        """Closest feasible twist (exact cone) to one twist ``[vx, vz, omega]`` (m/s, m/s, rad/s) or
+        to each row of an (n, 3) array, in the metric of :meth:`Scene.metric_twist`."""
         return self._core.project(_vec_or_rows(twist, "twist"))
 
     def project_polyhedral(self, twist: ArrayLike) -> np.ndarray:
-        """Closest twist in the polyhedral approximation (non-negative least squares)."""
+        """Closest twist of the polyhedral approximation to ``twist`` (m/s, m/s, rad/s) (non-negative
+        least squares)."""
         return self._core.project_polyhedral(list(_vec(twist, 3, "twist")), "approx")
 
     def contains_polyhedral(self, twist):
-        """Membership in the polyhedral approximation (one twist, or an (n, 3) array)."""
+        """Membership in the polyhedral approximation of one twist (m/s, m/s, rad/s), or of each row of
+        an (n, 3) array."""
         return self._core.contains_polyhedral(_vec_or_rows(twist, "twist"))
 
     def grip_force_range(self, twist: ArrayLike) -> Optional[tuple[float, float]]:
@@ -224,6 +247,8 @@ class MotionCone:
         return self._core.grip_force_range(list(_vec(twist, 3, "twist")))
 
     def min_grip_force(self, twist: ArrayLike) -> Optional[float]:
+        """Smallest per-finger grip force [N] for which the pusher motion of ``twist`` (m/s, m/s, rad/s)
+        sticks, or None if no grip force does."""
         r = self.grip_force_range(twist)
         return None if r is None else r[0]
 
@@ -251,7 +276,8 @@ def _errors(status: np.ndarray) -> list:
 
 @dataclass
 class MotionConeBatch:
-    """Motion cones of one pusher at many poses (vectorized in Rust, no Python loop)."""
+    """Motion cones of one pusher at many ``poses`` (n, 3) ``[x, z, theta]`` (m, m, rad),
+    vectorized in Rust (no Python loop)."""
 
     scene: "Scene"
     pusher: str
@@ -261,6 +287,7 @@ class MotionConeBatch:
 
     @property
     def valid(self) -> np.ndarray:
+        """Where each pose has a cone (status 0), bool array (n,)."""
         return self.status == 0
 
     @property
@@ -269,25 +296,30 @@ class MotionConeBatch:
         return _errors(self.status)
 
     def gravity_free_generators(self) -> np.ndarray:
+        """Gravity-free generators at every pose: unit twists (m/s, m/s, rad/s), shape (n, k, 3)."""
         g, _ = self.scene._core.generators_many(self.poses, self.pusher, True)
         return g
 
     def classify(self, twists) -> dict:
-        """Exact test of twist i at pose i: dict of arrays feasible, margin, active_limit, valid."""
+        """Exact test of twist i (m/s, m/s, rad/s) at pose i: dict of arrays feasible, margin,
+        active_limit, valid, and the errors (None where valid)."""
         t = _rows(twists, "twists")
         feas, margin, codes, status = self.scene._core.classify_many(self.poses, t, self.pusher)
         return {"feasible": feas, "margin": margin, "active_limit": _LIMITS[codes], "valid": status == 0,
                 "errors": _errors(status)}
 
     def contains(self, twists) -> np.ndarray:
+        """Exact test of twist i ``[vx, vz, omega]`` (m/s, m/s, rad/s) at pose i: bool array (n,)."""
         t = _rows(twists, "twists")
         return self.scene._core.classify_many(self.poses, t, self.pusher)[0]
 
     def margin(self, twists) -> np.ndarray:
+        """Signed margin of twist i (m/s, m/s, rad/s) at pose i in its exact cone, array (n,)."""
         t = _rows(twists, "twists")
         return self.scene._core.classify_many(self.poses, t, self.pusher)[1]
 
     def project(self, twists) -> np.ndarray:
+        """Closest feasible twist (m/s, m/s, rad/s) to twist i at pose i, array (n, 3)."""
         t = _rows(twists, "twists")
         out, _ = self.scene._core.project_many(self.poses, t, self.pusher)
         return out
@@ -348,11 +380,15 @@ class Scene:
 
     @classmethod
     def load(cls, path) -> "Scene":
+        """The planar scene of a TOML scene file (docs/scene-file.md). Raises ArgumentError when
+        ``path`` cannot be read, SceneError naming the field at fault."""
         p, text = read_scene_file(path)
         return cls(_core.Scene.from_toml(text), p, ("toml", text))
 
     @classmethod
     def from_toml(cls, text: str) -> "Scene":
+        """A planar scene from the text of its TOML file. Raises SceneError naming the field at
+        fault."""
         if not isinstance(text, str):
             raise ArgumentError(f"invalid `text`: the scene file's text, a str (got {type(text).__name__})", "text")
         return cls(_core.Scene.from_toml(text), None, ("toml", text))
@@ -374,14 +410,15 @@ class Scene:
     def __repr__(self) -> str:
         return f"Scene({self.name!r}, kind={self.kind}, pushers={self.pusher_names})"
 
-    name = core_property("name")
+    name = core_property("name", "The scene's name.")
     kind = core_property("kind", '"grasp" (object between finger pads) or "surface" (object on a plane).')
-    pusher_names = core_property("pusher_names")
+    pusher_names = core_property("pusher_names", "Names of the pushers, in file order (list of str).")
     notes = core_property("notes", "What the loader changed in the file's values: measured pusher points moved onto "
                                    "the outline (list of str, empty when nothing moved).")
 
     @property
     def pushers(self) -> list[Pusher]:
+        """Every pusher of the scene, in file order."""
         out = []
         for n in self.pusher_names:
             pts, normal, mu = self._core.pusher(n)
@@ -389,13 +426,15 @@ class Scene:
         return out
 
     def pusher(self, name: str) -> Pusher:
+        """Pusher ``name``; raises ArgumentError listing the names when there is none of that name."""
         pts, normal, mu = self._core.pusher(_name(name, "name"))
         return Pusher(name, np.asarray(pts), np.asarray(normal), mu)
 
     length = core_property("length", "Characteristic length L [m] weighing rotation against translation.")
 
     def metric_twist(self, twist) -> np.ndarray:
-        """Twists (rows) in the frame-invariant metric: [velocity of the COM, L omega]. Norms,
+        """Twists ``[vx, vz, omega]`` (m/s, m/s, rad/s; rows) in the frame-invariant metric: [velocity
+        of the COM (m/s), L omega (m/s)]. Norms,
         distances and projections of regrasp are Euclidean in these coordinates."""
         v = _twists(twist, "twist")
         c, L = self.com, self.length
@@ -409,20 +448,24 @@ class Scene:
         w = s[..., 2] / L
         return np.stack([s[..., 0] + w * c[1], s[..., 1] - w * c[0], w], axis=-1)
 
-    mass = core_property("mass")
-    com = core_property("com", wrap=np.array)
-    outline = core_property("outline")
+    mass = core_property("mass", "Mass of the object [kg].")
+    com = core_property("com", "Centre of mass ``[x, z]`` in the object frame [m], shape (2,).", wrap=np.array)
+    outline = core_property("outline", "Vertices of the object's outline in the object frame [m], shape (n, 2).")
 
     @property
     def gravity(self) -> tuple[np.ndarray, float]:
+        """Gravity: its unit direction ``[dx, dz]`` in the gripper frame and its magnitude g [m/s²]."""
         dx, dz, g = self._core.gravity
         return np.array([dx, dz]), g
 
-    grip_force = core_property("grip_force")
-    pad = core_property("pad")
+    grip_force = core_property("grip_force", "Grip force per finger [N] (None on a surface scene).")
+    pad = core_property("pad", 'The finger pad: ``("circle", radius, radius)`` or ``("rectangle", width, '
+                               'height)`` [m]; '
+                               "None on a surface.")
 
     @property
     def task(self) -> Optional[Task]:
+        """The scene's task (start, goal, tolerance), or None when the file has none."""
         t = self._core.task
         return None if t is None else Task(*(np.array(x) for x in t))
 
@@ -482,41 +525,48 @@ class Scene:
         return self._view(self._core.scaled(1.0, 1.0, 1.0, 1.0, "fixtureless"), "fixtureless")
 
     def carries_weight(self, pose, pusher: str) -> bool:
-        """Whether ``pusher`` alone can carry the object's weight at ``pose`` (the invariant case
+        """Whether ``pusher`` alone can carry the object's weight at ``pose`` ``[x, z, theta]``
+        (m, m, rad) (the invariant case
         of §5.1: its gravity-free pushes stick for any mass, grip force and finger friction)."""
         return self._core.carries_weight(list(_vec(pose, 3, "pose")), _name(pusher, "pusher"))
 
     def admissible(self, pose) -> bool | np.ndarray:
-        """Whether the whole finger pad lies on the object at ``pose`` (or each row of an array)."""
+        """Whether the whole finger pad lies on the object at ``pose`` ``[x, z, theta]`` (m, m, rad)
+        (or at each row of an (n, 3) array: a bool array)."""
         a = _array(pose, "pose")
         if a.ndim == 2:
             return self._core.admissible_many(_rows(a, "pose"))
         return self._core.admissible(list(_vec(a, 3, "pose")))
 
     def hold_ratio(self, pose) -> float:
-        """Share of the support's friction that gravity alone uses at ``pose`` (< 1 holds)."""
+        """Share of the support's friction that gravity alone uses at ``pose`` ``[x, z, theta]``
+        (m, m, rad) (< 1 holds). Raises ArgumentError when the pose is not admissible."""
         q = _vec(pose, 3, "pose")
         if not self.admissible(q):
             raise ArgumentError(f"invalid `pose`: {q.tolist()} is not admissible: the finger pad is not entirely on the object", "pose")
         return self._core.hold_ratio(list(q))
 
     def hold_grip_force(self, pose) -> Optional[float]:
-        """Smallest per-finger grip force that holds the object against gravity at ``pose``."""
+        """Smallest per-finger grip force [N] that holds the object against gravity at ``pose``
+        ``[x, z, theta]`` (m, m, rad); None on a surface scene."""
         if self.grip_force is None:
             return None
         return self.grip_force * self.hold_ratio(pose)
 
     def motion_cone(self, pose, pusher: str, check_hold: bool = True) -> MotionCone:
-        """The motion cone of ``pusher`` at ``pose``. Raises GraspError when the grasp cannot
-        hold the object there (pass ``check_hold=False`` for gravity-free and grip-force queries)."""
+        """The motion cone of ``pusher`` at ``pose`` ``[x, z, theta]`` (m, m, rad). Raises GraspError
+        when the grasp cannot hold the object there (pass ``check_hold=False`` for gravity-free and grip-force queries)."""
         q = list(_vec(pose, 3, "pose"))
         return MotionCone(self._core.motion_cone(q, _name(pusher, "pusher"), _flag(check_hold, "check_hold")), self)
 
     def gravity_free_cone(self, pose, pusher: str) -> GravityFreeCone:
+        """The gravity-free cone of ``pusher`` at ``pose`` ``[x, z, theta]`` (m, m, rad) (no hold
+        check)."""
         return self.motion_cone(pose, pusher, check_hold=False).gravity_free
 
     def motion_cones(self, poses, pusher: str, strict: bool = False) -> MotionConeBatch:
-        """Motion cones at many poses. With ``strict`` the first invalid pose raises."""
+        """Motion cones at many ``poses`` (n, 3) ``[x, z, theta]`` (m, m, rad). With ``strict`` the
+        first invalid pose raises ArgumentError; else its status says why."""
         q = _rows(poses, "poses")
         g, status = self._core.generators_many(q, _name(pusher, "pusher"), False)
         strict = _flag(strict, "strict")

@@ -29,6 +29,8 @@ class Scene3D:
 
     @classmethod
     def load(cls, path) -> "Scene3D":
+        """The 3-D scene of a scene file (``dimension = 3``; mesh paths relative to its folder). Raises
+        ArgumentError when ``path`` cannot be read, SceneError naming the field at fault."""
         p, text = read_scene_file(path)
         return cls(_core.Scene3D.from_toml(text, str(p.parent)), p)
 
@@ -44,26 +46,34 @@ class Scene3D:
     def __repr__(self) -> str:
         return f"Scene3D({self.name!r}, pushers={self.pusher_names})"
 
-    name = core_property("name")
-    pusher_names = core_property("pusher_names")
+    name = core_property("name", "The scene's name.")
+    pusher_names = core_property("pusher_names", "Names of the pushers, in file order (list of str).")
     notes = core_property("notes", "What the loader changed in the file's values: measured pusher points moved onto "
                                    "the object's surface (list of str, empty when nothing moved).")
     length = core_property("length", "Characteristic length L [m] weighing rotation against translation.")
-    mass = core_property("mass")
-    inertia = core_property("inertia")
+    mass = core_property("mass", "Mass of the object [kg].")
+    inertia = core_property("inertia", "Inertia matrix about the centre of mass, object frame [kg·m²], shape (3, 3).")
 
     @property
     def task(self):
+        """The task: start and goal poses ``[x, y, z, qw, qx, qy, qz]`` (m, m, m, -, -, -, -) and the
+        tolerance ``[x, y, z, angle]`` (m, m, m, rad)."""
         s, g, t = self._core.task
         return np.array(s), np.array(g), np.array(t)
 
     def mesh(self):
+        """The object's mesh: vertices (n, 3) in the object frame [m] and triangles (m, 3) (vertex
+        indices, uint32)."""
         return self._core.mesh()
 
     def pad_contacts(self, pose) -> list:
+        """Contact points of the two finger pads at ``pose`` ``[x, y, z, qw, qx, qy, qz]`` (m, quaternion),
+        in the object frame [m]: one (k, 3) array per pad."""
         return [np.array(p) for p in self._core.pad_contacts(list(_vec(pose, 7, "pose")))]
 
     def quasistatic_problem(self, pose, pusher: str, h: float = 1.0):
+        """The quasi-static problem (a ``_core.MncpProblem``) of ``pusher`` in contact at ``pose``
+        ``[x, y, z, qw, qx, qy, qz]`` (m, quaternion), with time step ``h`` [s] > 0."""
         return self._core.quasistatic_problem(list(_vec(pose, 7, "pose")), _name(pusher, "pusher"), _number(h, "h"))
 
     def simulate_push(self, pose, pusher: str, twist, duration: float, dt: float = 0.05) -> dict:
@@ -91,6 +101,7 @@ class Scene3D:
 
     def replay(self, plan, dt: float = 0.25, feedback: bool = False, max_replans: int = 10, seed: int = 0) -> dict:
         """Replays a 3-D plan (a :class:`~regrasp.Plan` or a plan dict) in the quasi-static
+        simulator with time step ``dt`` [s]
         simulator: each step's pusher moves with the step's twist for unit time from wherever
         the object is. Returns the final pose, the error to the goal (position [m] and angle
         [rad]), success (within the task's tolerance), the poses after each step and the

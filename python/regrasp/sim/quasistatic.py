@@ -48,7 +48,8 @@ def problem(scene: Scene, pose, pusher: str | None = None, h: float | None = Non
 
 
 def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: float = 0.05, **support) -> dict:
-    """Explicit time stepping of one push: the pusher moves with constant body ``twist``."""
+    """Explicit time stepping of one push from ``pose`` (m, m, rad): the pusher moves with
+    constant body ``twist`` (m/s, m/s, rad/s) for ``duration`` [s] in steps of ``dt`` [s]."""
     kw = support_kwargs(**support)
     duration, dt = _number(duration, "duration"), _number(dt, "dt")
     return scene._core.simulate_push(list(_vec(pose, 3, "pose")), _name(pusher, "pusher"), list(_vec(twist, 3, "twist")),
@@ -74,7 +75,8 @@ def body_twist(a, b) -> np.ndarray:
 
 @dataclass
 class Replay:
-    """Result of replaying a plan in a simulator."""
+    """Result of replaying a plan in a simulator: the final pose and the poses along the way
+    ``[x, z, theta]`` (m, m, rad)."""
 
     engine: str
     final_pose: np.ndarray
@@ -87,6 +89,7 @@ class Replay:
     steps: list = field(repr=False, default_factory=list)
 
     def to_json(self) -> dict:
+        """The replay as a JSON-ready dict (lists, not arrays)."""
         return {
             "engine": self.engine,
             "final_pose": self.final_pose.tolist(),
@@ -99,7 +102,7 @@ class Replay:
 def replay_plan(scene: Scene, plan, speed: float = SPEED, dt: float = 0.05, **support) -> Replay:
     """Replays a plan (a :class:`~regrasp.Plan` or a plan dict) in the quasi-static simulator:
     for each step the pusher is put in contact with the object where it is now, then follows the
-    planned object motion of that step (its body twist, at ``speed``)."""
+    planned object motion of that step (its body twist, at ``speed`` [m/s]) in steps of ``dt`` [s]."""
     speed, dt = _number(speed, "speed"), _number(dt, "dt")
     path = as_plan(plan, scene).path
     q = np.asarray(path[0]["pose"], float)

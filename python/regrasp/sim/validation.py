@@ -50,7 +50,8 @@ def _rotate_metric(v: np.ndarray, angle: float, rng) -> np.ndarray:
 
 
 def sample_push(scene: Scene, pose, pusher: str, kind: str, rng):
-    """A pusher motion of the given kind ('inside', 'near', 'random') for the validation."""
+    """A pusher motion (m/s, m/s, rad/s) at ``pose`` (m, m, rad) of the given kind ('inside',
+    'near', 'random') for the validation."""
     cone = scene.motion_cone(pose, pusher)
     E = cone._core.pusher_edges
     if cone.is_line_pusher:
@@ -276,6 +277,8 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
 
 
 def format_validation(res: dict) -> str:
+    """The validation results of :func:`validate` as text: per engine, the agreement of the
+    motion-cone prediction with the simulator."""
     lines = [f"{res['scene']}: {res['pushes']} random pushes"]
     for engine in ENGINES:
         if f"agreement_{engine}" not in res:

@@ -1,0 +1,2 @@
+"""Visualization: figures and animations with matplotlib (``plotting``) and the browser view of a
+plan (``viewer``)."""

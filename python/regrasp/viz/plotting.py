@@ -186,7 +186,8 @@ def _axes_pose(ax, t, q, label_prefix="", style=None):
 
 
 def plot_push(scene, tr: dict, pusher: str, twist, path) -> Path:
-    """Object pose in the grasp and contact forces over time for one simulated push."""
+    """Object pose (m, m, rad) in the grasp and contact forces [N] over time [s] for one simulated
+    push of ``twist`` (m/s, m/s, rad/s); the figure is written to ``path``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -275,7 +276,8 @@ PUSHER_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple",
 
 
 def animation_axes(scene, poses):
-    """A figure and bare, equal-aspect axes framing the object at every pose (1 cm margin)."""
+    """A figure and bare, equal-aspect axes framing the object at every pose of ``poses``
+    (m, m, rad) (1 cm margin)."""
     import matplotlib.pyplot as plt
 
     pts = np.vstack([_object_at(scene, q) for q in poses])

@@ -185,6 +185,8 @@ def page(scene, plan) -> str:
 
 
 def write_html(scene, plan, path) -> Path:
+    """Writes the view of ``plan`` in ``scene`` as one self-contained HTML page at ``path``
+    (atomically); returns the path."""
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     return write_text(p, page(scene, plan))
