@@ -38,9 +38,13 @@ fn twists(t: &Arg<'_>) -> PyResult<(Vec<Vec3>, bool)> {
 
 #[pymethods]
 impl MotionCone {
+    /// Name of the pusher.
     #[getter] fn pusher(&self) -> String { self.pusher.clone() }
+    /// The pose `[x, z, theta]` (m, m, rad).
     #[getter] fn pose(&self) -> [f64; 3] { self.push.spec().pose }
+    /// Characteristic length L [m] of the twist metric diag(1, 1, L²).
     #[getter] fn length(&self) -> f64 { self.push.metric().length }
+    /// Share of the pads' friction that gravity alone uses (< 1 holds).
     #[getter] fn hold_ratio(&self) -> f64 { self.push.hold_ratio() }
     /// Whether the pusher is a line pusher (two rigidly connected points).
     #[getter] fn line(&self) -> bool { self.push.spec().pusher.is_line() }
@@ -51,6 +55,7 @@ impl MotionCone {
             Ok(matrix_rows(py, &self.push.generators().map_err(to_py)?))
         })
     }
+    /// Generators of the gravity-free cone, one unit twist (m/s, m/s, rad/s) a row.
     #[getter]
     fn gravity_free_generators<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix_rows(py, &self.push.gravity_free_generators())
@@ -70,7 +75,8 @@ impl MotionCone {
         (matrix(py, &f.a), matrix(py, &f.js), vector(py, &f.gravity))
     }
 
-    /// Motion-cone ray (unit twist) produced by pusher wrench `wrench`, or None.
+    /// Motion-cone ray (unit twist) produced by pusher wrench `wrench` `[fx, fz, tau]` (N, N, N·m),
+    /// or None.
     fn ray<'py>(&self, py: Python<'py>, wrench: &Arg<'py>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
         guard(move || {
             let w = Vec3::from(numbers("wrench", wrench, "[fx, fz, τ]")?);
@@ -78,7 +84,8 @@ impl MotionCone {
         })
     }
 
-    /// Exact test of one twist: dict(feasible, margin, active_limit, pusher_wrench, support_wrench).
+    /// Exact test of one twist `[vx, vz, omega]` (m/s, m/s, rad/s): dict(feasible, margin,
+    /// active_limit, pusher_wrench, support_wrench), wrenches `[fx, fz, tau]` (N, N, N·m).
     fn classify<'py>(&self, py: Python<'py>, twist: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
         guard(move || {
             let c = self.push.classify(&twist3("twist", twist)?).map_err(to_py)?;
@@ -88,7 +95,7 @@ impl MotionCone {
         })
     }
 
-    /// Signed margins of one twist or of an (n, 3) array of twists.
+    /// Signed margins of one twist `[vx, vz, omega]` (m/s, m/s, rad/s) or of an (n, 3) array of twists.
     fn margin(&self, py: Python<'_>, twist: &Arg<'_>) -> PyResult<PyObject> {
         guard(move || {
             let (ts, many) = twists(twist)?;
@@ -97,7 +104,7 @@ impl MotionCone {
         })
     }
 
-    /// Exact membership of one twist or of an (n, 3) array of twists.
+    /// Exact membership of one twist (m/s, m/s, rad/s) or of an (n, 3) array of twists.
     fn contains(&self, py: Python<'_>, twist: &Arg<'_>) -> PyResult<PyObject> {
         guard(move || {
             let (ts, many) = twists(twist)?;
@@ -106,7 +113,7 @@ impl MotionCone {
         })
     }
 
-    /// Membership in the polyhedral approximation, of one twist or an (n, 3) array.
+    /// Membership in the polyhedral approximation, of one twist (m/s, m/s, rad/s) or an (n, 3) array.
     fn contains_polyhedral(&self, py: Python<'_>, twist: &Arg<'_>) -> PyResult<PyObject> {
         guard(move || {
             let (ts, many) = twists(twist)?;
@@ -114,14 +121,15 @@ impl MotionCone {
         })
     }
 
-    /// Margin of a twist in the gravity-free cone (exact, polyhedral).
+    /// Margin of a twist (m/s, m/s, rad/s) in the gravity-free cone (exact, polyhedral).
     fn gravity_free_margin(&self, twist: &Arg<'_>) -> PyResult<f64> {
         guard(move || {
             self.push.gravity_free_margin(&twist3("twist", twist)?).map_err(to_py)
         })
     }
 
-    /// Closest feasible twist (metric diag(1, 1, L²)), exact cone.
+    /// Closest feasible twist (m/s, m/s, rad/s; metric diag(1, 1, L²)), exact cone, to one twist
+    /// or to each row of an (n, 3) array.
     fn project(&self, py: Python<'_>, twist: &Arg<'_>) -> PyResult<PyObject> {
         guard(move || {
             let (ts, many) = twists(twist)?;
@@ -133,7 +141,8 @@ impl MotionCone {
         })
     }
 
-    /// Closest twist in a polyhedral cone: `which` "approx" (default) or "gravity_free".
+    /// Closest twist (m/s, m/s, rad/s) in a polyhedral cone: `which` "approx" (default) or
+    /// "gravity_free".
     #[pyo3(signature = (twist, which=None))]
     fn project_polyhedral<'py>(&self, py: Python<'py>, twist: &Arg<'py>, which: Option<&Arg<'py>>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         guard(move || {
@@ -145,7 +154,8 @@ impl MotionCone {
         })
     }
 
-    /// Per-finger grip-force range [min, max] for which the pusher motion of `twist` sticks.
+    /// Per-finger grip-force range (min, max) [N] for which the pusher motion of `twist`
+    /// (m/s, m/s, rad/s) sticks, or None.
     fn grip_force_range(&self, twist: &Arg<'_>) -> PyResult<Option<(f64, f64)>> {
         guard(move || {
             let r = self.push.grip_force_range(&twist3("twist", twist)?).map_err(to_py)?;
@@ -153,7 +163,8 @@ impl MotionCone {
         })
     }
 
-    /// Point pushers: object twist when the contact point moves with velocity `u` (object frame).
+    /// Point pushers: object twist (m/s, m/s, rad/s) when the contact point moves with velocity
+    /// `u` [m/s] (object frame), or None.
     fn point_pusher_twist<'py>(&self, py: Python<'py>, u: &Arg<'py>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
         guard(move || {
             let u = Vec2::from(numbers("u", u, "[ux, uz]")?);

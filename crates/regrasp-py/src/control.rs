@@ -35,8 +35,8 @@ impl Mpc {
 
 #[pymethods]
 impl Mpc {
-    /// The controller of the plan (`poses`, `pushers`) in `scene`, towards `goal` (default:
-    /// the task's). Every other keyword is a setting of `mpc_defaults()` (None: its default).
+    /// The controller of the plan (`poses` (n, 3) in (m, m, rad), `pushers`) in `scene`, towards
+    /// `goal` (default: the task's); `dt` [s], `speed` [m/s], `replan_time_limit` [s]. Every other keyword is a setting of `mpc_defaults()` (None: its default).
     #[new]
     #[pyo3(signature = (scene, poses, pushers, goal=None, dt=None, horizon=None, speed=None, stage_weight=None,
                         terminal_weight=None, effort_weight=None, margin=None, stall_steps=None, max_replans=None,
@@ -76,8 +76,9 @@ impl Mpc {
         })
     }
 
-    /// One control step from the measured pose: a dict with status, pusher, twist, knot,
-    /// tracking_error, projected, solve_time_s, replan_time_s.
+    /// One control step from the measured pose `pose` `[x, z, theta]` (m, m, rad): a dict with
+    /// status, pusher, twist (m/s, m/s, rad/s), knot, tracking_error, projected, solve_time_s and
+    /// replan_time_s (s).
     fn step<'py>(&self, py: Python<'py>, pose: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
         guard(move || {
             let q = pose3("pose", pose)?;
@@ -93,7 +94,7 @@ impl Mpc {
         })
     }
 
-    /// The QP at pose `pose` with the reference after knot `knot`: per horizon step a dict with
+    /// The QP at pose `pose` `[x, z, theta]` (m, m, rad) with the reference after knot `knot`: per horizon step a dict with
     /// the pusher, generators (k, 3) and weights (k,); and whether clarabel solved it.
     fn solve_qp<'py>(&self, py: Python<'py>, pose: &Arg<'py>, knot: &Arg<'py>) -> PyResult<Bound<'py, PyTuple>> {
         guard(move || {
@@ -110,6 +111,7 @@ impl Mpc {
     #[getter] fn knots<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> { Ok(rows_array(py, self.state()?.knots().to_vec())) }
     /// The pusher reaching each knot.
     #[getter] fn knot_pushers(&self) -> PyResult<Vec<Option<String>>> { Ok(self.state()?.knot_pushers().iter().map(|&p| self.name(p)).collect()) }
+    /// Re-plans made so far.
     #[getter] fn replans(&self) -> PyResult<usize> { Ok(self.state()?.replans) }
     /// Why the last re-planning failed (None if it did not).
     #[getter] fn replan_error(&self) -> PyResult<Option<String>> { Ok(self.state()?.last_replan_error.clone()) }

@@ -82,10 +82,13 @@ fn contact_dict<'py>(py: Python<'py>, c: &Contact) -> PyResult<Bound<'py, PyDict
 
 #[pymethods]
 impl MncpProblem {
+    /// Dimension of the twists: 3 (planar) or 6 (3-D).
     #[getter] fn dim(&self) -> usize { self.inner.dim }
+    /// The contacts' labels, in order.
     #[getter] fn labels(&self) -> Vec<String> { self.inner.contacts.iter().map(|c| c.label.clone()).collect() }
 
-    /// Forward problem: pusher twist given; returns the solution as a dict.
+    /// Forward problem: the pusher twist `pusher_twist` (m/s, rad/s) given; returns the solution
+    /// as a dict (twists in m/s and rad/s, forces in N).
     fn solve_forward<'py>(&self, py: Python<'py>, pusher_twist: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
         guard(move || {
             let u = DVector::from_vec(finite_numbers("pusher_twist", pusher_twist)?);
@@ -94,7 +97,8 @@ impl MncpProblem {
         })
     }
 
-    /// Inverse problem: object twist given; returns the pusher motion and forces.
+    /// Inverse problem: the object twist `twist` (m/s, rad/s) given; returns the pusher motion
+    /// (m/s, rad/s) and the forces (N) as a dict.
     fn solve_inverse<'py>(&self, py: Python<'py>, twist: &Arg<'py>) -> PyResult<Bound<'py, PyDict>> {
         guard(move || {
             let v = DVector::from_vec(finite_numbers("twist", twist)?);
@@ -103,7 +107,8 @@ impl MncpProblem {
         })
     }
 
-    /// Scaled violation of every constraint for a candidate solution (e.g. the reference's).
+    /// Scaled violation of every constraint for a candidate solution (e.g. the reference's):
+    /// twists (m/s, rad/s), normal and friction forces (N).
     fn residuals<'py>(
         &self, py: Python<'py>, twist: &Arg<'py>, pusher_twist: &Arg<'py>, normal_forces: &Arg<'py>, friction_forces: &Arg<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {

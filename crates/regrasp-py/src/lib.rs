@@ -18,6 +18,9 @@ mod settings;
 
 use pyo3::prelude::*;
 
+/// The compiled core of regrasp: scenes, motion cones, quasi-static dynamics, planning, control
+/// and SE(3) pose algebra (the Python API wraps it: `regrasp.Scene`, `regrasp.plan`, ...).
+/// Units are SI (m, rad, N, kg, s).
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::quiet_panic_hook();

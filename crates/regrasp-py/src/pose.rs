@@ -14,7 +14,8 @@ pub fn se3_log(a: &Arg<'_>, b: &Arg<'_>) -> PyResult<[f64; 6]> {
     })
 }
 
-/// `pose ∘ exp(t · twist)` (body twist; SE(3) exp).
+/// `pose ∘ exp(t · twist)`: `pose` `[x, y, z, qw, qx, qy, qz]` (m, unit quaternion), body
+/// `twist` `[vx, vy, vz, wx, wy, wz]` (m/s, rad/s), `t` [s] (SE(3) exp).
 #[pyfunction]
 pub fn se3_integrate(pose: &Arg<'_>, twist: &Arg<'_>, t: &Arg<'_>) -> PyResult<[f64; 7]> {
     guard(move || {

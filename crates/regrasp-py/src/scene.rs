@@ -52,7 +52,9 @@ impl Scene {
         })
     }
 
+    /// The scene's name.
     #[getter] fn name(&self) -> String { self.inner.name.clone() }
+    /// "grasp" (object between finger pads) or "surface" (object on a plane).
     #[getter]
     fn kind(&self) -> &'static str {
         match self.inner.support {
@@ -60,15 +62,23 @@ impl Scene {
             Support::Surface(_) => "surface",
         }
     }
+    /// Names of the pushers, in file order.
     #[getter] fn pusher_names(&self) -> Vec<String> { self.inner.pushers.iter().map(|p| p.name.clone()).collect() }
     /// What the loader changed in the file's values (pusher points snapped onto the outline).
     #[getter] fn notes(&self) -> Vec<String> { self.inner.notes().to_vec() }
+    /// Characteristic length L [m] weighing rotation against translation.
     #[getter] fn length(&self) -> f64 { self.inner.length }
+    /// Mass of the object [kg].
     #[getter] fn mass(&self) -> f64 { self.inner.mass }
+    /// Centre of mass `(x, z)` in the object frame [m].
     #[getter] fn com(&self) -> (f64, f64) { (self.inner.com.x, self.inner.com.y) }
+    /// Gravity: `(dx, dz, g)`, its unit direction in the gripper frame and magnitude g [m/s²].
     #[getter] fn gravity(&self) -> (f64, f64, f64) { (self.inner.gravity_dir.x, self.inner.gravity_dir.y, self.inner.g) }
+    /// Grip force per finger [N] (None on a surface).
     #[getter] fn grip_force(&self) -> Option<f64> { self.inner.grip_force() }
+    /// Factor on every pusher's friction (1 unless scaled).
     #[getter] fn friction_scale(&self) -> f64 { self.inner.friction_scale() }
+    /// Vertices of the outline in the object frame [m], shape (n, 2).
     #[getter]
     fn outline<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         rows_array(py, self.inner.outline.vertices().iter().map(|p| [p.x, p.y]).collect())
@@ -102,12 +112,14 @@ impl Scene {
     /// (start, goal, tolerance) or None.
     #[getter] fn task(&self) -> Option<([f64; 3], [f64; 3], [f64; 3])> { self.inner.task.map(|t| (t.start, t.goal, t.tolerance)) }
 
+    /// Whether the whole finger pad lies on the object at `pose` `[x, z, theta]` (m, m, rad).
     fn admissible(&self, pose: &Arg<'_>) -> PyResult<bool> {
         guard(move || {
             Ok(self.inner.admissible(&pose3("pose", pose)?))
         })
     }
 
+    /// `admissible` at each row of `poses` (n, 3) (m, m, rad): a bool array.
     fn admissible_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>) -> PyResult<Bound<'py, PyArray1<bool>>> {
         guard(move || {
             let q = rows::<3>("poses", poses)?;
@@ -115,6 +127,8 @@ impl Scene {
         })
     }
 
+    /// Share of the support's friction that gravity alone uses at `pose` `[x, z, theta]` (m, m, rad)
+    /// (< 1 holds).
     fn hold_ratio(&self, pose: &Arg<'_>) -> PyResult<f64> {
         guard(move || {
             let r = self.inner.hold_ratio(&pose3("pose", pose)?);
@@ -125,6 +139,7 @@ impl Scene {
         })
     }
 
+    /// The same scene with grip force `force` [N] per finger (grasp scenes).
     fn with_grip_force(&self, force: &Arg<'_>) -> PyResult<Self> {
         guard(move || {
             let force = positive("force", force)?;
@@ -135,7 +150,7 @@ impl Scene {
         })
     }
 
-    /// The motion cone of pusher `pusher` at `pose` (raises GraspError if the grasp cannot
+    /// The motion cone of pusher `pusher` at `pose` `[x, z, theta]` (m, m, rad) (raises GraspError if the grasp cannot
     /// hold, unless `check_hold` is False).
     #[pyo3(signature = (pose, pusher, check_hold=None))]
     fn motion_cone(&self, pose: &Arg<'_>, pusher: &Arg<'_>, check_hold: Option<&Arg<'_>>) -> PyResult<MotionCone> {
@@ -151,7 +166,7 @@ impl Scene {
         })
     }
 
-    /// Polyhedral (or gravity-free) generators at many poses: (generators (n, k, 3),
+    /// Polyhedral (or gravity-free) generators at many `poses` (n, 3) (m, m, rad): (generators (n, k, 3),
     /// status (n,) uint8; 0 = ok, see `status_messages`).
     fn generators_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>, pusher: &Arg<'py>, gravity_free: &Arg<'py>) -> PyResult<Generated<'py>> {
         guard(move || {
@@ -159,14 +174,14 @@ impl Scene {
         })
     }
 
-    /// Exact test of twist i at pose i: (feasible, margin, active-limit codes, status).
+    /// Exact test of twist i (m/s, m/s, rad/s) at pose i (m, m, rad): (feasible, margin, active-limit codes, status).
     fn classify_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>, twists: &Arg<'py>, pusher: &Arg<'py>) -> PyResult<Classified<'py>> {
         guard(move || {
             cones::classify_many(py, &self.inner, poses, twists, pusher)
         })
     }
 
-    /// Closest feasible twist to twist i at pose i: (projections (n, 3), status).
+    /// Closest feasible twist to twist i (m/s, m/s, rad/s) at pose i (m, m, rad): (projections (n, 3), status).
     fn project_many<'py>(&self, py: Python<'py>, poses: &Arg<'py>, twists: &Arg<'py>, pusher: &Arg<'py>) -> PyResult<Projected<'py>> {
         guard(move || {
             cones::project_many(py, &self.inner, poses, twists, pusher)
@@ -185,7 +200,8 @@ impl Scene {
         cones::status_messages()
     }
 
-    /// The quasi-static problem of `pusher` (or no pusher) at `pose`; the options default to
+    /// The quasi-static problem of `pusher` (or no pusher) at `pose` (m, m, rad), time step `h` [s],
+    /// pusher `speed` [m/s]; the options default to
     /// `quasistatic_defaults()`.
     #[pyo3(signature = (pose, pusher=None, support=None, rings=None, points=None, merge_fingers=None, h=None, speed=None))]
     #[allow(clippy::too_many_arguments)]
@@ -201,7 +217,8 @@ impl Scene {
         })
     }
 
-    /// Instantaneous pushes: pusher `pusher` at pose i moving with twist i (object frame).
+    /// Instantaneous pushes: pusher `pusher` at pose i (m, m, rad) moving with twist i (m/s, m/s,
+    /// rad/s; object frame).
     /// Returns (sticks (n,), object twists (n, 3), max residual (n,), errors (None if solved)).
     #[pyo3(signature = (poses, pusher, twists, support=None, rings=None, points=None, merge_fingers=None))]
     #[allow(clippy::too_many_arguments)]
@@ -215,7 +232,8 @@ impl Scene {
         })
     }
 
-    /// Explicit time stepping of one push (pusher body twist constant, object frame at t = 0).
+    /// Explicit time stepping of one push from `pose` (m, m, rad): pusher body `twist` (m/s, m/s,
+    /// rad/s) constant (object frame at t = 0) for `duration` [s] in steps of `dt` [s].
     #[pyo3(signature = (pose, pusher, twist, duration, dt, support=None, rings=None, points=None, merge_fingers=None))]
     #[allow(clippy::too_many_arguments)]
     fn simulate_push<'py>(

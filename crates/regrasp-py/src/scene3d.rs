@@ -37,20 +37,31 @@ impl Scene3D {
                 .map_err(to_py)
         })
     }
+    /// The scene's name.
     #[getter] fn name(&self) -> String { self.inner.name.clone() }
+    /// Names of the pushers, in file order.
     #[getter] fn pusher_names(&self) -> Vec<String> { self.inner.pushers.iter().map(|p| p.name.clone()).collect() }
     /// What the loader changed in the file's values (pusher points snapped onto the surface).
     #[getter] fn notes(&self) -> Vec<String> { self.inner.notes().to_vec() }
+    /// Characteristic length L [m] weighing rotation against translation.
     #[getter] fn length(&self) -> f64 { self.inner.length }
+    /// Mass of the object [kg].
     #[getter] fn mass(&self) -> f64 { self.inner.mass }
+    /// Inertia about the centre of mass, object frame [kg·m²], shape (3, 3).
     #[getter] fn inertia<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> { matrix(py, &self.inner.inertia) }
+    /// (start, goal, tolerance): poses `[x, y, z, qw, qx, qy, qz]` (m, unit quaternion) and the
+    /// tolerance `[x, y, z, angle]` (m, m, m, rad).
     #[getter]
     fn task(&self) -> ([f64; 7], [f64; 7], [f64; 4]) {
         (to_array(&self.inner.start), to_array(&self.inner.goal), self.inner.tolerance)
     }
+    /// Centre of mass in the object frame [m].
     #[getter] fn com(&self) -> [f64; 3] { self.inner.com.into() }
+    /// Grip force per finger [N].
     #[getter] fn grip_force(&self) -> f64 { self.inner.grip_force }
+    /// Friction coefficient of the finger pads.
     #[getter] fn grip_friction(&self) -> f64 { self.inner.grip_friction }
+    /// Gravity vector in the gripper frame [m/s²].
     #[getter] fn gravity(&self) -> [f64; 3] { self.inner.gravity.into() }
     /// Pusher `name` brought against the object at `pose` (default: the task's start): (contact
     /// points and normal in the object frame, friction). A rigid pusher's points do not depend
@@ -89,7 +100,8 @@ impl Scene3D {
         })
     }
 
-    /// Whether each step of a path (poses, pusher names) can be taken by its pusher (inverse
+    /// Whether each step of a path (poses (m, unit quaternion), pusher names, optional pusher
+    /// `twists` (m/s, rad/s)) can be taken by its pusher (inverse
     /// dynamics at 8 poses along it, pads on the object).
     #[pyo3(signature = (poses, pushers, twists=None))]
     fn validate_path(&self, py: Python<'_>, poses: &Arg<'_>, pushers: &Arg<'_>, twists: Option<&Arg<'_>>) -> PyResult<Vec<bool>> {
@@ -106,6 +118,7 @@ impl Scene3D {
         })
     }
 
+    /// Radius of the finger pads [m].
     #[getter] fn pad_radius(&self) -> f64 { self.inner.pad_radius }
 
     /// Vertices (n, 3) and triangles (m, 3) of the object's mesh.
@@ -113,7 +126,8 @@ impl Scene3D {
         let m = &self.inner.mesh;
         (rows_array(py, m.vertices.iter().map(|&v| v.into()).collect()), rows_array(py, m.triangles.iter().map(|t| t.map(|i| i as u32)).collect()))
     }
-    /// Contact points (object frame) of the two finger pads at `pose`.
+    /// Contact points (object frame, m) of the two finger pads at `pose` `[x, y, z, qw, qx, qy, qz]`
+    /// (m, unit quaternion).
     fn pad_contacts(&self, pose: &Arg<'_>) -> PyResult<Vec<Vec<[f64; 3]>>> {
         guard(move || {
             let pads = self.inner.pad_contacts(&pose7("pose", pose)?);
@@ -129,7 +143,8 @@ impl Scene3D {
             dynamics::spatial_problem(&self.inner, pose, pusher, h)
         })
     }
-    /// Time stepping of one push (pusher body twist [v, ω] constant, object frame at t = 0).
+    /// Time stepping of one push from `pose` (m, unit quaternion): pusher body `twist` `[v, ω]`
+    /// (m/s, rad/s) constant (object frame at t = 0) for `duration` [s] in steps of `dt` [s].
     fn simulate_push<'py>(
         &self,
         py: Python<'py>,
