@@ -185,8 +185,8 @@ class Plan:
         out = []
         for i, (q, name) in enumerate(zip(self.poses, self.pushers)):
             k = {"pose": [float(x) for x in q], "pusher": name}
-            if self.dimension == 3 and self.pusher_twists[i] is not None:
-                k["pusher_twist"] = [float(x) for x in self.pusher_twists[i]]
+            if self.dimension == 3 and self.pusher_twists[i] is not None:  # type: ignore[index]
+                k["pusher_twist"] = [float(x) for x in self.pusher_twists[i]]  # type: ignore[index]
             out.append(k)
         return out
 
@@ -267,7 +267,7 @@ class Plan:
             if k not in scene.pusher_names:
                 raise ArgumentError(f"invalid `{name}.path[{i}].pusher`: no pusher {k!r} in the scene",
                                     f"{name}.path[{i}].pusher")
-            if self.dimension == 3 and self.pusher_twists[i] is None and scene._core.is_plane(k):
+            if self.dimension == 3 and self.pusher_twists[i] is None and scene._core.is_plane(k):  # type: ignore[index]
                 raise ArgumentError(f"invalid `{name}.path[{i}].pusher_twist`: a step of plane {k!r} needs its pusher "
                                     "twist (a plane only rolls the object)", f"{name}.path[{i}].pusher_twist")
 

@@ -202,12 +202,12 @@ class MotionCone:
     hold_ratio = core_property("hold_ratio", "Share of the pads' friction that gravity alone uses (< 1 holds).")
     is_line_pusher = core_property("line", "A line pusher (two rigidly connected points) rather than a point pusher.")
 
-    def contains(self, twist):
+    def contains(self, twist: ArrayLike | Sequence[Sequence[float]]) -> bool | np.ndarray:
         """Exact test of one twist ``[vx, vz, omega]`` (m/s, m/s, rad/s) (a bool) or of each row of an
         (n, 3) array (a bool array): can the pusher produce it while sticking?"""
         return self._core.contains(_vec_or_rows(twist, "twist"))
 
-    def margin(self, twist):
+    def margin(self, twist: ArrayLike | Sequence[Sequence[float]]) -> float | np.ndarray:
         """Signed margin of a twist ``[vx, vz, omega]`` (m/s, m/s, rad/s) in the exact cone: a float
         for one twist, an array for an (n, 3) array (>= 0 inside)."""
         return self._core.margin(_vec_or_rows(twist, "twist"))
@@ -224,7 +224,7 @@ class MotionCone:
             support_wrench=np.array(d["support_wrench"]),
         )
 
-    def project(self, twist):
+    def project(self, twist: ArrayLike | Sequence[Sequence[float]]) -> np.ndarray:
         """Closest feasible twist (exact cone) to one twist ``[vx, vz, omega]`` (m/s, m/s, rad/s) or
         to each row of an (n, 3) array, in the metric of :meth:`Scene.metric_twist`."""
         return self._core.project(_vec_or_rows(twist, "twist"))
@@ -234,7 +234,7 @@ class MotionCone:
         least squares)."""
         return self._core.project_polyhedral(list(_vec(twist, 3, "twist")), "approx")
 
-    def contains_polyhedral(self, twist):
+    def contains_polyhedral(self, twist: ArrayLike | Sequence[Sequence[float]]) -> bool | np.ndarray:
         """Membership in the polyhedral approximation of one twist (m/s, m/s, rad/s), or of each row of
         an (n, 3) array."""
         return self._core.contains_polyhedral(_vec_or_rows(twist, "twist"))
@@ -478,7 +478,7 @@ class Scene:
     def _view(self, core, op: str, **kw) -> "Scene":
         """A view of this scene (a new core) that remembers how it was taken, so it pickles."""
         s = Scene(core, self.path, self.source)
-        s._ops = tuple(getattr(self, "_ops", ())) + ((op, kw),)
+        s._ops = tuple(getattr(self, "_ops", ())) + ((op, kw),)  # type: ignore[attr-defined]
         return s
 
     mode = core_property("mode", 'Which motion cones this scene answers with: "nominal", "robust" or "fixtureless".')

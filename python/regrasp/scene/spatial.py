@@ -96,7 +96,7 @@ class Scene3D:
         ``path`` list) can be taken by its pusher (see ``regrasp::trrt3d::validate_path3``)."""
         p = as_plan({"path": path} if isinstance(path, list) else path, self, "path")
         tw = p.pusher_twists
-        tw = None if all(u is None for u in tw) else [[0.0] * 6 if u is None else u.tolist() for u in tw]
+        tw = None if all(u is None for u in tw) else [[0.0] * 6 if u is None else u.tolist() for u in tw]  # type: ignore[union-attr]
         return self._core.validate_path(p.poses.tolist(), p.pushers, tw)
 
     def replay(self, plan, dt: float = 0.25, feedback: bool = False, max_replans: int = 10, seed: int = 0) -> dict:
@@ -197,7 +197,7 @@ def quat_angle(a, b) -> float:
     """Angle [rad] of the rotation between unit quaternions a and b ([w, x, y, z])."""
     a, b = np.asarray(a, float), np.asarray(b, float)
     d = abs(float(a @ b) / (np.linalg.norm(a) * np.linalg.norm(b)))
-    return float(2 * np.arccos(min(1.0, d)))
+    return float(2 * np.arccos(min(1.0, d)))  # type: ignore[call-overload]
 
 
 def twist_between(a, b) -> list:
