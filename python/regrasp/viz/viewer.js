@@ -2,7 +2,8 @@
 // The regrasp browser view: draws the data of viz/view_data.py on a 2-D canvas (painter's
 // algorithm, flat shading) in the gripper frame: ground, jaws, object, pushers, axes, gravity.
 const D = JSON.parse(document.getElementById("data").textContent);
-const cv = document.getElementById("c"), ctx = cv.getContext("2d");
+const SELFTEST = typeof location !== "undefined" && location.hash === "#selftest";  // tests read the canvas back
+const cv = document.getElementById("c"), ctx = cv.getContext("2d", { willReadFrequently: SELFTEST });
 const slider = document.getElementById("t"), info = document.getElementById("info");
 const speedBox = document.getElementById("speed"), playBtn = document.getElementById("play");
 let yaw = D.dimension === 2 ? 0.35 : 0.6, pitch = D.dimension === 2 ? 0.25 : 0.35, zoom = 1.0;
@@ -39,7 +40,7 @@ const towardsCamera = n => { const ny = -Math.sin(yaw)*n[0] + Math.cos(yaw)*n[1]
 const shadeOf = n => Math.max(0.15, dot(n, [0.3, -0.5, 0.8]) / (Math.hypot(...n) || 1));
 const rgb = (c, sh, a) => `rgba(${c.map(x => Math.round(x * (0.45 + 0.55*sh))).join(",")},${a})`;
 const COLOURS = { object: [150, 190, 240], painted: [250, 180, 70], jaw: [110, 110, 120], active: [230, 40, 40],
-                  feature: [170, 170, 170] };
+                  feature: [175, 150, 205] };
 function mesh(out, world, tris, colour, alpha, kind) {  // front faces of a closed mesh, for depth sorting
   for (const [i, t] of tris.entries()) {
     const a = world[t[0]], b = world[t[1]], c = world[t[2]], n = cross(sub(b, a), sub(c, a));
@@ -175,12 +176,15 @@ function tick() {  // about 0.7 s a step at speed 1
   slider.value = (Number(slider.value) + per) % 1001; draw(); requestAnimationFrame(tick);
 }
 if (!D.jaws) for (const el of document.querySelectorAll ? document.querySelectorAll(".jaws") : []) el.style.display = "none";
+const at = typeof location !== "undefined" && /^#t=([0-9.]+)$/.exec(location.hash);  // a link to a point along the plan
+if (at) slider.value = Math.min(1000, 1000 * Number(at[1]));
 fit();
 window.regraspViewer = { draw, poseAt, probes, drawn: () => drawn, drawnAll: () => drawnAll, jawGap: () => jawGap,
                          setT: v => { slider.value = v; draw(); } };
-if (typeof location !== "undefined" && location.hash === "#selftest") {  // for tests in a headless browser: walk the plan, report
+if (SELFTEST) {  // for tests in a headless browser: walk the plan, report
   const inkOf = () => { const px = ctx.getImageData(0, 0, cv.width, cv.height).data;
     let ink = 0; for (let i = 3; i < px.length; i += 4) if (px[i] > 0) ink++; return ink; };
+  fit();  // the layout as it is now (the window may have changed since the script started)
   const frames = [];
   for (const t of [0, 250, 500, 750, 1000]) {
     slider.value = t; layer = "object"; draw(); const ink = inkOf();  // the object (and pads) alone
@@ -194,7 +198,7 @@ if (typeof location !== "undefined" && location.hash === "#selftest") {  // for 
   const pixel = p => Array.from(ctx.getImageData(Math.round(p[0]*r), Math.round(p[1]*r), 1, 1).data);
   const out = document.createElement("pre"); out.id = "selftest";
   out.textContent = JSON.stringify({ triangles: D.triangles.length, frames, css: [W, H], pixels: [cv.width, cv.height],
-    offset: [rect.left, rect.top], dpr: r, probes: P,
+    offset: [rect.left, rect.top], viewport: [window.innerWidth, window.innerHeight], dpr: r, probes: P,
     probe_pixels: Object.fromEntries(Object.entries(P).map(([k, v]) => [k, v.map(pixel)])) });
   document.body.appendChild(out);
 }

@@ -47,7 +47,7 @@ body{font-family:system-ui,sans-serif;background:#fff;display:flex;flex-directio
 <div id="legend"><b>gripper frame</b> (drag: orbit, wheel: zoom)<br>
 <i style="background:#9ebff0"></i>object<br><i style="border:1px dashed #148c3c"></i>goal<br>
 <span class="jaws"><i style="background:#6e6e78"></i>jaws, <i style="background:#323232"></i>pads<br></span>
-<i style="background:#e62828"></i>pusher in contact<br><i style="background:#bbb"></i>other pushers<br>
+<i style="background:#e62828"></i>pusher in contact<br><i style="background:#cdbbe6"></i>other pushers<br>
 <i style="background:#cdb996"></i>__GROUND__<br>
 <span style="color:#d62728">x</span> <span style="color:#2ca02c">y</span> <span style="color:#1f5fd6">z</span> axes,
 <span style="color:#7b2fbf">g</span> gravity</div></div>
