@@ -11,10 +11,12 @@ import subprocess
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import regrasp
 from regrasp import Plan, Scene, Scene3D
-from regrasp.viz.view_data import FEATURE_DEPTH, _world, extrude, planar_pose
+from regrasp.viz.view_data import FEATURE_DEPTH, _world, ear_clip, extrude, planar_pose
 from regrasp.viz.viewer import description, page, write_html
 
 from .conftest import EXAMPLES, ROOT
@@ -134,6 +136,19 @@ def test_extrusion_of_a_non_convex_outline_is_closed_and_outward():
     volume = np.einsum("ij,ij->i", v[t[:, 0]], n).sum() / 6
     area = 0.5 * abs(np.sum(outline[:, 0] * np.roll(outline[:, 1], -1) - np.roll(outline[:, 0], -1) * outline[:, 1]))
     assert volume == pytest.approx(area * 0.01)  # positive: the normals point out
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(0.2, 1.0), min_size=3, max_size=12), st.floats(0, 6.28))
+def test_ear_clipping_tiles_star_shaped_polygons(radii, turn):
+    a = turn + 2 * np.pi * np.arange(len(radii)) / len(radii)
+    p = np.stack([np.cos(a), np.sin(a)], axis=1) * np.asarray(radii)[:, None]
+    t = np.asarray(ear_clip(p))
+    assert len(t) == len(p) - 2
+    e1, e2 = p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]]
+    areas = (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) / 2
+    polygon = 0.5 * np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
+    assert np.all(areas >= -1e-12) and areas.sum() == pytest.approx(polygon)  # counter-clockwise, no overlap
 
 
 def test_pages_are_small_and_refuse_a_wrong_scene(pivot, tshape, tmp_path):

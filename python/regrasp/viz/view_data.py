@@ -42,7 +42,7 @@ def extrude(outline, thickness: float):
     for i in range(n):
         j = (i + 1) % n
         tris += [[i, n + i, j], [j, n + i, n + j]]
-    return v, _outward(v, tris, v.mean(axis=0), convex=False)
+    return v, [list(map(int, x)) for x in tris]
 
 
 def _area(p) -> float:
@@ -76,11 +76,9 @@ def ear_clip(p) -> list:
     return out + [idx]
 
 
-def _outward(v, tris, centre, convex: bool = True) -> list:
-    """Triangles turned so their normals (right-hand rule) point away from ``centre`` (exact for
-    a convex body; for a prism's walls and caps, ``convex=False`` keeps the given order)."""
-    if not convex:
-        return [list(map(int, t)) for t in tris]
+def _outward(v, tris, centre) -> list:
+    """Triangles of a convex body turned so their normals (right-hand rule) point away from
+    ``centre``."""
     out = []
     for t in tris:
         a, b, c = v[t[0]], v[t[1]], v[t[2]]
