@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import numbers
+import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional
@@ -36,6 +37,9 @@ SUMMARY_TYPES = {
     "iterations": "int", "switch_overs": "int", "cost": "float", "goal_distance": "float", "propagation": "str",
     "seed": "int", "solves": "int", "step_margins": "float[]", "valid": "bool",
 }
+#: the scene object of each plan made by :func:`plan` (for its display), outside the plan's
+#: state: its file, equality and copies are unchanged
+_SCENES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 #: smallest step margin that counts as sticking (``valid``)
 MARGIN_TOL = 1e-9
 
@@ -176,6 +180,13 @@ class Plan:
     def __repr__(self) -> str:
         return (f"Plan(dimension={self.dimension}, scene={self.scene!r}, found={self.found}, "
                 f"steps={len(self.poses) - 1}, switch_overs={self.switch_overs}, valid={self.valid})")
+
+    def _repr_html_(self) -> str:
+        """Jupyter's display: the browser view of the plan when it knows its scene (a plan made
+        by :func:`plan`), else its summary (found, stop reason, steps, switch-overs, time)."""
+        from ..viz.viewer import plan_html
+
+        return plan_html(self, _SCENES.get(self))
 
     # -- views ---------------------------------------------------------------------------------
 
@@ -364,4 +375,5 @@ def plan(scene, start=None, goal=None, **settings) -> Plan:
     p = Plan.from_json(r)
     p.scene_file = scene.path
     p.check(scene)
+    _SCENES[p] = scene
     return p

@@ -410,6 +410,12 @@ class Scene:
     def __repr__(self) -> str:
         return f"Scene({self.name!r}, kind={self.kind}, pushers={self.pusher_names})"
 
+    def _repr_html_(self) -> str:
+        """Jupyter's display: the browser view of the scene at its start, the goal dashed."""
+        from ..viz.viewer import notebook_html
+
+        return notebook_html(self)
+
     name = core_property("name", "The scene's name.")
     kind = core_property("kind", '"grasp" (object between finger pads) or "surface" (object on a plane).')
     pusher_names = core_property("pusher_names", "Names of the pushers, in file order (list of str).")

@@ -46,6 +46,12 @@ class Scene3D:
     def __repr__(self) -> str:
         return f"Scene3D({self.name!r}, pushers={self.pusher_names})"
 
+    def _repr_html_(self) -> str:
+        """Jupyter's display: the browser view of the scene at its start, the goal dashed."""
+        from ..viz.viewer import notebook_html
+
+        return notebook_html(self)
+
     name = core_property("name", "The scene's name.")
     pusher_names = core_property("pusher_names", "Names of the pushers, in file order (list of str).")
     notes = core_property("notes", "What the loader changed in the file's values: measured pusher points moved onto "

@@ -1,149 +1,59 @@
-"""An interactive 3-D view of a 3-D plan in the browser: one self-contained HTML page (no
-network, no libraries) with the object, the finger pads and the active pusher's contacts, drawn
-on a canvas with flat shading; drag to orbit, wheel to zoom, a slider and a play button to move
-along the plan (poses interpolated by slerp between knots)."""
+"""The browser view of a scene or a plan: one self-contained HTML page (inline script, no
+network, no libraries) drawn on a canvas that fills the window (or a notebook's frame) and
+follows its size, at the screen's pixel density. In the gripper frame (the planner's view): the
+ground under the object (perpendicular to gravity, or the scene's support), both jaws of the
+parallel gripper (fingers, pads, palm) at the grasp's width, the object at the plan's poses
+(slerp between knots; play/pause, step slider, speed), the pushers as small bodies on the object
+(the one in contact red, its contact points marked), the gripper's axes (x red, y green, z blue),
+gravity (g) and the goal (dashed). Drag to orbit, wheel to zoom. Planar scenes are shown as
+their outline extruded across the jaw direction (see :mod:`regrasp.viz.view_data`)."""
 
 from __future__ import annotations
 
+import html
 import json
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import ArgumentError
 from ..files import write_text
 from ..planning.plan import as_plan
+from .view_data import planar_description, spatial_description
+
+SCRIPT = Path(__file__).with_name("viewer.js")
 
 PAGE = r"""<!doctype html>
-<html><head><meta charset="utf-8"><title>regrasp: __TITLE__</title>
+<html><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
+<title>regrasp: __TITLE__</title>
 <style>
-body{font-family:system-ui,sans-serif;margin:0;background:#f4f4f4}
-#bar{padding:8px;display:flex;gap:10px;align-items:center}
-canvas{background:#fff;display:block;margin:0 8px;border:1px solid #ccc}
+html,body{height:100%;margin:0}
+body{font-family:system-ui,sans-serif;background:#fff;display:flex;flex-direction:column;overflow:hidden}
+#bar{padding:6px 8px;display:flex;gap:10px;align-items:center;flex-wrap:wrap;background:#f4f4f4;border-bottom:1px solid #ddd}
+#t{flex:1;min-width:120px}
 #info{font-size:13px;color:#333}
+#wrap{position:relative;flex:1;min-height:200px}
+#c{position:absolute;left:0;top:0;width:100%;height:100%;display:block;cursor:grab}
+#legend{position:absolute;right:8px;top:8px;font-size:12px;background:rgba(255,255,255,0.85);padding:4px 8px;
+ border:1px solid #ddd;line-height:1.5;pointer-events:none}
+#legend i{display:inline-block;width:12px;height:10px;margin-right:5px;vertical-align:middle}
+#selftest{display:none}
 </style></head><body>
-<div id="bar"><button id="play">play</button><input id="t" type="range" min="0" max="1000" value="0" style="width:50%">
+<div id="bar"><button id="play">play</button>
+<input id="t" type="range" min="0" max="1000" value="0" step="any" list="knots" title="along the plan"><datalist id="knots">__KNOTS__</datalist>
+<label>speed <select id="speed"><option>0.25</option><option>0.5</option><option selected>1</option><option>2</option><option>4</option></select></label>
 <span id="info"></span></div>
-<canvas id="c" width="900" height="620"></canvas>
+<div id="wrap"><canvas id="c" width="900" height="620"></canvas>
+<div id="legend"><b>gripper frame</b> (drag: orbit, wheel: zoom)<br>
+<i style="background:#9ebff0"></i>object<br><i style="border:1px dashed #148c3c"></i>goal<br>
+<span class="jaws"><i style="background:#6e6e78"></i>jaws, <i style="background:#323232"></i>pads<br></span>
+<i style="background:#e62828"></i>pusher in contact<br><i style="background:#cdbbe6"></i>other pushers<br>
+<i style="background:#cdb996"></i>__GROUND__<br>
+<span style="color:#d62728">x</span> <span style="color:#2ca02c">y</span> <span style="color:#1f5fd6">z</span> axes,
+<span style="color:#7b2fbf">g</span> gravity</div></div>
 <script id="data" type="application/json">__DATA__</script>
 <script>
-"use strict";
-const D = JSON.parse(document.getElementById("data").textContent);
-const cv = document.getElementById("c"), ctx = cv.getContext("2d");
-const slider = document.getElementById("t"), info = document.getElementById("info");
-let yaw = 0.6, pitch = 0.35, zoom = 1.0, playing = false, drawn = 0;
-function qmul(a, b) { return [a[0]*b[0]-a[1]*b[1]-a[2]*b[2]-a[3]*b[3], a[0]*b[1]+a[1]*b[0]+a[2]*b[3]-a[3]*b[2],
-  a[0]*b[2]-a[1]*b[3]+a[2]*b[0]+a[3]*b[1], a[0]*b[3]+a[1]*b[2]-a[2]*b[1]+a[3]*b[0]]; }
-function qrot(q, v) { const p = qmul(qmul(q, [0, v[0], v[1], v[2]]), [q[0], -q[1], -q[2], -q[3]]); return [p[1], p[2], p[3]]; }
-function slerp(a, b, t) {
-  let d = a[0]*b[0]+a[1]*b[1]+a[2]*b[2]+a[3]*b[3]; if (d < 0) { b = b.map(x => -x); d = -d; }
-  if (d > 0.9995) { const r = a.map((x, i) => x + t*(b[i]-x)); const n = Math.hypot(...r); return r.map(x => x/n); }
-  const th = Math.acos(d), s = Math.sin(th);
-  return a.map((x, i) => (Math.sin((1-t)*th)*x + Math.sin(t*th)*b[i]) / s);
-}
-function poseAt(u) {  // u in [0, 1] along the plan
-  const n = D.poses.length - 1; if (n <= 0) return [D.poses[0], 0];
-  const f = Math.min(u * n, n - 1e-9), k = Math.floor(f), t = f - k, a = D.poses[k], b = D.poses[k+1];
-  const p = [0,1,2].map(i => a[i] + t*(b[i]-a[i]));
-  return [p.concat(slerp(a.slice(3), b.slice(3), t)), k + 1];
-}
-function view(v) {  // gripper frame -> camera (orbit), then perspective
-  const cy = Math.cos(yaw), sy = Math.sin(yaw), cp = Math.cos(pitch), sp = Math.sin(pitch);
-  let x = cy*v[0] + sy*v[1], y = -sy*v[0] + cy*v[1], z = v[2];
-  const y2 = cp*y - sp*z, z2 = sp*y + cp*z;
-  const dist = 4 * D.size, s = 0.3 * cv.height * zoom * dist / (dist + y2) / D.size;
-  return [cv.width/2 + x*s, cv.height/2 - z2*s, y2];
-}
-function draw() {
-  const u = slider.value / 1000, [q, step] = poseAt(u);
-  const pos = q.slice(0, 3), rot = q.slice(3);
-  const world = D.vertices.map(v => { const r = qrot(rot, v); return [r[0]+pos[0], r[1]+pos[1], r[2]+pos[2]]; });
-  const tris = [];
-  const light = [0.3, -0.5, 0.8];
-  for (const [i, t] of D.triangles.entries()) {
-    const a = world[t[0]], b = world[t[1]], c = world[t[2]];
-    const e1 = [b[0]-a[0], b[1]-a[1], b[2]-a[2]], e2 = [c[0]-a[0], c[1]-a[1], c[2]-a[2]];
-    const n = [e1[1]*e2[2]-e1[2]*e2[1], e1[2]*e2[0]-e1[0]*e2[2], e1[0]*e2[1]-e1[1]*e2[0]];
-    const nn = Math.hypot(...n) || 1, sh = Math.max(0.15, (n[0]*light[0]+n[1]*light[1]+n[2]*light[2]) / nn);
-    // a convex object: only the faces turned towards the camera (depth axis y2, camera at -y2)
-    const cy = Math.cos(yaw), sy = Math.sin(yaw), ny = -sy*n[0] + cy*n[1];
-    if (Math.cos(pitch)*ny - Math.sin(pitch)*n[2] > 0) continue;
-    const P = [a, b, c].map(view);
-    const col = D.marks[i] ? `rgb(${Math.round(140+110*sh)},${Math.round(90+90*sh)},${Math.round(30+40*sh)})`
-                           : `rgb(${Math.round(90+120*sh)},${Math.round(110+110*sh)},${Math.round(140+100*sh)})`;
-    tris.push([P, (P[0][2]+P[1][2]+P[2][2]) / 3, col]);
-  }
-  // the pads: discs at the gripper's +-Y extremes of the object
-  const pads = [];
-  for (const sgn of [1, -1]) {
-    let top = -1e9; for (const w of world) top = Math.max(top, sgn*w[1]);
-    const ring = []; for (let k = 0; k < 24; k++) { const a = 2*Math.PI*k/24; ring.push(view([D.pad*Math.cos(a), sgn*top, D.pad*Math.sin(a)])); }
-    // a pad on the object's near side is drawn over it, one on the far side is hidden by it
-    const facing = Math.cos(pitch)*(Math.cos(yaw)*sgn) < 0;
-    pads.push([ring, facing]);
-  }
-  tris.sort((x, y) => y[1] - x[1]);
-  ctx.clearRect(0, 0, cv.width, cv.height);
-  drawn = 0;
-  const poly = (pts, fill, stroke) => {
-    ctx.beginPath(); ctx.moveTo(pts[0][0], pts[0][1]); for (const p of pts.slice(1)) ctx.lineTo(p[0], p[1]);
-    ctx.closePath(); ctx.fillStyle = fill; ctx.fill(); ctx.strokeStyle = stroke; ctx.stroke(); drawn++;
-  };
-  for (const [ring, facing] of pads) if (!facing) poly(ring, "rgba(60,60,60,0.55)", "rgba(0,0,0,0.3)");
-  for (const t of tris) poly(t[0], t[2], t[2]);
-  for (const [ring, facing] of pads) if (facing) poly(ring, "rgba(60,60,60,0.55)", "rgba(0,0,0,0.3)");
-  // the pusher of the current step: its contact points, moving with the object
-  const name = D.pushers_of_steps[Math.min(step, D.pushers_of_steps.length - 1)];
-  // (a plane touches the object where it is lowest along its normal, given in the gripper frame)
-  let contacts = [];
-  if (name && D.planes[name]) {
-    const n = D.planes[name], dot = p => p[0]*n[0] + p[1]*n[1] + p[2]*n[2];
-    if (D.sphere) contacts = [[pos[0] - D.sphere*n[0], pos[1] - D.sphere*n[1], pos[2] - D.sphere*n[2]]];
-    else { const lo = Math.min(...world.map(dot)); contacts = world.filter(p => dot(p) < lo + 1e-6*D.size); }
-    // the plane itself: a square around the contact
-    const c = contacts[0], a = Math.abs(n[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0];
-    let t1 = [n[1]*a[2]-n[2]*a[1], n[2]*a[0]-n[0]*a[2], n[0]*a[1]-n[1]*a[0]];
-    const l = Math.hypot(...t1); t1 = t1.map(x => x / l);
-    const t2 = [n[1]*t1[2]-n[2]*t1[1], n[2]*t1[0]-n[0]*t1[2], n[0]*t1[1]-n[1]*t1[0]], h = 1.3 * D.size;
-    const sq = [[1, 1], [-1, 1], [-1, -1], [1, -1]].map(([i, j]) => view([0, 1, 2].map(k => c[k] + h*(i*t1[k] + j*t2[k]))));
-    poly(sq, "rgba(214,39,40,0.12)", "rgba(214,39,40,0.5)");
-  } else if (name && D.pusher_points[name]) {
-    contacts = D.pusher_points[name].map(pnt => { const r = qrot(rot, pnt); return [r[0]+pos[0], r[1]+pos[1], r[2]+pos[2]]; });
-  }
-  ctx.fillStyle = "#d62728";
-  for (const pnt of contacts) {
-    const P = view(pnt);
-    ctx.beginPath(); ctx.arc(P[0], P[1], 5, 0, 2*Math.PI); ctx.fill();
-  }
-  info.textContent = `${D.name}: step ${step} of ${D.poses.length - 1}` + (name ? `, pusher ${name}` : "") +
-    ` — position [${pos.map(x => (1000*x).toFixed(1)).join(", ")}] mm`;
-}
-let drag = null;
-cv.addEventListener("mousedown", e => { drag = [e.clientX, e.clientY]; });
-window.addEventListener("mouseup", () => { drag = null; });
-window.addEventListener("mousemove", e => { if (!drag) return; yaw += (e.clientX - drag[0]) * 0.01;
-  pitch = Math.max(-1.5, Math.min(1.5, pitch + (e.clientY - drag[1]) * 0.01)); drag = [e.clientX, e.clientY]; draw(); });
-cv.addEventListener("wheel", e => { e.preventDefault(); zoom *= e.deltaY < 0 ? 1.1 : 1/1.1; draw(); });
-slider.addEventListener("input", draw);
-document.getElementById("play").addEventListener("click", () => { playing = !playing; if (playing) tick(); });
-function tick() { if (!playing) return; slider.value = (Number(slider.value) + 5) % 1001; draw(); requestAnimationFrame(tick); }
-draw();
-window.regraspViewer = { draw, poseAt, drawn: () => drawn, setT: v => { slider.value = v; draw(); } };
-if (typeof location !== "undefined" && location.hash === "#selftest") {  // for tests in a headless browser: walk the plan, report
-  const frames = [];
-  for (const t of [0, 250, 500, 750, 1000]) {
-    slider.value = t; draw();
-    const [q] = poseAt(t / 1000);
-    const px = ctx.getImageData(0, 0, cv.width, cv.height).data;
-    let ink = 0; for (let i = 3; i < px.length; i += 4) if (px[i] > 0) ink++;
-    frames.push({ t, drawn, ink, pose: q, info: info.textContent });
-  }
-  yaw += 1.0; draw(); yaw -= 1.0;
-  const out = document.createElement("pre"); out.id = "selftest";
-  out.textContent = JSON.stringify({ triangles: D.triangles.length, frames });
-  document.body.appendChild(out);
-  slider.value = 500; draw();
-}
-</script></body></html>
+__SCRIPT__</script></body></html>
 """
 
 
@@ -157,36 +67,56 @@ def marks(scene) -> np.ndarray:
     return (np.prod(np.sign(c + 1e-12), axis=1) > 0).astype(int)
 
 
-def page(scene, plan) -> str:
-    """The HTML page of ``plan`` (a 3-D :class:`~regrasp.Plan` or plan dict) for ``scene`` (a Scene3D)."""
-    plan = as_plan(plan, scene)
-    v, t = scene.mesh()
-    v = np.asarray(v, float)
-    size = float(np.linalg.norm(v, axis=1).max())
-    data = {
-        "name": scene.name,
-        "vertices": v.tolist(),
-        "triangles": np.asarray(t, int).tolist(),
-        "poses": plan.poses.tolist(),
-        "pushers_of_steps": plan.pushers,
-        "pusher_points": {n: np.asarray(scene._core.pusher_points(n), float).tolist() for n in scene.pusher_names},
-        # plane pushers: their normals (gripper frame); the page finds where they touch
-        "planes": {n: np.asarray(scene._core.pusher_normal(n), float).tolist() for n in scene.pusher_names
-                   if scene._core.is_plane(n)},
-        "sphere": scene._core.sphere,
-        "marks": marks(scene).tolist(),
-        "pad": float(scene._core.pad_radius),
-        "size": size,
-    }
-    text = json.dumps(data).replace("</", "<\\/")
-    import html
+def description(scene, plan=None) -> dict:
+    """What the page draws (see :mod:`regrasp.viz.view_data`), for ``scene`` (a planar
+    :class:`~regrasp.Scene` or a :class:`~regrasp.Scene3D`) and ``plan`` (a :class:`~regrasp.Plan`
+    or plan dict for that scene; None: the scene alone, at its start, with its goal)."""
+    if getattr(scene, "dimension", None) not in (2, 3) or not hasattr(scene, "_core"):
+        raise ArgumentError(f"invalid `scene`: a regrasp Scene or Scene3D (got {type(scene).__name__})", "scene")
+    p = None if plan is None else as_plan(plan, scene)
+    poses, pushers = (None, None) if p is None else (p.poses, p.pushers)
+    if scene.dimension == 2:
+        d = planar_description(scene, poses, pushers)
+    else:
+        d = spatial_description(scene, poses, pushers, marks(scene))
+    d["name"] = scene.name
+    return d
 
-    return PAGE.replace("__TITLE__", html.escape(scene.name)).replace("__DATA__", text)
+
+def page(scene, plan=None) -> str:
+    """The HTML page (a str) of ``plan`` for ``scene``, or of the scene alone (``plan=None``)."""
+    d = description(scene, plan)
+    n = len(d["poses"]) - 1
+    knots = "".join(f'<option value="{1000 * k / n:.3f}"></option>' for k in range(n + 1)) if n > 0 else ""
+    ground = "ground" if d["ground"]["support"] is None else f"support ({html.escape(d['ground']['support'])})"
+    text = json.dumps(d, allow_nan=False).replace("</", "<\\/")
+    return (PAGE.replace("__TITLE__", html.escape(scene.name)).replace("__KNOTS__", knots)
+            .replace("__GROUND__", ground).replace("__SCRIPT__", SCRIPT.read_text()).replace("__DATA__", text))
 
 
 def write_html(scene, plan, path) -> Path:
-    """Writes the view of ``plan`` in ``scene`` as one self-contained HTML page at ``path``
+    """Writes :func:`page` of ``scene`` and ``plan`` (None: the scene alone) to ``path``
     (atomically); returns the path."""
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     return write_text(p, page(scene, plan))
+
+
+def notebook_html(scene, plan=None, height: int = 480) -> str:
+    """The page in an ``<iframe srcdoc>`` of ``height`` [px] filling the cell's width: what
+    ``_repr_html_`` of scenes and plans shows in Jupyter (its script runs in the frame)."""
+    return (f'<iframe srcdoc="{html.escape(page(scene, plan), quote=True)}" style="width:100%;height:{int(height)}px;'
+            f'border:1px solid #ddd" sandbox="allow-scripts"></iframe>')
+
+
+def plan_html(plan, scene=None) -> str:
+    """A plan's display in Jupyter: its browser view with ``scene``, else its summary table."""
+    if scene is not None:
+        return notebook_html(scene, plan)
+    rows = [("scene", plan.scene), ("found", plan.found), ("stop reason", plan.stop_reason),
+            ("steps", len(plan.poses) - 1), ("switch-overs", plan.switch_overs),
+            ("planning time [s]", None if plan.planning_time_s is None else f"{plan.planning_time_s:.3g}"),
+            ("valid", plan.valid)]
+    body = "".join(f"<tr><th style='text-align:left'>{k}</th><td>{html.escape(str(v))}</td></tr>"
+                   for k, v in rows if v is not None)
+    return f"<table><caption>regrasp plan ({plan.dimension}-D)</caption>{body}</table>"
