@@ -9,8 +9,8 @@ import numpy as np
 from ..errors import ArgumentError
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
-from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, VIDEO_SUFFIXES, add_scale_options,
-               add_verbose, check_count, check_number, check_outputs, check_positive, execute3d, floats, given, load,
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, PUSHER_HELP, VIDEO_SUFFIXES,
+               add_command, add_scale_options, add_verbose, check_pusher, check_count, check_number, check_outputs, check_positive, execute3d, floats, given, load,
                load_planar, reject_flags, scales, seed_arg)
 
 
@@ -142,6 +142,7 @@ def cmd_push(a) -> int:
     scene = load(a.scene, a)
     pose = floats(a.pose, POSE_SIZE[scene.dimension], "--pose")
     twist = floats(a.twist, 6 if scene.dimension == 3 else 3, "--twist")
+    check_pusher(scene, a.pusher)
     if scene.dimension == 3:
         tr = scene.simulate_push(pose, a.pusher, twist, a.duration, a.dt)
     else:
@@ -156,43 +157,47 @@ def cmd_push(a) -> int:
 
 
 def add_parsers(sub) -> None:
-    v = sub.add_parser("validate", help="motion-cone predictions against the simulators")
-    v.add_argument("scene")
+    v = add_command(sub, "validate", "motion-cone predictions against the simulators (planar scenes)",
+                    "regrasp validate examples/block-low-friction.toml --pushes 500 --engines quasistatic,mujoco",
+                    cmd_validate)
+    v.add_argument("scene", help="a planar scene file")
     v.add_argument("--pushes", type=int, default=2000, help=f"random pushes, 1 to {MAX_PUSHES}")
     v.add_argument("--engines", default="quasistatic", help="comma-separated: quasistatic,mujoco")
-    v.add_argument("--seed", type=seed_arg, default=0)
+    v.add_argument("--seed", type=seed_arg, default=0, help="random seed, a whole number >= 0")
     v.add_argument("--workers", type=int, help=f"local processes for MuJoCo, 1 to {MAX_WORKERS} (default: all cores)")
     v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
     v.add_argument("--support", default="points", choices=["points", "limit_surface"],
-                   help="quasi-static pads as point sets (default) or as the motion cones' limit surface")
-    v.add_argument("--json", action="store_true")
+                   help="quasi-static pads as point sets or as the motion cones' limit surface")
+    v.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(v)
-    v.set_defaults(fn=cmd_validate)
 
-    s = sub.add_parser("simulate", help="replay a plan in a simulator")
-    s.add_argument("scene")
-    s.add_argument("--plan", required=True)
-    s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"])
+    s = add_command(sub, "simulate", "replay a plan in a simulator (planar or 3-D)",
+                    "regrasp simulate examples/t-shape.toml --plan plan.json --engine mujoco --video replay.gif",
+                    cmd_simulate)
+    s.add_argument("scene", help="the scene file the plan is for")
+    s.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
+    s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"],
+                   help="our quasi-static simulator or MuJoCo")
     s.add_argument("--dt", type=float, help="quasi-static time step [s] (default 0.05 planar, 0.25 3-D)")
     add_scale_options(s, "MuJoCo: ")
     s.add_argument("--perturb", type=float,
-                   help="MuJoCo: also draw each factor uniformly in [1-P, 1+P] from --seed (default 0: none)")
-    s.add_argument("--seed", type=seed_arg, default=0)
-    s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo: an animation of the execution")
-    s.add_argument("--plot", metavar="PNG")
-    s.add_argument("--json", action="store_true")
+                   help="MuJoCo, planar: also draw each factor uniformly in [1-P, 1+P] from --seed (default 0: none)")
+    s.add_argument("--seed", type=seed_arg, default=0, help="random seed of --perturb")
+    s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo, planar: an animation of the execution")
+    s.add_argument("--plot", metavar="PNG", help="planar: planned against simulated poses")
+    s.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(s)
-    s.set_defaults(fn=cmd_simulate)
 
-    p = sub.add_parser("push", help="simulate one push and plot object motion and contact forces")
-    p.add_argument("scene")
+    p = add_command(sub, "push", "simulate one push in the quasi-static simulator (planar or 3-D)",
+                    "regrasp push examples/t-shape.toml --pose 0,0,0 --pusher top --twist 0,-0.01,0 --plot push.png",
+                    cmd_push)
+    p.add_argument("scene", help="the scene file")
     p.add_argument("--pose", required=True, help="x,z,theta (3-D scenes: x,y,z,qw,qx,qy,qz)")
-    p.add_argument("--pusher", required=True)
+    p.add_argument("--pusher", required=True, help=PUSHER_HELP)
     p.add_argument("--twist", required=True,
                    help="pusher body twist vx,vz,omega, object frame at the start (3-D: vx,vy,vz,wx,wy,wz)")
-    p.add_argument("--duration", type=float, default=1.0)
-    p.add_argument("--dt", type=float, default=0.02)
-    p.add_argument("--plot", metavar="PNG")
-    p.add_argument("--json", action="store_true")
+    p.add_argument("--duration", type=float, default=1.0, help="duration of the push [s]")
+    p.add_argument("--dt", type=float, default=0.02, help="time step [s], at most --duration")
+    p.add_argument("--plot", metavar="PNG", help="planar: object motion and contact forces")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(p)
-    p.set_defaults(fn=cmd_push)

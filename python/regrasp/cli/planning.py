@@ -9,7 +9,7 @@ from pathlib import Path
 from ..errors import ArgumentError
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan, plan
-from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_verbose, check_number, check_outputs, floats, load,
+from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_command, add_verbose, check_number, check_outputs, floats, load,
                mode_scene, planner_default, pusher_runs, reject_flags, seed_arg)
 
 #: the output options of `regrasp plan` and the file-name suffixes they take (None: any)
@@ -117,8 +117,10 @@ def cmd_plan(a) -> int:
 
 
 def add_parsers(sub) -> None:
-    pl = sub.add_parser("plan", help="plan a regrasp (T-RRT* with motion-cone propagation)")
-    pl.add_argument("scene")
+    pl = add_command(sub, "plan", "plan a regrasp (T-RRT* with motion-cone propagation; 3-D: inverse dynamics)",
+                     "regrasp plan examples/t-shape.toml --out plan.json --plot plan.png --animate plan.gif\n"
+                     "regrasp plan examples/pivot-3d.toml --html plan.html", cmd_plan)
+    pl.add_argument("scene", help="the scene file (planar or 3-D)")
     pl.add_argument("--out", metavar="PLAN.json",
                     help="write the plan file here (no plan found: the best partial plan, unless the file exists)")
     pl.add_argument("--partial-out", metavar="PLAN.json",
@@ -130,15 +132,15 @@ def add_parsers(sub) -> None:
                     help=f"planar only: how steps are made ({planner_default('propagation')})")
     pl.add_argument("--start", help="x,z,theta; 3-D: x,y,z,qw,qx,qy,qz (default: the scene's task)")
     pl.add_argument("--goal", help="x,z,theta; 3-D: x,y,z,qw,qx,qy,qz (default: the scene's task)")
-    pl.add_argument("--plot", metavar="PNG")
-    pl.add_argument("--animate", metavar="GIF")
-    pl.add_argument("--json", action="store_true")
+    pl.add_argument("--plot", metavar="PNG", help="draw the plan: object, pads and pushers at the poses "
+                    "(3-D: a 3-D figure of start, goal and intermediate poses)")
+    pl.add_argument("--animate", metavar="GIF", help="animate the plan (planar or 3-D)")
+    pl.add_argument("--json", action="store_true", help="print the plan (the plan file's object) instead of the summary")
     pl.add_argument("--robust", action="store_true",
-                    help="plan with robust motion cones for the scene's [uncertainty] (or --uncertainty)")
-    pl.add_argument("--uncertainty", metavar="P,F,N,M",
-                    help="relative spreads of pusher friction, finger friction, grip force, mass (implies --robust)")
-    pl.add_argument("--fixtureless", action="store_true",
-                    help="plan only with fixtureless-fixturing pushes (invariant to mass, grip force, finger friction)")
-    pl.add_argument("--html", metavar="HTML", help="3-D scenes: an interactive 3-D view of the plan (self-contained page)")
+                    help="planar only: plan with robust motion cones for the scene's [uncertainty] (or --uncertainty)")
+    pl.add_argument("--uncertainty", metavar="P,F,N,M", help="planar only: relative spreads of pusher friction, "
+                    "finger friction, grip force, mass, each in [0, 1) (implies --robust)")
+    pl.add_argument("--fixtureless", action="store_true", help="planar only: plan only with fixtureless-fixturing "
+                    "pushes (invariant to mass, grip force, finger friction)")
+    pl.add_argument("--html", metavar="HTML", help="an interactive view of the plan in the browser (self-contained page)")
     add_verbose(pl)
-    pl.set_defaults(fn=cmd_plan)
