@@ -7,14 +7,22 @@ A bar is shown only when stderr is a terminal and output is not quieted (``regra
 from __future__ import annotations
 
 import contextlib
+import os
 import sys
 import threading
 import time
 
 _quiet = False
 
-#: a bar of a task that ends sooner than this [s] is never drawn
+#: a bar of a task that ends sooner than this [s] is never drawn (environment: REGRASP_PROGRESS_DELAY)
 DELAY_S = 1.0
+
+
+def _delay() -> float:
+    try:
+        return max(float(os.environ.get("REGRASP_PROGRESS_DELAY", DELAY_S)), 0.0)
+    except ValueError:
+        return DELAY_S
 
 
 def set_quiet(quiet: bool) -> None:
@@ -36,6 +44,14 @@ def enabled() -> bool:
     return True
 
 
+def _columns() -> int:
+    """The width of the terminal on stderr (0 when it reports none)."""
+    try:
+        return os.get_terminal_size(sys.stderr.fileno()).columns
+    except (OSError, ValueError, AttributeError):
+        return 0
+
+
 class _Null:
     """A bar that draws nothing."""
 
@@ -50,7 +66,7 @@ class _Null:
 
 
 @contextlib.contextmanager
-def bar(total: float | None, desc: str, unit: str = "it", show: bool = True):
+def bar(total: float | None, desc: str, unit: str = "it", show: bool = True, bar_format: str | None = None):
     """A progress bar of ``total`` units (``update(n)`` advances it), closed on exit (also on an
     exception, so that a message follows a finished line); a bar that does nothing when bars are
     off or ``show`` is False."""
@@ -59,7 +75,10 @@ def bar(total: float | None, desc: str, unit: str = "it", show: bool = True):
         return
     from tqdm import tqdm
 
-    b = tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, delay=DELAY_S, leave=False, dynamic_ncols=True)
+    # a terminal that reports no size (a fresh pseudo-terminal) gets 80 columns, not an empty bar
+    sized = _columns() > 0
+    b = tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, delay=_delay(), leave=False, dynamic_ncols=sized,
+             ncols=None if sized else 80, nrows=None if sized else 24, bar_format=bar_format)
     try:
         yield b
     finally:
@@ -89,13 +108,14 @@ def elapsed(limit_s: float | None, desc: str, show: bool = True, period_s: float
         return
     total = limit_s if limit_s is not None and 0 < limit_s < float("inf") else None
     stop = threading.Event()
-    with bar(total, desc, "s", show) as b:
+    fmt = ("{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s" if total else "{desc}: {n:.1f} s")
+    with bar(total, desc, "s", show, fmt) as b:
         def tick() -> None:
             t0 = last = time.monotonic()
             while not stop.wait(period_s):
                 now = time.monotonic()
                 step = now - last if total is None else min(now - last, max(total - (last - t0), 0.0))
-                b.update(round(step, 3))
+                b.update(step)
                 last = now
 
         thread = threading.Thread(target=tick, name="regrasp-progress", daemon=True)

@@ -172,6 +172,15 @@ def reject_flags(a, flags, why: str) -> None:
                             "scene")
 
 
+def refuse_flags(a, flags, when: str, why: str) -> None:
+    """Invalid input when any of ``flags`` (attribute names; options that default to None or
+    False) is given ``when`` (e.g. "with --engine quasistatic"): ``why`` says what they need."""
+    bad = [option(f) for f in flags if getattr(a, f, None) is not None and getattr(a, f) is not False]
+    if bad:
+        raise ArgumentError(f"invalid `{bad[0]}`: {', '.join(bad)} {'has' if len(bad) == 1 else 'have'} no effect "
+                            f"{when}: {why}", bad[0])
+
+
 # --- scenes and plans --------------------------------------------------------------------------
 
 def load(path, a=None):

@@ -9,7 +9,7 @@ import numpy as np
 from ..errors import ArgumentError
 from ..planning.plan import Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_command, add_scale_options, add_verbose, check_count,
-               check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, reject_flags,
+               check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, refuse_flags, reject_flags,
                mpc_default, scales, seed_arg)
 
 #: options of the planar MPC, without meaning for 3-D control
@@ -51,6 +51,9 @@ def cmd_control(a) -> int:
     if scene.dimension == 3:
         return _control3d(scene, plan, a)
     _check_mpc_options(a)
+    if a.open_loop:
+        refuse_flags(a, ("robust", "uncertainty", "fixtureless", "horizon", "noise"), "with --open-loop",
+                     "they shape the MPC's feedback, which open-loop execution does not use")
     pokes = [Poke.parse(t) for t in a.poke or []]
     start_error = np.zeros(3) if a.start_error is None else floats(a.start_error, 3, "--start-error")
     res = control(scene, plan, engine=a.engine, policy="open_loop" if a.open_loop else "mpc", pokes=pokes,

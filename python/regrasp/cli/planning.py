@@ -8,14 +8,15 @@ from pathlib import Path
 
 from ..errors import ArgumentError
 from ..files import Outputs
-from ..planning.plan import POSE_SIZE, Plan, plan
+from .. import progress
+from ..planning.plan import POSE_SIZE, Plan, plan, planner_defaults
 from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_command, add_verbose, check_number, check_outputs, floats, load,
                mode_scene, planner_default, pusher_runs, reject_flags, seed_arg)
 
 #: the output options of `regrasp plan` and the file-name suffixes they take (None: any)
 OUTPUTS = {"out": None, "partial_out": None, "plot": FIGURE_SUFFIXES, "animate": ANIMATION_SUFFIXES, "html": None}
 
-PLANAR_ONLY = ("robust", "fixtureless", "uncertainty", "propagation", "plot", "animate")
+PLANAR_ONLY = ("robust", "fixtureless", "uncertainty", "propagation")
 
 
 def _scene_for(a):
@@ -23,10 +24,8 @@ def _scene_for(a):
     cone mode of the flags."""
     scene = load(a.scene, a)
     if scene.dimension == 3:
-        reject_flags(a, PLANAR_ONLY, "it plans with the inverse dynamics only; use --html for a view")
+        reject_flags(a, PLANAR_ONLY, "it plans with the inverse dynamics only, not with motion cones")
         return scene
-    if a.html:
-        raise ArgumentError("invalid `--html`: 3-D scenes only (planar: --plot, --animate)", "--html")
     return mode_scene(scene, a)
 
 
@@ -41,16 +40,17 @@ def _endpoints(scene, a):
 
 
 def _figure_writers(scene, p: Plan, a) -> list:
-    """(option, path, write_fn) of --plot, --animate (planar) and --html (3-D) given."""
+    """(option, path, write_fn) of --plot, --animate and --html given (planar or 3-D)."""
+    from ..viz import plotting
+
+    three = scene.dimension == 3
     out = []
     if a.plot:
-        from ..viz.plotting import plot_plan
-
-        out.append(("--plot", a.plot, lambda tmp: plot_plan(scene, p, tmp)))
+        draw = plotting.plot_plan3d if three else plotting.plot_plan
+        out.append(("--plot", a.plot, lambda tmp: draw(scene, p, tmp)))
     if a.animate:
-        from ..viz.plotting import animate_plan
-
-        out.append(("--animate", a.animate, lambda tmp: animate_plan(scene, p, tmp)))
+        animate = plotting.animate_plan3d if three else plotting.animate_plan
+        out.append(("--animate", a.animate, lambda tmp: animate(scene, p, tmp)))
     if a.html:
         from ..viz.viewer import write_html
 
@@ -105,7 +105,9 @@ def cmd_plan(a) -> int:
     start, goal = _endpoints(scene, a)
     settings = {k: v for k, v in (("seed", a.seed), ("time_limit", a.time_limit), ("propagation", a.propagation))
                 if v is not None}
-    p = plan(scene, start, goal, **settings)
+    limit = a.time_limit if a.time_limit is not None else planner_defaults(scene.dimension)["time_limit"]
+    with progress.elapsed(limit, f"planning {scene.name}"):
+        p = plan(scene, start, goal, **settings)
     said = _write_outputs(scene, p, a)
     print(json.dumps(p.to_json()) if a.json else summary(scene, p))
     if not p.found:

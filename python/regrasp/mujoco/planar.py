@@ -22,6 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .. import progress
 from ..errors import ArgumentError
 from ..scene.planar import Scene, _number
 from ..sim.quasistatic import Replay, body_twist, integrate_pose
@@ -231,7 +232,7 @@ class PlanarExecution(GripperRig):
         """Holds the object for ``settle`` [s], then executes the plan push by push."""
         self.idle(settle)
         max_slip = 0.0
-        for seg in _segments(self.path):
+        for seg in progress.iterate(_segments(self.path), "MuJoCo execution", unit="push"):
             max_slip = max(max_slip, self.segment(seg["pusher"], seg["knots"]))
         q = self.pose()
         task = self.scene.task
