@@ -235,7 +235,8 @@ def execute3d(scene, plan: Plan, a, **kw) -> dict:
         from ..mujoco.spatial import execute_plan3d
 
         return execute_plan3d(scene, plan, *scales(a), **kw)
-    return scene.replay(plan, **kw)
+    with progress.elapsed(None, f"quasi-static replay of {scene.name}"):
+        return scene.replay(plan, **kw)
 
 
 # --- the command -------------------------------------------------------------------------------

@@ -9,8 +9,8 @@ import numpy as np
 from ..errors import ArgumentError
 from ..planning.plan import Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_command, add_scale_options, add_verbose, check_count,
-               check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, refuse_flags, reject_flags,
-               mpc_default, scales, seed_arg)
+               check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, mpc_default,
+               refuse_flags, reject_flags, scales, seed_arg)
 
 #: options of the planar MPC, without meaning for 3-D control
 PLANAR_ONLY = ("poke", "start_error", "robust", "uncertainty", "fixtureless", "plot", "dt", "horizon", "noise")

@@ -11,8 +11,8 @@ from ..errors import ArgumentError
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, PUSHER_HELP, VIDEO_SUFFIXES,
-               add_command, add_scale_options, add_verbose, check_pusher, check_count, check_number, check_outputs, check_positive, execute3d, floats, given, load,
-               load_planar, refuse_flags, reject_flags, scales, seed_arg)
+               add_command, add_scale_options, add_verbose, check_count, check_number, check_outputs, check_positive,
+               check_pusher, execute3d, floats, given, load, load_planar, refuse_flags, reject_flags, scales, seed_arg)
 
 
 def cmd_validate(a) -> int:
@@ -49,6 +49,7 @@ def _check_engine_flags(a) -> None:
 def _simulate3d(scene, plan: Plan, a) -> int:
     reject_flags(a, ("perturb", "video", "plot"), "--perturb/--video/--plot are planar only "
                  "(3-D: --scale-*, --dt, --json; `regrasp plan --html` for a view)")
+    _check_engine_flags(a)
     r = execute3d(scene, plan, a, **given(a, "dt"))
     out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success")}
     out["max_pusher_slip"] = None
@@ -81,7 +82,6 @@ def _print_replay(scene, rep) -> None:
 
 def _check_simulate(a) -> None:
     """The options of `regrasp simulate`, before any work."""
-    _check_engine_flags(a)
     scales(a)
     check_positive(a, "dt", "time step [s]")
     if a.perturb is not None and not (0 <= a.perturb < 1):
@@ -113,6 +113,7 @@ def cmd_simulate(a) -> int:
     plan = Plan.load(a.plan, scene)
     if scene.dimension == 3:
         return _simulate3d(scene, plan, a)
+    _check_engine_flags(a)
     rep = _replay_planar(scene, plan, a)
     _write_figures(scene, rep, a)
     if a.json:

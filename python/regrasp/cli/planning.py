@@ -10,8 +10,8 @@ from ..errors import ArgumentError
 from ..files import Outputs
 from .. import progress
 from ..planning.plan import POSE_SIZE, Plan, plan, planner_defaults
-from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_command, add_verbose, check_number, check_outputs, floats, load,
-               mode_scene, planner_default, pusher_runs, reject_flags, seed_arg)
+from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_command, add_verbose, check_number, check_outputs,
+               floats, load, mode_scene, planner_default, pusher_runs, reject_flags, seed_arg)
 
 #: the output options of `regrasp plan` and the file-name suffixes they take (None: any)
 OUTPUTS = {"out": None, "partial_out": None, "plot": FIGURE_SUFFIXES, "animate": ANIMATION_SUFFIXES, "html": None}
