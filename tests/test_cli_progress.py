@@ -121,3 +121,10 @@ def test_the_bars_do_nothing_when_quiet_or_without_a_terminal(capsys):
         progress.set_quiet(False)
     assert not progress.enabled()  # pytest's stderr is not a terminal
     assert capsys.readouterr().err == ""
+
+
+def test_an_animation_counts_its_frames(tmp_path):
+    status, out, err = run_tty("plan", BLOCK, "--animate", tmp_path / "plan.gif", "--json")
+    assert status == 0, err
+    assert has_bar(err) and "animation frames" in err, err
+    assert (tmp_path / "plan.gif").read_bytes()[:4] == b"GIF8" and json.loads(out)["found"] is True

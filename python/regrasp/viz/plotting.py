@@ -266,7 +266,7 @@ def save_animation(anim, fig, path, writer) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
-        with progress.bar(None, f"frames of {path.name}", unit="frame") as bar:
+        with progress.bar(None, "animation frames", unit="frame") as bar:
             def advance(i: int, n: int) -> None:
                 bar.total = n
                 bar.update(1)
