@@ -73,8 +73,11 @@ REFUSED = [
     # push, 3-D: the figure is planar
     (["push", SPATIAL, "--pose", "0,0,0,1,0,0,0", "--pusher", "ground", "--twist", "0,0,0.001,0,0,0", "--plot", "P.png"],
      "--plot", "planar"),
-    # bench: -n and --quick
+    # approx-error: a scene without a grasp has no grip force to vary
+    (["approx-error", EXAMPLES / "block-on-incline.toml"], "scene", "no grasp"),
+    # bench: -n and --quick; -v (it reads no scene files)
     (["bench", "--quick", "-n", "1000"], "-n", "--quick"),
+    (["-v", "bench"], "--verbose", "no scene files"),
 ]
 
 #: refused given the plan files (PLAN: the planar plan; PLAN3: the 3-D plan)

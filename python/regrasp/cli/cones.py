@@ -111,6 +111,9 @@ def cmd_approx_error(a) -> int:
         raise ArgumentError(f"invalid `--forces`: grip forces must be positive, at most {MAX_FORCE:g} N", "--forces")
     scenes = [load_planar(p, "approx-error", a) for p in a.scenes or _bundled_planar_examples()]
     skipped = [s.name for s in scenes if s.kind != "grasp"]
+    if len(skipped) == len(scenes):
+        raise ArgumentError(f"invalid `scene`: {', '.join(skipped)} {'has' if len(skipped) == 1 else 'have'} no grasp, "
+                            "so no grip force to vary (approx-error compares cones per grip force)", "scene")
     if skipped and not a.json:
         print(f"(skipped {', '.join(skipped)}: no grasp, so no grip force to vary)", file=sys.stderr)
     rows = approximation_report(scenes, tuple(forces), a.samples, a.seed)

@@ -20,6 +20,7 @@ def cmd_bench(a) -> int:
     from ..bench import format_results, run
 
     check_count(a, "n", 1, MAX_CONES)
+    refuse_flags(a, ("verbose",), "with bench", "it reads no scene files whose notes it could print")
     if a.quick:
         refuse_flags(a, ("n",), "with --quick", "--quick measures 10,000 cones; give one of them")
     n = QUICK_CONES if a.quick else a.n or DEFAULT_CONES
