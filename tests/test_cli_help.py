@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import json
 import re
 import subprocess
 import sys
@@ -32,7 +33,7 @@ def run(*argv) -> tuple[int, str, str]:
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         try:
-            status = main(list(argv))
+            status = main([str(a) for a in argv])
         except SystemExit as e:
             status = e.code
     return status, out.getvalue(), err.getvalue()
@@ -112,3 +113,14 @@ def test_an_unknown_pusher_is_invalid_input_listing_the_scene_pushers(tmp_path):
         assert status == 2, (cmd, scene, err)
         assert "`--pusher`" in err and ", ".join(names) in err, err
         assert "Traceback" not in err and out == ""
+
+
+def test_a_plan_with_an_unknown_pusher_is_invalid_input_listing_the_scene_pushers(tmp_path):
+    status, _, err = run("plan", T_SHAPE, "--out", tmp_path / "p.json", "--seed", "0")
+    assert status == 0, err
+    plan = json.loads((tmp_path / "p.json").read_text())
+    plan["path"][1]["pusher"] = "nope"
+    (tmp_path / "p.json").write_text(json.dumps(plan))
+    status, _, err = run("simulate", T_SHAPE, "--plan", tmp_path / "p.json")
+    names = regrasp.load_scene(T_SHAPE).pusher_names
+    assert status == 2 and "pusher" in err and ", ".join(names) in err, err

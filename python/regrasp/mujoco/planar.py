@@ -161,7 +161,8 @@ class PlanarExecution(GripperRig):
         path = plan_dict(plan)["path"]
         for i, k in enumerate(path[1:], 1):
             if k["pusher"] not in scene.pusher_names:
-                raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r} in the scene",
+                raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r} in the scene "
+                                    f"(its pushers: {', '.join(scene.pusher_names)})",
                                     f"plan.path[{i}].pusher")
         super().__init__(scene, path[0]["pose"], sorted({k["pusher"] for k in path[1:]}), perturb, contact)
         self.path, self.speed = path, speed
