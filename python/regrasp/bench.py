@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import progress
 from .reference import cones as reference
 from .scene.planar import Scene
 
@@ -46,16 +47,23 @@ def run(n: int = 100_000, reps: int = 11, baseline_reps: int = 3, scene_path=Non
     params = reference.RefParams.from_scene(scene, pusher)
     twists = rng.normal(size=(n, 3)) * np.array([1.0, 1.0, 1.0 / scene.length])
     batch = scene.motion_cones(poses, pusher)
+    benchmarks = [
+        ("cone batch", lambda: _cone_batch(scene, pusher, params, poses, batch, reps, baseline_reps)),
+        ("membership", lambda: _membership(params, poses, twists, batch, reps)),
+        ("single cone", lambda: _single_cone(scene, pusher, params, poses[0], reps)),
+        ("projection", lambda: _projection(scene, pusher, poses, twists, reps)),
+        ("MNCP solver", lambda: run_mncp(reps=reps)),
+        ("planner", run_planner),
+        ("MuJoCo", run_mujoco),
+        ("MPC", run_mpc),
+        ("3-D planner", run_plan3d),
+    ]
     results = {}
-    results.update(_cone_batch(scene, pusher, params, poses, batch, reps, baseline_reps))
-    results.update(_membership(params, poses, twists, batch, reps))
-    results.update(_single_cone(scene, pusher, params, poses[0], reps))
-    results.update(_projection(scene, pusher, poses, twists, reps))
-    results.update(run_mncp(reps=reps))
-    results.update(run_planner())
-    results.update(run_mujoco())
-    results.update(run_mpc())
-    results.update(run_plan3d())
+    with progress.bar(len(benchmarks), "bench", unit="benchmark") as bar:
+        for name, measure in benchmarks:
+            bar.set_postfix_str(name)
+            results.update(measure())
+            bar.update(1)
     return results
 
 

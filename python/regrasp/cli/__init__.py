@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import errors
+from .. import errors, progress
 from ..errors import ArgumentError, RegraspError, SceneError
 from ..files import check_writable, refuse_overwrite_input
 from ..planning.plan import Plan, planner_defaults
@@ -121,6 +121,13 @@ def planner_default(key: str) -> str:
     return f"default {d2}" if d3 is None or d3 == d2 else f"default {d2} planar, {d3} 3-D"
 
 
+def mpc_default(key: str) -> str:
+    """The MPC's default of setting ``key`` for a help text (the Rust core's)."""
+    from .. import _core
+
+    return f"default {_core.mpc_defaults()[key]}"
+
+
 def given(a, *names: str) -> dict:
     """The options among ``names`` given on the command line (not None), by name: the callee's
     own defaults apply to the others."""
@@ -163,6 +170,15 @@ def reject_flags(a, flags, why: str) -> None:
     if bad:
         raise ArgumentError(f"invalid flags for a 3-D scene: {why} (no --{', --'.join(f.replace('_', '-') for f in bad)})",
                             "scene")
+
+
+def refuse_flags(a, flags, when: str, why: str) -> None:
+    """Invalid input when any of ``flags`` (attribute names; options that default to None or
+    False) is given ``when`` (e.g. "with --engine quasistatic"): ``why`` says what they need."""
+    bad = [option(f) for f in flags if getattr(a, f, None) is not None and getattr(a, f) is not False]
+    if bad:
+        raise ArgumentError(f"invalid `{bad[0]}`: {', '.join(bad)} {'has' if len(bad) == 1 else 'have'} no effect "
+                            f"{when}: {why}", bad[0])
 
 
 # --- scenes and plans --------------------------------------------------------------------------
@@ -219,7 +235,8 @@ def execute3d(scene, plan: Plan, a, **kw) -> dict:
         from ..mujoco.spatial import execute_plan3d
 
         return execute_plan3d(scene, plan, *scales(a), **kw)
-    return scene.replay(plan, **kw)
+    with progress.elapsed(None, f"quasi-static replay of {scene.name}"):
+        return scene.replay(plan, **kw)
 
 
 # --- the command -------------------------------------------------------------------------------
@@ -231,14 +248,68 @@ def add_verbose(p) -> None:
                    help="print the scene's notes (e.g. pusher points snapped onto the outline) on stderr")
 
 
+class Help(argparse.RawDescriptionHelpFormatter):
+    """Help texts that end with the option's default: ``(default: X)`` where the option has one and
+    its text does not already say it; ``(default: none)`` for an optional value without one."""
+
+    def _get_help_string(self, action) -> str:
+        text = action.help or ""
+        if "default" in text or action.default is argparse.SUPPRESS or action.required:
+            return text
+        if action.option_strings and action.nargs == 0:  # a flag: off unless given
+            return text
+        if action.default is None:
+            return f"{text} (default: none)" if action.option_strings else text
+        return f"{text} (default: %(default)s)"
+
+
+class Parser(argparse.ArgumentParser):
+    """The parsers of `regrasp` and of its commands: help with defaults and verbatim epilogs."""
+
+    def __init__(self, *args, **kw) -> None:
+        kw.setdefault("formatter_class", Help)
+        super().__init__(*args, **kw)
+
+
+def add_command(sub, name: str, summary: str, example: str, fn) -> Parser:
+    """A command ``name``: ``summary`` (one line) in `regrasp --help` and its own help, an example
+    (a command line, several on their own lines) as its epilog."""
+    p = sub.add_parser(name, help=summary, description=summary[0].upper() + summary[1:] + ".",
+                       epilog="example:\n" + "\n".join(f"  {line}" for line in example.splitlines()))
+    p.set_defaults(fn=fn)
+    return p
+
+
+def version() -> str:
+    """``regrasp VERSION (core NAME, ABI, PYTHON)``: the package and its compiled core."""
+    from .. import __version__, _core
+
+    name = Path(_core.__file__).name
+    abi = "abi3" if ".abi3." in name else name.split(".")[1] if name.count(".") > 1 else "unknown ABI"
+    py = f"{sys.implementation.name} {sys.version_info.major}.{sys.version_info.minor}"
+    return f"regrasp {__version__} (core {_core.__version__}: {name}, {abi}; {py})"
+
+
+def add_quiet(p, default=False) -> None:
+    """-q/--quiet: no progress bars (before the command, or as an option of any command)."""
+    p.add_argument("-q", "--quiet", action="store_true", default=default,
+                   help="no progress bars on stderr (bars are shown only when stderr is a terminal)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from . import cones, control, dynamics, planning, tools
 
-    ap = argparse.ArgumentParser(prog="regrasp", description=__doc__.splitlines()[0])
+    ap = Parser(prog="regrasp", description="In-hand regrasps by prehensile pushing: motion cones, planning, "
+                "simulation and control (`regrasp COMMAND --help` for each command).",
+                epilog="example:\n  regrasp demo --out out/demo\n  regrasp plan examples/t-shape.toml --plot plan.png")
+    ap.add_argument("--version", action="version", version=version(), help="print the version and exit")
     ap.add_argument("-v", "--verbose", action="store_true", help="print the scenes' notes on stderr")
-    sub = ap.add_subparsers(dest="cmd", required=True)
+    add_quiet(ap)
+    sub = ap.add_subparsers(dest="cmd", required=True, parser_class=Parser)
     for group in (planning, cones, dynamics, control, tools):
         group.add_parsers(sub)
+    for p in sub.choices.values():
+        add_quiet(p, argparse.SUPPRESS)
     return ap
 
 
@@ -292,12 +363,49 @@ def _say(message: str) -> None:
         pass
 
 
+#: the help of --pusher when no scene is given before --help
+PUSHER_HELP = "a pusher of the scene, by name (`regrasp COMMAND SCENE --help` lists the scene's pushers)"
+
+
+def check_pusher(scene, name: str) -> None:
+    """``--pusher`` names a pusher of ``scene``, else invalid input listing the scene's pushers."""
+    names = list(scene.pusher_names)
+    if name not in names:
+        raise ArgumentError(f"invalid `--pusher`: no pusher {name!r} in scene {scene.name!r}; its pushers: "
+                            f"{', '.join(names)}", "--pusher")
+
+
+def _scene_help(ap: argparse.ArgumentParser, argv: list) -> None:
+    """``regrasp COMMAND SCENE --help``: the --pusher help of COMMAND lists the pushers of SCENE
+    (the first readable scene among the arguments, loaded quietly)."""
+    if not ({"-h", "--help"} & set(argv)):
+        return
+    sub = next(a for a in ap._actions if isinstance(a, argparse._SubParsersAction))
+    cmd = next((t for t in argv if t in sub.choices), None)
+    action = cmd and next((a for a in sub.choices[cmd]._actions if "--pusher" in a.option_strings), None)
+    if action is None:
+        return
+    for token in argv[argv.index(cmd) + 1:]:
+        if token.startswith("-") or not Path(token).is_file():
+            continue
+        try:
+            scene = load_scene(token)
+        except Exception:  # not a scene: the help stays general
+            continue
+        action.help = f"a pusher of the scene, by name; pushers of {token}: {', '.join(scene.pusher_names)}"
+        return
+
+
 def main(argv=None) -> int:
     """The `regrasp` command; returns its exit status (docs/cli.md). Ctrl-C: 130, after
     "regrasp: interrupted" (outputs are written atomically: nothing half-done is left); a closed
     standard output (``| head``): 141, quietly."""
     try:
-        args = build_parser().parse_args(argv)
+        argv = sys.argv[1:] if argv is None else list(argv)
+        ap = build_parser()
+        _scene_help(ap, argv)
+        args = ap.parse_args(argv)
+        progress.set_quiet(args.quiet)
         status, message = _run(args)
         if message is not None:
             _say(message)

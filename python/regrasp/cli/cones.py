@@ -10,8 +10,8 @@ import numpy as np
 from ..errors import ArgumentError, GraspError
 from ..scene.common import is_3d_text, read_scene_file
 from ..scene.planar import Scene
-from . import (CANNOT, EXAMPLES, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, add_verbose, check_count, check_outputs, floats,
-               load_planar, seed_arg)
+from . import (CANNOT, EXAMPLES, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, PUSHER_HELP, add_command, add_verbose,
+               check_count, check_outputs, check_pusher, floats, load_planar, seed_arg)
 
 
 def _json_float(x):
@@ -79,6 +79,7 @@ def cmd_cone(a) -> int:
     check_outputs(a, {"plot": FIGURE_SUFFIXES}, [a.scene])
     scene = load_planar(a.scene, "cone", a)
     pose = floats(a.pose, 3, "--pose")
+    check_pusher(scene, a.pusher)
     twist = None if a.twist is None else floats(a.twist, 3, "--twist")
     try:
         rep = cone_report(scene, pose, a.pusher, twist)
@@ -110,6 +111,9 @@ def cmd_approx_error(a) -> int:
         raise ArgumentError(f"invalid `--forces`: grip forces must be positive, at most {MAX_FORCE:g} N", "--forces")
     scenes = [load_planar(p, "approx-error", a) for p in a.scenes or _bundled_planar_examples()]
     skipped = [s.name for s in scenes if s.kind != "grasp"]
+    if len(skipped) == len(scenes):
+        raise ArgumentError(f"invalid `scene`: {', '.join(skipped)} {'has' if len(skipped) == 1 else 'have'} no grasp, "
+                            "so no grip force to vary (approx-error compares cones per grip force)", "scene")
     if skipped and not a.json:
         print(f"(skipped {', '.join(skipped)}: no grasp, so no grip force to vary)", file=sys.stderr)
     rows = approximation_report(scenes, tuple(forces), a.samples, a.seed)
@@ -118,21 +122,22 @@ def cmd_approx_error(a) -> int:
 
 
 def add_parsers(sub) -> None:
-    c = sub.add_parser("cone", help="motion cone of a pusher at a pose")
-    c.add_argument("scene")
-    c.add_argument("--pose", required=True, help="x,z,theta (m, m, rad)")
-    c.add_argument("--pusher", required=True)
-    c.add_argument("--twist", help="vx,vz,omega for min_grip_force (default: the central gravity-free twist)")
-    c.add_argument("--json", action="store_true")
-    c.add_argument("--plot", metavar="PNG")
+    c = add_command(sub, "cone", "motion cone of a pusher at a pose (planar scenes)",
+                    "regrasp cone examples/t-shape.toml --pose 0,0,0 --pusher top --plot cone.png", cmd_cone)
+    c.add_argument("scene", help="a planar scene file")
+    c.add_argument("--pose", required=True, help="the object's pose in the gripper frame: x,z,theta [m, m, rad]")
+    c.add_argument("--pusher", required=True, help=PUSHER_HELP)
+    c.add_argument("--twist", help="vx,vz,omega whose grip-force range is reported (default: the central "
+                   "gravity-free twist)")
+    c.add_argument("--json", action="store_true", help="print the report as JSON")
+    c.add_argument("--plot", metavar="PNG", help="draw the cone in wrench and twist space")
     add_verbose(c)
-    c.set_defaults(fn=cmd_cone)
 
-    e = sub.add_parser("approx-error", help="polyhedral approximation vs exact cone, per scene and grip force")
-    e.add_argument("scenes", nargs="*", help="scene files (default: every bundled example)")
-    e.add_argument("--forces", default="5,20,80", help="grip forces per finger, N")
+    e = add_command(sub, "approx-error", "polyhedral approximation vs exact cone, per scene and grip force",
+                    "regrasp approx-error examples/t-shape.toml --forces 5,20 --samples 2000", cmd_approx_error)
+    e.add_argument("scenes", nargs="*", help="planar scene files (default: every bundled planar example)")
+    e.add_argument("--forces", default="5,20,80", help="grip forces per finger [N], comma-separated")
     e.add_argument("--samples", type=int, default=20000, help=f"random pushes per row, 1 to {MAX_SAMPLES}")
-    e.add_argument("--seed", type=seed_arg, default=0)
-    e.add_argument("--json", action="store_true")
+    e.add_argument("--seed", type=seed_arg, default=0, help="random seed, a whole number >= 0")
+    e.add_argument("--json", action="store_true", help="print the rows as a JSON array")
     add_verbose(e)
-    e.set_defaults(fn=cmd_approx_error)

@@ -8,9 +8,9 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..planning.plan import Plan
-from . import (CANNOT, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_scale_options, add_verbose, check_count,
-               check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, reject_flags,
-               scales, seed_arg)
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_command, add_scale_options, add_verbose, check_count,
+               check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, mpc_default,
+               refuse_flags, reject_flags, scales, seed_arg)
 
 #: options of the planar MPC, without meaning for 3-D control
 PLANAR_ONLY = ("poke", "start_error", "robust", "uncertainty", "fixtureless", "plot", "dt", "horizon", "noise")
@@ -51,6 +51,9 @@ def cmd_control(a) -> int:
     if scene.dimension == 3:
         return _control3d(scene, plan, a)
     _check_mpc_options(a)
+    if a.open_loop:
+        refuse_flags(a, ("robust", "uncertainty", "fixtureless", "horizon", "noise"), "with --open-loop",
+                     "they shape the MPC's feedback, which open-loop execution does not use")
     pokes = [Poke.parse(t) for t in a.poke or []]
     start_error = np.zeros(3) if a.start_error is None else floats(a.start_error, 3, "--start-error")
     res = control(scene, plan, engine=a.engine, policy="open_loop" if a.open_loop else "mpc", pokes=pokes,
@@ -71,24 +74,26 @@ def cmd_control(a) -> int:
 
 
 def add_parsers(sub) -> None:
-    k = sub.add_parser("control", help="track a plan with the MPC (closed loop) in a simulator "
-                                       "(3-D scenes: feedback by re-planning from the measured pose)")
-    k.add_argument("scene")
-    k.add_argument("--plan", required=True)
-    k.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"])
+    k = add_command(sub, "control", "track a plan with the MPC (closed loop) in a simulator "
+                    "(3-D scenes: feedback by re-planning from the measured pose)",
+                    "regrasp control examples/t-shape.toml --plan plan.json --poke 2,0.005,0,0 --plot control.png",
+                    cmd_control)
+    k.add_argument("scene", help="the scene file the plan is for")
+    k.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
+    k.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"], help="the world")
     k.add_argument("--poke", action="append", metavar="T,dx,dz,dtheta",
-                   help="displace the object in the grasp at time T [s] (repeatable)")
-    k.add_argument("--start-error", metavar="dx,dz,dtheta", help="the object starts this far from the plan's start")
+                   help="planar: displace the object in the grasp at time T [s] (repeatable)")
+    k.add_argument("--start-error", metavar="dx,dz,dtheta", help="planar: the object starts this far from the plan's start")
     add_scale_options(k)
-    k.add_argument("--robust", action="store_true", help="constrain the MPC with robust cones (scene's [uncertainty])")
-    k.add_argument("--uncertainty", metavar="P,F,N,M", help="spreads for the robust cones (implies --robust)")
-    k.add_argument("--fixtureless", action="store_true", help="constrain the MPC with fixtureless-fixturing cones")
+    k.add_argument("--robust", action="store_true",
+                   help="planar: constrain the MPC with robust cones (scene's [uncertainty])")
+    k.add_argument("--uncertainty", metavar="P,F,N,M", help="planar: spreads for the robust cones (implies --robust)")
+    k.add_argument("--fixtureless", action="store_true", help="planar: constrain the MPC with fixtureless-fixturing cones")
     k.add_argument("--open-loop", action="store_true", help="execute the plan open loop instead (for comparison)")
     k.add_argument("--noise", type=float, help="planar: pose measurement noise, standard deviation [m] (default 0)")
-    k.add_argument("--dt", type=float, help="planar: control period [s] (default: the controller's, 0.1)")
-    k.add_argument("--horizon", type=int, help="planar: MPC horizon in steps (default: the controller's, 5)")
-    k.add_argument("--seed", type=seed_arg, default=0)
-    k.add_argument("--plot", metavar="PNG", help="planned against executed poses, pokes marked")
-    k.add_argument("--json", action="store_true")
+    k.add_argument("--dt", type=float, help=f"planar: control period [s] ({mpc_default('dt')})")
+    k.add_argument("--horizon", type=int, help=f"planar: MPC horizon in steps ({mpc_default('horizon')})")
+    k.add_argument("--seed", type=seed_arg, default=0, help="random seed (measurement noise; seeds of re-plans)")
+    k.add_argument("--plot", metavar="PNG", help="planar: planned against executed poses, pokes marked")
+    k.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(k)
-    k.set_defaults(fn=cmd_control)

@@ -6,12 +6,13 @@ import json
 
 import numpy as np
 
+from .. import _core, progress
 from ..errors import ArgumentError
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
-from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, VIDEO_SUFFIXES, add_scale_options,
-               add_verbose, check_count, check_number, check_outputs, check_positive, execute3d, floats, given, load,
-               load_planar, reject_flags, scales, seed_arg)
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, PUSHER_HELP, VIDEO_SUFFIXES,
+               add_command, add_scale_options, add_verbose, check_count, check_number, check_outputs, check_positive,
+               check_pusher, execute3d, floats, given, load, load_planar, refuse_flags, reject_flags, scales, seed_arg)
 
 
 def cmd_validate(a) -> int:
@@ -19,20 +20,37 @@ def cmd_validate(a) -> int:
 
     check_count(a, "pushes", 1, MAX_PUSHES)
     check_count(a, "workers", 1, MAX_WORKERS)
-    scene = load_planar(a.scene, "validate", a)
     engines = tuple(e.strip() for e in a.engines.split(",") if e.strip())
-    res = validate(scene, a.pushes, a.seed, engines=engines, support=a.support, workers=a.workers,
-                   ray_address=a.ray, progress=not a.json and a.pushes >= 500)
+    if "mujoco" not in engines:
+        refuse_flags(a, ("workers", "ray"), "without the MuJoCo engine", "only MuJoCo pushes run in processes "
+                     "(add --engines mujoco)")
+    if "quasistatic" not in engines:
+        refuse_flags(a, ("support",), "without the quasi-static engine", "it is the quasi-static simulator's pad model")
+    scene = load_planar(a.scene, "validate", a)
+    res = validate(scene, a.pushes, a.seed, engines=engines, workers=a.workers, ray_address=a.ray, progress=True,
+                   **given(a, "support"))
     print(json.dumps(res) if a.json else format_validation(res))
     return OK
 
 
 # --- simulate ----------------------------------------------------------------------------------
 
+def _check_engine_flags(a) -> None:
+    """The flags of `regrasp simulate` that only one engine uses."""
+    if a.engine == "quasistatic":
+        refuse_flags(a, ("scale_friction", "scale_grip", "scale_mass", "perturb", "video"), "with --engine quasistatic",
+                     "they change or show the MuJoCo world (add --engine mujoco)")
+    else:
+        refuse_flags(a, ("dt",), "with --engine mujoco", "it is the quasi-static simulator's time step")
+    if not a.perturb:
+        refuse_flags(a, ("seed",), "without --perturb", "it seeds the factors --perturb draws")
+
+
 def _simulate3d(scene, plan: Plan, a) -> int:
     reject_flags(a, ("perturb", "video", "plot"), "--perturb/--video/--plot are planar only "
                  "(3-D: --scale-*, --dt, --json; `regrasp plan --html` for a view)")
-    r = execute3d(scene, plan, a, **(given(a, "dt") if a.engine == "quasistatic" else {}))
+    _check_engine_flags(a)
+    r = execute3d(scene, plan, a, **given(a, "dt"))
     out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success")}
     out["max_pusher_slip"] = None
     print(json.dumps(out) if a.json else f"{scene.name}: {r['engine']}: "
@@ -49,7 +67,7 @@ def _replay_planar(scene, plan: Plan, a):
     from ..mujoco.planar import Perturbation, execute_plan
 
     base = Perturbation(*scales(a))
-    pert = Perturbation.draw(a.perturb, np.random.default_rng(a.seed), base) if a.perturb else base
+    pert = Perturbation.draw(a.perturb, np.random.default_rng(a.seed or 0), base) if a.perturb else base
     rep = execute_plan(scene, plan, pert)
     return rep
 
@@ -95,6 +113,7 @@ def cmd_simulate(a) -> int:
     plan = Plan.load(a.plan, scene)
     if scene.dimension == 3:
         return _simulate3d(scene, plan, a)
+    _check_engine_flags(a)
     rep = _replay_planar(scene, plan, a)
     _write_figures(scene, rep, a)
     if a.json:
@@ -142,12 +161,16 @@ def cmd_push(a) -> int:
     scene = load(a.scene, a)
     pose = floats(a.pose, POSE_SIZE[scene.dimension], "--pose")
     twist = floats(a.twist, 6 if scene.dimension == 3 else 3, "--twist")
+    check_pusher(scene, a.pusher)
     if scene.dimension == 3:
-        tr = scene.simulate_push(pose, a.pusher, twist, a.duration, a.dt)
+        reject_flags(a, ("plot",), "--plot draws planar pushes only")
+        with progress.elapsed(None, "push"):
+            tr = scene.simulate_push(pose, a.pusher, twist, a.duration, a.dt)
     else:
         from ..sim.quasistatic import simulate_push
 
-        tr = simulate_push(scene, pose, a.pusher, twist, a.duration, a.dt)
+        with progress.elapsed(None, "push"):
+            tr = simulate_push(scene, pose, a.pusher, twist, a.duration, a.dt)
         if a.plot:
             from ..viz.plotting import plot_push
 
@@ -156,43 +179,48 @@ def cmd_push(a) -> int:
 
 
 def add_parsers(sub) -> None:
-    v = sub.add_parser("validate", help="motion-cone predictions against the simulators")
-    v.add_argument("scene")
+    v = add_command(sub, "validate", "motion-cone predictions against the simulators (planar scenes)",
+                    "regrasp validate examples/block-low-friction.toml --pushes 500 --engines quasistatic,mujoco",
+                    cmd_validate)
+    v.add_argument("scene", help="a planar scene file")
     v.add_argument("--pushes", type=int, default=2000, help=f"random pushes, 1 to {MAX_PUSHES}")
     v.add_argument("--engines", default="quasistatic", help="comma-separated: quasistatic,mujoco")
-    v.add_argument("--seed", type=seed_arg, default=0)
+    v.add_argument("--seed", type=seed_arg, default=0, help="random seed, a whole number >= 0")
     v.add_argument("--workers", type=int, help=f"local processes for MuJoCo, 1 to {MAX_WORKERS} (default: all cores)")
     v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
-    v.add_argument("--support", default="points", choices=["points", "limit_surface"],
-                   help="quasi-static pads as point sets (default) or as the motion cones' limit surface")
-    v.add_argument("--json", action="store_true")
+    v.add_argument("--support", choices=["points", "limit_surface"],
+                   help="quasi-static pads as point sets or as the motion cones' limit surface "
+                   f"(default {_core.quasistatic_defaults()['support']})")
+    v.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(v)
-    v.set_defaults(fn=cmd_validate)
 
-    s = sub.add_parser("simulate", help="replay a plan in a simulator")
-    s.add_argument("scene")
-    s.add_argument("--plan", required=True)
-    s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"])
+    s = add_command(sub, "simulate", "replay a plan in a simulator (planar or 3-D)",
+                    "regrasp simulate examples/t-shape.toml --plan plan.json --engine mujoco --video replay.gif",
+                    cmd_simulate)
+    s.add_argument("scene", help="the scene file the plan is for")
+    s.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
+    s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"],
+                   help="our quasi-static simulator or MuJoCo")
     s.add_argument("--dt", type=float, help="quasi-static time step [s] (default 0.05 planar, 0.25 3-D)")
     add_scale_options(s, "MuJoCo: ")
     s.add_argument("--perturb", type=float,
-                   help="MuJoCo: also draw each factor uniformly in [1-P, 1+P] from --seed (default 0: none)")
-    s.add_argument("--seed", type=seed_arg, default=0)
-    s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo: an animation of the execution")
-    s.add_argument("--plot", metavar="PNG")
-    s.add_argument("--json", action="store_true")
+                   help="MuJoCo, planar: also draw each factor uniformly in [1-P, 1+P] from --seed (default 0: none)")
+    s.add_argument("--seed", type=seed_arg, help="random seed of --perturb (default 0)")
+    s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo, planar: an animation of the execution")
+    s.add_argument("--plot", metavar="PNG", help="planar: planned against simulated poses")
+    s.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(s)
-    s.set_defaults(fn=cmd_simulate)
 
-    p = sub.add_parser("push", help="simulate one push and plot object motion and contact forces")
-    p.add_argument("scene")
+    p = add_command(sub, "push", "simulate one push in the quasi-static simulator (planar or 3-D)",
+                    "regrasp push examples/t-shape.toml --pose 0,0,0 --pusher top --twist 0,-0.01,0 --plot push.png",
+                    cmd_push)
+    p.add_argument("scene", help="the scene file")
     p.add_argument("--pose", required=True, help="x,z,theta (3-D scenes: x,y,z,qw,qx,qy,qz)")
-    p.add_argument("--pusher", required=True)
+    p.add_argument("--pusher", required=True, help=PUSHER_HELP)
     p.add_argument("--twist", required=True,
                    help="pusher body twist vx,vz,omega, object frame at the start (3-D: vx,vy,vz,wx,wy,wz)")
-    p.add_argument("--duration", type=float, default=1.0)
-    p.add_argument("--dt", type=float, default=0.02)
-    p.add_argument("--plot", metavar="PNG")
-    p.add_argument("--json", action="store_true")
+    p.add_argument("--duration", type=float, default=1.0, help="duration of the push [s]")
+    p.add_argument("--dt", type=float, default=0.02, help="time step [s], at most --duration")
+    p.add_argument("--plot", metavar="PNG", help="planar: object motion and contact forces")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(p)
-    p.set_defaults(fn=cmd_push)

@@ -8,14 +8,15 @@ from pathlib import Path
 
 from ..errors import ArgumentError
 from ..files import Outputs
-from ..planning.plan import POSE_SIZE, Plan, plan
-from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_verbose, check_number, check_outputs, floats, load,
-               mode_scene, planner_default, pusher_runs, reject_flags, seed_arg)
+from .. import progress
+from ..planning.plan import POSE_SIZE, Plan, plan, planner_defaults
+from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_command, add_verbose, check_number, check_outputs,
+               floats, load, mode_scene, planner_default, pusher_runs, reject_flags, seed_arg)
 
 #: the output options of `regrasp plan` and the file-name suffixes they take (None: any)
 OUTPUTS = {"out": None, "partial_out": None, "plot": FIGURE_SUFFIXES, "animate": ANIMATION_SUFFIXES, "html": None}
 
-PLANAR_ONLY = ("robust", "fixtureless", "uncertainty", "propagation", "plot", "animate")
+PLANAR_ONLY = ("robust", "fixtureless", "uncertainty", "propagation")
 
 
 def _scene_for(a):
@@ -23,10 +24,8 @@ def _scene_for(a):
     cone mode of the flags."""
     scene = load(a.scene, a)
     if scene.dimension == 3:
-        reject_flags(a, PLANAR_ONLY, "it plans with the inverse dynamics only; use --html for a view")
+        reject_flags(a, PLANAR_ONLY, "it plans with the inverse dynamics only, not with motion cones")
         return scene
-    if a.html:
-        raise ArgumentError("invalid `--html`: 3-D scenes only (planar: --plot, --animate)", "--html")
     return mode_scene(scene, a)
 
 
@@ -41,16 +40,17 @@ def _endpoints(scene, a):
 
 
 def _figure_writers(scene, p: Plan, a) -> list:
-    """(option, path, write_fn) of --plot, --animate (planar) and --html (3-D) given."""
+    """(option, path, write_fn) of --plot, --animate and --html given (planar or 3-D)."""
+    from ..viz import plotting
+
+    three = scene.dimension == 3
     out = []
     if a.plot:
-        from ..viz.plotting import plot_plan
-
-        out.append(("--plot", a.plot, lambda tmp: plot_plan(scene, p, tmp)))
+        draw = plotting.plot_plan3d if three else plotting.plot_plan
+        out.append(("--plot", a.plot, lambda tmp: draw(scene, p, tmp)))
     if a.animate:
-        from ..viz.plotting import animate_plan
-
-        out.append(("--animate", a.animate, lambda tmp: animate_plan(scene, p, tmp)))
+        animate = plotting.animate_plan3d if three else plotting.animate_plan
+        out.append(("--animate", a.animate, lambda tmp: animate(scene, p, tmp)))
     if a.html:
         from ..viz.viewer import write_html
 
@@ -105,7 +105,9 @@ def cmd_plan(a) -> int:
     start, goal = _endpoints(scene, a)
     settings = {k: v for k, v in (("seed", a.seed), ("time_limit", a.time_limit), ("propagation", a.propagation))
                 if v is not None}
-    p = plan(scene, start, goal, **settings)
+    limit = a.time_limit if a.time_limit is not None else planner_defaults(scene.dimension)["time_limit"]
+    with progress.elapsed(limit, f"planning {scene.name}"):
+        p = plan(scene, start, goal, **settings)
     said = _write_outputs(scene, p, a)
     print(json.dumps(p.to_json()) if a.json else summary(scene, p))
     if not p.found:
@@ -117,8 +119,10 @@ def cmd_plan(a) -> int:
 
 
 def add_parsers(sub) -> None:
-    pl = sub.add_parser("plan", help="plan a regrasp (T-RRT* with motion-cone propagation)")
-    pl.add_argument("scene")
+    pl = add_command(sub, "plan", "plan a regrasp (T-RRT* with motion-cone propagation; 3-D: inverse dynamics)",
+                     "regrasp plan examples/t-shape.toml --out plan.json --plot plan.png --animate plan.gif\n"
+                     "regrasp plan examples/pivot-3d.toml --html plan.html", cmd_plan)
+    pl.add_argument("scene", help="the scene file (planar or 3-D)")
     pl.add_argument("--out", metavar="PLAN.json",
                     help="write the plan file here (no plan found: the best partial plan, unless the file exists)")
     pl.add_argument("--partial-out", metavar="PLAN.json",
@@ -130,15 +134,15 @@ def add_parsers(sub) -> None:
                     help=f"planar only: how steps are made ({planner_default('propagation')})")
     pl.add_argument("--start", help="x,z,theta; 3-D: x,y,z,qw,qx,qy,qz (default: the scene's task)")
     pl.add_argument("--goal", help="x,z,theta; 3-D: x,y,z,qw,qx,qy,qz (default: the scene's task)")
-    pl.add_argument("--plot", metavar="PNG")
-    pl.add_argument("--animate", metavar="GIF")
-    pl.add_argument("--json", action="store_true")
+    pl.add_argument("--plot", metavar="PNG", help="draw the plan: object, pads and pushers at the poses "
+                    "(3-D: a 3-D figure of start, goal and intermediate poses)")
+    pl.add_argument("--animate", metavar="GIF", help="animate the plan (planar or 3-D)")
+    pl.add_argument("--json", action="store_true", help="print the plan (the plan file's object) instead of the summary")
     pl.add_argument("--robust", action="store_true",
-                    help="plan with robust motion cones for the scene's [uncertainty] (or --uncertainty)")
-    pl.add_argument("--uncertainty", metavar="P,F,N,M",
-                    help="relative spreads of pusher friction, finger friction, grip force, mass (implies --robust)")
-    pl.add_argument("--fixtureless", action="store_true",
-                    help="plan only with fixtureless-fixturing pushes (invariant to mass, grip force, finger friction)")
-    pl.add_argument("--html", metavar="HTML", help="3-D scenes: an interactive 3-D view of the plan (self-contained page)")
+                    help="planar only: plan with robust motion cones for the scene's [uncertainty] (or --uncertainty)")
+    pl.add_argument("--uncertainty", metavar="P,F,N,M", help="planar only: relative spreads of pusher friction, "
+                    "finger friction, grip force, mass, each in [0, 1) (implies --robust)")
+    pl.add_argument("--fixtureless", action="store_true", help="planar only: plan only with fixtureless-fixturing "
+                    "pushes (invariant to mass, grip force, finger friction)")
+    pl.add_argument("--html", metavar="HTML", help="an interactive view of the plan in the browser (self-contained page)")
     add_verbose(pl)
-    pl.set_defaults(fn=cmd_plan)

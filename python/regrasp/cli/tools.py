@@ -9,14 +9,21 @@ import numpy as np
 
 from ..scene.planar import Scene
 from ..files import Outputs, check_writable
-from . import CANNOT, EXAMPLES, MAX_CONES, OK, check_count, given, planner_default, pusher_runs, seed_arg
+from . import (CANNOT, EXAMPLES, MAX_CONES, OK, add_command, check_count, given, planner_default, pusher_runs, refuse_flags,
+               seed_arg)
+
+#: cones per batch of `regrasp bench`, and of `regrasp bench --quick`
+DEFAULT_CONES, QUICK_CONES = 100_000, 10_000
 
 
 def cmd_bench(a) -> int:
     from ..bench import format_results, run
 
     check_count(a, "n", 1, MAX_CONES)
-    n = 10_000 if a.quick else a.n
+    refuse_flags(a, ("verbose",), "with bench", "it reads no scene files whose notes it could print")
+    if a.quick:
+        refuse_flags(a, ("n",), "with --quick", "--quick measures 10,000 cones; give one of them")
+    n = QUICK_CONES if a.quick else a.n or DEFAULT_CONES
     res = run(n=n, reps=5 if a.quick else 11, baseline_reps=1 if a.quick else 3)
     print(json.dumps(res) if a.json else format_results(res))
     return OK
@@ -55,13 +62,12 @@ def cmd_demo(a) -> int:
 
 
 def add_parsers(sub) -> None:
-    b = sub.add_parser("bench", help="speed probe against numpy baselines")
-    b.add_argument("--json", action="store_true")
-    b.add_argument("--quick", action="store_true", help="10,000 cones instead of 100,000")
-    b.add_argument("-n", type=int, default=100_000, help=f"cones per batch, 1 to {MAX_CONES}")
-    b.set_defaults(fn=cmd_bench)
+    b = add_command(sub, "bench", "speed probe against numpy baselines", "regrasp bench --quick", cmd_bench)
+    b.add_argument("--json", action="store_true", help="print the results as JSON")
+    b.add_argument("--quick", action="store_true", help=f"{QUICK_CONES:,} cones instead of -n, fewer repetitions")
+    b.add_argument("-n", type=int, help=f"cones per batch, 1 to {MAX_CONES} (default {DEFAULT_CONES})")
 
-    d = sub.add_parser("demo", help="the bundled example end to end, writing its figures")
-    d.add_argument("--out", default="out/demo")
+    d = add_command(sub, "demo", "the bundled example end to end, writing its figures", "regrasp demo --out out/demo",
+                    cmd_demo)
+    d.add_argument("--out", default="out/demo", help="directory for the files (created)")
     d.add_argument("--seed", type=seed_arg, help=f"the planner's seed ({planner_default('seed')})")
-    d.set_defaults(fn=cmd_demo)

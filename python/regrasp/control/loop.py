@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _core
+from .. import _core, progress
 from ..errors import ArgumentError, RegraspError, check_seed
 from ..mujoco.model import plan_dict
 from ..mujoco.planar import Perturbation
@@ -296,8 +296,10 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
     se = _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error, noise, seed, pokes)
     run = ControlRun(scene, plan, engine, policy, pokes, se, perturb, controller_scene, noise, seed, dt, speed, horizon,
                      max_time, mpc)
-    while run.t <= run.max_time + 1e-9 and run.tick():
-        run.t += dt
+    with progress.bar(round(run.max_time, 3), f"control ({policy}, {engine})", unit="s") as bar:
+        while run.t <= run.max_time + 1e-9 and run.tick():
+            run.t += dt
+            bar.update(dt)
     return run.result()
 
 

@@ -22,6 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .. import progress
 from ..errors import ArgumentError
 from ..scene.planar import Scene, _number
 from ..sim.quasistatic import Replay, body_twist, integrate_pose
@@ -162,7 +163,8 @@ class PlanarExecution(GripperRig):
         path = plan_dict(plan)["path"]
         for i, k in enumerate(path[1:], 1):
             if k["pusher"] not in scene.pusher_names:
-                raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r} in the scene",
+                raise ArgumentError(f"invalid `plan.path[{i}].pusher`: no pusher {k['pusher']!r} in the scene "
+                                    f"(its pushers: {', '.join(scene.pusher_names)})",
                                     f"plan.path[{i}].pusher")
         super().__init__(scene, path[0]["pose"], sorted({k["pusher"] for k in path[1:]}), perturb, contact)
         self.path, self.speed = path, speed
@@ -233,7 +235,7 @@ class PlanarExecution(GripperRig):
         """Holds the object for ``settle`` [s], then executes the plan push by push."""
         self.idle(settle)
         max_slip = 0.0
-        for seg in _segments(self.path):
+        for seg in progress.iterate(_segments(self.path), "MuJoCo execution", unit="push"):
             max_slip = max(max_slip, self.segment(seg["pusher"], seg["knots"]))
         q = self.pose()
         task = self.scene.task

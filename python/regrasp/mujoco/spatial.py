@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _core
+from .. import _core, progress
 from ..errors import ArgumentError
 from .model import (FEATURE_BITS, OBJECT_BITS, PAD_BITS, Contact, Driver, Rig, add_driven_body, add_geom,
                     add_grip_motors, add_pad_sphere, add_pads, new_spec, plan_dict, set_inertial)
@@ -292,7 +292,13 @@ class SpatialExecution(Rig):
         from ..scene.spatial import goal_report, run_plan3d
 
         self.settle(settle)
-        q, poses, replans = run_plan3d(self.scene, path, self.push, self.in_grasp(), feedback, max_replans, seed)
+        with progress.bar(len(path) - 1, "MuJoCo execution", unit="step") as bar:
+            def push(a: dict, b: dict) -> np.ndarray:
+                q = self.push(a, b)
+                bar.update(1)
+                return q
+
+            q, poses, replans = run_plan3d(self.scene, path, push, self.in_grasp(), feedback, max_replans, seed)
         return {"engine": "mujoco", "view": self.view, **goal_report(self.scene, q), "poses": np.array(poses),
                 "replans": replans}
 

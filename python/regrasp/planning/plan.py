@@ -276,7 +276,8 @@ class Plan:
                                 f"scene, whose poses are {n} numbers {POSE_TEXT[scene.dimension]}", f"{name}.path[0].pose")
         for i, k in enumerate(self.pushers[1:], 1):
             if k not in scene.pusher_names:
-                raise ArgumentError(f"invalid `{name}.path[{i}].pusher`: no pusher {k!r} in the scene",
+                raise ArgumentError(f"invalid `{name}.path[{i}].pusher`: no pusher {k!r} in the scene "
+                                    f"(its pushers: {', '.join(scene.pusher_names)})",
                                     f"{name}.path[{i}].pusher")
             if self.dimension == 3 and self.pusher_twists[i] is None and scene._core.is_plane(k):  # type: ignore[index]
                 raise ArgumentError(f"invalid `{name}.path[{i}].pusher_twist`: a step of plane {k!r} needs its pusher "

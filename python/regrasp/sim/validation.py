@@ -20,6 +20,7 @@ import socket
 
 import numpy as np
 
+from .. import progress as bars
 from ..errors import ArgumentError, RegraspError, check_seed
 from .quasistatic import SPEED
 from ..scene.planar import Scene, _count
@@ -106,14 +107,16 @@ def sample_push(scene: Scene, pose, pusher: str, kind: str, rng):
 
 
 ENGINES = ("quasistatic", "mujoco")
+#: fewest quasi-static pushes solved in one call of the core (it solves a call's pushes in parallel)
+QS_BATCH = 64
 KINDS = ("inside", "near", "random")
 
 
-def samples(scene: Scene, pushes: int, seed: int) -> list:
+def samples(scene: Scene, pushes: int, seed: int, progress: bool = False) -> list:
     """The random pushes: (pusher, kind, pose, twist, predicted stick)."""
     rng = np.random.default_rng(seed)
     out = []
-    for k in range(pushes):
+    for k in bars.iterate(range(pushes), f"drawing pushes ({scene.name})", unit="push", show=progress):
         pusher = scene.pusher_names[rng.integers(len(scene.pusher_names))]
         pose = _random_pose(scene, rng)
         kind = KINDS[k % 3]
@@ -190,27 +193,35 @@ def _run_mujoco(scene: Scene, rows: list, workers: int, ray_address, progress: b
     size = max(1, min(50, len(jobs) // max(4 * workers, 1) or 1))
     chunks = [jobs[k:k + size] for k in range(0, len(jobs), size)]
     result = np.full(len(rows), np.nan)
-    bar = None
-    if progress:
-        try:
-            from tqdm import tqdm
-
-            bar = tqdm(total=len(jobs), desc=f"MuJoCo pushes ({scene.name})", unit="push")
-        except ImportError:
-            bar = None
-
-    def take(part):
-        for i, st in part:
-            result[i] = np.nan if st is None else float(st)
-        if bar is not None:
+    # the bar ends before any message (Ctrl-C included)
+    with bars.bar(len(jobs), f"MuJoCo pushes ({scene.name})", unit="push", show=progress) as bar:
+        def take(part):
+            for i, st in part:
+                result[i] = np.nan if st is None else float(st)
             bar.update(len(part))
 
-    try:
         _each_chunk(scene, chunks, workers, ray_address, take)
-    finally:  # the bar ends before any message (Ctrl-C included)
-        if bar is not None:
-            bar.close()
     return result
+
+
+def _run_quasistatic(scene: Scene, rows: list, support: str, progress: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Whether each push sticks in the quasi-static simulator and whether it was solved: the
+    pushes of each pusher in batches (of at least :data:`QS_BATCH`, for the progress bar)."""
+    sim, ok = np.zeros(len(rows), bool), np.zeros(len(rows), bool)
+    by: dict = {}
+    for i, r in enumerate(rows):
+        by.setdefault(r[0], []).append(i)
+    size = max(QS_BATCH, len(rows) // 50)
+    with bars.bar(len(rows), f"quasi-static pushes ({scene.name})", unit="push", show=progress) as bar:
+        for p, idx in by.items():
+            for k in range(0, len(idx), size):
+                part = idx[k:k + size]
+                st, _, _, err = scene._core.push_outcomes(np.array([rows[i][2] for i in part]), p,
+                                                         np.array([rows[i][3] for i in part]), support, 3, 0, True)
+                sim[part] = st
+                ok[part] = [e is None for e in err]
+                bar.update(len(part))
+    return sim, ok
 
 
 def _table(pred, sim, ok, mask) -> dict:
@@ -240,22 +251,13 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
         raise ArgumentError(f"invalid `engines`: the MuJoCo model is a parallel-jaw grasp; scene {scene.name!r} "
                             f"is a {scene.kind!r} scene (use quasistatic)", "engines")
     workers = workers or os.cpu_count() or 1
-    rows = samples(scene, pushes, seed)
+    rows = samples(scene, pushes, seed, progress)
     pred = np.array([r[4] for r in rows])
     kind = np.array([r[1] for r in rows])
     out = {"scene": scene.name, "pushes": pushes, "seed": seed}
     for engine in engines:
         if engine == "quasistatic":
-            sim = np.zeros(pushes, bool)
-            ok = np.zeros(pushes, bool)
-            by = {}
-            for i, r in enumerate(rows):
-                by.setdefault(r[0], []).append(i)
-            for p, idx in by.items():
-                st, _, _, err = scene._core.push_outcomes(np.array([rows[i][2] for i in idx]), p,
-                                                         np.array([rows[i][3] for i in idx]), support, 3, 0, True)
-                sim[idx] = st
-                ok[idx] = [e is None for e in err]
+            sim, ok = _run_quasistatic(scene, rows, support, progress)
             out["support_model"] = support
         else:
             res = _run_mujoco(scene, rows, workers, ray_address, progress)

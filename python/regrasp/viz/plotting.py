@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import progress
 from ..files import atomic_write
 from ..planning.plan import as_plan
 from ..scene.planar import MotionCone
@@ -266,7 +267,12 @@ def save_animation(anim, fig, path, writer) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
-        atomic_write(path, lambda tmp: anim.save(str(tmp), writer=writer))
+        with progress.bar(None, "animation frames", unit="frame") as bar:
+            def advance(i: int, n: int) -> None:
+                bar.total = n
+                bar.update(1)
+
+            atomic_write(path, lambda tmp: anim.save(str(tmp), writer=writer, progress_callback=advance))
     finally:
         plt.close(fig)
     return path
@@ -525,3 +531,76 @@ def animate_plan3d(scene, plan, path, fps: int = 12, frames_per_step: int = 6) -
 
     anim = FuncAnimation(fig, draw, frames=len(seq), interval=1000 / fps)
     return save_animation(anim, fig, path, PillowWriter(fps=fps))
+
+
+def _quat_matrix(q) -> np.ndarray:
+    """The rotation matrix of a unit quaternion ``[qw, qx, qy, qz]``."""
+    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def _runs_text(pushers) -> str:
+    """The pushes of a plan as runs of one pusher: ``left x3 -> bottom x2``."""
+    runs: list = []
+    for name in pushers[1:]:
+        if runs and runs[-1][0] == name:
+            runs[-1][1] += 1
+        else:
+            runs.append([name, 1])
+    return " -> ".join(f"{n} x{c}" for n, c in runs) or "no pushes"
+
+
+def plot_plan3d(scene, plan, path, intermediate: int = 3) -> Path:
+    """A 3-D plan in one static figure (gripper frame, equal scale): the object's mesh as a
+    wireframe at the start, at ``intermediate`` knots between and at the goal (each labelled with
+    its step and pusher), the two finger pads, and the plan's pusher runs."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    v, t = scene.mesh()
+    v, t = np.asarray(v, float), np.asarray(t, int)
+    plan = as_plan(plan, scene)
+    poses, names = np.asarray(plan.poses, float), plan.pushers
+    last = len(poses) - 1
+    knots = sorted({0, last, *np.linspace(0, last, intermediate + 2).round().astype(int).tolist()})
+    fig = plt.figure(figsize=(7, 6))
+    ax = fig.add_subplot(projection="3d")
+    cmap = plt.get_cmap("viridis")
+    world = {}
+    for k in knots:
+        w = v @ _quat_matrix(poses[k][3:]).T + poses[k][:3]
+        world[k] = w
+        color = cmap(k / max(last, 1))
+        label = "start" if k == 0 else "goal" if k == last else f"step {k} ({names[k]})"
+        ax.add_collection3d(Poly3DCollection(w[t], facecolor=(*color[:3], 0.06 if 0 < k < last else 0.15),
+                                             edgecolor=color, linewidth=0.4 if len(t) < 400 else 0.1))
+        ax.plot([], [], color=color, label=label)
+        c = w.mean(axis=0)
+        ax.text(c[0], c[1], c[2], label if k in (0, last) else str(k), fontsize=8, color=color)
+    pts = np.vstack(list(world.values()))
+    size = float(np.ptp(pts, axis=0).max()) / 2 or 0.01
+    a = np.linspace(0, 2 * np.pi, 40)
+    r = float(scene._core.pad_radius)
+    w0 = world[0]
+    for sgn in (1, -1):  # the pads, where the fingers hold the object at the start
+        y = sgn * np.max(sgn * w0[:, 1])
+        ax.add_collection3d(Poly3DCollection([np.c_[r * np.cos(a), np.full(40, y), r * np.sin(a)]],
+                                             facecolor="0.3", alpha=0.5))
+    ax.plot([], [], color="0.3", lw=6, alpha=0.5, label="finger pads")
+    mid = (pts.max(axis=0) + pts.min(axis=0)) / 2
+    for f, m in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid):
+        f(m - 1.2 * size, m + 1.2 * size)
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m] (grasp axis)")
+    ax.set_zlabel("z [m]")
+    ax.view_init(elev=18, azim=-60)
+    ax.legend(fontsize=7, loc="upper left")
+    status = "plan found" if plan.found else "no plan found (best partial plan)"
+    ax.set_title(f"{scene.name}: {status}, {last} steps\npushes: {_runs_text(names)}", fontsize=9)
+    return _save(fig, path)

@@ -1,0 +1,126 @@
+"""The command line's help: every option has a text and shows its default, every command a
+description and an example; `--version`; the scene's pushers in `--pusher`'s help and errors."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import regrasp
+from regrasp.cli import build_parser, main
+
+ROOT = Path(__file__).resolve().parents[1]
+T_SHAPE = ROOT / "examples" / "t-shape.toml"
+PIVOT = ROOT / "examples" / "pivot-3d.toml"
+
+
+def commands() -> dict[str, argparse.ArgumentParser]:
+    ap = build_parser()
+    (sub,) = [a for a in ap._actions if isinstance(a, argparse._SubParsersAction)]
+    return {"": ap, **sub.choices}
+
+
+def run(*argv) -> tuple[int, str, str]:
+    """`regrasp ARGV` in this process: (status, stdout, stderr); help and errors exit."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            status = main([str(a) for a in argv])
+        except SystemExit as e:
+            status = e.code
+    return status, out.getvalue(), err.getvalue()
+
+
+def flat(text: str) -> str:
+    """Help text with its line breaks (and the hyphens argparse breaks words at) undone."""
+    return re.sub(r"\s+", " ", re.sub(r"-\n\s+", "-", text))
+
+
+CMDS = commands()
+
+
+@pytest.mark.parametrize("name", sorted(CMDS))
+def test_every_option_has_help_and_shows_its_default(name):
+    p = CMDS[name]
+    fmt = p._get_formatter()
+    for action in p._actions:
+        if isinstance(action, (argparse._HelpAction, argparse._SubParsersAction)):
+            continue
+        where = f"regrasp {name} {'/'.join(action.option_strings) or action.dest}"
+        assert action.help and action.help.strip(), f"{where}: no help text"
+        text = fmt._expand_help(action) if action.option_strings else action.help
+        d = action.default
+        if action.option_strings and d not in (None, False, argparse.SUPPRESS):
+            assert f"default: {d}" in text or f"default {d}" in text, f"{where}: help {text!r} does not show default {d!r}"
+        if action.option_strings and action.nargs != 0 and not action.required:
+            assert "default" in text, f"{where}: help {text!r} does not say what applies when it is not given"
+
+
+@pytest.mark.parametrize("name", sorted(set(CMDS) - {""}))
+def test_every_command_has_a_description_an_example_and_help_that_exits_0(name):
+    p = CMDS[name]
+    assert p.description and len(p.description.splitlines()) == 1, f"regrasp {name}: no one-line description"
+    assert p.epilog and f"regrasp {name}" in p.epilog, f"regrasp {name}: no example in the epilog"
+    status, out, err = run(name, "--help")
+    assert status == 0, err
+    assert "example:" in out and p.description in flat(out)
+    # the defaults stated once, in the Rust settings, reach the help
+    if name == "plan":
+        assert f"(default {regrasp.planner_defaults(2)['time_limit']})" in flat(out)
+
+
+def test_the_defaults_come_from_the_core_settings():
+    from regrasp import _core
+
+    helps = {a.dest: a.help for a in CMDS["control"]._actions}
+    assert f"default {_core.mpc_defaults()['horizon']}" in helps["horizon"]
+    assert f"default {_core.mpc_defaults()['dt']}" in helps["dt"]
+
+
+def test_version_prints_the_package_and_core_versions():
+    status, out, _ = run("--version")
+    assert status == 0
+    assert re.fullmatch(rf"regrasp {re.escape(regrasp.__version__)} \(core \S+: \S+, \S+; \w+ \d+\.\d+\)\n", out), out
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "--version"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0 and r.stdout == out
+
+
+@pytest.mark.parametrize("cmd", ["cone", "push"])
+def test_the_pusher_help_lists_the_pushers_of_a_scene_given_before_help(cmd):
+    status, out, _ = run(cmd, str(T_SHAPE), "--help")
+    assert status == 0
+    names = regrasp.load_scene(T_SHAPE).pusher_names
+    assert f"pushers of {T_SHAPE}: {', '.join(names)}" in flat(out)
+    status, out, _ = run(cmd, "--help")  # no scene: it says how to see them
+    assert status == 0 and "lists the scene's pushers" in flat(out) and "pushers of" not in flat(out)
+
+
+def test_an_unknown_pusher_is_invalid_input_listing_the_scene_pushers(tmp_path):
+    cases = [("cone", T_SHAPE, ["--pose", "0,0,0"]),
+             ("push", T_SHAPE, ["--pose", "0,0,0", "--twist", "0,-0.01,0"]),
+             ("push", PIVOT, ["--pose", "0,0,0,1,0,0,0", "--twist", "0,0,0,0,0,0"])]
+    for cmd, scene, rest in cases:
+        status, out, err = run(cmd, str(scene), "--pusher", "nope", *rest)
+        names = regrasp.load_scene(scene).pusher_names
+        assert status == 2, (cmd, scene, err)
+        assert "`--pusher`" in err and ", ".join(names) in err, err
+        assert "Traceback" not in err and out == ""
+
+
+def test_a_plan_with_an_unknown_pusher_is_invalid_input_listing_the_scene_pushers(tmp_path):
+    status, _, err = run("plan", T_SHAPE, "--out", tmp_path / "p.json", "--seed", "0")
+    assert status == 0, err
+    plan = json.loads((tmp_path / "p.json").read_text())
+    plan["path"][1]["pusher"] = "nope"
+    (tmp_path / "p.json").write_text(json.dumps(plan))
+    status, _, err = run("simulate", T_SHAPE, "--plan", tmp_path / "p.json")
+    names = regrasp.load_scene(T_SHAPE).pusher_names
+    assert status == 2 and "pusher" in err and ", ".join(names) in err, err
