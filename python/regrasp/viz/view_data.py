@@ -158,7 +158,10 @@ def _world(poses, v):
 
 def ground(poses, vertices, gravity, size: float, support=None) -> dict:
     """The ground: a square perpendicular to gravity under the object (through its lowest point
-    over ``poses``), or the scene's support (``support``: a dict with ``point`` and ``normal``)."""
+    over ``poses``), or the scene's support (``support``: a dict with ``point`` [m] and ``normal``).
+    ``poses``: object poses in the gripper frame ([x, z, theta] in m, m, rad, or [x, y, z, qw, qx, qy,
+    qz] in m); ``vertices`` [m] in the object frame; ``size`` [m]: the object's size (the square's
+    half side is GROUND_HALF times it)."""
     if support is not None:
         up, point = np.asarray(support["normal"], float), np.asarray(support["point"], float)
     else:
@@ -210,7 +213,8 @@ def feature_edges(v, t, angle: float = 0.35) -> list:
 
 
 def planar_description(scene, plan_poses, plan_pushers) -> dict:
-    """The view's data for a planar :class:`~regrasp.Scene` (see the module doc)."""
+    """The view's data for a planar :class:`~regrasp.Scene` (see the module doc); ``plan_poses``:
+    object poses [x, z, theta] (m, m, rad) in the gripper frame, ``plan_pushers`` their pusher names."""
     outline = np.asarray(scene.outline, float)
     size = float(np.linalg.norm(outline - outline.mean(axis=0), axis=1).max())
     grasp = scene.kind == "grasp"
@@ -248,7 +252,9 @@ def planar_description(scene, plan_poses, plan_pushers) -> dict:
 
 
 def spatial_description(scene, plan_poses, plan_pushers, marks) -> dict:
-    """The view's data for a :class:`~regrasp.Scene3D` (see the module doc)."""
+    """The view's data for a :class:`~regrasp.Scene3D` (see the module doc); ``plan_poses``: object
+    poses [x, y, z, qw, qx, qy, qz] (m, unit quaternion) in the gripper frame, ``plan_pushers``
+    their pusher names."""
     core = scene._core
     v, t = scene.mesh()
     v = np.asarray(v, float)
