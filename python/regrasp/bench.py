@@ -8,14 +8,13 @@ their ratio (baseline / regrasp), plus the largest difference between the two an
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import numpy as np
 
 from .reference import cones as reference
 from .scene.planar import Scene
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+from .examples import ROOT as EXAMPLES  # the bundled example scenes
 
 
 def _median_time(fn, reps: int) -> float:

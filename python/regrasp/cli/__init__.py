@@ -1,10 +1,10 @@
-"""Command line: ``regrasp plan | cone | approx-error | validate | simulate | control | push | bench | demo``.
+"""Command line: ``regrasp plan | cone | approx-error | validate | simulate | control | push | bench | demo | examples``.
 
 Exit status: 0 success, 1 the task cannot be done (reason printed; also an internal error), 2 invalid
 input, 130 interrupted (Ctrl-C), 141 standard output closed early (e.g. piped into ``head``).
 
 One module per command group: ``cones`` (cone, approx-error), ``planning`` (plan), ``dynamics``
-(validate, simulate, push), ``control`` (control), ``tools`` (bench, demo). Each has
+(validate, simulate, push), ``control`` (control), ``tools`` (bench, demo), ``examples`` (examples). Each has
 ``add_parsers(sub)``; this module assembles them and holds what they share.
 """
 
@@ -24,7 +24,7 @@ from ..planning.plan import Plan, planner_defaults
 from ..scene import load_scene
 from ..scene.planar import Scene
 
-EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
+from ..examples import ROOT as EXAMPLES  # the bundled example scenes (regrasp.examples)
 
 #: exit statuses (docs/cli.md): 130 = 128 + SIGINT, 141 = 128 + SIGPIPE (the shell's convention)
 OK, CANNOT, INVALID, INTERRUPTED, BROKEN_PIPE = 0, 1, 2, 130, 141
@@ -232,12 +232,12 @@ def add_verbose(p) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from . import cones, control, dynamics, planning, tools
+    from . import cones, control, dynamics, examples, planning, tools
 
     ap = argparse.ArgumentParser(prog="regrasp", description=__doc__.splitlines()[0])
     ap.add_argument("-v", "--verbose", action="store_true", help="print the scenes' notes on stderr")
     sub = ap.add_subparsers(dest="cmd", required=True)
-    for group in (planning, cones, dynamics, control, tools):
+    for group in (planning, cones, dynamics, control, tools, examples):
         group.add_parsers(sub)
     return ap
 
