@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import ArgumentError, GraspError
 from ..scene.planar import Scene
-from . import (CANNOT, EXAMPLES, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, add_verbose, check_count, check_outputs, floats,
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, add_verbose, check_count, check_outputs, floats,
                load_planar, seed_arg)
 
 

@@ -10,7 +10,7 @@ from typing import Optional
 
 import numpy as np
 
-from .. import _core
+from .. import _core, quaternion
 from ..errors import ArgumentError, RegraspError, SceneError, check_seed
 from ..planning.plan import Plan, as_plan
 from .common import core_property, read_scene_file
@@ -132,12 +132,9 @@ def _core_from_toml(text: str, base):
 def twist_in(rel, u) -> list:
     """Body twist ``u`` of a frame B expressed in frame A, where ``rel`` = A⁻¹B (the adjoint):
     ``[R v + p × (R ω), R ω]``."""
-    from scipy.spatial.transform import Rotation
-
     rel, u = np.asarray(rel, float), np.asarray(u, float)
-    R = Rotation.from_quat([rel[4], rel[5], rel[6], rel[3]])
-    w = R.apply(u[3:])
-    return (R.apply(u[:3]) + np.cross(rel[:3], w)).tolist() + w.tolist()
+    w = quaternion.rotate(rel[3:], u[3:])
+    return (quaternion.rotate(rel[3:], u[:3]) + np.cross(rel[:3], w)).tolist() + w.tolist()
 
 
 def goal_report(scene: "Scene3D", q) -> dict:
