@@ -9,17 +9,22 @@ OUT    ?= out
 
 all: build
 
+DEVELOP := VIRTUAL_ENV=$(abspath $(VENV)) PATH="$(abspath $(BIN)):$$PATH" $(BIN)/maturin develop --release -q
+
+# The dependencies are pyproject.toml's, once: the core's, every extra (`all`) and `dev`, installed
+# by maturin with the package (editable install of python/regrasp).
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q "maturin>=1.5,<2" "numpy>=1.24" "scipy>=1.10" "matplotlib>=3.7" "casadi>=3.6" "mujoco>=3.1" "tqdm>=4.60" "ray>=2.9" "pytest>=7" "hypothesis>=6.80"
+	$(BIN)/pip install -q "maturin>=1.5,<2"
+	$(DEVELOP) -E all,dev
 	touch $@
 
 setup: $(STAMP)
 
-# Build the Rust extension into the virtual environment (editable install of python/regrasp).
+# Build the Rust extension into the virtual environment (the dependencies are there already).
 build: $(STAMP)
-	VIRTUAL_ENV=$(abspath $(VENV)) PATH="$(abspath $(BIN)):$$PATH" $(BIN)/maturin develop --release -q
+	$(DEVELOP)
 
 test: test-rust test-python
 

@@ -13,7 +13,7 @@ Quick use::
 """
 
 from ._core import __version__
-from .errors import ArgumentError, GraspError, InternalError, RegraspError, SceneError
+from .errors import ArgumentError, GraspError, InternalError, MissingExtraError, RegraspError, SceneError
 from .planning.plan import Plan, plan, planner_defaults
 from .scene import load_scene
 from .scene.planar import Classification, GravityFreeCone, MotionCone, MotionConeBatch, Pusher, Scene, Task
@@ -27,6 +27,7 @@ __all__ = [
     "ArgumentError",
     "GraspError",
     "InternalError",
+    "MissingExtraError",
     "RegraspError",
     "SceneError",
     "Classification",

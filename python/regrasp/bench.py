@@ -7,16 +7,17 @@ their ratio (baseline / regrasp), plus the largest difference between the two an
 
 from __future__ import annotations
 
+import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
 from . import progress
+from .errors import MissingExtraError
+from .examples import ROOT as EXAMPLES  # the bundled example scenes
+from .extras import have, need
 from .reference import cones as reference
 from .scene.planar import Scene
-
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def _median_time(fn, reps: int) -> float:
@@ -52,10 +53,10 @@ def run(n: int = 100_000, reps: int = 11, baseline_reps: int = 3, scene_path=Non
         ("membership", lambda: _membership(params, poses, twists, batch, reps)),
         ("single cone", lambda: _single_cone(scene, pusher, params, poses[0], reps)),
         ("projection", lambda: _projection(scene, pusher, poses, twists, reps)),
-        ("MNCP solver", lambda: run_mncp(reps=reps)),
+        ("MNCP solver", lambda: _unless_missing("the MNCP solver against IPOPT", lambda: run_mncp(reps=reps))),
         ("planner", run_planner),
-        ("MuJoCo", run_mujoco),
-        ("MPC", run_mpc),
+        ("MuJoCo", lambda: _unless_missing("MuJoCo's speed", run_mujoco)),
+        ("MPC", lambda: _unless_missing("the MPC step against SciPy", run_mpc)),
         ("3-D planner", run_plan3d),
     ]
     results = {}
@@ -65,6 +66,16 @@ def run(n: int = 100_000, reps: int = 11, baseline_reps: int = 3, scene_path=Non
             results.update(measure())
             bar.update(1)
     return results
+
+
+def _unless_missing(what: str, probe) -> dict:
+    """``probe()``, or nothing when it needs an optional dependency that is not installed (said
+    on stderr, with the extra that brings it)."""
+    try:
+        return probe()
+    except MissingExtraError as e:
+        print(f"bench: {what} skipped: it needs {e.what} (pip install 'regrasp[{e.extra}]')", file=sys.stderr)
+        return {}
 
 
 def _cone_batch(scene: Scene, pusher: str, params, poses, batch, reps: int, baseline_reps: int) -> dict:
@@ -147,7 +158,7 @@ def _projection(scene: Scene, pusher: str, poses, twists, reps: int) -> dict:
 def run_mujoco(steps: int = 4000) -> dict:
     """MuJoCo's speed on the gripper scene (steps per second) beside the quasi-static
     simulator's time for the same push (10 mm at 10 mm/s)."""
-    import mujoco
+    mujoco = need("mujoco", "mujoco")
 
     from .mujoco.push import PushRig
     from .sim.quasistatic import simulate_push
@@ -180,7 +191,7 @@ def run_mujoco(steps: int = 4000) -> dict:
 def _mpc_qp_scipy(scene: Scene, q, steps, targets, settings: dict):
     """The MPC's QP (see crates/regrasp-core/src/control/mpc.rs) solved by scipy's SLSQP: the
     baseline; ``settings`` the MPC's (``_core.mpc_defaults()``)."""
-    from scipy.optimize import minimize
+    minimize = need("scipy.optimize", "reference").minimize
 
     speed, dt = settings["speed"], settings["dt"]
     stage, terminal, effort = settings["stage_weight"], settings["terminal_weight"], settings["effort_weight"]
@@ -269,7 +280,7 @@ def run_plan3d(seeds: int = 10, examples=PLANNED_3D) -> dict:
         p = s.quasistatic_problem(first.poses[0], first.pushers[1], 1.0)
         u = first.pusher_twists[1]
         times = []
-        for _ in range(3):
+        for _ in range(3 if have("casadi") else 0):  # the IPOPT baseline needs regrasp[reference]
             try:
                 times.append(mncp_reference.solve(p, pusher_twist=u).solve_time_s)
             except Exception:  # noqa: BLE001 - a failed reference solve is left out
@@ -277,7 +288,8 @@ def run_plan3d(seeds: int = 10, examples=PLANNED_3D) -> dict:
         t_ipopt = float(np.median(times)) if times else float("nan")
         out[f"plan3d_{name}"] = {
             "median_s": t, "baseline_median_s": solves * t_ipopt, "ratio": solves * t_ipopt / max(t, 1e-9),
-            "baseline": f"the same search with IPOPT solves ({solves:.0f} solves x {1e3 * t_ipopt:.1f} ms)",
+            "baseline": f"the same search with IPOPT solves ({solves:.0f} solves x {1e3 * t_ipopt:.1f} ms)" if times
+                        else "IPOPT baseline skipped: pip install 'regrasp[reference]'",
             "found": sum(r.found for r in runs), "n": seeds, "median_solves": solves,
             "switch_overs": float(np.median([r.switch_overs for r in runs])),
         }

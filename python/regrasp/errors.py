@@ -28,6 +28,20 @@ class InternalError(RegraspError, RuntimeError):
     the message carries the panic's message and location.)"""
 
 
+class MissingExtraError(RegraspError, ImportError):
+    """An optional dependency is not installed: ``module`` (e.g. ``mujoco``) comes with the
+    package's extra ``extra`` (``pip install 'regrasp[mujoco]'``); ``what`` names it for people."""
+
+    def __init__(self, module: str, extra: str, what: str | None = None):
+        self.module, self.extra, self.what = module, extra, what or module
+        super().__init__(f"{self.what} is not installed (module `{module}`): pip install 'regrasp[{extra}]'")
+        ImportError.__init__(self, str(self), name=module)
+        self.field = None
+
+    def __reduce__(self):  # picklable (worker processes)
+        return type(self), (self.module, self.extra, self.what)
+
+
 def check_seed(seed) -> int:
     """A random seed: a whole number >= 0 (the core's generators take an unsigned 64-bit seed)."""
     import numbers

@@ -1,10 +1,10 @@
-"""Command line: ``regrasp plan | cone | approx-error | validate | simulate | control | push | bench | demo``.
+"""Command line: ``regrasp plan | cone | approx-error | validate | simulate | control | push | bench | demo | examples``.
 
-Exit status: 0 success, 1 the task cannot be done (reason printed; also an internal error), 2 invalid
-input, 130 interrupted (Ctrl-C), 141 standard output closed early (e.g. piped into ``head``).
+Exit status: 0 success, 1 the task cannot be done (reason printed; also an internal error, and a
+missing optional dependency: the extra to install is named), 2 invalid input, 130 interrupted (Ctrl-C), 141 standard output closed early (e.g. piped into ``head``).
 
 One module per command group: ``cones`` (cone, approx-error), ``planning`` (plan), ``dynamics``
-(validate, simulate, push), ``control`` (control), ``tools`` (bench, demo). Each has
+(validate, simulate, push), ``control`` (control), ``tools`` (bench, demo), ``examples`` (examples). Each has
 ``add_parsers(sub)``; this module assembles them and holds what they share.
 """
 
@@ -18,13 +18,12 @@ from pathlib import Path
 import numpy as np
 
 from .. import errors, progress
-from ..errors import ArgumentError, RegraspError, SceneError
+from ..errors import ArgumentError, MissingExtraError, RegraspError, SceneError
 from ..files import check_writable, refuse_overwrite_input
 from ..planning.plan import Plan, planner_defaults
 from ..scene import load_scene
 from ..scene.planar import Scene
 
-EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 
 #: exit statuses (docs/cli.md): 130 = 128 + SIGINT, 141 = 128 + SIGPIPE (the shell's convention)
 OK, CANNOT, INVALID, INTERRUPTED, BROKEN_PIPE = 0, 1, 2, 130, 141
@@ -297,7 +296,7 @@ def add_quiet(p, default=False) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from . import cones, control, dynamics, planning, tools
+    from . import cones, control, dynamics, examples, planning, tools
 
     ap = Parser(prog="regrasp", description="In-hand regrasps by prehensile pushing: motion cones, planning, "
                 "simulation and control (`regrasp COMMAND --help` for each command).",
@@ -306,7 +305,7 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("-v", "--verbose", action="store_true", help="print the scenes' notes on stderr")
     add_quiet(ap)
     sub = ap.add_subparsers(dest="cmd", required=True, parser_class=Parser)
-    for group in (planning, cones, dynamics, control, tools):
+    for group in (planning, cones, dynamics, control, tools, examples):
         group.add_parsers(sub)
     for p in sub.choices.values():
         add_quiet(p, argparse.SUPPRESS)
@@ -326,6 +325,8 @@ def _run(args) -> tuple[int, str | None]:
         return INVALID, str(e)
     except internal as e:  # a caught panic of the Rust core
         return CANNOT, _internal(e)
+    except MissingExtraError as e:  # an optional dependency not installed: which extra brings it
+        return CANNOT, f"`regrasp {args.cmd}` needs {e.what}: pip install 'regrasp[{e.extra}]'"
     except RegraspError as e:  # GraspError and the rest: the task cannot be done
         return CANNOT, str(e)
     except (KeyboardInterrupt, BrokenPipeError):

@@ -8,9 +8,8 @@ import sys
 import numpy as np
 
 from ..errors import ArgumentError, GraspError
-from ..scene.common import is_3d_text, read_scene_file
 from ..scene.planar import Scene
-from . import (CANNOT, EXAMPLES, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, PUSHER_HELP, add_command, add_verbose,
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, PUSHER_HELP, add_command, add_verbose,
                check_count, check_outputs, check_pusher, floats, load_planar, seed_arg)
 
 
@@ -99,7 +98,9 @@ def cmd_cone(a) -> int:
 
 
 def _bundled_planar_examples() -> list:
-    return [p for p in sorted(EXAMPLES.glob("*.toml")) if not is_3d_text(read_scene_file(p)[1])]
+    from .. import examples
+
+    return examples.planar()
 
 
 def cmd_approx_error(a) -> int:

@@ -8,6 +8,7 @@ import numpy as np
 
 from .. import _core, progress
 from ..errors import ArgumentError
+from ..extras import need
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, PUSHER_HELP, VIDEO_SUFFIXES,
@@ -88,6 +89,7 @@ def _check_simulate(a) -> None:
         raise ArgumentError("invalid `--perturb`: a spread in [0, 1)", "--perturb")
     check_outputs(a, {"plot": FIGURE_SUFFIXES, "video": VIDEO_SUFFIXES}, [a.scene, a.plan])
     if a.video and a.video.lower().endswith(".mp4"):
+        need("matplotlib", "plot")
         import matplotlib.animation
 
         if not matplotlib.animation.writers.is_available("ffmpeg"):

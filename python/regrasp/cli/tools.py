@@ -7,9 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import examples
 from ..scene.planar import Scene
 from ..files import Outputs, check_writable
-from . import (CANNOT, EXAMPLES, MAX_CONES, OK, add_command, check_count, given, planner_default, pusher_runs, refuse_flags,
+from . import (CANNOT, MAX_CONES, OK, add_command, check_count, given, planner_default, pusher_runs, refuse_flags,
                seed_arg)
 
 #: cones per batch of `regrasp bench`, and of `regrasp bench --quick`
@@ -32,11 +33,11 @@ def cmd_bench(a) -> int:
 def cmd_demo(a) -> int:
     from ..planning.plan import plan
     from ..sim.quasistatic import replay_plan
-    from ..viz.plotting import animate_plan, plot_motion_cone, plot_plan, plot_replay
+    from ..extras import have
 
     out = Path(a.out)
     check_writable(out / "t-shape-plan.json", "--out", create_folder=True)
-    path = EXAMPLES / "t-shape.toml"
+    path = examples.path("t-shape")
     scene = Scene.load(path)
     t = scene.task
     print(f"demo: regrasp of the T-shaped object ({path.name}) from {t.start.tolist()} to {t.goal.tolist()}")
@@ -51,14 +52,27 @@ def cmd_demo(a) -> int:
           f"error {np.round(1e3 * rep.goal_error[:2], 2).tolist()} mm / {np.degrees(rep.goal_error[2]):.2f} deg, "
           f"{'within' if rep.success else 'outside'} the tolerance")
     out.mkdir(parents=True, exist_ok=True)
+    figures = have("matplotlib")
     with Outputs() as outs:  # all or none
         outs.write(out / "t-shape-plan.json", lambda tmp: p.save(tmp))
-        outs.write(out / "t-shape-plan.png", lambda tmp: plot_plan(scene, p, tmp))
-        outs.write(out / "t-shape-plan.gif", lambda tmp: animate_plan(scene, p, tmp))
-        outs.write(out / f"cone-{first}.png", lambda tmp: plot_motion_cone(scene.motion_cone(t.start, first), tmp))
-        outs.write(out / "t-shape-replay.png", lambda tmp: plot_replay(scene, rep, tmp))
-    print(f"wrote {out}/t-shape-plan.json, t-shape-plan.png, t-shape-plan.gif, t-shape-replay.png, cone-{first}.png")
+        if figures:
+            _demo_figures(outs, out, scene, p, rep, first)
+    print(f"wrote {out}/t-shape-plan.json" + (f", t-shape-plan.png, t-shape-plan.gif, t-shape-replay.png, cone-{first}.png"
+                                              if figures else ""))
+    if not figures:
+        print("figures skipped: pip install 'regrasp[plot]'")
     return OK if p.found else CANNOT
+
+
+def _demo_figures(outs, out: Path, scene, p, rep, first: str) -> None:
+    """The demo's figures and animation (matplotlib), staged in ``outs``."""
+    from ..viz.plotting import animate_plan, plot_motion_cone, plot_plan, plot_replay
+
+    start = scene.task.start
+    outs.write(out / "t-shape-plan.png", lambda tmp: plot_plan(scene, p, tmp))
+    outs.write(out / "t-shape-plan.gif", lambda tmp: animate_plan(scene, p, tmp))
+    outs.write(out / f"cone-{first}.png", lambda tmp: plot_motion_cone(scene.motion_cone(start, first), tmp))
+    outs.write(out / "t-shape-replay.png", lambda tmp: plot_replay(scene, rep, tmp))
 
 
 def add_parsers(sub) -> None:

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ArgumentError
+from ..extras import need
 from ..scene.planar import Scene
 
 THICKNESS = 0.012  # m, the object's thickness along the grasp axis
@@ -186,7 +187,7 @@ def _padded(v, n: int, fill: float = 0.0) -> list:
 
 def new_spec(name: str, gravity, contact: Contact = Contact()):
     """An empty model with the options and the geoms' default contact parameters of ``contact``."""
-    import mujoco
+    mujoco = need("mujoco", "mujoco")
 
     spec = mujoco.MjSpec()
     spec.modelname = name
@@ -210,7 +211,7 @@ def add_geom(body, kind: str, size, bits=(0, 0), friction=None, **kw):
     """A geom of MuJoCo type ``kind`` ("box", "sphere", ...) with collision ``bits`` (contype,
     conaffinity) and ``friction`` (sliding, torsional, rolling; what is not given is 0, None:
     MuJoCo's default); other attributes as keywords."""
-    import mujoco
+    mujoco = need("mujoco", "mujoco")
 
     if friction is not None:
         kw["friction"] = _padded(friction, 3)
@@ -240,7 +241,7 @@ def add_driven_body(parent, name: str, spatial: bool = False):
     Unlike a mocap body, its contacts see its velocity, so friction drags what it touches. It is
     heavy (1 t, 1000 kg m²) so that contact forces do not change its velocity within a step: a
     light driven body is kicked back by its contacts every step, which they see as slip."""
-    import mujoco
+    mujoco = need("mujoco", "mujoco")
 
     body = parent.add_body(name=name, gravcomp=1.0)
     slide, hinge, ball = mujoco.mjtJoint.mjJNT_SLIDE, mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_BALL
@@ -256,7 +257,7 @@ def add_pads(parent, ys, geoms, gravcomp: float = 1.0):
     """The two pads, bodies ``pad_left`` (+Y side) and ``pad_right`` at Y = ``ys``, each on a
     slide joint along Y (damping 20) squeezed by the motors of :func:`add_grip_motors`;
     ``geoms(body, sign)`` adds a pad's geoms (sign +1 left, −1 right)."""
-    import mujoco
+    mujoco = need("mujoco", "mujoco")
 
     for (name, sign), y in zip((("pad_left", 1), ("pad_right", -1)), ys):
         body = parent.add_body(name=name, pos=[0.0, y, 0.0], gravcomp=gravcomp)
@@ -275,7 +276,7 @@ def add_pad_sphere(body, sign: int, mu: float, torsion: float):
 
 def add_grip_motors(spec):
     """Force actuators squeezing the pads (control: the grip force [N])."""
-    import mujoco
+    mujoco = need("mujoco", "mujoco")
 
     for side, gear in (("left", -1.0), ("right", 1.0)):
         spec.add_actuator(name=f"grip_{side}", target=f"pad_{side}", trntype=mujoco.mjtTrn.mjTRN_JOINT,
@@ -410,7 +411,7 @@ class Rig:
     """A compiled model with its data, the pads squeezed with ``grip_force`` [N] each."""
 
     def __init__(self, spec, contact: Contact, grip_force: float):
-        import mujoco
+        mujoco = need("mujoco", "mujoco")
 
         self.contact, self.dt = contact, contact.timestep
         self.model = spec.compile()
@@ -420,13 +421,13 @@ class Rig:
 
     def step(self):
         """One MuJoCo time step (``mj_step``)."""
-        import mujoco
+        mujoco = need("mujoco", "mujoco")
 
         mujoco.mj_step(self.model, self.data)
 
     def forward(self):
         """Recomputes the derived quantities without stepping (``mj_forward``)."""
-        import mujoco
+        mujoco = need("mujoco", "mujoco")
 
         mujoco.mj_forward(self.model, self.data)
 

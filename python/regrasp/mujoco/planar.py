@@ -24,6 +24,7 @@ import numpy as np
 
 from .. import progress
 from ..errors import ArgumentError
+from ..extras import need
 from ..scene.planar import Scene, _number
 from ..sim.quasistatic import Replay, body_twist, integrate_pose
 from .push import MAX_DURATION
@@ -259,10 +260,10 @@ def execute_plan(scene: Scene, plan, perturb: Perturbation = Perturbation(), spe
 def animate_execution(scene: Scene, rep: Replay, path, fps: int = 20, every: int = 3):
     """A GIF (or MP4 when ffmpeg is available) of the object in the grasp during an execution,
     with the planned pose dashed."""
-    import matplotlib
+    matplotlib = need("matplotlib", "plot")
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
     from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
     from matplotlib.patches import Circle, Polygon
 

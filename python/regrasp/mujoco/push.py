@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..extras import need
 from ..scene.planar import Scene, _name, _number, _vec
 
 #: the longest push :func:`simulate_push` simulates [s] (MuJoCo steps of 0.5 ms: a bound on its time)
@@ -42,7 +43,7 @@ class PushRig(Rig):
 
     def reset(self, pose):
         """Resets the simulation with the object at ``pose`` ``[x, z, theta]`` (m, m, rad)."""
-        import mujoco
+        mujoco = need("mujoco", "mujoco")
 
         mujoco.mj_resetData(self.model, self.data)
         put_object(self.model, self.data, pose)

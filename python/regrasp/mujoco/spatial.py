@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _core, progress
+from .. import _core, progress, quaternion
 from ..errors import ArgumentError
 from .model import (FEATURE_BITS, OBJECT_BITS, PAD_BITS, Contact, Driver, Rig, add_driven_body, add_geom,
                     add_grip_motors, add_pad_sphere, add_pads, new_spec, plan_dict, set_inertial)
@@ -71,10 +71,7 @@ def _tangents(n) -> tuple:
 
 def _quat(t1, t2, n) -> np.ndarray:
     """The quaternion [w, x, y, z] of the frame with axes t1, t2, n."""
-    from scipy.spatial.transform import Rotation
-
-    q = Rotation.from_matrix(np.c_[t1, t2, n]).as_quat()
-    return np.r_[q[3], q[:3]]
+    return quaternion.from_matrix(np.c_[t1, t2, n])
 
 
 def plane_frame(scene, name: str, pose) -> np.ndarray:

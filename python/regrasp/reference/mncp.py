@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import RegraspError
+from ..extras import need
 
 
 class ReferenceSolverError(RegraspError):
@@ -68,7 +69,7 @@ class _Program:
         return x
 
     def var(self, name: str, n: int, lb: float, ub: float, init):
-        import casadi as ca
+        ca = need("casadi", "reference")
 
         return self.unknown(ca.SX.sym(name, n), n, lb, ub, init)
 
@@ -86,7 +87,7 @@ class _Program:
 def _twists(prog: _Program, dim: int, vs: float, pusher_twist, twist, x0):
     """The object's twist V and the pusher's U (scaled): the given one a constant, the other an
     unknown started at the given one (or at ``x0["twist"]``)."""
-    import casadi as ca
+    ca = need("casadi", "reference")
 
     if twist is None:
         init = np.asarray(pusher_twist) / vs if x0 is None else np.asarray(x0["twist"]) / vs
@@ -103,7 +104,7 @@ def _twists(prog: _Program, dim: int, vs: float, pusher_twist, twist, x0):
 def _friction(prog: _Program, c: dict, fn, ft, s, ut, k: int, fs: float) -> None:
     """The friction law of one contact: Coulomb's cone with maximum dissipation, or a
     limit-surface patch."""
-    import casadi as ca
+    ca = need("casadi", "reference")
 
     if c["friction"] == "coulomb":
         mu = c["mu"]
@@ -125,7 +126,7 @@ def _friction(prog: _Program, c: dict, fn, ft, s, ut, k: int, fs: float) -> None
 def _contact(prog: _Program, i: int, c: dict, V, U, h: float, vs: float, fs: float):
     """One contact's unknowns and constraints; returns its normal force, friction force and its
     term of the Newton–Euler equations."""
-    import casadi as ca
+    ca = need("casadi", "reference")
 
     jn, jt = np.asarray(c["jn"]), np.asarray(c["jt"])
     jno, jto = np.asarray(c["jn_other"]), np.asarray(c["jt_other"])
@@ -147,7 +148,7 @@ def _contact(prog: _Program, i: int, c: dict, V, U, h: float, vs: float, fs: flo
 def _solve_relaxed(prog: _Program, newton_euler, dim: int, tol: float, max_iter: int):
     """IPOPT on the program, the relaxation ε driven from 1 to 1e-10, each solve warm-starting
     the next. Returns (x, the last solution, solver stats, iterations, seconds)."""
-    import casadi as ca
+    ca = need("casadi", "reference")
 
     eps = ca.SX.sym("eps")
     g = [newton_euler] + prog.g + [r - eps for r in prog.relaxed]
@@ -175,7 +176,7 @@ def solve(problem, pusher_twist=None, twist=None, tol: float = 1e-10, accept: fl
     ``problem`` is a :class:`regrasp._core.MncpProblem`. Raises :class:`ReferenceSolverError`
     when IPOPT fails or the solution's largest scaled constraint residual exceeds ``accept``.
     """
-    import casadi as ca
+    ca = need("casadi", "reference")
 
     if (pusher_twist is None) == (twist is None):
         raise ValueError("give exactly one of pusher_twist (forward) or twist (inverse)")

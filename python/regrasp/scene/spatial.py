@@ -10,8 +10,8 @@ from typing import Optional
 
 import numpy as np
 
-from .. import _core
-from ..errors import ArgumentError, RegraspError, check_seed
+from .. import _core, quaternion
+from ..errors import ArgumentError, RegraspError, SceneError, check_seed
 from ..planning.plan import Plan, as_plan
 from .common import core_property, read_scene_file
 from .planar import _flag, _name, _number, _vec
@@ -32,7 +32,7 @@ class Scene3D:
         """The 3-D scene of a scene file (``dimension = 3``; mesh paths relative to its folder). Raises
         ArgumentError when ``path`` cannot be read, SceneError naming the field at fault."""
         p, text = read_scene_file(path)
-        return cls(_core.Scene3D.from_toml(text, str(p.parent)), p)
+        return cls(_core_from_toml(text, p.parent), p)
 
     @classmethod
     def from_toml(cls, text: str, base=None) -> "Scene3D":
@@ -41,7 +41,7 @@ class Scene3D:
             raise ArgumentError(f"invalid `text`: the scene file's text, a str (got {type(text).__name__})", "text")
         if base is not None and not isinstance(base, (str, Path)):
             raise ArgumentError(f"invalid `base`: a folder path or None (got {type(base).__name__})", "base")
-        return cls(_core.Scene3D.from_toml(text, None if base is None else str(base)))
+        return cls(_core_from_toml(text, base))
 
     def __repr__(self) -> str:
         return f"Scene3D({self.name!r}, pushers={self.pusher_names})"
@@ -134,15 +134,24 @@ class Scene3D:
         return {"engine": "quasistatic", **goal_report(self, end), "poses": np.array(poses), "replans": replans}
 
 
+def _core_from_toml(text: str, base):
+    """The core's 3-D scene of ``text`` (mesh paths relative to folder ``base``, None: the current
+    folder); an unreadable ``object.mesh`` says which folder its path is relative to."""
+    try:
+        return _core.Scene3D.from_toml(text, None if base is None else str(base))
+    except SceneError as e:
+        if e.field != "object.mesh" or "cannot read" not in str(e):
+            raise
+        folder = Path(base or ".").absolute()
+        raise SceneError(f"{e} (`object.mesh` is relative to the scene file's folder, {folder})", e.field) from None
+
+
 def twist_in(rel, u) -> list:
     """Body twist ``u`` of a frame B expressed in frame A, where ``rel`` = A⁻¹B (the adjoint):
     ``[R v + p × (R ω), R ω]``."""
-    from scipy.spatial.transform import Rotation
-
     rel, u = np.asarray(rel, float), np.asarray(u, float)
-    R = Rotation.from_quat([rel[4], rel[5], rel[6], rel[3]])
-    w = R.apply(u[3:])
-    return (R.apply(u[:3]) + np.cross(rel[:3], w)).tolist() + w.tolist()
+    w = quaternion.rotate(rel[3:], u[3:])
+    return (quaternion.rotate(rel[3:], u[:3]) + np.cross(rel[:3], w)).tolist() + w.tolist()
 
 
 def goal_report(scene: "Scene3D", q) -> dict:

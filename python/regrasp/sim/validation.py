@@ -22,6 +22,7 @@ import numpy as np
 
 from .. import progress as bars
 from ..errors import ArgumentError, RegraspError, check_seed
+from ..extras import need
 from .quasistatic import SPEED
 from ..scene.planar import Scene, _count
 
@@ -164,10 +165,7 @@ def _each_chunk(scene: Scene, chunks: list, workers: int, ray_address, take) -> 
     """``take(outcomes)`` of every chunk, run on Ray (``ray_address``), here (one worker) or in a
     process pool."""
     if ray_address is not None:
-        try:
-            import ray
-        except ImportError as e:
-            raise ArgumentError("invalid `--ray`: the `ray` package is not installed (pip install ray)", "--ray") from e
+        ray = need("ray", "ray")
         if not ray.is_initialized():
             _check_reachable(ray_address)
             ray.init(address=None if ray_address == "local" else ray_address, include_dashboard=False,
@@ -250,6 +248,10 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
     if "mujoco" in engines and scene.kind != "grasp":
         raise ArgumentError(f"invalid `engines`: the MuJoCo model is a parallel-jaw grasp; scene {scene.name!r} "
                             f"is a {scene.kind!r} scene (use quasistatic)", "engines")
+    if "mujoco" in engines:  # before any work
+        need("mujoco", "mujoco")
+        if ray_address is not None:
+            need("ray", "ray")
     workers = workers or os.cpu_count() or 1
     rows = samples(scene, pushes, seed, progress)
     pred = np.array([r[4] for r in rows])

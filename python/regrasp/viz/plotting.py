@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import progress
+from ..extras import need
 from ..files import atomic_write
 from ..planning.plan import as_plan
 from ..scene.planar import MotionCone
@@ -46,10 +47,10 @@ def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
     by gravity and their intersection (the wrench set); (right) twist space: the exact, curved
     motion cone, its polyhedral approximation and the gravity-free cone; beside them a chart of
     ray directions where the difference shows."""
-    import matplotlib
+    matplotlib = need("matplotlib", "plot")
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
 
     fig = plt.figure(figsize=(18, 6))
     samples = boundary_samples(cone)
@@ -189,10 +190,10 @@ def _axes_pose(ax, t, q, label_prefix="", style=None):
 def plot_push(scene, tr: dict, pusher: str, twist, path) -> Path:
     """Object pose (m, m, rad) in the grasp and contact forces [N] over time [s] for one simulated
     push of ``twist`` (m/s, m/s, rad/s); the figure is written to ``path``."""
-    import matplotlib
+    matplotlib = need("matplotlib", "plot")
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
 
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
     t = tr["t"]
@@ -219,10 +220,10 @@ def plot_push(scene, tr: dict, pusher: str, twist, path) -> Path:
 
 def plot_replay(scene, rep, path, extra=None) -> Path:
     """Planned against executed object pose in the grasp over a replayed plan."""
-    import matplotlib
+    matplotlib = need("matplotlib", "plot")
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
 
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
     _axes_pose(ax, rep.t, rep.planned, "planned ", dict(ls="--", color="0.5"))
@@ -247,7 +248,7 @@ def save_time_figure(fig, axes, title: str, path, fontsize: int = 8) -> Path:
 
 def _save(fig, path) -> Path:
     """Lays out, writes (creating the folder) and closes a figure."""
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
 
     fig.tight_layout()
     path = Path(path)
@@ -262,7 +263,7 @@ def _save(fig, path) -> Path:
 
 def save_animation(anim, fig, path, writer) -> Path:
     """Writes an animation atomically with ``writer`` (creating the folder) and closes its figure."""
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -284,7 +285,7 @@ PUSHER_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple",
 def animation_axes(scene, poses):
     """A figure and bare, equal-aspect axes framing the object at every pose of ``poses``
     (m, m, rad) (1 cm margin)."""
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
 
     pts = np.vstack([_object_at(scene, q) for q in poses])
     lo, hi = pts.min(axis=0) - 0.01, pts.max(axis=0) + 0.01
@@ -312,10 +313,10 @@ def _pusher_at(scene, q, name):
 def plot_plan(scene, plan, path) -> Path:
     """The object in the grasp (gripper frame) at the plan's knots, the finger pad, and each
     push coloured by its pusher (thesis Figs 4-11..4-14); beside it the pose over the steps."""
-    import matplotlib
+    matplotlib = need("matplotlib", "plot")
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
     from matplotlib.patches import Circle, Polygon
 
     plan = as_plan(plan, scene)
@@ -367,10 +368,10 @@ def plot_plan(scene, plan, path) -> Path:
 
 def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> Path:
     """A GIF of the plan: the object moving in the grasp, the active pusher drawn in colour."""
-    import matplotlib
+    matplotlib = need("matplotlib", "plot")
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
     from matplotlib.animation import FuncAnimation, PillowWriter
     from matplotlib.patches import Circle, Polygon
 
@@ -419,10 +420,10 @@ def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> 
 def plot_control(scene, res, path, extra=None) -> Path:
     """Planned (reference) against executed poses of a controlled run, pokes and re-plans marked
     (like the thesis' Figs 5-8..5-11): x, z and θ over time, and the path in the X–Z plane."""
-    import matplotlib
+    matplotlib = need("matplotlib", "plot")
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
 
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
     _axes_pose(ax[:2], res.t, res.reference, "reference ", dict(ls="--", color="0.5"))
@@ -465,13 +466,13 @@ def plot_control(scene, res, path, extra=None) -> Path:
 def animate_plan3d(scene, plan, path, fps: int = 12, frames_per_step: int = 6) -> Path:
     """A GIF of a 3-D plan: the object moving in the grasp (pads grey, the active pusher's
     contact points red), poses interpolated along each step's twist."""
-    import matplotlib
+    matplotlib = need("matplotlib", "plot")
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
     from matplotlib.animation import FuncAnimation, PillowWriter
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-    from scipy.spatial.transform import Rotation, Slerp
+    from ..quaternion import rotate, slerp
 
     v, t = scene.mesh()
     v, t = np.asarray(v, float), np.asarray(t, int)
@@ -480,11 +481,10 @@ def animate_plan3d(scene, plan, path, fps: int = 12, frames_per_step: int = 6) -
     seq = []
     for k in range(len(poses) - 1):
         a, b = poses[k], poses[k + 1]
-        sl = Slerp([0, 1], Rotation.from_quat([[a[4], a[5], a[6], a[3]], [b[4], b[5], b[6], b[3]]]))
         for s in np.linspace(0, 1, frames_per_step, endpoint=k == len(poses) - 2):
-            seq.append((a[:3] + s * (b[:3] - a[:3]), sl(s), names[k + 1], k + 1))
+            seq.append((a[:3] + s * (b[:3] - a[:3]), slerp(a[3:], b[3:], s), names[k + 1], k + 1))
     if not seq:
-        seq = [(poses[0][:3], Rotation.from_quat([poses[0][4], poses[0][5], poses[0][6], poses[0][3]]), None, 0)]
+        seq = [(poses[0][:3], poses[0][3:], None, 0)]
     size = float(np.linalg.norm(v, axis=1).max())
     pad_r = float(scene._core.pad_radius)
     from .viewer import marks
@@ -496,7 +496,7 @@ def animate_plan3d(scene, plan, path, fps: int = 12, frames_per_step: int = 6) -
     def draw(i):
         ax.cla()
         p, R, name, step = seq[i]
-        w = R.apply(v) + p
+        w = rotate(R, v) + p
         ax.add_collection3d(Poly3DCollection(w[t], facecolor=face, edgecolor="k", linewidth=0.3 if len(t) < 200 else 0.05,
                                              alpha=0.9))
         a = np.linspace(0, 2 * np.pi, 30)
@@ -518,7 +518,7 @@ def animate_plan3d(scene, plan, path, fps: int = 12, frames_per_step: int = 6) -
             ax.add_collection3d(Poly3DCollection([sq], facecolor="tab:red", alpha=0.12))
             ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], color="tab:red", s=30)
         elif name:
-            pts = R.apply(np.asarray(scene._core.pusher_points(name), float)) + p
+            pts = rotate(R, np.asarray(scene._core.pusher_points(name), float)) + p
             ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], color="tab:red", s=30)
         for f, lim in ((ax.set_xlim, 0), (ax.set_ylim, 1), (ax.set_zlim, 2)):
             f(-1.1 * size, 1.1 * size)
@@ -556,10 +556,10 @@ def plot_plan3d(scene, plan, path, intermediate: int = 3) -> Path:
     """A 3-D plan in one static figure (gripper frame, equal scale): the object's mesh as a
     wireframe at the start, at ``intermediate`` knots between and at the goal (each labelled with
     its step and pusher), the two finger pads, and the plan's pusher runs."""
-    import matplotlib
+    matplotlib = need("matplotlib", "plot")
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = need("matplotlib.pyplot", "plot")
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     v, t = scene.mesh()

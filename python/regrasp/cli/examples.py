@@ -1,0 +1,40 @@
+"""`regrasp examples`: the bundled example scenes (``regrasp.examples``), listed or copied."""
+
+from __future__ import annotations
+
+from .. import examples
+from ..errors import ArgumentError
+from . import OK
+
+
+def cmd_examples(a) -> int:
+    names = [a.name] if a.name else examples.names()
+    if a.copy:
+        if not a.name:
+            raise ArgumentError("invalid `--copy`: name the example to copy (regrasp examples NAME --copy DIR); "
+                                f"the examples: {', '.join(examples.names())}", "--copy")
+        try:
+            dest = examples.copy(a.name, a.copy)
+        except ArgumentError as e:
+            if e.field != "dest_folder":
+                raise
+            raise ArgumentError(str(e).replace("`dest_folder`", "`--copy`"), "--copy") from None
+        extra = examples.meshes(a.name)
+        print(f"wrote {dest}" + (f" and {', '.join(extra)} beside it" if extra else ""))
+        return OK
+    width = max(len(n) for n in names)
+    for n in names:
+        print(f"{n:{width}s}  {examples.dimension(n)}-D  {examples.description(n)}")
+    if a.name:
+        print(f"file: {examples.path(a.name)}")
+    return OK
+
+
+def add_parsers(sub) -> None:
+    e = sub.add_parser("examples", help="list the bundled example scenes, or copy one (and its meshes) into a folder",
+                       description="List the example scenes bundled with regrasp (name, dimension, what it shows), "
+                                   "or write one into a folder with --copy to edit it.")
+    e.add_argument("name", nargs="?", help="one example (default: list them all)")
+    e.add_argument("--copy", metavar="DIR", help="write the scene file of NAME and the meshes it uses into DIR "
+                   "(created if needed; existing files are not overwritten) (default: none, only list)")
+    e.set_defaults(fn=cmd_examples)

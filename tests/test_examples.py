@@ -1,0 +1,66 @@
+"""The bundled examples (``regrasp.examples``, ``regrasp examples``) and a 3-D scene whose mesh
+is missing."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+import regrasp
+from regrasp import examples
+
+from .conftest import EXAMPLES
+
+
+def test_names_paths_and_dimensions():
+    names = examples.names()
+    assert names == sorted(p.stem for p in EXAMPLES.glob("*.toml")) and "t-shape" in names
+    assert examples.path("t-shape") == examples.ROOT / "t-shape.toml" == examples.path("t-shape.toml")
+    planar, spatial = examples.planar(), examples.spatial()
+    assert sorted(p.stem for p in planar + spatial) == names
+    assert all(regrasp.load_scene(p).dimension == 2 for p in planar)
+    assert all(regrasp.load_scene(p).dimension == 3 for p in spatial)
+    assert all(examples.description(n) for n in names)
+
+
+def test_an_unknown_name_lists_the_names():
+    with pytest.raises(regrasp.ArgumentError) as e:
+        examples.path("t-shap")
+    assert e.value.field == "name" and "t-shape" in str(e.value) and "prism-3d" in str(e.value)
+
+
+def test_a_copied_3d_example_loads_with_its_mesh_and_is_not_overwritten(tmp_path):
+    p = examples.copy("prism-3d", tmp_path / "mine")
+    assert (tmp_path / "mine" / "meshes" / "prism.obj").read_bytes() == (examples.ROOT / "meshes" / "prism.obj").read_bytes()
+    assert regrasp.load_scene(p).dimension == 3
+    p.write_text(p.read_text() + "\n# edited\n")
+    with pytest.raises(regrasp.ArgumentError) as e:
+        examples.copy("prism-3d", tmp_path / "mine")
+    assert e.value.field == "dest_folder"
+    assert p.read_text().endswith("# edited\n")  # untouched
+
+
+def test_a_missing_mesh_names_the_field_the_path_and_its_folder(tmp_path):
+    (tmp_path / "prism-3d.toml").write_text(examples.path("prism-3d").read_text())
+    with pytest.raises(regrasp.SceneError) as e:
+        regrasp.load_scene(tmp_path / "prism-3d.toml")
+    msg = str(e.value)
+    assert e.value.field == "object.mesh" and "meshes/prism.obj" in msg and str(tmp_path) in msg, msg
+
+
+def test_cli_lists_and_copies(tmp_path):
+    def cli(*args):
+        return subprocess.run([sys.executable, "-m", "regrasp.cli", *args], capture_output=True, text=True, cwd=tmp_path)
+
+    r = cli("examples")
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert [ln.split()[0] for ln in lines] == examples.names()
+    assert any(ln.split()[:2] == ["prism-3d", "3-D"] for ln in lines) and any(ln.split()[:2] == ["t-shape", "2-D"] for ln in lines)
+    r = cli("examples", "prism-3d", "--copy", "out")
+    assert r.returncode == 0 and (tmp_path / "out" / "meshes" / "prism.obj").exists(), r.stderr
+    again, nameless, unknown = cli("examples", "prism-3d", "--copy", "out"), cli("examples", "--copy", "x"), cli("examples", "nope")
+    for bad, opt in ((again, "--copy"), (nameless, "--copy"), (unknown, "name")):
+        assert bad.returncode == 2 and f"`{opt}`" in bad.stderr and "Traceback" not in bad.stderr, bad.stderr
