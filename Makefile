@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.deps-stamp
 OUT    ?= out
 
-.PHONY: all setup build test test-rust test-python demo bench clean
+.PHONY: all setup build test test-rust test-python demo bench docs clean
 
 all: build
 
@@ -36,6 +36,10 @@ test-python: build
 
 demo: build
 	$(BIN)/regrasp demo --out $(OUT)/demo
+
+# The docs site (mkdocs.yml: docs/ and the API pages from the docstrings) into site/.
+docs: build
+	$(BIN)/mkdocs build --strict
 
 bench: build
 	cargo bench -p regrasp-core --bench cones --bench mncp --bench mpc

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from .. import examples
 from ..errors import ArgumentError
-from . import OK
+from . import OK, add_command
 
 
 def cmd_examples(a) -> int:
@@ -31,10 +31,8 @@ def cmd_examples(a) -> int:
 
 
 def add_parsers(sub) -> None:
-    e = sub.add_parser("examples", help="list the bundled example scenes, or copy one (and its meshes) into a folder",
-                       description="List the example scenes bundled with regrasp (name, dimension, what it shows), "
-                                   "or write one into a folder with --copy to edit it.")
+    e = add_command(sub, "examples", "list the bundled example scenes, or copy one (and its meshes) into a folder",
+                    "regrasp examples\nregrasp examples pivot-3d --copy my-scenes", cmd_examples)
     e.add_argument("name", nargs="?", help="one example (default: list them all)")
     e.add_argument("--copy", metavar="DIR", help="write the scene file of NAME and the meshes it uses into DIR "
-                   "(created if needed; existing files are not overwritten) (default: none, only list)")
-    e.set_defaults(fn=cmd_examples)
+                   "(created if needed; existing files are not overwritten; default: none, only list)")
