@@ -10,9 +10,10 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional, Sequence
+from typing import Optional, Sequence, overload
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .. import _core
 from ..errors import ArgumentError, SceneError
@@ -202,12 +203,26 @@ class MotionCone:
     hold_ratio = core_property("hold_ratio", "Share of the pads' friction that gravity alone uses (< 1 holds).")
     is_line_pusher = core_property("line", "A line pusher (two rigidly connected points) rather than a point pusher.")
 
-    def contains(self, twist: ArrayLike | Sequence[Sequence[float]]) -> bool | np.ndarray:
+    @overload
+    def contains(self, twist: Sequence[float]) -> bool: ...
+    @overload
+    def contains(self, twist: Sequence[Sequence[float]]) -> NDArray[np.bool_]: ...
+    @overload
+    def contains(self, twist: NDArray[np.float64]) -> bool | NDArray[np.bool_]: ...
+
+    def contains(self, twist: ArrayLike | Sequence[Sequence[float]]) -> bool | NDArray[np.bool_]:
         """Exact test of one twist ``[vx, vz, omega]`` (m/s, m/s, rad/s) (a bool) or of each row of an
         (n, 3) array (a bool array): can the pusher produce it while sticking?"""
         return self._core.contains(_vec_or_rows(twist, "twist"))
 
-    def margin(self, twist: ArrayLike | Sequence[Sequence[float]]) -> float | np.ndarray:
+    @overload
+    def margin(self, twist: Sequence[float]) -> float: ...
+    @overload
+    def margin(self, twist: Sequence[Sequence[float]]) -> NDArray[np.float64]: ...
+    @overload
+    def margin(self, twist: NDArray[np.float64]) -> float | NDArray[np.float64]: ...
+
+    def margin(self, twist: ArrayLike | Sequence[Sequence[float]]) -> float | NDArray[np.float64]:
         """Signed margin of a twist ``[vx, vz, omega]`` (m/s, m/s, rad/s) in the exact cone: a float
         for one twist, an array for an (n, 3) array (>= 0 inside)."""
         return self._core.margin(_vec_or_rows(twist, "twist"))
@@ -308,12 +323,12 @@ class MotionConeBatch:
         return {"feasible": feas, "margin": margin, "active_limit": _LIMITS[codes], "valid": status == 0,
                 "errors": _errors(status)}
 
-    def contains(self, twists) -> np.ndarray:
+    def contains(self, twists: ArrayLike) -> NDArray[np.bool_]:
         """Exact test of twist i ``[vx, vz, omega]`` (m/s, m/s, rad/s) at pose i: bool array (n,)."""
         t = _rows(twists, "twists")
         return self.scene._core.classify_many(self.poses, t, self.pusher)[0]
 
-    def margin(self, twists) -> np.ndarray:
+    def margin(self, twists: ArrayLike) -> NDArray[np.float64]:
         """Signed margin of twist i (m/s, m/s, rad/s) at pose i in its exact cone, array (n,)."""
         t = _rows(twists, "twists")
         return self.scene._core.classify_many(self.poses, t, self.pusher)[1]
