@@ -16,7 +16,9 @@ from hypothesis import strategies as st
 
 import regrasp
 from regrasp import Plan, Scene, Scene3D
-from regrasp.viz.view_data import FEATURE_DEPTH, _world, ear_clip, extrude, planar_pose
+from regrasp.polygon import triangulate
+from regrasp.pose import planar_to_spatial
+from regrasp.viz.view_data import FEATURE_DEPTH, _world, extrude
 from regrasp.viz.viewer import description, page, write_html
 
 from .conftest import EXAMPLES, ROOT
@@ -99,9 +101,9 @@ def test_planar_page_extrudes_the_outline_and_keeps_the_scenes_numbers(tshape):
     # the planar pose [x, z, theta] moves the outline as in the plane
     q = np.array([0.01, -0.02, 0.7])
     R = np.array([[np.cos(q[2]), -np.sin(q[2])], [np.sin(q[2]), np.cos(q[2])]])
-    w = _world([planar_pose(q)], v)[0]
+    w = _world([planar_to_spatial(q)], v)[0]
     assert np.allclose(w[:, [0, 2]], v[:, [0, 2]] @ R.T + q[:2]) and np.allclose(w[:, 1], v[:, 1])
-    assert np.allclose(d["poses"], [planar_pose(x) for x in p.poses])
+    assert np.allclose(d["poses"], [planar_to_spatial(x) for x in p.poses])
     g, _ = s.gravity
     assert d["gravity"]["direction"] == pytest.approx([g[0], 0, g[1]])
     check_ground(d, [g[0], 0, g[1]])
@@ -116,7 +118,8 @@ def test_planar_page_extrudes_the_outline_and_keeps_the_scenes_numbers(tshape):
     check_ground(d, [g[0], 0, g[1]])
     # the scene alone: its start, its goal; an object on a surface: no jaws, the support as ground
     d = description(s)
-    assert np.allclose(d["poses"], [planar_pose(s.task.start)]) and np.allclose(d["goal"], planar_pose(s.task.goal))
+    assert np.allclose(d["poses"], [planar_to_spatial(s.task.start)])
+    assert np.allclose(d["goal"], planar_to_spatial(s.task.goal))
     d = description(Scene.load(EXAMPLES / "block-on-incline.toml"))
     assert d["jaws"] is None and d["ground"]["support"] == "surface" and d["goal"] is None
     kinds = {f["name"]: f["kind"] for f in d["features"]}
@@ -143,7 +146,7 @@ def test_extrusion_of_a_non_convex_outline_is_closed_and_outward():
 def test_ear_clipping_tiles_star_shaped_polygons(radii, turn):
     a = turn + 2 * np.pi * np.arange(len(radii)) / len(radii)
     p = np.stack([np.cos(a), np.sin(a)], axis=1) * np.asarray(radii)[:, None]
-    t = np.asarray(ear_clip(p))
+    t = np.asarray(triangulate(p))
     assert len(t) == len(p) - 2
     e1, e2 = p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]]
     areas = (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) / 2
@@ -174,7 +177,7 @@ def test_planar_page_draws_every_frame_in_node(tshape, tmp_path):
         assert fr["drawn_all"] > fr["drawn"] + 10  # ground, jaws, pushers, goal
         assert fr["jaw_gap"] == pytest.approx(width)
     assert "pusher top" in out["frames"][0]["info"]
-    assert np.allclose(out["frames"][-1]["pose"], planar_pose(p.poses[-1]), atol=1e-9)
+    assert np.allclose(out["frames"][-1]["pose"], planar_to_spatial(p.poses[-1]), atol=1e-9)
 
 
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",

@@ -25,6 +25,8 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..extras import need
+from ..polygon import cross, triangulate
+from ..pose import planar_quat
 from ..scene.planar import Scene
 
 THICKNESS = 0.012  # m, the object's thickness along the grasp axis
@@ -60,29 +62,7 @@ def plan_dict(plan) -> dict:
     return plan.to_json() if hasattr(plan, "to_json") else plan
 
 
-# --- planar poses ----------------------------------------------------------------------------
-
-def quat_y(theta: float) -> np.ndarray:
-    """Quaternion of the planar angle theta (a rotation by −theta about +Y)."""
-    return np.array([np.cos(-theta / 2), 0.0, np.sin(-theta / 2), 0.0])
-
-
-def compose(a, b) -> np.ndarray:
-    """Planar pose composition a ∘ b."""
-    c, s = np.cos(a[2]), np.sin(a[2])
-    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], a[2] + b[2]])
-
-
-def inverse(a) -> np.ndarray:
-    """The inverse of a planar pose ``a`` ``[x, z, theta]`` (m, m, rad)."""
-    c, s = np.cos(a[2]), np.sin(a[2])
-    return np.array([-(c * a[0] + s * a[1]), -(-s * a[0] + c * a[1]), -a[2]])
-
-
-def rotate(theta: float, v) -> np.ndarray:
-    """The planar vector ``v`` turned by ``theta``."""
-    return compose((0.0, 0.0, theta), (v[0], v[1], 0.0))[:2]
-
+# --- the object's planar pose in MuJoCo ---------------------------------------------------------
 
 def planar_pose(model, data, body: str) -> np.ndarray:
     """Planar pose [x, z, theta] of a body's frame in the world."""
@@ -96,51 +76,18 @@ def put_object(model, data, pose):
     q = np.asarray(pose, float)
     a, v = int(model.jnt_qposadr[0]), int(model.jnt_dofadr[0])
     data.qpos[a:a + 3] = [q[0], 0.0, q[1]]
-    data.qpos[a + 3:a + 7] = quat_y(q[2])
+    data.qpos[a + 3:a + 7] = planar_quat(q[2])
     data.qvel[v:v + 6] = 0.0
 
 
 # --- outlines ----------------------------------------------------------------------------------
-
-def _cross(o, a, b):
-    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-
-def triangulate(poly: np.ndarray) -> list:
-    """Ear clipping of a simple counter-clockwise polygon: triangles as index triples."""
-    idx = list(range(len(poly)))
-    tris = []
-    guard = 0
-    while len(idx) > 3 and guard < 10000:
-        guard += 1
-        for k in range(len(idx)):
-            i0, i1, i2 = idx[k - 1], idx[k], idx[(k + 1) % len(idx)]
-            a, b, c = poly[i0], poly[i1], poly[i2]
-            if _cross(a, b, c) <= 1e-15:
-                continue  # reflex or flat corner
-            inside = False
-            for j in idx:
-                if j in (i0, i1, i2):
-                    continue
-                p = poly[j]
-                if _cross(a, b, p) >= 0 and _cross(b, c, p) >= 0 and _cross(c, a, p) >= 0:
-                    inside = True
-                    break
-            if not inside:
-                tris.append((i0, i1, i2))
-                idx.pop(k)
-                break
-    if len(idx) == 3:
-        tris.append(tuple(idx))
-    return tris
-
 
 def _merge_once(poly: np.ndarray, pieces: list) -> bool:
     """Merges the first two neighbouring pieces whose union is convex; whether it found some."""
     def convex(ids):
         pts = poly[ids]
         n = len(pts)
-        return all(_cross(pts[i], pts[(i + 1) % n], pts[(i + 2) % n]) >= -1e-15 for i in range(n))
+        return all(cross(pts[i], pts[(i + 1) % n], pts[(i + 2) % n]) >= -1e-15 for i in range(n))
 
     for i in range(len(pieces)):
         for j in range(i + 1, len(pieces)):
@@ -296,7 +243,7 @@ def add_object(spec, scene: Scene, pose, friction: float = 0.0, mass_scale: floa
     is the object frame."""
     o = scene.outline
     q = np.asarray(pose, float)
-    body = spec.worldbody.add_body(name="object", pos=[q[0], 0.0, q[1]], quat=quat_y(q[2]))
+    body = spec.worldbody.add_body(name="object", pos=[q[0], 0.0, q[1]], quat=planar_quat(q[2]))
     body.add_freejoint()
     m = scene.mass * mass_scale
     L = scene.length
@@ -349,7 +296,7 @@ def add_feature_geom(body, scene: Scene, pusher: str, friction_scale: float = 1.
         mid = p.points.mean(axis=0) - n * 0.003
         half = np.linalg.norm(p.points[1] - p.points[0]) / 2
         return add_geom(body, "box", [0.003, depth, half], FEATURE_BITS, [mu], pos=[mid[0], 0.0, mid[1]],
-                        quat=quat_y(np.arctan2(n[1], n[0])), condim=3)
+                        quat=planar_quat(np.arctan2(n[1], n[0])), condim=3)
     c = p.points[0] - n * FEATURE_RADIUS
     return add_geom(body, "cylinder", [FEATURE_RADIUS, depth], FEATURE_BITS, [mu], pos=[c[0], 0.0, c[1]],
                     quat=_EULER_X90, condim=3)

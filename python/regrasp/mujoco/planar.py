@@ -24,12 +24,12 @@ import numpy as np
 
 from .. import progress
 from ..errors import ArgumentError
-from ..extras import need
 from ..scene.planar import Scene, _number
 from ..sim.quasistatic import Replay, body_twist, integrate_pose
 from .push import MAX_DURATION
+from ..pose import planar_compose, planar_inverse, planar_quat, planar_rotate
 from .model import (Contact, Driver, Rig, add_driven_body, add_feature, add_grip_motors, add_object, add_planar_pads,
-                    compose, inverse, plan_dict, planar_pose, planar_spec, put_object, quat_y, rotate)
+                    plan_dict, planar_pose, planar_spec, put_object)
 
 GAP = 0.002  # m between the object and a feature when it is brought
 PARK = np.array([0.0, 5.0, 0.0])
@@ -130,18 +130,18 @@ class GripperRig(Rig):
 
     def pose(self) -> np.ndarray:
         """The object's pose in the grasp."""
-        return compose(inverse(self.g), planar_pose(self.model, self.data, "object"))
+        return planar_compose(planar_inverse(self.g), planar_pose(self.model, self.data, "object"))
 
     def place_feature(self, pusher: str, at, back: float) -> Feature:
         """Puts ``pusher``'s feature where it meets the object at pose ``at`` in the grasp, then
         ``back`` [m] further along its normal (away from the object)."""
         p = self.scene.pusher(pusher)
-        F = compose(self.g, np.asarray(at, float))
-        n_w = rotate(F[2], p.normal / np.linalg.norm(p.normal))
+        F = planar_compose(self.g, np.asarray(at, float))
+        n_w = planar_rotate(F[2], p.normal / np.linalg.norm(p.normal))
         F = F - np.array([back * n_w[0], back * n_w[1], 0.0])
         m = self.mocap(f"feature_{pusher}")
         self.data.mocap_pos[m] = [F[0], 0.0, F[1]]
-        self.data.mocap_quat[m] = quat_y(F[2])
+        self.data.mocap_quat[m] = planar_quat(F[2])
         self.current = Feature(pusher, m, F, n_w, self.geoms(f"feature_{pusher}"))
         return self.current
 
@@ -202,7 +202,7 @@ class PlanarExecution(GripperRig):
 
         def path(u):
             self.planned = a + (b - a) * u
-            return compose(F, inverse(integrate_pose(P, xi, u)))
+            return planar_compose(F, planar_inverse(integrate_pose(P, xi, u)))
 
         self.move(path, length / self.speed)
         return integrate_pose(P, xi, 1.0)
@@ -212,7 +212,7 @@ class PlanarExecution(GripperRig):
         object's frame."""
         ref = self.scene.pusher(self.current.pusher).points.mean(axis=0)
         obj = planar_pose(self.model, self.data, "object")
-        return compose(inverse(obj), compose(self.current.frame, np.r_[ref, 0.0]))[:2]
+        return planar_compose(planar_inverse(obj), planar_compose(self.current.frame, np.r_[ref, 0.0]))[:2]
 
     def segment(self, pusher: str, knots: list) -> float:
         """One push: the feature placed the gap away from where the plan needs it, the approach,
@@ -260,14 +260,11 @@ def execute_plan(scene: Scene, plan, perturb: Perturbation = Perturbation(), spe
 def animate_execution(scene: Scene, rep: Replay, path, fps: int = 20, every: int = 3):
     """A GIF (or MP4 when ffmpeg is available) of the object in the grasp during an execution,
     with the planned pose dashed."""
-    matplotlib = need("matplotlib", "plot")
+    from ..viz.plotting import _object_at, animation_axes, pyplot, save_animation
 
-    matplotlib.use("Agg")
-    plt = need("matplotlib.pyplot", "plot")
-    from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
+    plt = pyplot()
+    from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter, writers
     from matplotlib.patches import Circle, Polygon
-
-    from ..viz.plotting import _object_at, animation_axes, save_animation
 
     idx = list(range(0, len(rep.t), every))
     fig, ax = animation_axes(scene, [rep.poses[i] for i in idx])
@@ -289,7 +286,7 @@ def animate_execution(scene: Scene, rep: Replay, path, fps: int = 20, every: int
     anim = FuncAnimation(fig, draw, frames=len(idx), blit=False)
     path = str(path)
     if path.lower().endswith(".mp4"):
-        if not matplotlib.animation.writers.is_available("ffmpeg"):
+        if not writers.is_available("ffmpeg"):
             plt.close(fig)
             raise ArgumentError("invalid `--video`: MP4 needs ffmpeg, which is not installed; use a .gif", "--video")
         writer = FFMpegWriter(fps=fps)
@@ -333,16 +330,17 @@ class WorldRig(GripperRig):
         if self.current is None or self.current.pusher != pusher:
             self.bring(pusher, belief)
         F = self.current.frame
-        rel = compose(inverse(belief), compose(inverse(self.g), F))  # the feature seen from the object
+        # the feature seen from the object
+        rel = planar_compose(planar_inverse(belief), planar_compose(planar_inverse(self.g), F))
         n = max(1, int(round(duration / self.dt)))
         tw = np.asarray(twist, float)
         for i in range(1, n + 1):
-            P = compose(integrate_pose(belief, tw, duration * i / n), rel)
-            self.step_to(compose(F, inverse(P)))
+            P = planar_compose(integrate_pose(belief, tw, duration * i / n), rel)
+            self.step_to(planar_compose(F, planar_inverse(P)))
 
     def poke(self, delta):
         """Displaces the object in the grasp by ``delta`` (the current feature backs off first)."""
         self.back_off()
-        put_object(self.model, self.data, compose(self.g, self.pose() + np.asarray(delta, float)))
+        put_object(self.model, self.data, planar_compose(self.g, self.pose() + np.asarray(delta, float)))
         self.forward()
         self.idle(0.1)

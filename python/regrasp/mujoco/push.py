@@ -16,8 +16,9 @@ from ..scene.planar import Scene, _name, _number, _vec
 #: the longest push :func:`simulate_push` simulates [s] (MuJoCo steps of 0.5 ms: a bound on its time)
 MAX_DURATION = 60.0
 from ..sim.quasistatic import integrate_pose
+from ..pose import planar_compose, planar_inverse, planar_rotate
 from .model import (FEATURE_RADIUS, Contact, Driver, Rig, add_driven_body, add_feature_geom, add_grip_motors,
-                    add_object, add_planar_pads, compose, inverse, planar_pose, planar_spec, put_object, rotate)
+                    add_object, add_planar_pads, planar_pose, planar_spec, put_object)
 
 Settings = Contact  # kept for callers of the first version
 
@@ -89,8 +90,8 @@ class PushRig(Rig):
         if len(pts) == 1:
             return self._point_slip(pose, tw, distance, speed, pts[0])
         r = self.push(pose, tw, distance / speed, record_dt=distance / speed)
-        rel0 = compose(inverse(r["pusher_pose"][0]), r["pose"][0])
-        rel1 = compose(inverse(r["pusher_pose"][-1]), r["pose"][-1])
+        rel0 = planar_compose(planar_inverse(r["pusher_pose"][0]), r["pose"][0])
+        rel1 = planar_compose(planar_inverse(r["pusher_pose"][-1]), r["pose"][-1])
         n = self.scene.pusher(self.pusher).normal
         n = n / np.linalg.norm(n)
         t = np.array([-n[1], n[0]])
@@ -99,7 +100,7 @@ class PushRig(Rig):
             # the object's material point at contact point c, seen from the pusher, before and
             # after: its slide along the contact, and how far it lifted off the pusher (pressing
             # further in is the soft contact's compliance, not a slip)
-            d = compose(rel1, np.r_[c, 0.0])[:2] - compose(rel0, np.r_[c, 0.0])[:2]
+            d = planar_compose(rel1, np.r_[c, 0.0])[:2] - planar_compose(rel0, np.r_[c, 0.0])[:2]
             worst = max(worst, float(np.hypot(d @ t, max(0.0, d @ n))))
         return worst / distance
 
@@ -115,11 +116,11 @@ class PushRig(Rig):
         for k in range(len(r["t"]) - 1):
             q0, q1 = r["pose"][k], r["pose"][k + 1]
             p0, p1 = r["pusher_pose"][k], r["pusher_pose"][k + 1]
-            nw = rotate(q0[2], n)
-            x = compose(p0, centre)[:2] + FEATURE_RADIUS * nw  # the contact point (world)
-            mo = compose(inverse(q0), np.r_[x, 0.0])  # material points there
-            mp = compose(inverse(p0), np.r_[x, 0.0])
-            d = (compose(q1, mo)[:2] - x) - (compose(p1, mp)[:2] - x)
+            nw = planar_rotate(q0[2], n)
+            x = planar_compose(p0, centre)[:2] + FEATURE_RADIUS * nw  # the contact point (world)
+            mo = planar_compose(planar_inverse(q0), np.r_[x, 0.0])  # material points there
+            mp = planar_compose(planar_inverse(p0), np.r_[x, 0.0])
+            d = (planar_compose(q1, mo)[:2] - x) - (planar_compose(p1, mp)[:2] - x)
             slide += abs(d[0] * nw[1] - d[1] * nw[0])
         return float(slide / distance)
 

@@ -28,8 +28,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _core, progress, quaternion
+from .. import _core, progress
 from ..errors import ArgumentError
+from ..pose import quat_from_matrix, tangents, twist_between
 from .model import (FEATURE_BITS, OBJECT_BITS, PAD_BITS, Contact, Driver, Rig, add_driven_body, add_geom,
                     add_grip_motors, add_pad_sphere, add_pads, new_spec, plan_dict, set_inertial)
 
@@ -61,17 +62,9 @@ def _shift(v) -> np.ndarray:
     return np.r_[v, 1, 0, 0, 0]
 
 
-def _tangents(n) -> tuple:
-    """Two unit vectors t1, t2 with (t1, t2, n) a right-handed frame."""
-    a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
-    t1 = np.cross(a, n)
-    t1 /= np.linalg.norm(t1)
-    return t1, np.cross(n, t1)
-
-
 def _quat(t1, t2, n) -> np.ndarray:
     """The quaternion [w, x, y, z] of the frame with axes t1, t2, n."""
-    return quaternion.from_matrix(np.c_[t1, t2, n])
+    return quat_from_matrix(np.c_[t1, t2, n])
 
 
 def plane_frame(scene, name: str, pose) -> np.ndarray:
@@ -79,7 +72,7 @@ def plane_frame(scene, name: str, pose) -> np.ndarray:
     (the object frame then), of the plane's own frame (origin at the contact, +Z its normal)."""
     pts, n, _ = scene._core.pusher_spec(name, list(map(float, pose)))
     n = np.asarray(n, float) / np.linalg.norm(n)
-    return np.r_[np.asarray(pts, float).mean(axis=0), _quat(*_tangents(n), n)]
+    return np.r_[np.asarray(pts, float).mean(axis=0), _quat(*tangents(n), n)]
 
 
 def add_feature_geoms(body, scene, name: str, friction: float):
@@ -95,7 +88,7 @@ def add_feature_geoms(body, scene, name: str, friction: float):
         return add_geom(body, "sphere", [R_FEATURE], pos=pts[0] - n * R_FEATURE, **kw)
     if len(pts) == 2:
         return add_geom(body, "capsule", [R_FEATURE], fromto=np.ravel(pts - n * R_FEATURE), **kw)
-    t1, t2 = (-t for t in _tangents(n))
+    t1, t2 = tangents(n)
     c = pts.mean(axis=0)
     e1, e2 = np.abs((pts - c) @ t1).max(), np.abs((pts - c) @ t2).max()
     return add_geom(body, "box", [e1, e2, 0.0015], pos=c - n * 0.0015, quat=_quat(t1, t2, n), **kw)
@@ -262,8 +255,6 @@ class SpatialExecution(Rig):
         """One step of the plan, from path entry ``a`` to ``b``: brings b's pusher if it is a new
         one, then moves it with the step's pusher twist over unit time. Returns the object's
         measured pose in the grasp."""
-        from ..scene.spatial import twist_between
-
         p = b["pusher"]
         if self.pusher != p:
             self.approach(p)

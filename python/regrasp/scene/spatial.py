@@ -10,9 +10,10 @@ from typing import Optional
 
 import numpy as np
 
-from .. import _core, quaternion
+from .. import _core
 from ..errors import ArgumentError, RegraspError, SceneError, check_seed
 from ..planning.plan import Plan, as_plan
+from ..pose import quat_angle, twist_between, twist_in
 from .common import core_property, read_scene_file
 from .planar import _flag, _name, _number, _vec
 
@@ -146,14 +147,6 @@ def _core_from_toml(text: str, base):
         raise SceneError(f"{e} (`object.mesh` is relative to the scene file's folder, {folder})", e.field) from None
 
 
-def twist_in(rel, u) -> list:
-    """Body twist ``u`` of a frame B expressed in frame A, where ``rel`` = A⁻¹B (the adjoint):
-    ``[R v + p × (R ω), R ω]``."""
-    rel, u = np.asarray(rel, float), np.asarray(u, float)
-    w = quaternion.rotate(rel[3:], u[3:])
-    return (quaternion.rotate(rel[3:], u[:3]) + np.cross(rel[:3], w)).tolist() + w.tolist()
-
-
 def goal_report(scene: "Scene3D", q) -> dict:
     """The final pose, its error to the task's goal (position [m], angle [rad]) and whether it
     is within the task's tolerance."""
@@ -206,15 +199,3 @@ def check_plan3d(scene: "Scene3D", plan) -> list:
     """The path (a list of entries) of a 3-D plan (a :class:`~regrasp.Plan` or a plan dict),
     checked against ``scene``; errors name the field (``plan.path[2].pusher_twist``)."""
     return as_plan(plan, scene).path
-
-
-def quat_angle(a, b) -> float:
-    """Angle [rad] of the rotation between unit quaternions a and b ([w, x, y, z])."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    d = abs(float(a @ b) / (np.linalg.norm(a) * np.linalg.norm(b)))
-    return float(2 * np.arccos(min(1.0, d)))  # type: ignore[call-overload]
-
-
-def twist_between(a, b) -> list:
-    """The constant body twist taking pose a to pose b in unit time (SE(3) log, the core's)."""
-    return list(_core.se3_log([float(x) for x in a], [float(x) for x in b]))

@@ -10,7 +10,16 @@ from .. import progress
 from ..extras import need
 from ..files import atomic_write
 from ..planning.plan import as_plan
+from ..pose import quat_rotate, slerp, tangents
 from ..scene.planar import MotionCone
+
+
+def pyplot():
+    """``matplotlib.pyplot`` with the non-interactive Agg backend (figures are written to files);
+    needs the ``plot`` extra."""
+    matplotlib = need("matplotlib", "plot")
+    matplotlib.use("Agg")
+    return need("matplotlib.pyplot", "plot")
 
 
 def _lambda(A, Js, wg, p):
@@ -47,10 +56,7 @@ def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
     by gravity and their intersection (the wrench set); (right) twist space: the exact, curved
     motion cone, its polyhedral approximation and the gravity-free cone; beside them a chart of
     ray directions where the difference shows."""
-    matplotlib = need("matplotlib", "plot")
-
-    matplotlib.use("Agg")
-    plt = need("matplotlib.pyplot", "plot")
+    plt = pyplot()
 
     fig = plt.figure(figsize=(18, 6))
     samples = boundary_samples(cone)
@@ -190,10 +196,7 @@ def _axes_pose(ax, t, q, label_prefix="", style=None):
 def plot_push(scene, tr: dict, pusher: str, twist, path) -> Path:
     """Object pose (m, m, rad) in the grasp and contact forces [N] over time [s] for one simulated
     push of ``twist`` (m/s, m/s, rad/s); the figure is written to ``path``."""
-    matplotlib = need("matplotlib", "plot")
-
-    matplotlib.use("Agg")
-    plt = need("matplotlib.pyplot", "plot")
+    plt = pyplot()
 
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
     t = tr["t"]
@@ -220,10 +223,7 @@ def plot_push(scene, tr: dict, pusher: str, twist, path) -> Path:
 
 def plot_replay(scene, rep, path, extra=None) -> Path:
     """Planned against executed object pose in the grasp over a replayed plan."""
-    matplotlib = need("matplotlib", "plot")
-
-    matplotlib.use("Agg")
-    plt = need("matplotlib.pyplot", "plot")
+    plt = pyplot()
 
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
     _axes_pose(ax, rep.t, rep.planned, "planned ", dict(ls="--", color="0.5"))
@@ -248,7 +248,7 @@ def save_time_figure(fig, axes, title: str, path, fontsize: int = 8) -> Path:
 
 def _save(fig, path) -> Path:
     """Lays out, writes (creating the folder) and closes a figure."""
-    plt = need("matplotlib.pyplot", "plot")
+    plt = pyplot()
 
     fig.tight_layout()
     path = Path(path)
@@ -263,7 +263,7 @@ def _save(fig, path) -> Path:
 
 def save_animation(anim, fig, path, writer) -> Path:
     """Writes an animation atomically with ``writer`` (creating the folder) and closes its figure."""
-    plt = need("matplotlib.pyplot", "plot")
+    plt = pyplot()
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -285,7 +285,7 @@ PUSHER_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple",
 def animation_axes(scene, poses):
     """A figure and bare, equal-aspect axes framing the object at every pose of ``poses``
     (m, m, rad) (1 cm margin)."""
-    plt = need("matplotlib.pyplot", "plot")
+    plt = pyplot()
 
     pts = np.vstack([_object_at(scene, q) for q in poses])
     lo, hi = pts.min(axis=0) - 0.01, pts.max(axis=0) + 0.01
@@ -313,10 +313,7 @@ def _pusher_at(scene, q, name):
 def plot_plan(scene, plan, path) -> Path:
     """The object in the grasp (gripper frame) at the plan's knots, the finger pad, and each
     push coloured by its pusher (thesis Figs 4-11..4-14); beside it the pose over the steps."""
-    matplotlib = need("matplotlib", "plot")
-
-    matplotlib.use("Agg")
-    plt = need("matplotlib.pyplot", "plot")
+    plt = pyplot()
     from matplotlib.patches import Circle, Polygon
 
     plan = as_plan(plan, scene)
@@ -368,10 +365,7 @@ def plot_plan(scene, plan, path) -> Path:
 
 def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> Path:
     """A GIF of the plan: the object moving in the grasp, the active pusher drawn in colour."""
-    matplotlib = need("matplotlib", "plot")
-
-    matplotlib.use("Agg")
-    plt = need("matplotlib.pyplot", "plot")
+    plt = pyplot()
     from matplotlib.animation import FuncAnimation, PillowWriter
     from matplotlib.patches import Circle, Polygon
 
@@ -420,10 +414,7 @@ def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> 
 def plot_control(scene, res, path, extra=None) -> Path:
     """Planned (reference) against executed poses of a controlled run, pokes and re-plans marked
     (like the thesis' Figs 5-8..5-11): x, z and θ over time, and the path in the X–Z plane."""
-    matplotlib = need("matplotlib", "plot")
-
-    matplotlib.use("Agg")
-    plt = need("matplotlib.pyplot", "plot")
+    plt = pyplot()
 
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
     _axes_pose(ax[:2], res.t, res.reference, "reference ", dict(ls="--", color="0.5"))
@@ -463,82 +454,103 @@ def plot_control(scene, res, path, extra=None) -> Path:
     return _save(fig, path)
 
 
-def animate_plan3d(scene, plan, path, fps: int = 12, frames_per_step: int = 6) -> Path:
-    """A GIF of a 3-D plan: the object moving in the grasp (pads grey, the active pusher's
-    contact points red), poses interpolated along each step's twist."""
-    matplotlib = need("matplotlib", "plot")
-
-    matplotlib.use("Agg")
-    plt = need("matplotlib.pyplot", "plot")
-    from matplotlib.animation import FuncAnimation, PillowWriter
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-    from ..quaternion import rotate, slerp
-
+def _plan3d(scene, plan):
+    """The prelude of the 3-D figures: the object's mesh (vertices [m] in the object frame,
+    triangles), the plan checked against ``scene`` and its poses (m, unit quaternion) as an array."""
     v, t = scene.mesh()
-    v, t = np.asarray(v, float), np.asarray(t, int)
     plan = as_plan(plan, scene)
-    poses, names = plan.poses, plan.pushers
+    return np.asarray(v, float), np.asarray(t, int), plan, np.asarray(plan.poses, float)
+
+
+def _at(pose, v) -> np.ndarray:
+    """Points ``v`` [m] of the object frame in the gripper frame at ``pose`` (m, unit quaternion)."""
+    return quat_rotate(pose[3:], v) + pose[:3]
+
+
+def _frames3d(poses, names, frames_per_step: int) -> list:
+    """The animation's frames: (pose, pusher, step) with the position interpolated linearly and
+    the orientation by slerp between consecutive poses (m, unit quaternion)."""
     seq = []
     for k in range(len(poses) - 1):
         a, b = poses[k], poses[k + 1]
         for s in np.linspace(0, 1, frames_per_step, endpoint=k == len(poses) - 2):
-            seq.append((a[:3] + s * (b[:3] - a[:3]), slerp(a[3:], b[3:], s), names[k + 1], k + 1))
-    if not seq:
-        seq = [(poses[0][:3], poses[0][3:], None, 0)]
-    size = float(np.linalg.norm(v, axis=1).max())
-    pad_r = float(scene._core.pad_radius)
+            seq.append((np.r_[a[:3] + s * (b[:3] - a[:3]), slerp(a[3:], b[3:], s)], names[k + 1], k + 1))
+    return seq or [(poses[0], None, 0)]
+
+
+def _pads3d(ax, w, r: float, alpha: float) -> None:
+    """The two finger pads (discs of radius ``r`` [m] in x-z) where they hold the object's
+    vertices ``w`` [m] (gripper frame)."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    a = np.linspace(0, 2 * np.pi, 40)
+    for sgn in (1, -1):
+        y = sgn * np.max(sgn * w[:, 1])
+        ax.add_collection3d(Poly3DCollection([np.c_[r * np.cos(a), np.full(40, y), r * np.sin(a)]],
+                                             facecolor="0.3", alpha=alpha))
+
+
+def _pusher3d(ax, scene, name: str, pose, w, size: float) -> None:
+    """The active pusher's contact points (red) at object ``pose`` (m, unit quaternion), with the
+    object's vertices ``w`` [m] there; a plane also as a translucent square of half side 1.3 ``size`` [m]."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    core = scene._core
+    if not core.is_plane(name):
+        pts = _at(pose, np.asarray(core.pusher_points(name), float))
+    else:  # where the object is lowest along the plane's normal (gripper frame)
+        nrm = np.asarray(core.pusher_normal(name), float)
+        low = (w @ nrm).min()
+        pts = w[w @ nrm < low + 1e-6 * size] if not core.sphere else (pose[:3] - core.sphere * nrm)[None]
+        t1, t2 = tangents(nrm)
+        sq = [pts[0] + 1.3 * size * (i * t1 + j * t2) for i, j in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+        ax.add_collection3d(Poly3DCollection([sq], facecolor="tab:red", alpha=0.12))
+    ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], color="tab:red", s=30)
+
+
+def _axes3d(ax, centre, half: float) -> None:
+    """Equal-scale 3-D axes of half-extent ``half`` [m] about ``centre`` [m], labelled, seen from
+    the side."""
+    for f, m in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+        f(m - half, m + half)
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m] (grasp axis)")
+    ax.set_zlabel("z [m]")
+    ax.view_init(elev=18, azim=-60)
+
+
+def animate_plan3d(scene, plan, path, fps: int = 12, frames_per_step: int = 6) -> Path:
+    """A GIF of a 3-D plan: the object moving in the grasp (pads grey, the active pusher's
+    contact points red); between poses the position is interpolated linearly and the
+    orientation by slerp (``frames_per_step`` frames a step, ``fps`` frames a second)."""
+    plt = pyplot()
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
     from .viewer import marks
 
+    v, t, plan, poses = _plan3d(scene, plan)
+    seq = _frames3d(poses, plan.pushers, frames_per_step)
+    size = float(np.linalg.norm(v, axis=1).max())
     face = np.where(marks(scene)[:, None] > 0, np.array([0.9, 0.6, 0.2]), np.array([0.56, 0.70, 0.85]))
     fig = plt.figure(figsize=(5.5, 5))
     ax = fig.add_subplot(projection="3d")
 
     def draw(i):
         ax.cla()
-        p, R, name, step = seq[i]
-        w = rotate(R, v) + p
+        pose, name, step = seq[i]
+        w = _at(pose, v)
         ax.add_collection3d(Poly3DCollection(w[t], facecolor=face, edgecolor="k", linewidth=0.3 if len(t) < 200 else 0.05,
                                              alpha=0.9))
-        a = np.linspace(0, 2 * np.pi, 30)
-        for sgn in (1, -1):
-            y = sgn * np.max(sgn * w[:, 1])
-            disc = np.c_[pad_r * np.cos(a), np.full(30, y), pad_r * np.sin(a)]
-            ax.add_collection3d(Poly3DCollection([disc], facecolor="0.3", alpha=0.6))
-        if name and scene._core.is_plane(name):
-            # a plane: where the object is lowest along its normal (gripper frame), and the plane
-            nrm = np.asarray(scene._core.pusher_normal(name), float)
-            low = (w @ nrm).min()
-            pts = w[w @ nrm < low + 1e-6 * size] if not scene._core.sphere else (p - scene._core.sphere * nrm)[None]
-            c = pts[0]
-            a = np.array([1.0, 0, 0]) if abs(nrm[0]) < 0.9 else np.array([0, 1.0, 0])
-            t1 = np.cross(nrm, a)
-            t1 /= np.linalg.norm(t1)
-            t2 = np.cross(nrm, t1)
-            sq = [c + 1.3 * size * (i * t1 + j * t2) for i, j in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
-            ax.add_collection3d(Poly3DCollection([sq], facecolor="tab:red", alpha=0.12))
-            ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], color="tab:red", s=30)
-        elif name:
-            pts = rotate(R, np.asarray(scene._core.pusher_points(name), float)) + p
-            ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], color="tab:red", s=30)
-        for f, lim in ((ax.set_xlim, 0), (ax.set_ylim, 1), (ax.set_zlim, 2)):
-            f(-1.1 * size, 1.1 * size)
-        ax.set_xlabel("x")
-        ax.set_ylabel("y (grasp axis)")
-        ax.set_zlabel("z")
+        _pads3d(ax, w, float(scene._core.pad_radius), 0.6)
+        if name:
+            _pusher3d(ax, scene, name, pose, w, size)
+        _axes3d(ax, (0.0, 0.0, 0.0), 1.1 * size)
         ax.set_title(f"{scene.name}: step {step}/{len(poses) - 1}" + (f", pusher {name}" if name else ""), fontsize=9)
-        ax.view_init(elev=18, azim=-60)
-        ax.set_box_aspect((1, 1, 1))
 
     anim = FuncAnimation(fig, draw, frames=len(seq), interval=1000 / fps)
     return save_animation(anim, fig, path, PillowWriter(fps=fps))
-
-
-def _quat_matrix(q) -> np.ndarray:
-    """The rotation matrix of a unit quaternion ``[qw, qx, qy, qz]``."""
-    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
 def _runs_text(pushers) -> str:
@@ -556,25 +568,17 @@ def plot_plan3d(scene, plan, path, intermediate: int = 3) -> Path:
     """A 3-D plan in one static figure (gripper frame, equal scale): the object's mesh as a
     wireframe at the start, at ``intermediate`` knots between and at the goal (each labelled with
     its step and pusher), the two finger pads, and the plan's pusher runs."""
-    matplotlib = need("matplotlib", "plot")
-
-    matplotlib.use("Agg")
-    plt = need("matplotlib.pyplot", "plot")
+    plt = pyplot()
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    v, t = scene.mesh()
-    v, t = np.asarray(v, float), np.asarray(t, int)
-    plan = as_plan(plan, scene)
-    poses, names = np.asarray(plan.poses, float), plan.pushers
-    last = len(poses) - 1
+    v, t, plan, poses = _plan3d(scene, plan)
+    names, last = plan.pushers, len(poses) - 1
     knots = sorted({0, last, *np.linspace(0, last, intermediate + 2).round().astype(int).tolist()})
     fig = plt.figure(figsize=(7, 6))
     ax = fig.add_subplot(projection="3d")
     cmap = plt.get_cmap("viridis")
-    world = {}
-    for k in knots:
-        w = v @ _quat_matrix(poses[k][3:]).T + poses[k][:3]
-        world[k] = w
+    world = {k: _at(poses[k], v) for k in knots}
+    for k, w in world.items():
         color = cmap(k / max(last, 1))
         label = "start" if k == 0 else "goal" if k == last else f"step {k} ({names[k]})"
         ax.add_collection3d(Poly3DCollection(w[t], facecolor=(*color[:3], 0.06 if 0 < k < last else 0.15),
@@ -583,23 +587,9 @@ def plot_plan3d(scene, plan, path, intermediate: int = 3) -> Path:
         c = w.mean(axis=0)
         ax.text(c[0], c[1], c[2], label if k in (0, last) else str(k), fontsize=8, color=color)
     pts = np.vstack(list(world.values()))
-    size = float(np.ptp(pts, axis=0).max()) / 2 or 0.01
-    a = np.linspace(0, 2 * np.pi, 40)
-    r = float(scene._core.pad_radius)
-    w0 = world[0]
-    for sgn in (1, -1):  # the pads, where the fingers hold the object at the start
-        y = sgn * np.max(sgn * w0[:, 1])
-        ax.add_collection3d(Poly3DCollection([np.c_[r * np.cos(a), np.full(40, y), r * np.sin(a)]],
-                                             facecolor="0.3", alpha=0.5))
+    _pads3d(ax, world[0], float(scene._core.pad_radius), 0.5)  # where the fingers hold it at the start
     ax.plot([], [], color="0.3", lw=6, alpha=0.5, label="finger pads")
-    mid = (pts.max(axis=0) + pts.min(axis=0)) / 2
-    for f, m in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid):
-        f(m - 1.2 * size, m + 1.2 * size)
-    ax.set_box_aspect((1, 1, 1))
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m] (grasp axis)")
-    ax.set_zlabel("z [m]")
-    ax.view_init(elev=18, azim=-60)
+    _axes3d(ax, (pts.max(axis=0) + pts.min(axis=0)) / 2, 1.2 * (float(np.ptp(pts, axis=0).max()) / 2 or 0.01))
     ax.legend(fontsize=7, loc="upper left")
     status = "plan found" if plan.found else "no plan found (best partial plan)"
     ax.set_title(f"{scene.name}: {status}, {last} steps\npushes: {_runs_text(names)}", fontsize=9)

@@ -13,6 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..polygon import signed_area, triangulate
+from ..pose import planar_to_spatial, quat_rotate, tangents
+
 #: depth of a pusher's body behind its contact, as a fraction of the object's size
 FEATURE_DEPTH = 0.25
 #: length of the drawn axes, as a fraction of the object's size
@@ -21,59 +24,21 @@ AXIS_LENGTH = 0.7
 GROUND_HALF = 2.0
 
 
-def planar_pose(q) -> list:
-    """A planar pose ``[x, z, theta]`` as a 3-D pose: a turn by theta in the x-z plane (x towards
-    z) is a rotation by -theta about y."""
-    x, z, th = (float(v) for v in q)
-    return [x, 0.0, z, float(np.cos(th / 2)), 0.0, float(-np.sin(th / 2)), 0.0]
-
-
 def extrude(outline, thickness: float):
     """The prism of a simple polygon (x, z) across y in [-thickness/2, thickness/2]: vertices
     (2n, 3) and outward triangles (caps by ear clipping, walls as quads)."""
     p = np.asarray(outline, float)
-    if _area(p) < 0:
+    if signed_area(p) < 0:
         p = p[::-1]
     n, h = len(p), thickness / 2
     v = np.array([[x, y, z] for y in (-h, h) for x, z in p])
-    caps = ear_clip(p)
+    caps = triangulate(p)
     # a counter-clockwise (x, z) polygon: its normal is x × z = -y, so the cap at -h as is
     tris = [[a, b, c] for a, b, c in caps] + [[n + a, n + c, n + b] for a, b, c in caps]
     for i in range(n):
         j = (i + 1) % n
         tris += [[i, n + i, j], [j, n + i, n + j]]
     return v, [list(map(int, x)) for x in tris]
-
-
-def _area(p) -> float:
-    return 0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
-
-
-def ear_clip(p) -> list:
-    """Triangles (index triples) of a simple counter-clockwise polygon, by ear clipping."""
-    idx, out = list(range(len(p))), []
-
-    def cross(o, a, b):
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    def inside(q, a, b, c):
-        return cross(a, b, q) >= 0 and cross(b, c, q) >= 0 and cross(c, a, q) >= 0
-
-    while len(idx) > 3:
-        for k in range(len(idx)):
-            i, j, m = idx[k - 1], idx[k], idx[(k + 1) % len(idx)]
-            a, b, c = p[i], p[j], p[m]
-            if cross(a, b, c) <= 1e-15:
-                continue  # reflex (or flat) corner
-            if any(inside(p[o], a, b, c) for o in idx if o not in (i, j, m)):
-                continue
-            out.append([i, j, m])
-            idx.pop(k)
-            break
-        else:  # numerically degenerate: fan the rest
-            out += [[idx[0], idx[k], idx[k + 1]] for k in range(1, len(idx) - 1)]
-            return out
-    return out + [idx]
 
 
 def _outward(v, tris, centre) -> list:
@@ -87,14 +52,6 @@ def _outward(v, tris, centre) -> list:
     return out
 
 
-def _frame(n):
-    """Two unit vectors completing the unit normal ``n`` to a right-handed frame."""
-    a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
-    t1 = np.cross(n, a)
-    t1 /= np.linalg.norm(t1)
-    return t1, np.cross(n, t1)
-
-
 def feature_mesh(points, normal, depth: float):
     """The body of a pusher touching the object at ``points`` (object frame) with ``normal``
     (into the object): its kind ("corner", "edge" or "face"), vertices and outward triangles.
@@ -106,7 +63,7 @@ def feature_mesh(points, normal, depth: float):
     d -= np.outer(d @ n, n)
     _, s, vt = np.linalg.svd(d) if len(d) > 1 else (None, np.zeros(1), np.eye(3))
     rank = int(np.sum(s > 1e-9 * max(1.0, depth)))
-    t1, t2 = (vt[0], np.cross(n, vt[0])) if rank >= 1 else _frame(n)
+    t1, t2 = (vt[0], np.cross(n, vt[0])) if rank >= 1 else tangents(n)
     back = c - depth * n
     w = 0.6 * depth
     if rank == 0:
@@ -144,16 +101,9 @@ def _with_features(v, features) -> np.ndarray:
     return np.concatenate([np.asarray(v, float)] + [np.asarray(f["vertices"], float) for f in features])
 
 
-def _rotate(q, v):
-    """Vectors ``v`` (rows) turned by the unit quaternion ``q`` = [w, x, y, z]."""
-    w, u = q[0], np.asarray(q[1:], float)
-    t = 2 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
-
-
 def _world(poses, v):
     """The vertices ``v`` (object frame) at every pose: (poses, vertices, 3)."""
-    return np.array([_rotate(np.asarray(q[3:]) / np.linalg.norm(q[3:]), v) + q[:3] for q in np.asarray(poses, float)])
+    return np.array([quat_rotate(q[3:], v) + q[:3] for q in np.asarray(poses, float)])
 
 
 def ground(poses, vertices, gravity, size: float, support=None) -> dict:
@@ -170,7 +120,7 @@ def ground(poses, vertices, gravity, size: float, support=None) -> dict:
         level = float((w @ up).min())
         mid = w.reshape(-1, 3).mean(axis=0)
         point = mid - (mid @ up - level) * up
-    t1, t2 = _frame(up)
+    t1, t2 = tangents(up)
     return {"point": point.tolist(), "normal": up.tolist(), "t1": t1.tolist(), "t2": t2.tolist(),
             "half": GROUND_HALF * size, "support": None if support is None else support.get("name")}
 
@@ -224,7 +174,7 @@ def planar_description(scene, plan_poses, plan_pushers) -> dict:
     v, t = extrude(outline, thick)
     task = scene.task
     start = task.start if task is not None else np.zeros(3)
-    poses = [planar_pose(q) for q in (plan_poses if plan_poses is not None else [start])]
+    poses = [planar_to_spatial(q) for q in (plan_poses if plan_poses is not None else [start])]
     h = thick / 2
     pushers = []
     for p in scene.pushers:
@@ -247,7 +197,7 @@ def planar_description(scene, plan_poses, plan_pushers) -> dict:
         "jaws": jaws(poses, _with_features(v, feats), pad, thick, size) if grasp else None,
         "ground": ground(poses, v, gravity, size, support),
         "gravity": {"direction": gravity, "g": float(g), "in_plane": not grasp},
-        "goal": planar_pose(task.goal) if task is not None else None,
+        "goal": planar_to_spatial(task.goal) if task is not None else None,
     })
 
 

@@ -1,0 +1,135 @@
+"""Pose helpers in numpy, in one place. 3-D poses are ``[x, y, z, qw, qx, qy, qz]`` (m, unit
+quaternion ``[w, x, y, z]``), body twists ``[vx, vy, vz, wx, wy, wz]`` (m/s, rad/s); planar poses
+``[x, z, theta]`` (m, m, rad) in the x-z plane, a turn by theta (x towards z) being a rotation by
+-theta about +y. The SE(3) algebra itself (compose, inverse, log, exp) is the core's
+(``_core.se3_*``); here: quaternions (matrix, rotating vectors, from a matrix, slerp, angle),
+planar poses (their quaternion and 3-D pose, compose, inverse, rotate), the frame of a normal,
+and twists between poses and frames."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core
+
+# --- quaternions -------------------------------------------------------------------------------
+
+
+def quat_matrix(q) -> np.ndarray:
+    """The 3 x 3 rotation matrix of quaternion ``q`` ``[w, x, y, z]`` (normalized first)."""
+    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def quat_rotate(q, v) -> np.ndarray:
+    """Vector(s) ``v`` (shape (3,) or (n, 3), any unit) rotated by quaternion ``q``."""
+    return np.asarray(v, float) @ quat_matrix(q).T
+
+
+def quat_from_matrix(R) -> np.ndarray:
+    """The unit quaternion (w >= 0) of rotation matrix ``R`` (Shepperd's method: the largest of
+    the four squared components is computed first, so it is accurate for every rotation)."""
+    R = np.asarray(R, float)
+    t = np.trace(R)
+    k = int(np.argmax([t, R[0, 0], R[1, 1], R[2, 2]]))
+    q = np.empty(4)
+    if k == 0:
+        r = np.sqrt(1 + t)
+        q[:] = [r / 2, (R[2, 1] - R[1, 2]) / (2 * r), (R[0, 2] - R[2, 0]) / (2 * r), (R[1, 0] - R[0, 1]) / (2 * r)]
+    else:
+        i, j, m = k - 1, k % 3, (k + 1) % 3
+        r = np.sqrt(1 + R[i, i] - R[j, j] - R[m, m])
+        q[0] = (R[m, j] - R[j, m]) / (2 * r)
+        q[1 + i], q[1 + j], q[1 + m] = r / 2, (R[j, i] + R[i, j]) / (2 * r), (R[m, i] + R[i, m]) / (2 * r)
+    q /= np.linalg.norm(q)
+    return -q if q[0] < 0 else q
+
+
+def slerp(a, b, s: float) -> np.ndarray:
+    """The quaternion a fraction ``s`` in [0, 1] of the way from ``a`` to ``b`` along the
+    shortest rotation between them (spherical linear interpolation)."""
+    a, b = np.asarray(a, float) / np.linalg.norm(a), np.asarray(b, float) / np.linalg.norm(b)
+    d = float(a @ b)
+    if d < 0:
+        b, d = -b, -d
+    if d > 1 - 1e-12:
+        q = a + s * (b - a)
+    else:
+        th = np.arccos(d)
+        q = (np.sin((1 - s) * th) * a + np.sin(s * th) * b) / np.sin(th)
+    return q / np.linalg.norm(q)
+
+
+def quat_angle(a, b) -> float:
+    """Angle [rad] in [0, pi] of the rotation between quaternions ``a`` and ``b`` ([w, x, y, z],
+    normalized first); accurate for small angles too (an arctangent, not an arccosine)."""
+    a, b = np.asarray(a, float) / np.linalg.norm(a), np.asarray(b, float) / np.linalg.norm(b)
+    vec = a[0] * b[1:] - b[0] * a[1:] - np.cross(a[1:], b[1:])  # vector part of a⁻¹ b
+    return float(2 * np.arctan2(np.linalg.norm(vec), abs(float(a @ b))))
+
+
+# --- frames ------------------------------------------------------------------------------------
+
+
+def tangents(n) -> tuple:
+    """Two unit vectors ``t1, t2`` completing the direction ``n`` (normalized first) to the
+    right-handed orthonormal frame ``(t1, t2, n)``."""
+    n = np.asarray(n, float) / np.linalg.norm(n)
+    a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+    t1 = np.cross(n, a)
+    t1 /= np.linalg.norm(t1)
+    return t1, np.cross(n, t1)
+
+
+# --- planar poses ------------------------------------------------------------------------------
+
+
+def planar_quat(theta: float) -> np.ndarray:
+    """The quaternion ``[w, x, y, z]`` of the planar angle ``theta`` [rad] (a rotation by −theta
+    about +y)."""
+    return np.array([np.cos(theta / 2), 0.0, -np.sin(theta / 2), 0.0])
+
+
+def planar_to_spatial(q) -> list:
+    """The planar pose ``q`` ``[x, z, theta]`` (m, m, rad) as a 3-D pose ``[x, 0, z, qw, qx, qy, qz]``."""
+    x, z, th = (float(v) for v in q)
+    return [x, 0.0, z, *map(float, planar_quat(th))]
+
+
+def planar_compose(a, b) -> np.ndarray:
+    """Planar pose composition ``a ∘ b`` of poses ``[x, z, theta]`` (m, m, rad)."""
+    c, s = np.cos(a[2]), np.sin(a[2])
+    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], a[2] + b[2]])
+
+
+def planar_inverse(a) -> np.ndarray:
+    """The inverse of a planar pose ``a`` ``[x, z, theta]`` (m, m, rad)."""
+    c, s = np.cos(a[2]), np.sin(a[2])
+    return np.array([-(c * a[0] + s * a[1]), -(-s * a[0] + c * a[1]), -a[2]])
+
+
+def planar_rotate(theta: float, v) -> np.ndarray:
+    """The planar vector ``v`` ``[x, z]`` (any unit) turned by ``theta`` [rad] (x towards z)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
+
+
+# --- twists ------------------------------------------------------------------------------------
+
+
+def twist_in(rel, u) -> list:
+    """Body twist ``u`` (m/s, rad/s) of a frame B expressed in frame A, where the pose ``rel`` =
+    A⁻¹B (m, unit quaternion) (the adjoint): ``[R v + p × (R ω), R ω]``."""
+    rel, u = np.asarray(rel, float), np.asarray(u, float)
+    w = quat_rotate(rel[3:], u[3:])
+    return (quat_rotate(rel[3:], u[:3]) + np.cross(rel[:3], w)).tolist() + w.tolist()
+
+
+def twist_between(a, b) -> list:
+    """The constant body twist (m/s, rad/s) taking pose ``a`` to pose ``b`` (m, unit quaternion)
+    in unit time (SE(3) log, the core's)."""
+    return list(_core.se3_log([float(x) for x in a], [float(x) for x in b]))
