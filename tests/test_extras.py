@@ -153,3 +153,37 @@ def test_demo_without_extras_writes_the_plan_and_skips_the_figures(blocker, tmp_
     assert "plan found" in r.stdout
     assert sorted(p.name for p in (tmp_path / "demo").iterdir()) == ["t-shape-plan.json"]
     assert json.loads((tmp_path / "demo" / "t-shape-plan.json").read_text())["found"] is True
+
+
+DRAWN_CASES = [  # (id, command line after `regrasp`): each asks for a drawn output
+    ("plan --plot", ["plan", "{ex}/t-shape.toml", "--out", "{tmp}/plan.json", "--plot", "{tmp}/p.png"]),
+    ("plan --animate", ["plan", "{ex}/t-shape.toml", "--out", "{tmp}/plan.json", "--animate", "{tmp}/p.gif"]),
+    ("cone --plot", ["cone", "{ex}/block-low-friction.toml", "--pose", "0,0,0", "--pusher", "left", "--plot", "{tmp}/c.png"]),
+    ("simulate --plot", ["simulate", "{ex}/block-high-friction.toml", "--plan", "{plan}", "--plot", "{tmp}/r.png"]),
+    ("simulate --video", ["simulate", "{ex}/block-high-friction.toml", "--plan", "{plan}", "--engine", "mujoco",
+                          "--video", "{tmp}/v.gif"]),
+    ("push --plot", ["push", "{ex}/t-shape.toml", "--pose", "0,0,0", "--pusher", "top", "--twist", "0,-0.01,0",
+                     "--plot", "{tmp}/p.png"]),
+    ("control --plot", ["control", "{ex}/block-high-friction.toml", "--plan", "{plan}", "--plot", "{tmp}/k.png"]),
+]
+
+
+@pytest.mark.parametrize("args", [c[1] for c in DRAWN_CASES], ids=[c[0] for c in DRAWN_CASES])
+def test_a_missing_plot_extra_is_found_before_any_work(blocker, planar_plan, tmp_path, args):
+    """Without matplotlib, a command asked for a figure, animation or video exits 1 naming
+    regrasp[plot] before it loads the scene (so before any plan or simulation is made)."""
+    args = [a.format(ex=EXAMPLES, tmp=tmp_path, plan=planar_plan) for a in args]
+    code = textwrap.dedent(f'''
+        import sys
+        import regrasp.cli
+        def loaded(*args, **kw):
+            print("the scene was loaded", file=sys.stderr)
+            raise SystemExit(3)
+        regrasp.cli.load_scene = loaded
+        sys.exit(regrasp.cli.main({args!r}))
+    ''')
+    r = run(blocker, ["-c", code], ("matplotlib",))
+    assert r.returncode == 1, (r.returncode, r.stdout, r.stderr)
+    assert "the scene was loaded" not in r.stderr and r.stdout == "", r.stderr
+    assert f"`regrasp {args[0]}` needs matplotlib: pip install 'regrasp[plot]'" in r.stderr, r.stderr
+    assert list(tmp_path.iterdir()) == []

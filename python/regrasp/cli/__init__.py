@@ -19,6 +19,7 @@ import numpy as np
 
 from .. import errors, progress
 from ..errors import ArgumentError, MissingExtraError, RegraspError, SceneError
+from ..extras import need
 from ..files import check_writable, refuse_overwrite_input
 from ..planning.plan import Plan, planner_defaults
 from ..scene import load_scene
@@ -44,6 +45,8 @@ MAX_FORCE = 10_000.0
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff", ".webp")
 ANIMATION_SUFFIXES = (".gif", ".webp", ".png", ".tif", ".tiff")
 VIDEO_SUFFIXES = ANIMATION_SUFFIXES + (".mp4",)
+#: the suffix sets of outputs drawn with matplotlib (the `plot` extra)
+DRAWN = (FIGURE_SUFFIXES, ANIMATION_SUFFIXES, VIDEO_SUFFIXES)
 
 
 # --- arguments ---------------------------------------------------------------------------------
@@ -90,7 +93,8 @@ def option(name: str) -> str:
 
 def check_outputs(a, outputs: dict, inputs=(), create_folder: bool = True) -> None:
     """The output options ``{attribute: suffixes or None}`` given: writable (before the work),
-    not an input file, not one another, with a suffix of ``suffixes``."""
+    not an input file, not one another, with a suffix of ``suffixes``, and what draws them
+    installed (:func:`check_drawing`)."""
     paths = {option(k): getattr(a, k, None) for k in outputs}
     refuse_overwrite_input(paths, inputs)
     for k, suffixes in outputs.items():
@@ -100,7 +104,21 @@ def check_outputs(a, outputs: dict, inputs=(), create_folder: bool = True) -> No
         if suffixes and Path(v).suffix.lower() not in suffixes:
             raise ArgumentError(f"invalid `{option(k)}`: cannot write {v}: the name must end in one of "
                                 f"{', '.join(suffixes)}", option(k))
+        check_drawing(v, suffixes, option(k))
         check_writable(v, option(k), create_folder=create_folder)
+
+
+def check_drawing(path, suffixes, opt: str) -> None:
+    """Figures, animations and videos (``suffixes`` one of :data:`DRAWN`) need matplotlib (a
+    MissingExtraError naming ``regrasp[plot]``), an MP4 also ffmpeg: checked before any work."""
+    if suffixes not in DRAWN:
+        return
+    need("matplotlib", "plot")
+    if Path(path).suffix.lower() == ".mp4":
+        import matplotlib.animation
+
+        if not matplotlib.animation.writers.is_available("ffmpeg"):
+            raise ArgumentError(f"invalid `{opt}`: MP4 needs ffmpeg, which is not installed; use a .gif", opt)
 
 
 def floats(text: str, n: int, name: str) -> np.ndarray:
@@ -162,18 +180,10 @@ def check_positive(a, name: str, what: str) -> None:
         raise ArgumentError(f"invalid `--{name.replace('_', '-')}`: must be a positive {what}", f"--{name.replace('_', '-')}")
 
 
-def reject_flags(a, flags, why: str) -> None:
-    """Invalid input when any of ``flags`` (attribute names; options that default to None or
-    False) is given: ``why`` says what applies."""
-    bad = [f for f in flags if getattr(a, f, None) is not None and getattr(a, f) is not False]
-    if bad:
-        raise ArgumentError(f"invalid flags for a 3-D scene: {why} (no --{', --'.join(f.replace('_', '-') for f in bad)})",
-                            "scene")
-
-
 def refuse_flags(a, flags, when: str, why: str) -> None:
     """Invalid input when any of ``flags`` (attribute names; options that default to None or
-    False) is given ``when`` (e.g. "with --engine quasistatic"): ``why`` says what they need."""
+    False) is given ``when`` (e.g. "with --engine quasistatic", "for a 3-D scene"): ``why`` says
+    what they need; the error names the first offending option."""
     bad = [option(f) for f in flags if getattr(a, f, None) is not None and getattr(a, f) is not False]
     if bad:
         raise ArgumentError(f"invalid `{bad[0]}`: {', '.join(bad)} {'has' if len(bad) == 1 else 'have'} no effect "

@@ -10,7 +10,7 @@ from ..errors import ArgumentError
 from ..planning.plan import Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_command, add_scale_options, add_verbose, check_count,
                check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, mpc_default,
-               refuse_flags, reject_flags, scales, seed_arg)
+               refuse_flags, scales, seed_arg)
 
 #: options of the planar MPC, without meaning for 3-D control
 PLANAR_ONLY = ("poke", "start_error", "robust", "uncertainty", "fixtureless", "plot", "dt", "horizon", "noise")
@@ -19,7 +19,7 @@ PLANAR_ONLY = ("poke", "start_error", "robust", "uncertainty", "fixtureless", "p
 def _control3d(scene, plan: Plan, a) -> int:
     """3-D: the plan executed with feedback by re-planning (see
     :func:`regrasp.scene.spatial.run_plan3d`), or open loop with --open-loop."""
-    reject_flags(a, PLANAR_ONLY, "3-D control re-plans from the measured pose")
+    refuse_flags(a, PLANAR_ONLY, "for a 3-D scene", "3-D control re-plans from the measured pose")
     if a.engine == "quasistatic" and any(getattr(a, f) is not None for f in SCALES):
         raise ArgumentError("invalid `--scale-*`: the quasi-static 3-D world is the scene itself (MuJoCo only)", "--engine")
     fb = not a.open_loop

@@ -8,12 +8,11 @@ import numpy as np
 
 from .. import _core, progress
 from ..errors import ArgumentError
-from ..extras import need
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, PUSHER_HELP, VIDEO_SUFFIXES,
                add_command, add_scale_options, add_verbose, check_count, check_number, check_outputs, check_positive,
-               check_pusher, execute3d, floats, given, load, load_planar, refuse_flags, reject_flags, scales, seed_arg)
+               check_pusher, execute3d, floats, given, load, load_planar, refuse_flags, scales, seed_arg)
 
 
 def cmd_validate(a) -> int:
@@ -48,7 +47,7 @@ def _check_engine_flags(a) -> None:
 
 
 def _simulate3d(scene, plan: Plan, a) -> int:
-    reject_flags(a, ("perturb", "video", "plot"), "--perturb/--video/--plot are planar only "
+    refuse_flags(a, ("perturb", "video", "plot"), "for a 3-D scene", "they are planar only "
                  "(3-D: --scale-*, --dt, --json; `regrasp plan --html` for a view)")
     _check_engine_flags(a)
     r = execute3d(scene, plan, a, **given(a, "dt"))
@@ -88,12 +87,6 @@ def _check_simulate(a) -> None:
     if a.perturb is not None and not (0 <= a.perturb < 1):
         raise ArgumentError("invalid `--perturb`: a spread in [0, 1)", "--perturb")
     check_outputs(a, {"plot": FIGURE_SUFFIXES, "video": VIDEO_SUFFIXES}, [a.scene, a.plan])
-    if a.video and a.video.lower().endswith(".mp4"):
-        need("matplotlib", "plot")
-        import matplotlib.animation
-
-        if not matplotlib.animation.writers.is_available("ffmpeg"):
-            raise ArgumentError("invalid `--video`: MP4 needs ffmpeg, which is not installed; use a .gif", "--video")
 
 
 def _write_figures(scene, rep, a) -> None:
@@ -165,7 +158,7 @@ def cmd_push(a) -> int:
     twist = floats(a.twist, 6 if scene.dimension == 3 else 3, "--twist")
     check_pusher(scene, a.pusher)
     if scene.dimension == 3:
-        reject_flags(a, ("plot",), "--plot draws planar pushes only")
+        refuse_flags(a, ("plot",), "for a 3-D scene", "it draws planar pushes only")
         with progress.elapsed(None, "push"):
             tr = scene.simulate_push(pose, a.pusher, twist, a.duration, a.dt)
     else:

@@ -11,7 +11,7 @@ from ..files import Outputs
 from .. import progress
 from ..planning.plan import POSE_SIZE, Plan, plan, planner_defaults
 from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_command, add_verbose, check_number, check_outputs,
-               floats, load, mode_scene, planner_default, pusher_runs, reject_flags, seed_arg)
+               floats, load, mode_scene, planner_default, pusher_runs, refuse_flags, seed_arg)
 
 #: the output options of `regrasp plan` and the file-name suffixes they take (None: any)
 OUTPUTS = {"out": None, "partial_out": None, "plot": FIGURE_SUFFIXES, "animate": ANIMATION_SUFFIXES, "html": None}
@@ -24,7 +24,7 @@ def _scene_for(a):
     cone mode of the flags."""
     scene = load(a.scene, a)
     if scene.dimension == 3:
-        reject_flags(a, PLANAR_ONLY, "it plans with the inverse dynamics only, not with motion cones")
+        refuse_flags(a, PLANAR_ONLY, "for a 3-D scene", "it plans with the inverse dynamics only, not with motion cones")
         return scene
     return mode_scene(scene, a)
 
