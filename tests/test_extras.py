@@ -187,3 +187,30 @@ def test_a_missing_plot_extra_is_found_before_any_work(blocker, planar_plan, tmp
     assert "the scene was loaded" not in r.stderr and r.stdout == "", r.stderr
     assert f"`regrasp {args[0]}` needs matplotlib: pip install 'regrasp[plot]'" in r.stderr, r.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def _no_nan(constant: str):
+    raise ValueError(f"not JSON: {constant}")
+
+
+def test_bench_json_without_reference_is_valid_json(blocker):
+    """`regrasp bench --json` with the baselines' extras missing prints valid JSON (no NaN):
+    a skipped baseline has None as its time and ratio. Made small: fewer cones, one seed, one
+    example of each planner."""
+    code = textwrap.dedent('''
+        import sys
+        from regrasp import bench
+        import regrasp.cli
+        full_run, planner, plan3d = bench.run, bench.run_planner, bench.run_plan3d
+        bench.run = lambda **kw: full_run(**{**kw, "n": 300, "reps": 1, "baseline_reps": 1})
+        bench.run_planner = lambda: planner(seeds=1, time_limit=5.0, examples=("block-high-friction",))
+        bench.run_plan3d = lambda: plan3d(seeds=1, examples=("offset-3d",))
+        sys.exit(regrasp.cli.main(["bench", "--quick", "--json"]))
+    ''')
+    r = run(blocker, ["-c", code], ("casadi", "scipy", "mujoco"))
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout, parse_constant=_no_nan)
+    skipped = res["plan3d_offset-3d"]
+    assert skipped["baseline_median_s"] is None and skipped["ratio"] is None, skipped
+    assert "regrasp[reference]" in skipped["baseline"]
+    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_", "mujoco_")) for k in res), sorted(res)
