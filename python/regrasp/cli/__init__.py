@@ -11,6 +11,7 @@ One module per command group: ``cones`` (cone, approx-error), ``planning`` (plan
 from __future__ import annotations
 
 import argparse
+import inspect
 import os
 import sys
 from pathlib import Path
@@ -136,6 +137,12 @@ def planner_default(key: str) -> str:
     """The planner's default of setting ``key`` for a help text (the Rust core's)."""
     d2, d3 = planner_defaults(2).get(key), planner_defaults(3).get(key)
     return f"default {d2}" if d3 is None or d3 == d2 else f"default {d2} planar, {d3} 3-D"
+
+
+def api_default(fn, name: str):
+    """The default of parameter ``name`` of API function ``fn``: a command-line option's default
+    is read from the function it calls (stated once, there)."""
+    return inspect.signature(fn).parameters[name].default
 
 
 def mpc_default(key: str) -> str:

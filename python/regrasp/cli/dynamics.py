@@ -11,7 +11,7 @@ from ..errors import ArgumentError
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, PUSHER_HELP, VIDEO_SUFFIXES,
-               add_command, add_scale_options, add_verbose, check_count, check_number, check_outputs, check_positive,
+               add_command, add_scale_options, api_default, add_verbose, check_count, check_number, check_outputs, check_positive,
                check_pusher, execute3d, floats, given, load, load_planar, refuse_flags, scales, seed_arg)
 
 
@@ -28,7 +28,7 @@ def cmd_validate(a) -> int:
         refuse_flags(a, ("support",), "without the quasi-static engine", "it is the quasi-static simulator's pad model")
     scene = load_planar(a.scene, "validate", a)
     res = validate(scene, a.pushes, a.seed, engines=engines, workers=a.workers, ray_address=a.ray, progress=True,
-                   **given(a, "support"))
+                   support=a.support)
     print(json.dumps(res) if a.json else format_validation(res))
     return OK
 
@@ -58,6 +58,10 @@ def _simulate3d(scene, plan: Plan, a) -> int:
     return OK if r["success"] else CANNOT
 
 
+#: the seed of the factors `regrasp simulate --perturb` draws when --seed is not given
+PERTURB_SEED = 0
+
+
 def _replay_planar(scene, plan: Plan, a):
     """The planar plan replayed in the engine of --engine."""
     if a.engine == "quasistatic":
@@ -67,7 +71,8 @@ def _replay_planar(scene, plan: Plan, a):
     from ..mujoco.planar import Perturbation, execute_plan
 
     base = Perturbation(*scales(a))
-    pert = Perturbation.draw(a.perturb, np.random.default_rng(a.seed or 0), base) if a.perturb else base
+    seed = PERTURB_SEED if a.seed is None else a.seed
+    pert = Perturbation.draw(a.perturb, np.random.default_rng(seed), base) if a.perturb else base
     rep = execute_plan(scene, plan, pert)
     return rep
 
@@ -174,13 +179,17 @@ def cmd_push(a) -> int:
 
 
 def add_parsers(sub) -> None:
+    from ..scene.spatial import Scene3D
+    from ..sim import quasistatic
+    from ..sim.validation import validate
+
     v = add_command(sub, "validate", "motion-cone predictions against the simulators (planar scenes)",
                     "regrasp validate examples/block-low-friction.toml --pushes 500 --engines quasistatic,mujoco",
                     cmd_validate)
     v.add_argument("scene", help="a planar scene file")
-    v.add_argument("--pushes", type=int, default=2000, help=f"random pushes, 1 to {MAX_PUSHES}")
+    v.add_argument("--pushes", type=int, default=api_default(validate, "pushes"), help=f"random pushes, 1 to {MAX_PUSHES}")
     v.add_argument("--engines", default="quasistatic", help="comma-separated: quasistatic,mujoco")
-    v.add_argument("--seed", type=seed_arg, default=0, help="random seed, a whole number >= 0")
+    v.add_argument("--seed", type=seed_arg, default=api_default(validate, "seed"), help="random seed, a whole number >= 0")
     v.add_argument("--workers", type=int, help=f"local processes for MuJoCo, 1 to {MAX_WORKERS} (default: all cores)")
     v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
     v.add_argument("--support", choices=["points", "limit_surface"],
@@ -196,11 +205,12 @@ def add_parsers(sub) -> None:
     s.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
     s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"],
                    help="our quasi-static simulator or MuJoCo")
-    s.add_argument("--dt", type=float, help="quasi-static time step [s] (default 0.05 planar, 0.25 3-D)")
+    s.add_argument("--dt", type=float, help=f"quasi-static time step [s] (default {api_default(quasistatic.replay_plan, 'dt')} "
+                   f"planar, {api_default(Scene3D.replay, 'dt')} 3-D)")
     add_scale_options(s, "MuJoCo: ")
     s.add_argument("--perturb", type=float,
                    help="MuJoCo, planar: also draw each factor uniformly in [1-P, 1+P] from --seed (default 0: none)")
-    s.add_argument("--seed", type=seed_arg, help="random seed of --perturb (default 0)")
+    s.add_argument("--seed", type=seed_arg, help=f"random seed of --perturb (default {PERTURB_SEED})")
     s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo, planar: an animation of the execution")
     s.add_argument("--plot", metavar="PNG", help="planar: planned against simulated poses")
     s.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -215,7 +225,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--twist", required=True,
                    help="pusher body twist vx,vz,omega, object frame at the start (3-D: vx,vy,vz,wx,wy,wz)")
     p.add_argument("--duration", type=float, default=1.0, help="duration of the push [s]")
-    p.add_argument("--dt", type=float, default=0.02, help="time step [s], at most --duration")
+    p.add_argument("--dt", type=float, default=api_default(quasistatic.simulate_push, "dt"),
+                   help="time step [s], at most --duration")
     p.add_argument("--plot", metavar="PNG", help="planar: object motion and contact forces")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(p)
