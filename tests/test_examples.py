@@ -71,3 +71,26 @@ def test_cli_lists_and_copies(tmp_path):
     again, nameless, unknown = cli("examples", "prism-3d", "--copy", "out"), cli("examples", "--copy", "x"), cli("examples", "nope")
     for bad, opt in ((again, "--copy"), (nameless, "--copy"), (unknown, "name")):
         assert bad.returncode == 2 and f"`{opt}`" in bad.stderr and "Traceback" not in bad.stderr, bad.stderr
+
+
+def test_a_failed_copy_leaves_no_files_and_no_new_folders(tmp_path, monkeypatch):
+    """All or none: the mesh cannot be copied, so neither the scene file nor the folders the
+    copy made are left."""
+    real = examples.shutil.copyfile
+
+    def copyfile(src, dst):
+        if str(src).endswith(".obj"):
+            raise OSError(28, "No space left on device", str(dst))
+        return real(src, dst)
+
+    monkeypatch.setattr(examples.shutil, "copyfile", copyfile)
+    with pytest.raises(OSError):
+        examples.copy("prism-3d", tmp_path / "new" / "mine")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_copy_names_the_callers_option():
+    dest = examples.path("t-shape").parent  # the file exists there
+    with pytest.raises(regrasp.ArgumentError) as e:
+        examples.copy("t-shape", dest, field="--copy")
+    assert e.value.field == "--copy" and str(e.value).startswith("invalid `--copy`:"), str(e.value)
