@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import inspect
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -289,11 +290,25 @@ class Parser(argparse.ArgumentParser):
 
 def add_command(sub, name: str, summary: str, example: str, fn) -> Parser:
     """A command ``name``: ``summary`` (one line) in `regrasp --help` and its own help, an example
-    (a command line, several on their own lines) as its epilog."""
+    (a command line, several on their own lines) as its epilog (see :func:`example_epilog`)."""
     p = sub.add_parser(name, help=summary, description=summary[0].upper() + summary[1:] + ".",
-                       epilog="example:\n" + "\n".join(f"  {line}" for line in example.splitlines()))
+                       epilog=example_epilog(example))
     p.set_defaults(fn=fn)
     return p
+
+
+def example_epilog(example: str) -> str:
+    """``example:`` and the command lines of ``example``; where they read a bundled example's
+    scene file (``t-shape.toml``), a line saying how to get it (any folder, after pip install)."""
+    from .. import examples
+
+    lines = [f"  {line}" for line in example.splitlines()]
+    used = [n for n in examples.names() if re.search(rf"(?<![\w/.-]){re.escape(n)}\.toml\b", example)]
+    if used and "--copy" not in example:
+        name = used[0] if len(used) == 1 else "NAME"
+        lines.append(f"  ({', '.join(f'{n}.toml' for n in used)}: bundled example{'s' * (len(used) > 1)}; "
+                     f"`regrasp examples {name} --copy .` writes {name}.toml here)")
+    return "example:\n" + "\n".join(lines)
 
 
 def version() -> str:
@@ -317,7 +332,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     ap = Parser(prog="regrasp", description="In-hand regrasps by prehensile pushing: motion cones, planning, "
                 "simulation and control (`regrasp COMMAND --help` for each command).",
-                epilog="example:\n  regrasp demo --out out/demo\n  regrasp plan examples/t-shape.toml --plot plan.png")
+                epilog=example_epilog("regrasp demo --out out/demo\nregrasp examples t-shape --copy .\n"
+                                      "regrasp plan t-shape.toml --plot plan.png"))
     ap.add_argument("--version", action="version", version=version(), help="print the version and exit")
     ap.add_argument("-v", "--verbose", action="store_true", help="print the scenes' notes on stderr")
     add_quiet(ap)

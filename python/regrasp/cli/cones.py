@@ -126,7 +126,7 @@ def add_parsers(sub) -> None:
     from ..reference.approx_error import approximation_report
 
     c = add_command(sub, "cone", "motion cone of a pusher at a pose (planar scenes)",
-                    "regrasp cone examples/t-shape.toml --pose 0,0,0 --pusher top --plot cone.png", cmd_cone)
+                    "regrasp cone t-shape.toml --pose 0,0,0 --pusher top --plot cone.png", cmd_cone)
     c.add_argument("scene", help="a planar scene file")
     c.add_argument("--pose", required=True, help="the object's pose in the gripper frame: x,z,theta [m, m, rad]")
     c.add_argument("--pusher", required=True, help=PUSHER_HELP)
@@ -137,7 +137,7 @@ def add_parsers(sub) -> None:
     add_verbose(c)
 
     e = add_command(sub, "approx-error", "polyhedral approximation vs exact cone, per scene and grip force",
-                    "regrasp approx-error examples/t-shape.toml --forces 5,20 --samples 2000", cmd_approx_error)
+                    "regrasp approx-error t-shape.toml --forces 5,20 --samples 2000", cmd_approx_error)
     e.add_argument("scenes", nargs="*", help="planar scene files (default: every bundled planar example)")
     e.add_argument("--forces", default=",".join(f"{f:g}" for f in api_default(approximation_report, "forces")),
                    help="grip forces per finger [N], comma-separated")

@@ -77,7 +77,7 @@ def cmd_control(a) -> int:
 def add_parsers(sub) -> None:
     k = add_command(sub, "control", "track a plan with the MPC (closed loop) in a simulator "
                     "(3-D scenes: feedback by re-planning from the measured pose)",
-                    "regrasp control examples/t-shape.toml --plan plan.json --poke 2,0.005,0,0 --plot control.png",
+                    "regrasp control t-shape.toml --plan plan.json --poke 2,0.005,0,0 --plot control.png",
                     cmd_control)
     k.add_argument("scene", help="the scene file the plan is for")
     k.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")

@@ -184,7 +184,7 @@ def add_parsers(sub) -> None:
     from ..sim.validation import validate
 
     v = add_command(sub, "validate", "motion-cone predictions against the simulators (planar scenes)",
-                    "regrasp validate examples/block-low-friction.toml --pushes 500 --engines quasistatic,mujoco",
+                    "regrasp validate block-low-friction.toml --pushes 500 --engines quasistatic,mujoco",
                     cmd_validate)
     v.add_argument("scene", help="a planar scene file")
     v.add_argument("--pushes", type=int, default=api_default(validate, "pushes"), help=f"random pushes, 1 to {MAX_PUSHES}")
@@ -199,7 +199,7 @@ def add_parsers(sub) -> None:
     add_verbose(v)
 
     s = add_command(sub, "simulate", "replay a plan in a simulator (planar or 3-D)",
-                    "regrasp simulate examples/t-shape.toml --plan plan.json --engine mujoco --video replay.gif",
+                    "regrasp simulate t-shape.toml --plan plan.json --engine mujoco --video replay.gif",
                     cmd_simulate)
     s.add_argument("scene", help="the scene file the plan is for")
     s.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
@@ -217,7 +217,7 @@ def add_parsers(sub) -> None:
     add_verbose(s)
 
     p = add_command(sub, "push", "simulate one push in the quasi-static simulator (planar or 3-D)",
-                    "regrasp push examples/t-shape.toml --pose 0,0,0 --pusher top --twist 0,-0.01,0 --plot push.png",
+                    "regrasp push t-shape.toml --pose 0,0,0 --pusher top --twist 0,-0.01,0 --plot push.png",
                     cmd_push)
     p.add_argument("scene", help="the scene file")
     p.add_argument("--pose", required=True, help="x,z,theta (3-D scenes: x,y,z,qw,qx,qy,qz)")

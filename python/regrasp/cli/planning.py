@@ -120,8 +120,8 @@ def cmd_plan(a) -> int:
 
 def add_parsers(sub) -> None:
     pl = add_command(sub, "plan", "plan a regrasp (T-RRT* with motion-cone propagation; 3-D: inverse dynamics)",
-                     "regrasp plan examples/t-shape.toml --out plan.json --plot plan.png --animate plan.gif\n"
-                     "regrasp plan examples/pivot-3d.toml --html plan.html", cmd_plan)
+                     "regrasp plan t-shape.toml --out plan.json --plot plan.png --animate plan.gif\n"
+                     "regrasp plan pivot-3d.toml --html plan.html", cmd_plan)
     pl.add_argument("scene", help="the scene file (planar or 3-D)")
     pl.add_argument("--out", metavar="PLAN.json",
                     help="write the plan file here (no plan found: the best partial plan, unless the file exists)")
