@@ -85,6 +85,42 @@ def test_the_defaults_come_from_the_core_settings():
     assert f"default {_core.mpc_defaults()['dt']}" in helps["dt"]
 
 
+def test_the_defaults_come_from_the_api():
+    """Each option's default is the one of the function the command calls (stated there once)."""
+    import inspect
+
+    from regrasp import _core, bench
+    from regrasp.reference.approx_error import approximation_report
+    from regrasp.sim import quasistatic
+    from regrasp.sim.validation import validate
+
+    def api(fn, name):
+        return inspect.signature(fn).parameters[name].default
+
+    def default(cmd, dest):
+        return next(a for a in CMDS[cmd]._actions if a.dest == dest).default
+
+    assert default("validate", "pushes") == api(validate, "pushes")
+    assert default("validate", "seed") == api(validate, "seed")
+    assert default("push", "dt") == api(quasistatic.simulate_push, "dt") == quasistatic.DT
+    assert [float(f) for f in default("approx-error", "forces").split(",")] == list(api(approximation_report, "forces"))
+    assert default("approx-error", "samples") == api(approximation_report, "samples")
+    assert default("control", "seed") == _core.mpc_defaults()["seed"]
+    helps = {a.dest: a.help for a in CMDS["bench"]._actions}
+    assert f"default {bench.CONES:,}" in helps["n"] and f"{bench.QUICK['n']:,} cones" in helps["quick"]
+
+
+@pytest.mark.parametrize("name", sorted(CMDS))
+def test_the_examples_work_from_any_folder(name):
+    """The epilogs name no file of the repository (absent after pip install): a scene file they
+    use is a bundled example, and they say how to copy it here."""
+    epilog = CMDS[name].epilog
+    assert "examples/" not in epilog, epilog
+    for scene in set(re.findall(r"(?<![\w/.-])([\w-]+)\.toml\b", epilog)) - {"NAME"}:
+        assert scene in regrasp.examples.names(), (scene, epilog)
+        assert re.search(rf"regrasp examples ({scene}|NAME) --copy", epilog), epilog
+
+
 def test_version_prints_the_package_and_core_versions():
     status, out, _ = run("--version")
     assert status == 0

@@ -5,24 +5,31 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import tomllib
 
 import pytest
 
 import regrasp
 from regrasp import examples
 
-from .conftest import EXAMPLES
+
+#: the bundled examples (README, "Example scenes"): planar, then 3-D
+PLANAR_NAMES = ["block-fixtureless", "block-high-friction", "block-low-friction", "block-on-incline",
+                "block-tilted-gripper", "block-xztheta", "t-shape"]
+SPATIAL_NAMES = ["ball-roll-3d", "block-3d", "light-side-3d", "offset-3d", "pivot-3d", "pivot-single-3d", "prism-3d"]
 
 
 def test_names_paths_and_dimensions():
-    names = examples.names()
-    assert names == sorted(p.stem for p in EXAMPLES.glob("*.toml")) and "t-shape" in names
-    assert examples.path("t-shape") == examples.ROOT / "t-shape.toml" == examples.path("t-shape.toml")
-    planar, spatial = examples.planar(), examples.spatial()
-    assert sorted(p.stem for p in planar + spatial) == names
-    assert all(regrasp.load_scene(p).dimension == 2 for p in planar)
-    assert all(regrasp.load_scene(p).dimension == 3 for p in spatial)
-    assert all(examples.description(n) for n in names)
+    assert examples.names() == sorted(PLANAR_NAMES + SPATIAL_NAMES)
+    assert examples.path("t-shape") == examples.path("t-shape.toml")
+    assert examples.path("t-shape").name == "t-shape.toml" and examples.path("t-shape").is_file()
+    assert [p.stem for p in examples.planar()] == PLANAR_NAMES
+    assert [p.stem for p in examples.spatial()] == SPATIAL_NAMES
+    for name in PLANAR_NAMES + SPATIAL_NAMES:
+        declared = tomllib.loads(examples.path(name).read_text()).get("dimension", 2)  # planar files have no key
+        assert declared == (3 if name in SPATIAL_NAMES else 2), name
+        assert examples.dimension(name) == declared == regrasp.load_scene(examples.path(name)).dimension, name
+        assert examples.description(name), name
 
 
 def test_an_unknown_name_lists_the_names():
@@ -64,3 +71,26 @@ def test_cli_lists_and_copies(tmp_path):
     again, nameless, unknown = cli("examples", "prism-3d", "--copy", "out"), cli("examples", "--copy", "x"), cli("examples", "nope")
     for bad, opt in ((again, "--copy"), (nameless, "--copy"), (unknown, "name")):
         assert bad.returncode == 2 and f"`{opt}`" in bad.stderr and "Traceback" not in bad.stderr, bad.stderr
+
+
+def test_a_failed_copy_leaves_no_files_and_no_new_folders(tmp_path, monkeypatch):
+    """All or none: the mesh cannot be copied, so neither the scene file nor the folders the
+    copy made are left."""
+    real = examples.shutil.copyfile
+
+    def copyfile(src, dst):
+        if str(src).endswith(".obj"):
+            raise OSError(28, "No space left on device", str(dst))
+        return real(src, dst)
+
+    monkeypatch.setattr(examples.shutil, "copyfile", copyfile)
+    with pytest.raises(OSError):
+        examples.copy("prism-3d", tmp_path / "new" / "mine")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_copy_names_the_callers_option():
+    dest = examples.path("t-shape").parent  # the file exists there
+    with pytest.raises(regrasp.ArgumentError) as e:
+        examples.copy("t-shape", dest, field="--copy")
+    assert e.value.field == "--copy" and str(e.value).startswith("invalid `--copy`:"), str(e.value)

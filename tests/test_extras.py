@@ -153,3 +153,64 @@ def test_demo_without_extras_writes_the_plan_and_skips_the_figures(blocker, tmp_
     assert "plan found" in r.stdout
     assert sorted(p.name for p in (tmp_path / "demo").iterdir()) == ["t-shape-plan.json"]
     assert json.loads((tmp_path / "demo" / "t-shape-plan.json").read_text())["found"] is True
+
+
+DRAWN_CASES = [  # (id, command line after `regrasp`): each asks for a drawn output
+    ("plan --plot", ["plan", "{ex}/t-shape.toml", "--out", "{tmp}/plan.json", "--plot", "{tmp}/p.png"]),
+    ("plan --animate", ["plan", "{ex}/t-shape.toml", "--out", "{tmp}/plan.json", "--animate", "{tmp}/p.gif"]),
+    ("cone --plot", ["cone", "{ex}/block-low-friction.toml", "--pose", "0,0,0", "--pusher", "left", "--plot", "{tmp}/c.png"]),
+    ("simulate --plot", ["simulate", "{ex}/block-high-friction.toml", "--plan", "{plan}", "--plot", "{tmp}/r.png"]),
+    ("simulate --video", ["simulate", "{ex}/block-high-friction.toml", "--plan", "{plan}", "--engine", "mujoco",
+                          "--video", "{tmp}/v.gif"]),
+    ("push --plot", ["push", "{ex}/t-shape.toml", "--pose", "0,0,0", "--pusher", "top", "--twist", "0,-0.01,0",
+                     "--plot", "{tmp}/p.png"]),
+    ("control --plot", ["control", "{ex}/block-high-friction.toml", "--plan", "{plan}", "--plot", "{tmp}/k.png"]),
+]
+
+
+@pytest.mark.parametrize("args", [c[1] for c in DRAWN_CASES], ids=[c[0] for c in DRAWN_CASES])
+def test_a_missing_plot_extra_is_found_before_any_work(blocker, planar_plan, tmp_path, args):
+    """Without matplotlib, a command asked for a figure, animation or video exits 1 naming
+    regrasp[plot] before it loads the scene (so before any plan or simulation is made)."""
+    args = [a.format(ex=EXAMPLES, tmp=tmp_path, plan=planar_plan) for a in args]
+    code = textwrap.dedent(f'''
+        import sys
+        import regrasp.cli
+        def loaded(*args, **kw):
+            print("the scene was loaded", file=sys.stderr)
+            raise SystemExit(3)
+        regrasp.cli.load_scene = loaded
+        sys.exit(regrasp.cli.main({args!r}))
+    ''')
+    r = run(blocker, ["-c", code], ("matplotlib",))
+    assert r.returncode == 1, (r.returncode, r.stdout, r.stderr)
+    assert "the scene was loaded" not in r.stderr and r.stdout == "", r.stderr
+    assert f"`regrasp {args[0]}` needs matplotlib: pip install 'regrasp[plot]'" in r.stderr, r.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def _no_nan(constant: str):
+    raise ValueError(f"not JSON: {constant}")
+
+
+def test_bench_json_without_reference_is_valid_json(blocker):
+    """`regrasp bench --json` with the baselines' extras missing prints valid JSON (no NaN):
+    a skipped baseline has None as its time and ratio. Made small: fewer cones, one seed, one
+    example of each planner."""
+    code = textwrap.dedent('''
+        import sys
+        from regrasp import bench
+        import regrasp.cli
+        full_run, planner, plan3d = bench.run, bench.run_planner, bench.run_plan3d
+        bench.run = lambda **kw: full_run(**{**kw, "n": 300, "reps": 1, "baseline_reps": 1})
+        bench.run_planner = lambda: planner(seeds=1, time_limit=5.0, examples=("block-high-friction",))
+        bench.run_plan3d = lambda: plan3d(seeds=1, examples=("offset-3d",))
+        sys.exit(regrasp.cli.main(["bench", "--quick", "--json"]))
+    ''')
+    r = run(blocker, ["-c", code], ("casadi", "scipy", "mujoco"))
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout, parse_constant=_no_nan)
+    skipped = res["plan3d_offset-3d"]
+    assert skipped["baseline_median_s"] is None and skipped["ratio"] is None, skipped
+    assert "regrasp[reference]" in skipped["baseline"]
+    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_", "mujoco_")) for k in res), sorted(res)

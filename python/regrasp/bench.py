@@ -13,8 +13,8 @@ import time
 import numpy as np
 
 from . import progress
+from . import examples as bundled
 from .errors import MissingExtraError
-from .examples import ROOT as EXAMPLES  # the bundled example scenes
 from .extras import have, need
 from .reference import cones as reference
 from .scene.planar import Scene
@@ -39,10 +39,18 @@ def _random_poses(scene: Scene, n: int, rng) -> np.ndarray:
     return out[:n]
 
 
-def run(n: int = 100_000, reps: int = 11, baseline_reps: int = 3, scene_path=None, pusher: str = "left") -> dict:
+#: cones per batch, repetitions of the timed regrasp calls and of the slow baselines (``regrasp bench``)
+CONES, REPS, BASELINE_REPS = 100_000, 11, 3
+#: the settings of :func:`run` for a quick look (``regrasp bench --quick``)
+QUICK = {"n": 10_000, "reps": 5, "baseline_reps": 1}
+
+
+def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, scene_path=None,
+        pusher: str = "left") -> dict:
     """Every measurement (see the module notes): the cone batches on ``n`` random poses of the
-    scene (default: the low-friction block), then the solver, planner, MuJoCo and MPC probes."""
-    scene = Scene.load(scene_path or EXAMPLES / "block-low-friction.toml")
+    scene (default: the low-friction block), then the solver, planner, MuJoCo and MPC probes.
+    A baseline that was skipped (its extra not installed) has None as its time and ratio."""
+    scene = Scene.load(scene_path or bundled.path("block-low-friction"))
     rng = np.random.default_rng(0)
     poses = _random_poses(scene, n, rng)
     params = reference.RefParams.from_scene(scene, pusher)
@@ -163,7 +171,7 @@ def run_mujoco(steps: int = 4000) -> dict:
     from .mujoco.push import PushRig
     from .sim.quasistatic import simulate_push
 
-    scene = Scene.load(EXAMPLES / "block-low-friction.toml")
+    scene = Scene.load(bundled.path("block-low-friction"))
     rig = PushRig(scene, "left")
     rig.reset([0.0, 0.0, 0.0])
 
@@ -235,7 +243,7 @@ def run_mpc(reps: int = 200) -> dict:
 
     out = {}
     for name in ("block-high-friction", "t-shape"):
-        scene = Scene.load(EXAMPLES / f"{name}.toml")
+        scene = Scene.load(bundled.path(name))
         p = plan(scene, seed=0)
         poses = p.poses.tolist()
         q = (np.asarray(poses[0]) + [0.0005, -0.0005, 0.01]).tolist()
@@ -271,7 +279,7 @@ def run_plan3d(seeds: int = 10, examples=PLANNED_3D) -> dict:
 
     out = {}
     for name in examples:
-        s = Scene3D.load(EXAMPLES / f"{name}.toml")
+        s = Scene3D.load(bundled.path(name))
         runs = [s.plan(seed=k, time_limit=60.0) for k in range(seeds)]
         t = float(np.median([r.planning_time_s for r in runs]))
         solves = float(np.median([r.solves for r in runs]))
@@ -285,11 +293,13 @@ def run_plan3d(seeds: int = 10, examples=PLANNED_3D) -> dict:
                 times.append(mncp_reference.solve(p, pusher_twist=u).solve_time_s)
             except Exception:  # noqa: BLE001 - a failed reference solve is left out
                 pass
-        t_ipopt = float(np.median(times)) if times else float("nan")
+        t_ipopt = float(np.median(times)) if times else 0.0
+        t_base = solves * t_ipopt if times else None  # None: skipped (valid JSON, not NaN)
         out[f"plan3d_{name}"] = {
-            "median_s": t, "baseline_median_s": solves * t_ipopt, "ratio": solves * t_ipopt / max(t, 1e-9),
-            "baseline": f"the same search with IPOPT solves ({solves:.0f} solves x {1e3 * t_ipopt:.1f} ms)" if times
-                        else "IPOPT baseline skipped: pip install 'regrasp[reference]'",
+            "median_s": t, "baseline_median_s": t_base, "ratio": None if t_base is None else t_base / max(t, 1e-9),
+            "baseline": f"the same search with IPOPT solves ({solves:.0f} solves x {1e3 * t_ipopt:.1f} ms)"
+                        if times else "IPOPT baseline skipped: " + ("every reference solve failed" if have("casadi")
+                                                                    else "pip install 'regrasp[reference]'"),
             "found": sum(r.found for r in runs), "n": seeds, "median_solves": solves,
             "switch_overs": float(np.median([r.switch_overs for r in runs])),
         }
@@ -307,7 +317,7 @@ def run_planner(seeds: int = 10, time_limit: float = 30.0, examples=PLANNED) -> 
 
     out = {}
     for name in examples:
-        scene = Scene.load(EXAMPLES / f"{name}.toml")
+        scene = Scene.load(bundled.path(name))
         stats = {}
         for prop in ("motion_cone", "stable_check", "mncp"):
             runs = [plan(scene, seed=k, propagation=prop, time_limit=time_limit) for k in range(seeds)]
@@ -340,7 +350,7 @@ def run_mncp(reps: int = 11, ref_reps: int = 3) -> dict:
     that slides and one that separates."""
     from .reference import mncp as mncp_reference
 
-    scene = Scene.load(EXAMPLES / "block-low-friction.toml")
+    scene = Scene.load(bundled.path("block-low-friction"))
     p = scene._core.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, 4, False)
     out = {}
     for name, u in (("stick", [0.01, 0.0, 0.0]), ("slide", [0.002, 0.01, 0.0]), ("separate", [-0.01, 0.0, 0.2])):
@@ -365,10 +375,11 @@ def run_mncp(reps: int = 11, ref_reps: int = 3) -> dict:
 
 def format_results(res: dict) -> str:
     """The benchmark results of :func:`run` as a table: one row per benchmark, with regrasp's time,
-    the baseline's and their ratio."""
+    the baseline's and their ratio (``-`` for a skipped baseline)."""
     lines = [f"{'benchmark':42s} {'regrasp':>12s} {'baseline':>12s} {'ratio':>9s}  baseline"]
     for name, r in res.items():
-        lines.append(
-            f"{name:42s} {r['median_s'] * 1e3:10.3f}ms {r['baseline_median_s'] * 1e3:10.3f}ms {r['ratio']:8.1f}x  {r['baseline']}"
-        )
+        base, ratio = r["baseline_median_s"], r["ratio"]
+        base_text = f"{'-':>12s}" if base is None else f"{base * 1e3:10.3f}ms"
+        ratio_text = f"{'-':>9s}" if ratio is None else f"{ratio:8.1f}x"
+        lines.append(f"{name:42s} {r['median_s'] * 1e3:10.3f}ms {base_text} {ratio_text}  {r['baseline']}")
     return "\n".join(lines)

@@ -17,7 +17,7 @@ import importlib
 
 from .errors import MissingExtraError
 
-#: the people's name of each optional top-level module
+#: the display name of each optional top-level module (for error messages), by import name
 NAMES = {"mujoco": "MuJoCo", "matplotlib": "matplotlib", "casadi": "CasADi (IPOPT)", "scipy": "SciPy", "ray": "Ray"}
 
 

@@ -32,16 +32,13 @@ def set_quiet(quiet: bool) -> None:
 
 
 def enabled() -> bool:
-    """Whether bars are drawn: not quieted, stderr a terminal and tqdm installed."""
+    """Whether bars are drawn: not quieted and stderr a terminal."""
     if _quiet:
         return False
     try:
-        if not sys.stderr.isatty():
-            return False
-        import tqdm  # noqa: F401
-    except (AttributeError, ValueError, ImportError):  # stderr closed or replaced; no tqdm
+        return sys.stderr.isatty()
+    except (AttributeError, ValueError):  # stderr closed or replaced
         return False
-    return True
 
 
 def _columns() -> int:

@@ -11,7 +11,9 @@ One module per command group: ``cones`` (cone, approx-error), ``planning`` (plan
 from __future__ import annotations
 
 import argparse
+import inspect
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -19,6 +21,7 @@ import numpy as np
 
 from .. import errors, progress
 from ..errors import ArgumentError, MissingExtraError, RegraspError, SceneError
+from ..extras import need
 from ..files import check_writable, refuse_overwrite_input
 from ..planning.plan import Plan, planner_defaults
 from ..scene import load_scene
@@ -44,6 +47,8 @@ MAX_FORCE = 10_000.0
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff", ".webp")
 ANIMATION_SUFFIXES = (".gif", ".webp", ".png", ".tif", ".tiff")
 VIDEO_SUFFIXES = ANIMATION_SUFFIXES + (".mp4",)
+#: the suffix sets of outputs drawn with matplotlib (the `plot` extra)
+DRAWN = (FIGURE_SUFFIXES, ANIMATION_SUFFIXES, VIDEO_SUFFIXES)
 
 
 # --- arguments ---------------------------------------------------------------------------------
@@ -90,7 +95,8 @@ def option(name: str) -> str:
 
 def check_outputs(a, outputs: dict, inputs=(), create_folder: bool = True) -> None:
     """The output options ``{attribute: suffixes or None}`` given: writable (before the work),
-    not an input file, not one another, with a suffix of ``suffixes``."""
+    not an input file, not one another, with a suffix of ``suffixes``, and what draws them
+    installed (:func:`check_drawing`)."""
     paths = {option(k): getattr(a, k, None) for k in outputs}
     refuse_overwrite_input(paths, inputs)
     for k, suffixes in outputs.items():
@@ -100,7 +106,21 @@ def check_outputs(a, outputs: dict, inputs=(), create_folder: bool = True) -> No
         if suffixes and Path(v).suffix.lower() not in suffixes:
             raise ArgumentError(f"invalid `{option(k)}`: cannot write {v}: the name must end in one of "
                                 f"{', '.join(suffixes)}", option(k))
+        check_drawing(v, suffixes, option(k))
         check_writable(v, option(k), create_folder=create_folder)
+
+
+def check_drawing(path, suffixes, opt: str) -> None:
+    """Figures, animations and videos (``suffixes`` one of :data:`DRAWN`) need matplotlib (a
+    MissingExtraError naming ``regrasp[plot]``), an MP4 also ffmpeg: checked before any work."""
+    if suffixes not in DRAWN:
+        return
+    need("matplotlib", "plot")
+    if Path(path).suffix.lower() == ".mp4":
+        import matplotlib.animation
+
+        if not matplotlib.animation.writers.is_available("ffmpeg"):
+            raise ArgumentError(f"invalid `{opt}`: MP4 needs ffmpeg, which is not installed; use a .gif", opt)
 
 
 def floats(text: str, n: int, name: str) -> np.ndarray:
@@ -118,6 +138,12 @@ def planner_default(key: str) -> str:
     """The planner's default of setting ``key`` for a help text (the Rust core's)."""
     d2, d3 = planner_defaults(2).get(key), planner_defaults(3).get(key)
     return f"default {d2}" if d3 is None or d3 == d2 else f"default {d2} planar, {d3} 3-D"
+
+
+def api_default(fn, name: str):
+    """The default of parameter ``name`` of API function ``fn``: a command-line option's default
+    is read from the function it calls (stated once, there)."""
+    return inspect.signature(fn).parameters[name].default
 
 
 def mpc_default(key: str) -> str:
@@ -162,18 +188,10 @@ def check_positive(a, name: str, what: str) -> None:
         raise ArgumentError(f"invalid `--{name.replace('_', '-')}`: must be a positive {what}", f"--{name.replace('_', '-')}")
 
 
-def reject_flags(a, flags, why: str) -> None:
-    """Invalid input when any of ``flags`` (attribute names; options that default to None or
-    False) is given: ``why`` says what applies."""
-    bad = [f for f in flags if getattr(a, f, None) is not None and getattr(a, f) is not False]
-    if bad:
-        raise ArgumentError(f"invalid flags for a 3-D scene: {why} (no --{', --'.join(f.replace('_', '-') for f in bad)})",
-                            "scene")
-
-
 def refuse_flags(a, flags, when: str, why: str) -> None:
     """Invalid input when any of ``flags`` (attribute names; options that default to None or
-    False) is given ``when`` (e.g. "with --engine quasistatic"): ``why`` says what they need."""
+    False) is given ``when`` (e.g. "with --engine quasistatic", "for a 3-D scene"): ``why`` says
+    what they need; the error names the first offending option."""
     bad = [option(f) for f in flags if getattr(a, f, None) is not None and getattr(a, f) is not False]
     if bad:
         raise ArgumentError(f"invalid `{bad[0]}`: {', '.join(bad)} {'has' if len(bad) == 1 else 'have'} no effect "
@@ -272,11 +290,25 @@ class Parser(argparse.ArgumentParser):
 
 def add_command(sub, name: str, summary: str, example: str, fn) -> Parser:
     """A command ``name``: ``summary`` (one line) in `regrasp --help` and its own help, an example
-    (a command line, several on their own lines) as its epilog."""
+    (a command line, several on their own lines) as its epilog (see :func:`example_epilog`)."""
     p = sub.add_parser(name, help=summary, description=summary[0].upper() + summary[1:] + ".",
-                       epilog="example:\n" + "\n".join(f"  {line}" for line in example.splitlines()))
+                       epilog=example_epilog(example))
     p.set_defaults(fn=fn)
     return p
+
+
+def example_epilog(example: str) -> str:
+    """``example:`` and the command lines of ``example``; where they read a bundled example's
+    scene file (``t-shape.toml``), a line saying how to get it (any folder, after pip install)."""
+    from .. import examples
+
+    lines = [f"  {line}" for line in example.splitlines()]
+    used = [n for n in examples.names() if re.search(rf"(?<![\w/.-]){re.escape(n)}\.toml\b", example)]
+    if used and "--copy" not in example:
+        name = used[0] if len(used) == 1 else "NAME"
+        lines.append(f"  ({', '.join(f'{n}.toml' for n in used)}: bundled example{'s' * (len(used) > 1)}; "
+                     f"`regrasp examples {name} --copy .` writes {name}.toml here)")
+    return "example:\n" + "\n".join(lines)
 
 
 def version() -> str:
@@ -300,7 +332,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     ap = Parser(prog="regrasp", description="In-hand regrasps by prehensile pushing: motion cones, planning, "
                 "simulation and control (`regrasp COMMAND --help` for each command).",
-                epilog="example:\n  regrasp demo --out out/demo\n  regrasp plan examples/t-shape.toml --plot plan.png")
+                epilog=example_epilog("regrasp demo --out out/demo\nregrasp examples t-shape --copy .\n"
+                                      "regrasp plan t-shape.toml --plot plan.png"))
     ap.add_argument("--version", action="version", version=version(), help="print the version and exit")
     ap.add_argument("-v", "--verbose", action="store_true", help="print the scenes' notes on stderr")
     add_quiet(ap)

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import ArgumentError, GraspError
 from ..scene.planar import Scene
-from . import (CANNOT, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, PUSHER_HELP, add_command, add_verbose,
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, PUSHER_HELP, add_command, add_verbose, api_default,
                check_count, check_outputs, check_pusher, floats, load_planar, seed_arg)
 
 
@@ -123,8 +123,10 @@ def cmd_approx_error(a) -> int:
 
 
 def add_parsers(sub) -> None:
+    from ..reference.approx_error import approximation_report
+
     c = add_command(sub, "cone", "motion cone of a pusher at a pose (planar scenes)",
-                    "regrasp cone examples/t-shape.toml --pose 0,0,0 --pusher top --plot cone.png", cmd_cone)
+                    "regrasp cone t-shape.toml --pose 0,0,0 --pusher top --plot cone.png", cmd_cone)
     c.add_argument("scene", help="a planar scene file")
     c.add_argument("--pose", required=True, help="the object's pose in the gripper frame: x,z,theta [m, m, rad]")
     c.add_argument("--pusher", required=True, help=PUSHER_HELP)
@@ -135,10 +137,13 @@ def add_parsers(sub) -> None:
     add_verbose(c)
 
     e = add_command(sub, "approx-error", "polyhedral approximation vs exact cone, per scene and grip force",
-                    "regrasp approx-error examples/t-shape.toml --forces 5,20 --samples 2000", cmd_approx_error)
+                    "regrasp approx-error t-shape.toml --forces 5,20 --samples 2000", cmd_approx_error)
     e.add_argument("scenes", nargs="*", help="planar scene files (default: every bundled planar example)")
-    e.add_argument("--forces", default="5,20,80", help="grip forces per finger [N], comma-separated")
-    e.add_argument("--samples", type=int, default=20000, help=f"random pushes per row, 1 to {MAX_SAMPLES}")
-    e.add_argument("--seed", type=seed_arg, default=0, help="random seed, a whole number >= 0")
+    e.add_argument("--forces", default=",".join(f"{f:g}" for f in api_default(approximation_report, "forces")),
+                   help="grip forces per finger [N], comma-separated")
+    e.add_argument("--samples", type=int, default=api_default(approximation_report, "samples"),
+                   help=f"random pushes per row, 1 to {MAX_SAMPLES}")
+    e.add_argument("--seed", type=seed_arg, default=api_default(approximation_report, "seed"),
+                   help="random seed, a whole number >= 0")
     e.add_argument("--json", action="store_true", help="print the rows as a JSON array")
     add_verbose(e)

@@ -6,11 +6,12 @@ import json
 
 import numpy as np
 
+from .. import _core
 from ..errors import ArgumentError
 from ..planning.plan import Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_command, add_scale_options, add_verbose, check_count,
                check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, mpc_default,
-               refuse_flags, reject_flags, scales, seed_arg)
+               refuse_flags, scales, seed_arg)
 
 #: options of the planar MPC, without meaning for 3-D control
 PLANAR_ONLY = ("poke", "start_error", "robust", "uncertainty", "fixtureless", "plot", "dt", "horizon", "noise")
@@ -19,7 +20,7 @@ PLANAR_ONLY = ("poke", "start_error", "robust", "uncertainty", "fixtureless", "p
 def _control3d(scene, plan: Plan, a) -> int:
     """3-D: the plan executed with feedback by re-planning (see
     :func:`regrasp.scene.spatial.run_plan3d`), or open loop with --open-loop."""
-    reject_flags(a, PLANAR_ONLY, "3-D control re-plans from the measured pose")
+    refuse_flags(a, PLANAR_ONLY, "for a 3-D scene", "3-D control re-plans from the measured pose")
     if a.engine == "quasistatic" and any(getattr(a, f) is not None for f in SCALES):
         raise ArgumentError("invalid `--scale-*`: the quasi-static 3-D world is the scene itself (MuJoCo only)", "--engine")
     fb = not a.open_loop
@@ -76,7 +77,7 @@ def cmd_control(a) -> int:
 def add_parsers(sub) -> None:
     k = add_command(sub, "control", "track a plan with the MPC (closed loop) in a simulator "
                     "(3-D scenes: feedback by re-planning from the measured pose)",
-                    "regrasp control examples/t-shape.toml --plan plan.json --poke 2,0.005,0,0 --plot control.png",
+                    "regrasp control t-shape.toml --plan plan.json --poke 2,0.005,0,0 --plot control.png",
                     cmd_control)
     k.add_argument("scene", help="the scene file the plan is for")
     k.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
@@ -93,7 +94,8 @@ def add_parsers(sub) -> None:
     k.add_argument("--noise", type=float, help="planar: pose measurement noise, standard deviation [m] (default 0)")
     k.add_argument("--dt", type=float, help=f"planar: control period [s] ({mpc_default('dt')})")
     k.add_argument("--horizon", type=int, help=f"planar: MPC horizon in steps ({mpc_default('horizon')})")
-    k.add_argument("--seed", type=seed_arg, default=0, help="random seed (measurement noise; seeds of re-plans)")
+    k.add_argument("--seed", type=seed_arg, default=_core.mpc_defaults()["seed"],
+                   help="random seed (measurement noise; seeds of re-plans)")
     k.add_argument("--plot", metavar="PNG", help="planar: planned against executed poses, pokes marked")
     k.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(k)

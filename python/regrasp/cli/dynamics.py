@@ -8,12 +8,11 @@ import numpy as np
 
 from .. import _core, progress
 from ..errors import ArgumentError
-from ..extras import need
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, PUSHER_HELP, VIDEO_SUFFIXES,
-               add_command, add_scale_options, add_verbose, check_count, check_number, check_outputs, check_positive,
-               check_pusher, execute3d, floats, given, load, load_planar, refuse_flags, reject_flags, scales, seed_arg)
+               add_command, add_scale_options, api_default, add_verbose, check_count, check_number, check_outputs, check_positive,
+               check_pusher, execute3d, floats, given, load, load_planar, refuse_flags, scales, seed_arg)
 
 
 def cmd_validate(a) -> int:
@@ -29,7 +28,7 @@ def cmd_validate(a) -> int:
         refuse_flags(a, ("support",), "without the quasi-static engine", "it is the quasi-static simulator's pad model")
     scene = load_planar(a.scene, "validate", a)
     res = validate(scene, a.pushes, a.seed, engines=engines, workers=a.workers, ray_address=a.ray, progress=True,
-                   **given(a, "support"))
+                   support=a.support)
     print(json.dumps(res) if a.json else format_validation(res))
     return OK
 
@@ -48,7 +47,7 @@ def _check_engine_flags(a) -> None:
 
 
 def _simulate3d(scene, plan: Plan, a) -> int:
-    reject_flags(a, ("perturb", "video", "plot"), "--perturb/--video/--plot are planar only "
+    refuse_flags(a, ("perturb", "video", "plot"), "for a 3-D scene", "they are planar only "
                  "(3-D: --scale-*, --dt, --json; `regrasp plan --html` for a view)")
     _check_engine_flags(a)
     r = execute3d(scene, plan, a, **given(a, "dt"))
@@ -57,6 +56,10 @@ def _simulate3d(scene, plan: Plan, a) -> int:
     print(json.dumps(out) if a.json else f"{scene.name}: {r['engine']}: "
           f"{'success' if r['success'] else 'outside the tolerance'}, error {np.round(r['goal_error'], 5).tolist()}")
     return OK if r["success"] else CANNOT
+
+
+#: the seed of the factors `regrasp simulate --perturb` draws when --seed is not given
+PERTURB_SEED = 0
 
 
 def _replay_planar(scene, plan: Plan, a):
@@ -68,7 +71,8 @@ def _replay_planar(scene, plan: Plan, a):
     from ..mujoco.planar import Perturbation, execute_plan
 
     base = Perturbation(*scales(a))
-    pert = Perturbation.draw(a.perturb, np.random.default_rng(a.seed or 0), base) if a.perturb else base
+    seed = PERTURB_SEED if a.seed is None else a.seed
+    pert = Perturbation.draw(a.perturb, np.random.default_rng(seed), base) if a.perturb else base
     rep = execute_plan(scene, plan, pert)
     return rep
 
@@ -88,12 +92,6 @@ def _check_simulate(a) -> None:
     if a.perturb is not None and not (0 <= a.perturb < 1):
         raise ArgumentError("invalid `--perturb`: a spread in [0, 1)", "--perturb")
     check_outputs(a, {"plot": FIGURE_SUFFIXES, "video": VIDEO_SUFFIXES}, [a.scene, a.plan])
-    if a.video and a.video.lower().endswith(".mp4"):
-        need("matplotlib", "plot")
-        import matplotlib.animation
-
-        if not matplotlib.animation.writers.is_available("ffmpeg"):
-            raise ArgumentError("invalid `--video`: MP4 needs ffmpeg, which is not installed; use a .gif", "--video")
 
 
 def _write_figures(scene, rep, a) -> None:
@@ -165,7 +163,7 @@ def cmd_push(a) -> int:
     twist = floats(a.twist, 6 if scene.dimension == 3 else 3, "--twist")
     check_pusher(scene, a.pusher)
     if scene.dimension == 3:
-        reject_flags(a, ("plot",), "--plot draws planar pushes only")
+        refuse_flags(a, ("plot",), "for a 3-D scene", "it draws planar pushes only")
         with progress.elapsed(None, "push"):
             tr = scene.simulate_push(pose, a.pusher, twist, a.duration, a.dt)
     else:
@@ -181,13 +179,17 @@ def cmd_push(a) -> int:
 
 
 def add_parsers(sub) -> None:
+    from ..scene.spatial import Scene3D
+    from ..sim import quasistatic
+    from ..sim.validation import validate
+
     v = add_command(sub, "validate", "motion-cone predictions against the simulators (planar scenes)",
-                    "regrasp validate examples/block-low-friction.toml --pushes 500 --engines quasistatic,mujoco",
+                    "regrasp validate block-low-friction.toml --pushes 500 --engines quasistatic,mujoco",
                     cmd_validate)
     v.add_argument("scene", help="a planar scene file")
-    v.add_argument("--pushes", type=int, default=2000, help=f"random pushes, 1 to {MAX_PUSHES}")
+    v.add_argument("--pushes", type=int, default=api_default(validate, "pushes"), help=f"random pushes, 1 to {MAX_PUSHES}")
     v.add_argument("--engines", default="quasistatic", help="comma-separated: quasistatic,mujoco")
-    v.add_argument("--seed", type=seed_arg, default=0, help="random seed, a whole number >= 0")
+    v.add_argument("--seed", type=seed_arg, default=api_default(validate, "seed"), help="random seed, a whole number >= 0")
     v.add_argument("--workers", type=int, help=f"local processes for MuJoCo, 1 to {MAX_WORKERS} (default: all cores)")
     v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
     v.add_argument("--support", choices=["points", "limit_surface"],
@@ -197,24 +199,25 @@ def add_parsers(sub) -> None:
     add_verbose(v)
 
     s = add_command(sub, "simulate", "replay a plan in a simulator (planar or 3-D)",
-                    "regrasp simulate examples/t-shape.toml --plan plan.json --engine mujoco --video replay.gif",
+                    "regrasp simulate t-shape.toml --plan plan.json --engine mujoco --video replay.gif",
                     cmd_simulate)
     s.add_argument("scene", help="the scene file the plan is for")
     s.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
     s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"],
                    help="our quasi-static simulator or MuJoCo")
-    s.add_argument("--dt", type=float, help="quasi-static time step [s] (default 0.05 planar, 0.25 3-D)")
+    s.add_argument("--dt", type=float, help=f"quasi-static time step [s] (default {api_default(quasistatic.replay_plan, 'dt')} "
+                   f"planar, {api_default(Scene3D.replay, 'dt')} 3-D)")
     add_scale_options(s, "MuJoCo: ")
     s.add_argument("--perturb", type=float,
                    help="MuJoCo, planar: also draw each factor uniformly in [1-P, 1+P] from --seed (default 0: none)")
-    s.add_argument("--seed", type=seed_arg, help="random seed of --perturb (default 0)")
+    s.add_argument("--seed", type=seed_arg, help=f"random seed of --perturb (default {PERTURB_SEED})")
     s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo, planar: an animation of the execution")
     s.add_argument("--plot", metavar="PNG", help="planar: planned against simulated poses")
     s.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(s)
 
     p = add_command(sub, "push", "simulate one push in the quasi-static simulator (planar or 3-D)",
-                    "regrasp push examples/t-shape.toml --pose 0,0,0 --pusher top --twist 0,-0.01,0 --plot push.png",
+                    "regrasp push t-shape.toml --pose 0,0,0 --pusher top --twist 0,-0.01,0 --plot push.png",
                     cmd_push)
     p.add_argument("scene", help="the scene file")
     p.add_argument("--pose", required=True, help="x,z,theta (3-D scenes: x,y,z,qw,qx,qy,qz)")
@@ -222,7 +225,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--twist", required=True,
                    help="pusher body twist vx,vz,omega, object frame at the start (3-D: vx,vy,vz,wx,wy,wz)")
     p.add_argument("--duration", type=float, default=1.0, help="duration of the push [s]")
-    p.add_argument("--dt", type=float, default=0.02, help="time step [s], at most --duration")
+    p.add_argument("--dt", type=float, default=api_default(quasistatic.simulate_push, "dt"),
+                   help="time step [s], at most --duration")
     p.add_argument("--plot", metavar="PNG", help="planar: object motion and contact forces")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(p)

@@ -13,12 +13,7 @@ def cmd_examples(a) -> int:
         if not a.name:
             raise ArgumentError("invalid `--copy`: name the example to copy (regrasp examples NAME --copy DIR); "
                                 f"the examples: {', '.join(examples.names())}", "--copy")
-        try:
-            dest = examples.copy(a.name, a.copy)
-        except ArgumentError as e:
-            if e.field != "dest_folder":
-                raise
-            raise ArgumentError(str(e).replace("`dest_folder`", "`--copy`"), "--copy") from None
+        dest = examples.copy(a.name, a.copy, field="--copy")
         extra = examples.meshes(a.name)
         print(f"wrote {dest}" + (f" and {', '.join(extra)} beside it" if extra else ""))
         return OK

@@ -11,7 +11,7 @@ from ..files import Outputs
 from .. import progress
 from ..planning.plan import POSE_SIZE, Plan, plan, planner_defaults
 from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_command, add_verbose, check_number, check_outputs,
-               floats, load, mode_scene, planner_default, pusher_runs, reject_flags, seed_arg)
+               floats, load, mode_scene, planner_default, pusher_runs, refuse_flags, seed_arg)
 
 #: the output options of `regrasp plan` and the file-name suffixes they take (None: any)
 OUTPUTS = {"out": None, "partial_out": None, "plot": FIGURE_SUFFIXES, "animate": ANIMATION_SUFFIXES, "html": None}
@@ -24,7 +24,7 @@ def _scene_for(a):
     cone mode of the flags."""
     scene = load(a.scene, a)
     if scene.dimension == 3:
-        reject_flags(a, PLANAR_ONLY, "it plans with the inverse dynamics only, not with motion cones")
+        refuse_flags(a, PLANAR_ONLY, "for a 3-D scene", "it plans with the inverse dynamics only, not with motion cones")
         return scene
     return mode_scene(scene, a)
 
@@ -120,8 +120,8 @@ def cmd_plan(a) -> int:
 
 def add_parsers(sub) -> None:
     pl = add_command(sub, "plan", "plan a regrasp (T-RRT* with motion-cone propagation; 3-D: inverse dynamics)",
-                     "regrasp plan examples/t-shape.toml --out plan.json --plot plan.png --animate plan.gif\n"
-                     "regrasp plan examples/pivot-3d.toml --html plan.html", cmd_plan)
+                     "regrasp plan t-shape.toml --out plan.json --plot plan.png --animate plan.gif\n"
+                     "regrasp plan pivot-3d.toml --html plan.html", cmd_plan)
     pl.add_argument("scene", help="the scene file (planar or 3-D)")
     pl.add_argument("--out", metavar="PLAN.json",
                     help="write the plan file here (no plan found: the best partial plan, unless the file exists)")

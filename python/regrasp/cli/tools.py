@@ -13,20 +13,15 @@ from ..files import Outputs, check_writable
 from . import (CANNOT, MAX_CONES, OK, add_command, check_count, given, planner_default, pusher_runs, refuse_flags,
                seed_arg)
 
-#: cones per batch of `regrasp bench`, and of `regrasp bench --quick`
-DEFAULT_CONES, QUICK_CONES = 100_000, 10_000
-
-
 def cmd_bench(a) -> int:
-    from ..bench import format_results, run
+    from .. import bench
 
     check_count(a, "n", 1, MAX_CONES)
     refuse_flags(a, ("verbose",), "with bench", "it reads no scene files whose notes it could print")
     if a.quick:
-        refuse_flags(a, ("n",), "with --quick", "--quick measures 10,000 cones; give one of them")
-    n = QUICK_CONES if a.quick else a.n or DEFAULT_CONES
-    res = run(n=n, reps=5 if a.quick else 11, baseline_reps=1 if a.quick else 3)
-    print(json.dumps(res) if a.json else format_results(res))
+        refuse_flags(a, ("n",), "with --quick", f"--quick measures {bench.QUICK['n']:,} cones; give one of them")
+    res = bench.run(**(bench.QUICK if a.quick else given(a, "n")))
+    print(json.dumps(res, allow_nan=False) if a.json else bench.format_results(res))
     return OK
 
 
@@ -76,10 +71,13 @@ def _demo_figures(outs, out: Path, scene, p, rep, first: str) -> None:
 
 
 def add_parsers(sub) -> None:
+    from .. import bench
+
     b = add_command(sub, "bench", "speed probe against numpy baselines", "regrasp bench --quick", cmd_bench)
     b.add_argument("--json", action="store_true", help="print the results as JSON")
-    b.add_argument("--quick", action="store_true", help=f"{QUICK_CONES:,} cones instead of -n, fewer repetitions")
-    b.add_argument("-n", type=int, help=f"cones per batch, 1 to {MAX_CONES} (default {DEFAULT_CONES})")
+    b.add_argument("--quick", action="store_true", help=f"{bench.QUICK['n']:,} cones instead of -n, fewer repetitions "
+                   f"({bench.QUICK['reps']} instead of {bench.REPS})")
+    b.add_argument("-n", type=int, help=f"cones per batch, 1 to {MAX_CONES} (default {bench.CONES:,})")
 
     d = add_command(sub, "demo", "the bundled example end to end, writing its figures", "regrasp demo --out out/demo",
                     cmd_demo)

@@ -77,22 +77,47 @@ def meshes(name: str) -> list[str]:
     return [mesh] if isinstance(mesh, str) else []
 
 
-def copy(name: str, dest_folder) -> Path:
+def copy(name: str, dest_folder, field: str = "dest_folder") -> Path:
     """Copies example ``name`` and the meshes it refers to into ``dest_folder`` (created if
     needed), keeping their relative paths so that the copy loads as it is; returns the copied
     scene file. Files that exist are not overwritten (an :class:`~regrasp.ArgumentError` naming
-    ``dest_folder``, before anything is written); the files are written atomically, all or none."""
+    ``field``, the caller's name of ``dest_folder``, before anything is written); the files are
+    written atomically, all or none (folders this call created are removed again on failure)."""
     from ..files import Outputs, as_path
 
     src = path(name)
-    dest = as_path(dest_folder, "dest_folder")
+    dest = as_path(dest_folder, field)
     rels = [src.name] + meshes(name)
     taken = [r for r in rels if (dest / r).exists()]
     if taken:
-        raise ArgumentError(f"invalid `dest_folder`: {', '.join(str(dest / r) for r in taken)} already exist"
-                            " (not overwritten)", "dest_folder")
-    with Outputs() as outs:  # all or none
-        for rel in rels:
-            (dest / rel).parent.mkdir(parents=True, exist_ok=True)
-            outs.write(dest / rel, lambda tmp, rel=rel: shutil.copyfile(ROOT / rel, tmp))
+        raise ArgumentError(f"invalid `{field}`: {', '.join(str(dest / r) for r in taken)} already exist"
+                            " (not overwritten)", field)
+    created = _missing_folders(dest / r for r in rels)
+    try:
+        with Outputs() as outs:  # all or none
+            for rel in rels:
+                (dest / rel).parent.mkdir(parents=True, exist_ok=True)
+                outs.write(dest / rel, lambda tmp, rel=rel: shutil.copyfile(ROOT / rel, tmp))
+    except BaseException:
+        for folder in created:
+            _remove_empty(folder)
+        raise
     return dest / src.name
+
+
+def _missing_folders(files) -> list[Path]:
+    """The folders above ``files`` that do not exist yet, deepest first."""
+    missing = set()
+    for f in files:
+        for folder in Path(f).parents:
+            if folder.exists():
+                break
+            missing.add(folder)
+    return sorted(missing, key=lambda p: len(p.parts), reverse=True)
+
+
+def _remove_empty(folder: Path) -> None:
+    try:
+        folder.rmdir()
+    except OSError:  # not empty (something else wrote there) or already gone
+        pass

@@ -20,6 +20,8 @@ from ..scene.planar import Scene, _count, _flag, _name, _number, _vec
 #: The simulator's defaults, stated once in the Rust core (``quasistatic::Options``).
 DEFAULTS = _core.quasistatic_defaults()
 SPEED = DEFAULTS["speed"]  # m/s, the thesis' pushing speed
+#: time step of simulated pushes and plan replays [s] (``regrasp push --dt``, ``regrasp simulate --dt``)
+DT = 0.05
 
 
 def support_kwargs(support: str | None = None, rings: int | None = None, points: int | None = None,
@@ -47,7 +49,7 @@ def problem(scene: Scene, pose, pusher: str | None = None, h: float | None = Non
                                            kw["points"], kw["merge_fingers"], h, SPEED)
 
 
-def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: float = 0.05, **support) -> dict:
+def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: float = DT, **support) -> dict:
     """Explicit time stepping of one push from ``pose`` (m, m, rad): the pusher moves with
     constant body ``twist`` (m/s, m/s, rad/s) for ``duration`` [s] in steps of ``dt`` [s]."""
     kw = support_kwargs(**support)
@@ -99,7 +101,7 @@ class Replay:
         }
 
 
-def replay_plan(scene: Scene, plan, speed: float = SPEED, dt: float = 0.05, **support) -> Replay:
+def replay_plan(scene: Scene, plan, speed: float = SPEED, dt: float = DT, **support) -> Replay:
     """Replays a plan (a :class:`~regrasp.Plan` or a plan dict) in the quasi-static simulator:
     for each step the pusher is put in contact with the object where it is now, then follows the
     planned object motion of that step (its body twist, at ``speed`` [m/s]) in steps of ``dt`` [s]."""

@@ -23,7 +23,7 @@ import numpy as np
 from .. import progress as bars
 from ..errors import ArgumentError, RegraspError, check_seed
 from ..extras import need
-from .quasistatic import SPEED
+from .quasistatic import SPEED, support_kwargs
 from ..scene.planar import Scene, _count
 
 #: most random pushes one validation takes (a bound on its time: about 1 ms a push)
@@ -202,9 +202,10 @@ def _run_mujoco(scene: Scene, rows: list, workers: int, ray_address, progress: b
     return result
 
 
-def _run_quasistatic(scene: Scene, rows: list, support: str, progress: bool) -> tuple[np.ndarray, np.ndarray]:
+def _run_quasistatic(scene: Scene, rows: list, support: dict, progress: bool) -> tuple[np.ndarray, np.ndarray]:
     """Whether each push sticks in the quasi-static simulator and whether it was solved: the
-    pushes of each pusher in batches (of at least :data:`QS_BATCH`, for the progress bar)."""
+    pushes of each pusher in batches (of at least :data:`QS_BATCH`, for the progress bar);
+    ``support`` the pad model (:func:`~regrasp.sim.quasistatic.support_kwargs`)."""
     sim, ok = np.zeros(len(rows), bool), np.zeros(len(rows), bool)
     by: dict = {}
     for i, r in enumerate(rows):
@@ -215,7 +216,8 @@ def _run_quasistatic(scene: Scene, rows: list, support: str, progress: bool) -> 
             for k in range(0, len(idx), size):
                 part = idx[k:k + size]
                 st, _, _, err = scene._core.push_outcomes(np.array([rows[i][2] for i in part]), p,
-                                                         np.array([rows[i][3] for i in part]), support, 3, 0, True)
+                                                         np.array([rows[i][3] for i in part]), support["support"],
+                                                         support["rings"], support["points"], support["merge_fingers"])
                 sim[part] = st
                 ok[part] = [e is None for e in err]
                 bar.update(len(part))
@@ -232,14 +234,14 @@ def _table(pred, sim, ok, mask) -> dict:
     }
 
 
-def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasistatic",), support: str = "points",
+def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasistatic",), support: str | None = None,
              workers: int | None = None, ray_address=None, progress: bool = False) -> dict:
-    """Agreement of the exact motion-cone prediction with each engine (see the module notes)."""
+    """Agreement of the exact motion-cone prediction with each engine (see the module notes);
+    ``support`` the quasi-static pad model, "points" or "limit_surface" (default: the core's)."""
     pushes, seed = _count(pushes, "pushes", 1, MAX_PUSHES), check_seed(seed)
     if isinstance(engines, str) or not isinstance(engines, (list, tuple)) or not engines:
         raise ArgumentError(f"invalid `engines`: a list of engine names (got {engines!r:.60})", "engines")
-    if not isinstance(support, str) or support not in ("points", "limit_surface"):
-        raise ArgumentError(f"invalid `support`: must be 'points' or 'limit_surface' (got {support!r:.60})", "support")
+    support = support_kwargs(support)
     if workers is not None:
         workers = _count(workers, "workers", 1, 4096)
     for e in engines:
@@ -260,7 +262,7 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
     for engine in engines:
         if engine == "quasistatic":
             sim, ok = _run_quasistatic(scene, rows, support, progress)
-            out["support_model"] = support
+            out["support_model"] = support["support"]
         else:
             res = _run_mujoco(scene, rows, workers, ray_address, progress)
             ok = ~np.isnan(res)

@@ -96,10 +96,10 @@ def page(scene, plan=None) -> str:
 
 def write_html(scene, plan, path) -> Path:
     """Writes :func:`page` of ``scene`` and ``plan`` (None: the scene alone) to ``path``
-    (atomically); returns the path."""
-    p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    return write_text(p, page(scene, plan))
+    (atomically; its folder created, once the page is made); returns the path."""
+    p, text = Path(path), page(scene, plan)
+    p.parent.mkdir(parents=True, exist_ok=True)  # atomic_write does not create folders
+    return write_text(p, text)
 
 
 def notebook_html(scene, plan=None, height: int = 480) -> str:
