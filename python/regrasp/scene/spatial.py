@@ -5,6 +5,7 @@ documented in ``crates/regrasp-core/src/scene3d.rs`` and the README."""
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 from typing import Optional
 
@@ -137,14 +138,25 @@ class Scene3D:
 
 def _core_from_toml(text: str, base):
     """The core's 3-D scene of ``text`` (mesh paths relative to folder ``base``, None: the current
-    folder); an unreadable ``object.mesh`` says which folder its path is relative to."""
+    folder), after :func:`_check_mesh_file`."""
+    _check_mesh_file(text, base)
+    return _core.Scene3D.from_toml(text, None if base is None else str(base))
+
+
+def _check_mesh_file(text: str, base) -> None:
+    """A missing ``object.mesh`` file is a SceneError naming the folder its path is relative to
+    (a copied scene file without its meshes); the core reports every other mesh fault."""
     try:
-        return _core.Scene3D.from_toml(text, None if base is None else str(base))
-    except SceneError as e:
-        if e.field != "object.mesh" or "cannot read" not in str(e):
-            raise
-        folder = Path(base or ".").absolute()
-        raise SceneError(f"{e} (`object.mesh` is relative to the scene file's folder, {folder})", e.field) from None
+        mesh = tomllib.loads(text).get("object", {}).get("mesh")
+    except tomllib.TOMLDecodeError:
+        return  # the core reports the syntax error with its line
+    if not isinstance(mesh, str) or not mesh.strip():
+        return
+    folder = Path(base or ".").absolute()
+    if not (folder / mesh).is_file():
+        raise SceneError(f"scene field `object.mesh`: cannot read {mesh}: no such file (`object.mesh` is relative "
+                         f"to the scene file's folder, {folder}; `regrasp examples NAME --copy DIR` copies a "
+                         f"bundled scene with its meshes)", "object.mesh")
 
 
 def goal_report(scene: "Scene3D", q) -> dict:
