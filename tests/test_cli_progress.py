@@ -128,3 +128,54 @@ def test_an_animation_counts_its_frames(tmp_path):
     assert status == 0, err
     assert has_bar(err) and "animation frames" in err, err
     assert (tmp_path / "plan.gif").read_bytes()[:4] == b"GIF8" and json.loads(out)["found"] is True
+
+
+def run_tty_python(code: str, timeout: float = 60) -> str:
+    """Python ``code`` with stderr on a pseudo-terminal: what it wrote there."""
+    master, slave = pty.openpty()
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.DEVNULL, stderr=slave,
+                         stdin=subprocess.DEVNULL, env=env(0.0))
+    os.close(slave)
+    err = b""
+    try:
+        while select.select([master], [], [], timeout)[0]:
+            try:
+                chunk = os.read(master, 65536)
+            except OSError:
+                break
+            if not chunk:
+                break
+            err += chunk
+        p.wait(timeout)
+    finally:
+        os.close(master)
+    assert p.returncode == 0, err
+    return err.decode(errors="replace")
+
+
+def test_a_note_during_a_bar_gets_its_own_line():
+    """A message printed while a bar is drawn (e.g. bench's skip notices) is not glued onto it."""
+    code = ("import time; from regrasp import progress\n"
+            "with progress.bar(4, 'bench', unit='benchmark') as b:\n"
+            "    b.update(1); b.refresh(); time.sleep(0.1)\n"
+            "    progress.note('bench: the MNCP solver against IPOPT skipped: test')\n"
+            "    b.update(1)\n")
+    err = run_tty_python(code)
+    assert has_bar(err), err
+    segments = [s.strip() for s in re.split(r"[\r\n]", err)]
+    assert "bench: the MNCP solver against IPOPT skipped: test" in segments, err
+
+
+def test_bench_prints_its_notices_through_progress_note(monkeypatch, capsys):
+    from regrasp import bench
+    from regrasp.errors import MissingExtraError
+
+    said = []
+    monkeypatch.setattr(progress, "note", said.append)
+
+    def missing():
+        raise MissingExtraError("casadi", "reference")
+
+    assert bench._unless_missing("the MNCP solver against IPOPT", missing) == {}
+    assert said and "skipped" in said[0] and "regrasp[reference]" in said[0]
+    assert capsys.readouterr().err == ""

@@ -189,3 +189,17 @@ def test_mujoco_agrees_with_the_quasistatic_pivot():
     # the pusher slips in both: the object turns about half of the pusher's 30 degrees
     assert 0.3 < qs["pose"][-1][2] / (3.0 * w) < 0.7
     assert abs(mj["pose"][-1][2] - qs["pose"][-1][2]) < 0.15 * abs(qs["pose"][-1][2])
+
+
+def test_the_push_time_step_defaults_to_min_dt_and_duration():
+    """dt: time step [s], default min(0.05, duration): a push shorter than DT is one step (no dt
+    needed), a longer one steps of DT."""
+    sc = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    short = quasistatic.simulate_push(sc, [0, 0, 0], "left", [0.01, 0, 0], 0.03)
+    assert np.allclose(short["t"], [0.0, 0.03])
+    long = quasistatic.simulate_push(sc, [0, 0, 0], "left", [0.01, 0, 0], 0.2)
+    assert np.allclose(np.diff(long["t"]), quasistatic.DT)
+    explicit = quasistatic.simulate_push(sc, [0, 0, 0], "left", [0.01, 0, 0], 0.2, 0.05)
+    assert np.allclose(long["pose"], explicit["pose"])
+    assert quasistatic.push_dt(0.03) == 0.03 and quasistatic.push_dt(1.0) == quasistatic.DT
+    assert quasistatic.push_dt(1.0, 0.01) == 0.01

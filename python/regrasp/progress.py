@@ -1,7 +1,8 @@
 """Progress bars on stderr (tqdm), for work that can take more than a few seconds.
 
 A bar is shown only when stderr is a terminal and output is not quieted (``regrasp -q``, or
-:func:`set_quiet`); otherwise the bars do nothing. Standard output is never written to.
+:func:`set_quiet`); otherwise the bars do nothing. Standard output is never written to. Messages
+on stderr during a bar go through :func:`note` (on their own line, not glued onto the bar).
 """
 
 from __future__ import annotations
@@ -47,6 +48,18 @@ def _columns() -> int:
         return os.get_terminal_size(sys.stderr.fileno()).columns
     except (OSError, ValueError, AttributeError):
         return 0
+
+
+def note(text: str) -> None:
+    """Prints ``text`` on its own line of stderr: above a progress bar being drawn (the bar is
+    cleared and redrawn below it), plainly when no bar can be shown. Every message printed on
+    stderr while a bar may be shown goes through here."""
+    if enabled():
+        from tqdm import tqdm
+
+        tqdm.write(text, file=sys.stderr)
+    else:
+        print(text, file=sys.stderr)
 
 
 class _Null:

@@ -137,7 +137,7 @@ def floats(text: str, n: int, name: str) -> np.ndarray:
 def planner_default(key: str) -> str:
     """The planner's default of setting ``key`` for a help text (the Rust core's)."""
     d2, d3 = planner_defaults(2).get(key), planner_defaults(3).get(key)
-    return f"default {d2}" if d3 is None or d3 == d2 else f"default {d2} planar, {d3} 3-D"
+    return f"default: {d2}" if d3 is None or d3 == d2 else f"default: {d2} planar, {d3} 3-D"
 
 
 def api_default(fn, name: str):
@@ -150,7 +150,7 @@ def mpc_default(key: str) -> str:
     """The MPC's default of setting ``key`` for a help text (the Rust core's)."""
     from .. import _core
 
-    return f"default {_core.mpc_defaults()[key]}"
+    return f"default: {_core.mpc_defaults()[key]}"
 
 
 def given(a, *names: str) -> dict:
@@ -164,9 +164,9 @@ SCALES = ("scale_friction", "scale_grip", "scale_mass")
 
 def add_scale_options(p, what: str = "") -> None:
     """--scale-friction/--scale-grip/--scale-mass (factors on the world's physics)."""
-    p.add_argument("--scale-friction", type=float, help=f"{what}factor on every friction coefficient of the world (default 1)")
-    p.add_argument("--scale-grip", type=float, help=f"{what}factor on the world's grip force (default 1)")
-    p.add_argument("--scale-mass", type=float, help=f"{what}factor on the object's mass in the world (default 1)")
+    p.add_argument("--scale-friction", type=float, help=f"{what}factor on every friction coefficient of the world (default: 1)")
+    p.add_argument("--scale-grip", type=float, help=f"{what}factor on the world's grip force (default: 1)")
+    p.add_argument("--scale-mass", type=float, help=f"{what}factor on the object's mass in the world (default: 1)")
 
 
 def scales(a) -> tuple[float, float, float]:
@@ -200,22 +200,44 @@ def refuse_flags(a, flags, when: str, why: str) -> None:
 
 # --- scenes and plans --------------------------------------------------------------------------
 
-def load(path, a=None):
-    """The scene file ``path`` (planar or 3-D); with ``--verbose`` its notes (e.g. pusher points
-    snapped onto the outline) are printed on stderr."""
-    scene = load_scene(path)
+def load(path, a=None, arg: str = "scene"):
+    """The scene file ``path`` (planar or 3-D) of the command-line argument ``arg``; with
+    ``--verbose`` its notes (e.g. pusher points snapped onto the outline) are printed on stderr.
+    A file that cannot be read is invalid input naming ``arg`` (see :func:`unreadable`)."""
+    try:
+        scene = load_scene(path)
+    except ArgumentError as e:
+        if e.field != "path":
+            raise
+        raise unreadable(path, e, arg) from e
     if getattr(a, "verbose", False):
         for note in getattr(scene, "notes", None) or []:
-            print(f"regrasp: {path}: {note}", file=sys.stderr)
+            progress.note(f"regrasp: {path}: {note}")
     return scene
 
 
-def load_planar(path, cmd: str, a=None) -> Scene:
+def unreadable(path, e: ArgumentError, arg: str = "scene") -> ArgumentError:
+    """The error of a scene file that cannot be read, naming the argument ``arg``; a missing file
+    named like a bundled example gets a hint how to write it here, any other missing one how to
+    list them."""
+    from .. import examples
+
+    reason = str(e).split(": ", 1)[-1]
+    if not Path(path).exists():
+        stem = Path(path).name.removesuffix(".toml")
+        if stem in examples.names():
+            reason += f"; {stem} is a bundled example: `regrasp examples {stem} --copy .` writes it here"
+        else:
+            reason += "; `regrasp examples` lists the bundled scenes"
+    return ArgumentError(f"invalid `{arg}`: {reason}", arg)
+
+
+def load_planar(path, cmd: str, a=None, arg: str = "scene") -> Scene:
     """A planar scene for commands that have no 3-D counterpart (a clear error for a 3-D one)."""
-    scene = load(path, a)
+    scene = load(path, a, arg)
     if scene.dimension == 3:
-        raise ArgumentError(f"invalid `scene`: `regrasp {cmd}` works on planar scenes; {path} is a 3-D scene "
-                            "(3-D scenes: plan, simulate, push, control)", "scene")
+        raise ArgumentError(f"invalid `{arg}`: `regrasp {cmd}` works on planar scenes; {path} is a 3-D scene "
+                            "(3-D scenes: plan, simulate, push, control)", arg)
     return scene
 
 
@@ -234,15 +256,36 @@ def mode_scene(scene: Scene, a) -> Scene:
     return scene
 
 
+def rounded(v, digits: int = 5) -> list:
+    """Numbers ``v`` rounded for printing, ``-0.0`` shown as ``0.0``."""
+    return (np.round(np.asarray(v, float), digits) + 0.0).tolist()
+
+
+def plural(n: int, word: str, words: str | None = None) -> str:
+    """``1 step``, ``2 steps`` (``words``: the plural where it is not ``word + "s"``)."""
+    return f"{n} {word if n == 1 else words or word + 's'}"
+
+
+def error3d(err) -> str:
+    """A 3-D goal error ``[dx, dy, dz, angle]`` for people: position [m], angle [rad]."""
+    return f"position {rounded(err[:3])} m, angle {rounded(err[3:])[0]} rad"
+
+
+def runs(pushers) -> list[list]:
+    """Consecutive steps with one pusher: ``[[name, steps], ...]`` (``pushers[0]``, the start's, is
+    no step)."""
+    out = []
+    for name in pushers[1:]:
+        if out and out[-1][0] == name:
+            out[-1][1] += 1
+        else:
+            out.append([name, 1])
+    return out
+
+
 def pusher_runs(pushers) -> str:
     """The pushes of a plan: consecutive steps with one pusher, ``left x3 -> bottom x2``."""
-    runs = []
-    for name in pushers[1:]:
-        if runs and runs[-1][0] == name:
-            runs[-1][1] += 1
-        else:
-            runs.append([name, 1])
-    return " -> ".join(f"{n} x{c}" for n, c in runs)
+    return " -> ".join(f"{n} x{c}" for n, c in runs(pushers)) or "no pushes"
 
 
 def execute3d(scene, plan: Plan, a, **kw) -> dict:
@@ -267,10 +310,13 @@ def add_verbose(p) -> None:
 
 class Help(argparse.RawDescriptionHelpFormatter):
     """Help texts that end with the option's default: ``(default: X)`` where the option has one and
-    its text does not already say it; ``(default: none)`` for an optional value without one."""
+    its text does not already say it; ``(default: none)`` for an optional value without one;
+    ``(required)`` for a required option."""
 
     def _get_help_string(self, action) -> str:
         text = action.help or ""
+        if action.required and action.option_strings:
+            return f"{text} (required)"
         if "default" in text or action.default is argparse.SUPPRESS or action.required:
             return text
         if action.option_strings and action.nargs == 0:  # a flag: off unless given
@@ -337,9 +383,10 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--version", action="version", version=version(), help="print the version and exit")
     ap.add_argument("-v", "--verbose", action="store_true", help="print the scenes' notes on stderr")
     add_quiet(ap)
-    sub = ap.add_subparsers(dest="cmd", required=True, parser_class=Parser)
+    sub = ap.add_subparsers(dest="cmd", metavar="COMMAND", parser_class=Parser)
     for group in (planning, cones, dynamics, control, tools, examples):
         group.add_parsers(sub)
+    ap.description += f"\nCOMMAND: one of {{{','.join(sub.choices)}}}."
     for p in sub.choices.values():
         add_quiet(p, argparse.SUPPRESS)
     return ap
@@ -392,13 +439,14 @@ def _quiet_stdout() -> None:
 
 def _say(message: str) -> None:
     try:
-        print(f"regrasp: {message}", file=sys.stderr)
+        progress.note(f"regrasp: {message}")
     except (OSError, ValueError):  # stderr closed too
         pass
 
 
-#: the help of --pusher when no scene is given before --help
-PUSHER_HELP = "a pusher of the scene, by name (`regrasp COMMAND SCENE --help` lists the scene's pushers)"
+def pusher_help(cmd: str) -> str:
+    """The help of --pusher of command ``cmd`` when no scene is given before --help."""
+    return f"a pusher of the scene, by name (`regrasp {cmd} SCENE --help` lists the scene's pushers)"
 
 
 def check_pusher(scene, name: str) -> None:
@@ -430,6 +478,12 @@ def _scene_help(ap: argparse.ArgumentParser, argv: list) -> None:
         return
 
 
+def commands(ap: argparse.ArgumentParser) -> list[str]:
+    """The command names of parser ``ap`` (`regrasp`'s), in the order of its help."""
+    sub = next(a for a in ap._actions if isinstance(a, argparse._SubParsersAction))
+    return list(sub.choices)
+
+
 def main(argv=None) -> int:
     """The `regrasp` command; returns its exit status (docs/cli.md). Ctrl-C: 130, after
     "regrasp: interrupted" (outputs are written atomically: nothing half-done is left); a closed
@@ -439,6 +493,8 @@ def main(argv=None) -> int:
         ap = build_parser()
         _scene_help(ap, argv)
         args = ap.parse_args(argv)
+        if args.cmd is None:
+            ap.error(f"a COMMAND is required: one of {', '.join(commands(ap))} (`regrasp --help` says what each does)")
         progress.set_quiet(args.quiet)
         status, message = _run(args)
         if message is not None:

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import json
-import sys
 
 import numpy as np
 
 from ..errors import ArgumentError, GraspError
 from ..scene.planar import Scene
-from . import (CANNOT, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, PUSHER_HELP, add_command, add_verbose, api_default,
+from .. import progress
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, pusher_help, add_command, add_verbose, api_default,
                check_count, check_outputs, check_pusher, floats, load_planar, seed_arg)
 
 
@@ -84,7 +84,7 @@ def cmd_cone(a) -> int:
         rep = cone_report(scene, pose, a.pusher, twist)
     except GraspError as e:
         hold = scene.hold_grip_force(pose)
-        print(f"regrasp: {e} (holding needs at least {hold:.3f} N per finger)", file=sys.stderr)
+        progress.note(f"regrasp: {e} (holding needs at least {hold:.3f} N per finger)")
         return CANNOT
     if a.plot:
         from ..viz.plotting import plot_motion_cone
@@ -116,7 +116,7 @@ def cmd_approx_error(a) -> int:
         raise ArgumentError(f"invalid `scene`: {', '.join(skipped)} {'has' if len(skipped) == 1 else 'have'} no grasp, "
                             "so no grip force to vary (approx-error compares cones per grip force)", "scene")
     if skipped and not a.json:
-        print(f"(skipped {', '.join(skipped)}: no grasp, so no grip force to vary)", file=sys.stderr)
+        progress.note(f"(skipped {', '.join(skipped)}: no grasp, so no grip force to vary)")
     rows = approximation_report(scenes, tuple(forces), a.samples, a.seed)
     print(json.dumps(rows) if a.json else format_report(rows))
     return OK
@@ -129,7 +129,7 @@ def add_parsers(sub) -> None:
                     "regrasp cone t-shape.toml --pose 0,0,0 --pusher top --plot cone.png", cmd_cone)
     c.add_argument("scene", help="a planar scene file")
     c.add_argument("--pose", required=True, help="the object's pose in the gripper frame: x,z,theta [m, m, rad]")
-    c.add_argument("--pusher", required=True, help=PUSHER_HELP)
+    c.add_argument("--pusher", required=True, help=pusher_help("cone"))
     c.add_argument("--twist", help="vx,vz,omega whose grip-force range is reported (default: the central "
                    "gravity-free twist)")
     c.add_argument("--json", action="store_true", help="print the report as JSON")

@@ -9,9 +9,9 @@ import numpy as np
 from .. import _core
 from ..errors import ArgumentError
 from ..planning.plan import Plan
-from . import (CANNOT, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_command, add_scale_options, add_verbose, check_count,
+from . import (CANNOT, api_default, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_command, add_scale_options, add_verbose, check_count,
                check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, mpc_default,
-               refuse_flags, scales, seed_arg)
+               plural, refuse_flags, rounded, scales, seed_arg, error3d)
 
 #: options of the planar MPC, without meaning for 3-D control
 PLANAR_ONLY = ("poke", "start_error", "robust", "uncertainty", "fixtureless", "plot", "dt", "horizon", "noise")
@@ -31,7 +31,7 @@ def _control3d(scene, plan: Plan, a) -> int:
         print(json.dumps(out))
     else:
         print(f"{scene.name}: {out['policy']} in {r['engine']}: {'success' if r['success'] else 'failure'}, "
-              f"{r['replans']} re-plans; error {np.round(r['goal_error'], 5).tolist()}")
+              f"{plural(r['replans'], 're-plan')}; error {error3d(r['goal_error'])}")
     return OK if r["success"] else CANNOT
 
 
@@ -67,17 +67,25 @@ def cmd_control(a) -> int:
     if a.json:
         print(json.dumps(res.to_json()))
     else:
-        print(f"{scene.name}: {res.policy} in {res.engine}: {'success' if res.success else 'failure'} "
-              f"after {res.t[-1]:.1f} s, {res.replans} re-plans, median MPC step {1e3 * res.mpc_step_median_s:.3f} ms; "
-              f"final pose {np.round(res.final_pose, 5).tolist()}, error {np.round(res.goal_error, 5).tolist()}"
-              + (f" ({res.failure})" if res.failure else ""))
+        print(_summary(scene, res))
     return OK if res.success else CANNOT
 
 
+def _summary(scene, res) -> str:
+    """What `regrasp control` prints for a planar run (the MPC's figures only for the MPC)."""
+    mpc = (f", {plural(res.replans, 're-plan')}, median MPC step {1e3 * res.mpc_step_median_s:.3f} ms"
+           if res.policy == "mpc" else "")
+    return (f"{scene.name}: {res.policy} in {res.engine}: {'success' if res.success else 'failure'} "
+            f"after {res.t[-1]:.1f} s{mpc}; final pose {rounded(res.final_pose)}, error {rounded(res.goal_error)} "
+            "(m, m, rad)" + (f"; {res.failure}" if res.failure else ""))
+
+
 def add_parsers(sub) -> None:
+    from ..control.loop import control
+
     k = add_command(sub, "control", "track a plan with the MPC (closed loop) in a simulator "
                     "(3-D scenes: feedback by re-planning from the measured pose)",
-                    "regrasp control t-shape.toml --plan plan.json --poke 2,0.005,0,0 --plot control.png",
+                    "regrasp control t-shape.toml --plan plan.json --poke 2,0.002,0,0 --plot control.png",
                     cmd_control)
     k.add_argument("scene", help="the scene file the plan is for")
     k.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
@@ -91,7 +99,8 @@ def add_parsers(sub) -> None:
     k.add_argument("--uncertainty", metavar="P,F,N,M", help="planar: spreads for the robust cones (implies --robust)")
     k.add_argument("--fixtureless", action="store_true", help="planar: constrain the MPC with fixtureless-fixturing cones")
     k.add_argument("--open-loop", action="store_true", help="execute the plan open loop instead (for comparison)")
-    k.add_argument("--noise", type=float, help="planar: pose measurement noise, standard deviation [m] (default 0)")
+    k.add_argument("--noise", type=float, help="planar: pose measurement noise, standard deviation: x, z [m], theta "
+                   f"NOISE/L [rad] with L the object's length (default: {api_default(control, 'noise')})")
     k.add_argument("--dt", type=float, help=f"planar: control period [s] ({mpc_default('dt')})")
     k.add_argument("--horizon", type=int, help=f"planar: MPC horizon in steps ({mpc_default('horizon')})")
     k.add_argument("--seed", type=seed_arg, default=_core.mpc_defaults()["seed"],

@@ -10,9 +10,9 @@ from .. import _core, progress
 from ..errors import ArgumentError
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
-from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, PUSHER_HELP, VIDEO_SUFFIXES,
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, pusher_help, VIDEO_SUFFIXES,
                add_command, add_scale_options, api_default, add_verbose, check_count, check_number, check_outputs, check_positive,
-               check_pusher, execute3d, floats, given, load, load_planar, refuse_flags, scales, seed_arg)
+               check_pusher, execute3d, floats, given, load, load_planar, plural, refuse_flags, runs, rounded, scales, seed_arg, error3d)
 
 
 def cmd_validate(a) -> int:
@@ -54,7 +54,7 @@ def _simulate3d(scene, plan: Plan, a) -> int:
     out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success")}
     out["max_pusher_slip"] = None
     print(json.dumps(out) if a.json else f"{scene.name}: {r['engine']}: "
-          f"{'success' if r['success'] else 'outside the tolerance'}, error {np.round(r['goal_error'], 5).tolist()}")
+          f"{'success' if r['success'] else 'outside the tolerance'}, error {error3d(r['goal_error'])}")
     return OK if r["success"] else CANNOT
 
 
@@ -77,11 +77,15 @@ def _replay_planar(scene, plan: Plan, a):
     return rep
 
 
-def _print_replay(scene, rep) -> None:
-    print(f"{scene.name}: replayed {len(rep.steps)} pushes in the {rep.engine} simulator")
+def _print_replay(scene, plan: Plan, rep) -> None:
+    """The replay's summary: the plan's steps and pusher runs (the same in both engines), then one
+    line per step (quasi-static) or per pusher run (MuJoCo executes a run as one push)."""
+    steps = len(plan.pushers) - 1
+    print(f"{scene.name}: replayed {plural(steps, 'step')} in {plural(len(runs(plan.pushers)), 'pusher run')} in the {rep.engine} "
+          f"simulator; slip per {'step' if rep.engine == 'quasistatic' else 'pusher run'}:")
     for k, st in enumerate(rep.steps, 1):
         print(f"  {k:2d} {st['pusher']:12s} slip {1e3 * st['slip']:.3f} mm")
-    print(f"  final pose {np.round(rep.final_pose, 5).tolist()}, error to goal {np.round(rep.goal_error, 5).tolist()}: "
+    print(f"  final pose {rounded(rep.final_pose)}, error to goal {rounded(rep.goal_error)} (m, m, rad): "
           f"{'success' if rep.success else 'outside the tolerance'}; largest pusher slip {1e3 * rep.max_pusher_slip:.3f} mm")
 
 
@@ -119,7 +123,7 @@ def cmd_simulate(a) -> int:
     if a.json:
         print(json.dumps(rep.to_json()))
     else:
-        _print_replay(scene, rep)
+        _print_replay(scene, plan, rep)
     return OK if rep.success else CANNOT
 
 
@@ -141,14 +145,17 @@ def _push_report(scene, a, twist, tr: dict) -> int:
         print(json.dumps(out))
     else:
         print(f"{scene.name}: pusher '{a.pusher}' with body twist {twist.tolist()} for {a.duration} s")
-        print(f"  final pose {np.round(out['final_pose'], 5).tolist()}; pusher sticks in "
+        print(f"  final pose {rounded(out['final_pose'])}; pusher sticks in "
               f"{100 * out['pusher_sticking_share']:.0f}% of the steps; largest constraint residual {out['max_residual']:.1e}")
     return OK
 
 
 def _check_push(a) -> None:
     """--duration, --dt (positive, at most MAX_STEPS steps) and --plot, before any work."""
+    from ..sim.quasistatic import push_dt
+
     check_number(a, "duration", 0.0, MAX_DURATION, what="duration [s]", lo_open=True)
+    a.dt = push_dt(a.duration, a.dt)
     check_number(a, "dt", 0.0, a.duration, what="time step [s] (at most --duration)", lo_open=True)
     if a.duration / a.dt > MAX_STEPS:
         raise ArgumentError(f"invalid `--dt`: --duration / --dt is at most {MAX_STEPS} steps "
@@ -194,7 +201,7 @@ def add_parsers(sub) -> None:
     v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
     v.add_argument("--support", choices=["points", "limit_surface"],
                    help="quasi-static pads as point sets or as the motion cones' limit surface "
-                   f"(default {_core.quasistatic_defaults()['support']})")
+                   f"(default: {_core.quasistatic_defaults()['support']})")
     v.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(v)
 
@@ -205,12 +212,12 @@ def add_parsers(sub) -> None:
     s.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
     s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"],
                    help="our quasi-static simulator or MuJoCo")
-    s.add_argument("--dt", type=float, help=f"quasi-static time step [s] (default {api_default(quasistatic.replay_plan, 'dt')} "
+    s.add_argument("--dt", type=float, help=f"quasi-static time step [s] (default: {api_default(quasistatic.replay_plan, 'dt')} "
                    f"planar, {api_default(Scene3D.replay, 'dt')} 3-D)")
     add_scale_options(s, "MuJoCo: ")
     s.add_argument("--perturb", type=float,
-                   help="MuJoCo, planar: also draw each factor uniformly in [1-P, 1+P] from --seed (default 0: none)")
-    s.add_argument("--seed", type=seed_arg, help=f"random seed of --perturb (default {PERTURB_SEED})")
+                   help="MuJoCo, planar: also draw each factor uniformly in [1-P, 1+P] from --seed (default: 0, none)")
+    s.add_argument("--seed", type=seed_arg, help=f"random seed of --perturb (default: {PERTURB_SEED})")
     s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo, planar: an animation of the execution")
     s.add_argument("--plot", metavar="PNG", help="planar: planned against simulated poses")
     s.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -221,12 +228,11 @@ def add_parsers(sub) -> None:
                     cmd_push)
     p.add_argument("scene", help="the scene file")
     p.add_argument("--pose", required=True, help="x,z,theta (3-D scenes: x,y,z,qw,qx,qy,qz)")
-    p.add_argument("--pusher", required=True, help=PUSHER_HELP)
+    p.add_argument("--pusher", required=True, help=pusher_help("push"))
     p.add_argument("--twist", required=True,
                    help="pusher body twist vx,vz,omega, object frame at the start (3-D: vx,vy,vz,wx,wy,wz)")
     p.add_argument("--duration", type=float, default=1.0, help="duration of the push [s]")
-    p.add_argument("--dt", type=float, default=api_default(quasistatic.simulate_push, "dt"),
-                   help="time step [s], at most --duration")
+    p.add_argument("--dt", type=float, help=f"time step [s], at most --duration (default: min({quasistatic.DT}, --duration))")
     p.add_argument("--plot", metavar="PNG", help="planar: object motion and contact forces")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(p)

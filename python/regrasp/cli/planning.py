@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 from ..errors import ArgumentError
@@ -11,7 +10,7 @@ from ..files import Outputs
 from .. import progress
 from ..planning.plan import POSE_SIZE, Plan, plan, planner_defaults
 from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_command, add_verbose, check_number, check_outputs,
-               floats, load, mode_scene, planner_default, pusher_runs, refuse_flags, seed_arg)
+               floats, load, mode_scene, planner_default, plural, pusher_runs, refuse_flags, seed_arg)
 
 #: the output options of `regrasp plan` and the file-name suffixes they take (None: any)
 OUTPUTS = {"out": None, "partial_out": None, "plot": FIGURE_SUFFIXES, "animate": ANIMATION_SUFFIXES, "html": None}
@@ -62,7 +61,8 @@ def _write_outputs(scene, p: Plan, a) -> list[str]:
     """Writes the outputs asked for, all or none (each atomically). A plan found: --out and the
     figures. None found: the best partial plan to --partial-out, else to --out when that file does
     not exist yet; figures only where no file exists yet (an existing output is left untouched).
-    Returns what to say on stderr about the outputs of a partial plan."""
+    Returns what to say about the outputs: ``wrote PATH`` per file of a found plan (stdout), the
+    partial plan's outputs (stderr)."""
     opt = "--partial-out" if not p.found and a.partial_out else "--out"
     plan_file = getattr(a, opt[2:].replace("-", "_"))
     writers = ([(opt, plan_file, lambda tmp: p.save(tmp))] if plan_file else []) + _figure_writers(scene, p, a)
@@ -75,17 +75,26 @@ def _write_outputs(scene, p: Plan, a) -> list[str]:
                 continue
             Path(path).parent.mkdir(parents=True, exist_ok=True)
             outs.write(path, write)
-            if not p.found:
+            if p.found:
+                said.append(f"wrote {path}")
+            else:
                 what = "plan" if opt in ("--out", "--partial-out") else "plan's figure"
                 said.append(f"wrote the best partial {what} to {path} (`{opt}`)")
     return said
+
+
+#: the warning of a planar plan found whose steps do not all pass the exact motion-cone test
+SLIP_WARNING = ("warning: the plan was found by the {propagation} propagation, and some of its steps fail the exact "
+                "motion-cone test (sticking along the whole step): executing it may slip (check it with "
+                "`regrasp simulate`)")
 
 
 def summary(scene, p: Plan) -> str:
     """What `regrasp plan` prints without --json."""
     head = "plan found" if p.found else f"no plan found ({p.stop_reason}); best partial plan"
     solves = f", {p.solves} inverse/forward solves" if p.dimension == 3 else ""
-    lines = [f"{scene.name}: {head}: {len(p.poses) - 1} steps, {p.switch_overs} switch-overs, {p.nodes} nodes{solves}, "
+    lines = [f"{scene.name}: {head}: {plural(len(p.poses) - 1, 'step')}, {plural(p.switch_overs, 'switch-over')}, "
+             f"{plural(p.nodes, 'node')}{solves}, "
              f"{1e3 * p.planning_time_s:.2f} ms ({p.propagation}, seed {p.seed})",
              "  pushes: " + pusher_runs(p.pushers)]
     if p.dimension == 2:
@@ -110,10 +119,14 @@ def cmd_plan(a) -> int:
         p = plan(scene, start, goal, **settings)
     said = _write_outputs(scene, p, a)
     print(json.dumps(p.to_json()) if a.json else summary(scene, p))
+    if p.found and not a.json:
+        print("\n".join(said), end="\n" if said else "")
+    if p.found and p.dimension == 2 and not p.valid:
+        progress.note(f"regrasp: {SLIP_WARNING.format(propagation=p.propagation)}")
     if not p.found:
-        print(f"regrasp: no plan found: {p.stop_reason}", file=sys.stderr)
+        progress.note(f"regrasp: no plan found: {p.stop_reason}")
         for line in said:
-            print(f"regrasp: {line}", file=sys.stderr)
+            progress.note(f"regrasp: {line}")
         return CANNOT
     return OK
 

@@ -10,7 +10,7 @@ import numpy as np
 from .. import examples
 from ..scene.planar import Scene
 from ..files import Outputs, check_writable
-from . import (CANNOT, MAX_CONES, OK, add_command, check_count, given, planner_default, pusher_runs, refuse_flags,
+from . import (CANNOT, MAX_CONES, OK, add_command, check_count, given, planner_default, plural, pusher_runs, rounded, refuse_flags,
                seed_arg)
 
 def cmd_bench(a) -> int:
@@ -37,14 +37,14 @@ def cmd_demo(a) -> int:
     t = scene.task
     print(f"demo: regrasp of the T-shaped object ({path.name}) from {t.start.tolist()} to {t.goal.tolist()}")
     p = plan(scene, **given(a, "seed"))
-    print(f"  {'plan found' if p.found else 'NO plan found'} in {1e3 * p.planning_time_s:.2f} ms: {len(p.poses) - 1} steps, "
-          f"{p.switch_overs} switch-overs ({pusher_runs(p.pushers)})")
+    print(f"  {'plan found' if p.found else 'NO plan found'} in {1e3 * p.planning_time_s:.2f} ms: {plural(len(p.poses) - 1, 'step')}, "
+          f"{plural(p.switch_overs, 'switch-over')} ({pusher_runs(p.pushers)})")
     print(f"  every step sticks along its length by the exact motion-cone test: {p.valid}")
     # the motion cones the first push relies on, and the plan replayed in the quasi-static simulator
     first = p.pushers[1] if len(p.pushers) > 1 else scene.pusher_names[0]
     rep = replay_plan(scene, p)
-    print(f"  replayed in the quasi-static simulator: final pose {np.round(rep.final_pose, 4).tolist()}, "
-          f"error {np.round(1e3 * rep.goal_error[:2], 2).tolist()} mm / {np.degrees(rep.goal_error[2]):.2f} deg, "
+    print(f"  replayed in the quasi-static simulator: final pose {rounded(rep.final_pose, 4)} (m, m, rad), "
+          f"error {rounded(1e3 * rep.goal_error[:2], 2)} mm / {round(float(np.degrees(rep.goal_error[2])), 2) + 0.0:.2f} deg, "
           f"{'within' if rep.success else 'outside'} the tolerance")
     out.mkdir(parents=True, exist_ok=True)
     figures = have("matplotlib")
@@ -77,7 +77,7 @@ def add_parsers(sub) -> None:
     b.add_argument("--json", action="store_true", help="print the results as JSON")
     b.add_argument("--quick", action="store_true", help=f"{bench.QUICK['n']:,} cones instead of -n, fewer repetitions "
                    f"({bench.QUICK['reps']} instead of {bench.REPS})")
-    b.add_argument("-n", type=int, help=f"cones per batch, 1 to {MAX_CONES} (default {bench.CONES:,})")
+    b.add_argument("-n", type=int, help=f"cones per batch, 1 to {MAX_CONES} (default: {bench.CONES:,})")
 
     d = add_command(sub, "demo", "the bundled example end to end, writing its figures", "regrasp demo --out out/demo",
                     cmd_demo)

@@ -186,6 +186,7 @@ class ControlRun:
         self.pending = list(self.pokes)
         self.ts, self.qs, self.refs, self.used, self.statuses, self.times = [], [], [], [], [], []
         self.t, self.k, self.stuck, self.failure = 0.0, 0, 0, ""
+        self.world_failed = False
 
     def measure(self) -> np.ndarray:
         """Applies the pokes due, records the true pose and returns its (noisy) measurement."""
@@ -207,9 +208,18 @@ class ControlRun:
         try:
             self.plant.push(pusher, twist, self.dt, belief)
         except RegraspError as e:  # the world rejected the push (e.g. the grasp cannot hold the object)
-            self.failure = f"the world failed: {e}"
+            self.world_failed, self.failure = True, self._world_failure(e)
             return False
         return True
+
+    def _world_failure(self, e: RegraspError) -> str:
+        """What the world's refusal ``e`` of a push means, in the user's terms, with the time [s]
+        and the object's pose (m, m, rad)."""
+        q = [round(float(v), 5) + 0.0 for v in self.plant.pose()]
+        if getattr(e, "field", None) == "pose" and "not admissible" in str(e):
+            return (f"the object left the admissible region at t = {self.t:.2f} s (the finger pad no longer "
+                    f"entirely on the object): pose {q} (m, m, rad)")
+        return f"the world could not go on at t = {self.t:.2f} s, pose {q} (m, m, rad): {e}"
 
     def _wait(self) -> bool:
         """Nothing to push: goes on only while pokes are to come (the plant idles a period)."""
@@ -266,7 +276,7 @@ class ControlRun:
             ref = self.refs[-1] if self.refs else self.knots[-1]
             self._record(ref, self.statuses[-1] if self.statuses else "", None)
         err = q - self.goal
-        ok = bool(np.all(np.abs(err) <= self.tol)) and not self.failure.startswith("the world")
+        ok = bool(np.all(np.abs(err) <= self.tol)) and not self.world_failed
         failure = self.failure
         if not ok and not failure:
             failure = "time out" if self.t > self.max_time else "ended outside the tolerance"

@@ -49,11 +49,19 @@ def problem(scene: Scene, pose, pusher: str | None = None, h: float | None = Non
                                            kw["points"], kw["merge_fingers"], h, SPEED)
 
 
-def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: float = DT, **support) -> dict:
+def push_dt(duration: float, dt: float | None = None) -> float:
+    """The time step [s] of a push of ``duration`` [s]: ``dt`` when given, else min(:data:`DT`,
+    ``duration``) (a short push is one step)."""
+    return min(DT, duration) if dt is None else dt
+
+
+def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: float | None = None, **support) -> dict:
     """Explicit time stepping of one push from ``pose`` (m, m, rad): the pusher moves with
-    constant body ``twist`` (m/s, m/s, rad/s) for ``duration`` [s] in steps of ``dt`` [s]."""
+    constant body ``twist`` (m/s, m/s, rad/s) for ``duration`` [s] in steps of ``dt`` [s]
+    (dt: time step [s], default min(0.05, duration))."""
     kw = support_kwargs(**support)
-    duration, dt = _number(duration, "duration"), _number(dt, "dt")
+    duration = _number(duration, "duration")
+    dt = _number(push_dt(duration, dt), "dt")
     return scene._core.simulate_push(list(_vec(pose, 3, "pose")), _name(pusher, "pusher"), list(_vec(twist, 3, "twist")),
                                      duration, dt, kw["support"], kw["rings"], kw["points"], kw["merge_fingers"])
 

@@ -310,6 +310,13 @@ def _pusher_at(scene, q, name):
     return p.points @ R.T + q[:2], R @ p.normal
 
 
+def _used_pushers(pushers, names) -> list[str]:
+    """The pushers among ``names`` (the scene's, in its order) that steps ``pushers`` use (the
+    legend lists only those)."""
+    used = set(pushers[1:])
+    return [nm for nm in names if nm in used]
+
+
 def plot_plan(scene, plan, path) -> Path:
     """The object in the grasp (gripper frame) at the plan's knots, the finger pad, and each
     push coloured by its pusher (thesis Figs 4-11..4-14); beside it the pose over the steps."""
@@ -337,7 +344,7 @@ def plot_plan(scene, plan, path) -> Path:
     pad = scene.pad
     if pad is not None:
         a.add_patch(Circle((0, 0), pad[1], color="0.2", alpha=0.6, zorder=5))
-    for nm in names:
+    for nm in _used_pushers(plan.pushers, names):
         a.plot([], [], color=color[nm], lw=3, label=f"pusher {nm}")
     a.plot([], [], "k", label="start (filled)")
     a.plot([], [], "--", color="0.3", label="goal")
