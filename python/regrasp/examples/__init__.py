@@ -90,7 +90,7 @@ def copy(name: str, dest_folder, field: str = "dest_folder") -> Path:
     rels = [src.name] + meshes(name)
     taken = [r for r in rels if (dest / r).exists()]
     if taken:
-        raise ArgumentError(f"invalid `{field}`: {', '.join(str(dest / r) for r in taken)} already exist"
+        raise ArgumentError(f"invalid `{field}`: {', '.join(str(dest / r) for r in taken)} already exist{'s' if len(taken) == 1 else ''}"
                             " (not overwritten)", field)
     created = _missing_folders(dest / r for r in rels)
     try:

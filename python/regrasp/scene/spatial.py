@@ -84,11 +84,16 @@ class Scene3D:
         ``[x, y, z, qw, qx, qy, qz]`` (m, quaternion), with time step ``h`` [s] > 0."""
         return self._core.quasistatic_problem(list(_vec(pose, 7, "pose")), _name(pusher, "pusher"), _number(h, "h"))
 
-    def simulate_push(self, pose, pusher: str, twist, duration: float, dt: float = 0.05) -> dict:
-        """The pusher moves with constant body ``twist`` for ``duration`` [s] > 0 in steps of
-        ``dt`` [s] > 0 (quasi-static time stepping)."""
+    def simulate_push(self, pose, pusher: str, twist, duration: float, dt: Optional[float] = None) -> dict:
+        """The pusher moves with constant body ``twist`` (m/s, rad/s) for ``duration`` [s] > 0 in steps
+        of ``dt`` [s] > 0 (quasi-static time stepping; default min(0.05 s, ``duration``), as the planar
+        :func:`~regrasp.sim.quasistatic.simulate_push`)."""
+        from ..sim.quasistatic import push_dt
+
+        duration = _number(duration, "duration")
+        dt = push_dt(duration, None if dt is None else _number(dt, "dt"))
         return self._core.simulate_push(list(_vec(pose, 7, "pose")), _name(pusher, "pusher"), list(_vec(twist, 6, "twist")),
-                                        _number(duration, "duration"), _number(dt, "dt"))
+                                        duration, dt)
 
     def plan(self, start=None, goal=None, **settings) -> Plan:
         """T-RRT* over SE(3) with inverse-dynamics and rolling unit steps (thesis §4.2): the same
