@@ -208,7 +208,7 @@ def test_planner_settings_default_to_the_cores():
     a = build_parser().parse_args(["plan", "x.toml"])
     assert (a.seed, a.time_limit, a.propagation) == (None, None, None)
     r = subprocess.run([sys.executable, "-m", "regrasp.cli", "plan", "--help"], capture_output=True, text=True)
-    assert f"default {regrasp.planner_defaults(2)['time_limit']}" in " ".join(r.stdout.split())
+    assert f"(default: {regrasp.planner_defaults(2)['time_limit']})" in " ".join(r.stdout.split())
 
 
 def test_the_simulators_and_views_take_a_plan(planar, spatial, tmp_path):
