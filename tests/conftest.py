@@ -84,3 +84,19 @@ def twist_dirs(n, L, rng):
     d = rng.normal(size=(n, 3))
     d /= np.linalg.norm(d, axis=1)[:, None]
     return d * np.array([1.0, 1.0, 1.0 / L])
+
+
+def run_cli(*args) -> tuple:
+    """`regrasp ARGS` in this process: (exit status, stdout, stderr); help and errors exit."""
+    import contextlib
+    import io
+
+    from regrasp.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            status = main([str(a) for a in args])
+        except SystemExit as e:
+            status = e.code
+    return status, out.getvalue(), err.getvalue()

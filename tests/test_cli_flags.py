@@ -4,14 +4,12 @@ or the command refuses it (exit 2, the flag and the reason on stderr)."""
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 from pathlib import Path
 
 import pytest
 
-from regrasp.cli import main as cli_main
+from .conftest import run_cli as run
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
@@ -21,15 +19,6 @@ SPATIAL = EXAMPLES / "pivot-3d.toml"
 PLAN_ARGS = ["--time-limit", "5", "--seed", "0"]
 
 
-def run(*args) -> tuple[int, str, str]:
-    """`regrasp ARGS` in this process: (status, stdout, stderr)."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            status = cli_main([str(a) for a in args])
-        except SystemExit as e:
-            status = e.code
-    return status, out.getvalue(), err.getvalue()
 
 
 @pytest.fixture(scope="module")

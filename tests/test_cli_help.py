@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import io
 import json
 import re
 import subprocess
@@ -15,7 +14,9 @@ from pathlib import Path
 import pytest
 
 import regrasp
-from regrasp.cli import build_parser, main
+from regrasp.cli import build_parser
+
+from .conftest import run_cli as run
 
 ROOT = Path(__file__).resolve().parents[1]
 T_SHAPE = ROOT / "examples" / "t-shape.toml"
@@ -28,15 +29,6 @@ def commands() -> dict[str, argparse.ArgumentParser]:
     return {"": ap, **sub.choices}
 
 
-def run(*argv) -> tuple[int, str, str]:
-    """`regrasp ARGV` in this process: (status, stdout, stderr); help and errors exit."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            status = main([str(a) for a in argv])
-        except SystemExit as e:
-            status = e.code
-    return status, out.getvalue(), err.getvalue()
 
 
 def flat(text: str) -> str:

@@ -3,15 +3,15 @@ simulators, plurals, no ``-0.0``, units on 3-D errors, no figures that do not ap
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import re
 from pathlib import Path
 
 import pytest
 
-from regrasp.cli import error3d, main as cli_main, plural, pusher_runs, rounded
+from regrasp.cli import error3d, plural, pusher_runs, rounded
+
+from .conftest import run_cli as run
 
 #: a printed negative zero (``-0.0`` not followed by more digits)
 NEG_ZERO = re.compile(r"-0\.0(?![\d])")
@@ -21,15 +21,6 @@ T_SHAPE = EXAMPLES / "t-shape.toml"
 PIVOT = EXAMPLES / "pivot-3d.toml"
 
 
-def run(*args) -> tuple[int, str, str]:
-    """`regrasp ARGS` in this process: (status, stdout, stderr)."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            status = cli_main([str(a) for a in args])
-        except SystemExit as e:
-            status = e.code
-    return status, out.getvalue(), err.getvalue()
 
 
 @pytest.fixture(scope="module")
