@@ -54,6 +54,15 @@ def test_docstrings_and_units_reach_the_pages(site):
     assert "Per-finger grip-force range (min, max) [N]" in html
 
 
+def test_properties_made_by_core_property_show_their_description(site):
+    """The site imports the modules (``force_inspection``), so the descriptions that
+    ``core_property`` gives its properties reach the page, as they reach ``help()``."""
+    import regrasp
+
+    html = (site / "api" / "mechanics" / "index.html").read_text()
+    assert regrasp.Scene.pusher_names.__doc__ in html
+
+
 def test_contract_pages_are_in_the_site(site):
     for page in ("scene-file", "plan-file", "cli"):
         assert (site / page / "index.html").exists(), page
