@@ -133,3 +133,49 @@ def twist_between(a, b) -> list:
     """The constant body twist (m/s, rad/s) taking pose ``a`` to pose ``b`` (m, unit quaternion)
     in unit time (SE(3) log, the core's)."""
     return list(_core.se3_log([float(x) for x in a], [float(x) for x in b]))
+
+
+# --- SE(3) poses (the core's algebra, numpy in and out) ----------------------------------------
+
+
+def compose(*poses) -> np.ndarray:
+    """The composition ``a ∘ b ∘ ...`` of poses ``[x, y, z, qw, qx, qy, qz]`` (m, unit quaternion)."""
+    out = [float(x) for x in poses[0]]
+    for p in poses[1:]:
+        out = _core.se3_compose(out, [float(x) for x in p])
+    return np.array(out)
+
+
+def inverse(a) -> np.ndarray:
+    """The inverse of pose ``a`` ``[x, y, z, qw, qx, qy, qz]`` (m, unit quaternion)."""
+    return np.array(_core.se3_inverse([float(x) for x in a]))
+
+
+def integrate(pose, twist, t: float = 1.0) -> np.ndarray:
+    """``pose ∘ exp(t · twist)``: pose (m, unit quaternion), body twist (m/s, rad/s), ``t`` [s]."""
+    return np.array(_core.se3_integrate([float(x) for x in pose], [float(x) for x in twist], float(t)))
+
+
+def from_frame(R, p) -> np.ndarray:
+    """The pose ``[x, y, z, qw, qx, qy, qz]`` of the frame with rotation matrix ``R`` (columns: its
+    axes) and origin ``p`` [m]."""
+    return np.concatenate([np.asarray(p, float), quat_from_matrix(R)])
+
+
+def transform(pose, v) -> np.ndarray:
+    """Point(s) ``v`` [m] (shape (3,) or (n, 3)) of a frame mapped by its pose (m, unit quaternion)
+    into the reference frame: ``R v + p``."""
+    pose = np.asarray(pose, float)
+    return quat_rotate(pose[3:], v) + pose[:3]
+
+
+def interpolate(a, b, s: float) -> np.ndarray:
+    """The pose a fraction ``s`` in [0, 1] of the way from pose ``a`` to pose ``b`` (m, unit
+    quaternion), the position along the straight line and the rotation by :func:`slerp`."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return np.concatenate([a[:3] + s * (b[:3] - a[:3]), slerp(a[3:], b[3:], s)])
+
+
+def z_turn(phi: float) -> np.ndarray:
+    """The pose (no translation) of a turn by ``phi`` [rad] about +z."""
+    return np.array([0.0, 0.0, 0.0, np.cos(phi / 2), 0.0, 0.0, np.sin(phi / 2)])
