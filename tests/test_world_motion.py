@@ -1,0 +1,250 @@
+"""The gripper's world-frame trajectory of a plan in a workcell (regrasp.execution), checked
+independently: 4 x 4 matrices and scipy's expm, not the package's pose algebra."""
+
+import time
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+import regrasp
+from regrasp import ArgumentError, Plan
+from regrasp.execution import Timing, world_motion
+from regrasp.execution.world_motion import LABELS, object_points
+from regrasp.workcell import Table, Workcell, default_workcell
+from regrasp.workcell.description import Feature, Robot
+
+EXAMPLE_WORKCELL = regrasp.examples.ROOT / "workcells" / "workcell-ur5e.toml"
+PLANS: dict = {}
+
+
+def plan_of(name):
+    if name not in PLANS:
+        scene = regrasp.load_scene(regrasp.examples.path(name))
+        PLANS[name] = (scene, regrasp.plan(scene, seed=0))
+    return PLANS[name]
+
+
+def rot(q):
+    w, x, y, z = np.asarray(q) / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def T(pose):
+    """4 x 4 matrix of a 7-vector pose."""
+    m = np.eye(4)
+    m[:3, :3], m[:3, 3] = rot(pose[3:]), pose[:3]
+    return m
+
+
+def T_planar(q):
+    """4 x 4 matrix of a planar pose [x, z, theta]: x-z plane, theta turning x towards z."""
+    x, z, th = q
+    c, s = np.cos(th), np.sin(th)
+    m = np.eye(4)
+    m[:3, :3] = [[c, 0, -s], [0, 1, 0], [s, 0, c]]
+    m[:3, 3] = [x, 0, z]
+    return m
+
+
+def hat(xi):
+    m = np.zeros((4, 4))
+    v, w = xi[:3], xi[3:]
+    m[:3, :3] = [[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]
+    m[:3, 3] = v
+    return m
+
+
+def contact_matrix(pts, n):
+    """The pusher's contact frame in the object frame from its points and normal (3-D)."""
+    pts, n = np.asarray(pts, float), np.asarray(n, float) / np.linalg.norm(n)
+    o = pts.mean(axis=0)
+    if len(pts) == 2:
+        x = (pts[1] - pts[0]) / np.linalg.norm(pts[1] - pts[0])
+        z = n - (n @ x) * x
+        z /= np.linalg.norm(z)
+    else:
+        z = n
+        a = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+        x = np.cross(n, a)
+        x /= np.linalg.norm(x)
+    m = np.eye(4)
+    m[:3, :3], m[:3, 3] = np.column_stack([x, np.cross(z, x), z]), o
+    return m
+
+
+def pusher_matrices(scene, plan, a):
+    """Independently: the pusher's contact frame in the gripper frame at each knot of push ``a``."""
+    if scene.dimension == 2:
+        p = scene.pusher(a.pusher)
+        pts = np.column_stack([p.points[:, 0], np.zeros(len(p.points)), p.points[:, 1]])
+        C = contact_matrix(pts, [p.normal[0], 0, p.normal[1]])
+        return {k: T_planar(plan.poses[k]) @ C for k in range(a.first, a.last + 1)}   # sticking
+    pts, n, _ = scene._core.pusher_spec(a.pusher, list(plan.poses[a.first]))
+    Pk = {a.first: T(plan.poses[a.first]) @ contact_matrix(pts, n)}
+    for k in range(a.first + 1, a.last + 1):
+        O = T(plan.poses[k - 1])
+        xi = plan.pusher_twists[k]
+        if xi is None:
+            xi = np.array(regrasp.pose.twist_between(plan.poses[k - 1], plan.poses[k]))
+        Pk[k] = O @ expm(hat(xi)) @ np.linalg.inv(O) @ Pk[k - 1]
+    return Pk
+
+
+CASES = ["block-low-friction", "t-shape", "block-tilted-gripper", "pivot-3d", "ball-roll-3d", "offset-3d"]
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_gripper_renders_the_plan_with_the_fixed_feature(name):
+    scene, plan = plan_of(name)
+    m = world_motion(scene, plan)
+    contacts = {c.name: c for c in m.workcell.contacts()}
+    assert [(a.first, a.last) for a in m.assignments][0][0] == 0
+    assert m.assignments[-1].last == len(plan.poses) - 1
+    knots = iter(m.knots)
+    for a in m.assignments:
+        F = T(a.frame)
+        c = contacts[a.feature]
+        assert np.allclose(F[:3, 3], c.frame[:3], atol=1e-12)                  # at the feature's contact
+        assert np.allclose(F[:3, 2], rot(c.frame[3:])[:, 2], atol=1e-12)      # pushing its way
+        for k, Pk in pusher_matrices(scene, plan, a).items():
+            kk, j = next(knots)
+            assert kk == k and m.push[j] == a.index
+            # G_k ∘ P_k = F at every knot
+            assert np.abs(T(m.gripper[j]) @ Pk - F).max() < 1e-9, (a.pusher, k)
+            assert np.allclose(m.in_hand[j], np.asarray(plan.poses[k]) if scene.dimension == 3
+                               else regrasp.pose.planar_to_spatial(plan.poses[k]), atol=1e-12)
+        if scene.dimension == 2:                                                # a sticking push keeps
+            W = m.object[m.push == a.index][np.array(m.labels)[m.push == a.index] == "push"]
+            assert np.abs(W - W[0]).max() < 1e-9                                # the object still
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_the_motion_is_continuous_timed_and_held(name):
+    scene, plan = plan_of(name)
+    tm = Timing()
+    m = world_motion(scene, plan, timing=tm)
+    n = len(m.times)
+    assert m.gripper.shape == m.object.shape == m.in_hand.shape == (n, 7) and len(m.labels) == n
+    assert set(m.labels) <= set(LABELS) and m.labels[0] == "start" and m.labels.count("start") == 1
+    dt = np.diff(m.times)
+    assert m.times[0] == 0 and np.all(dt > 0) and np.all(dt <= tm.sample_period + 1e-12)
+    force = scene.grip_force if scene.dimension == 2 else scene._core.grip_force
+    assert np.all(m.grip_force == force)
+    reach = max(np.linalg.norm(T(m.in_hand[i])[:3, :3] @ object_points(scene).T + m.in_hand[i][:3, None], axis=0).max()
+                for i in range(n))
+    for X, what in ((m.gripper, "gripper"), (m.object, "object")):
+        step = np.linalg.norm(np.diff(X[:, :3], axis=0), axis=1)
+        turn = 2 * np.arccos(np.clip(np.abs(np.sum(X[1:, 3:] * X[:-1, 3:], axis=1)), 0, 1))
+        assert np.all(turn <= tm.move_turn * dt + 1e-6), what
+        assert np.all(step <= (tm.move_speed + tm.move_turn * (reach if what == "object" else 0)) * dt + 1e-6), what
+    # the object's world pose is the gripper's composed with the planned pose in the hand
+    for i in range(0, n, 7):
+        assert np.abs(T(m.object[i]) - T(m.gripper[i]) @ T(m.in_hand[i])).max() < 1e-12
+    json = m.to_dict()
+    assert len(json["times"]) == n and json["duration_s"] == m.duration > 0
+
+
+@pytest.mark.parametrize("name", ["block-low-friction", "pivot-3d"])
+def test_approach_retreat_and_transfers_clear_the_features(name):
+    scene, plan = plan_of(name)
+    tm = Timing(clearance=0.03)
+    m = world_motion(scene, plan, timing=tm)
+    labels = np.array(m.labels)
+    pts = object_points(scene)
+    for a in m.assignments:
+        F = T(a.frame)
+        P0 = pusher_matrices(scene, plan, a)
+        idx = np.flatnonzero(m.push == a.index)
+        for part in ("approach", "retreat"):
+            js = idx[labels[idx] == part]
+            assert len(js) >= 1
+            Pk = P0[a.first] if part == "approach" else P0[a.last]
+            # the pusher's contact point, seen from the feature's frame: on its normal line,
+            # between contact and the clearance
+            local = np.array([(np.linalg.inv(F) @ T(m.gripper[j]) @ Pk)[:3, 3] for j in js])
+            assert np.allclose(local[:, :2], 0, atol=1e-9)
+            assert np.all(local[:, 2] >= -1e-9) and np.all(local[:, 2] <= tm.clearance + 1e-9)
+            # it ends in contact (approach) or the clearance away (retreat), and starts from the
+            # clearance away (the pre-contact pose before the approach) or in contact (the push's end)
+            before = (np.linalg.inv(F) @ T(m.gripper[js[0] - 1]) @ Pk)[:3, 3]
+            assert np.allclose(before[:2], 0, atol=1e-9)
+            assert local[-1, 2] == pytest.approx(0.0 if part == "approach" else tm.clearance, abs=1e-9)
+            assert before[2] == pytest.approx(tm.clearance if part == "approach" else 0.0, abs=1e-9)
+            assert np.all(np.diff(local[:, 2]) * (1 if part == "retreat" else -1) > 0)   # monotone
+    # transfers at the safe height: every point of the object above every feature by the clearance
+    top = m.workcell.top()
+    high = [j for j in np.flatnonzero(labels == "transfer") if np.isclose(m.gripper[j, 2], m.safe_height)]
+    assert high
+    for j in high:
+        world = (T(m.object[j]) @ np.c_[pts, np.ones(len(pts))].T)[:3]
+        assert world[2].min() > top + tm.clearance - 1e-9
+    # during every transfer, the next (or last) push's contact point stays at least the clearance
+    # from its feature's contact point
+    for j in np.flatnonzero(labels == "transfer"):
+        a = next((a for a in m.assignments if np.any(m.push[j:] == a.index)), m.assignments[-1])
+        Pk = pusher_matrices(scene, plan, a)[a.first if np.any(m.push[j:] == a.index) else a.last]
+        d = np.linalg.norm((T(m.gripper[j]) @ Pk)[:3, 3] - a.frame[:3])
+        assert d >= tm.clearance - 1e-9
+
+
+def test_a_push_no_feature_serves_is_refused_naming_it():
+    scene, plan = plan_of("block-low-friction")
+    bare = Workcell("bare", Table(0.75, [1.2, 0.8], 0.5, [0.5, 0]), (), Robot("ur5e", [0, 0, 0.75, 1, 0, 0, 0]))
+    pushers = plan.pushers
+    k = next(i for i in range(1, len(pushers)) if pushers[i] == "left")
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, plan, bare)
+    assert e.value.field == f"plan.path[{k}].pusher"
+    assert "`left`" in str(e.value) and "push " in str(e.value) and "edge" in str(e.value)
+    # a feature of the right kind but too little friction is refused too, saying so
+    slick = Feature("slick", "block", [0.5, 0.25, 0.8, 1, 0, 0, 0], 0.01, [0.1, 0.1, 0.1])
+    w = Workcell("slick", Table(0.75, [1.2, 0.8], 0.5, [0.5, 0]), (slick,), Robot("ur5e", [0, 0, 0.75, 1, 0, 0, 0]))
+    with pytest.raises(ArgumentError, match="friction"):
+        world_motion(scene, plan, w)
+    # an edge shorter than the line pusher is refused
+    short = Feature("short", "edge", [0.5, 0.25, 0.9, 0.7071067811865476, 0, 0.7071067811865476, 0], 0.9, length=0.01)
+    w = Workcell("short", Table(0.75, [1.2, 0.8], 0.5, [0.5, 0]), (short,), Robot("ur5e", [0, 0, 0.75, 1, 0, 0, 0]))
+    with pytest.raises(ArgumentError, match="shorter"):
+        world_motion(scene, plan, w)
+
+
+def test_the_example_workcell_renders_a_plan_and_bad_arguments_are_refused():
+    scene, plan = plan_of("block-low-friction")
+    w = Workcell.load(EXAMPLE_WORKCELL)
+    m = world_motion(scene, plan, w, start=[0.3, 0, 1.2, 1, 0, 0, 0])
+    assert np.allclose(m.gripper[0], [0.3, 0, 1.2, 1, 0, 0, 0])
+    assert {a.feature for a in m.assignments} <= {c.name for c in w.contacts()}
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, plan, w, start=[0, 0, 0, 0, 0, 0, 0])
+    assert e.value.field == "start"
+    with pytest.raises(ArgumentError) as e:
+        Timing(push_speed=0)
+    assert e.value.field == "timing.push_speed"
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, {"path": []})
+    assert e.value.field == "plan"
+    scene3, plan3 = plan_of("offset-3d")
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, plan3)
+    assert e.value.field == "plan.path[0].pose"
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, Plan(dimension=2, poses=[plan.poses[0]], pushers=[None]))
+    assert e.value.field == "plan.path"
+    surface = regrasp.load_scene(regrasp.examples.path("block-on-incline"))
+    with pytest.raises(ArgumentError) as e:
+        world_motion(surface, Plan(dimension=2, poses=[[0, 0, 0], [0, 0.001, 0]], pushers=[None, "finger"]))
+    assert e.value.field == "scene"
+
+
+def test_time_to_turn_a_plan_into_a_world_trajectory():
+    scene, plan = plan_of("t-shape")
+    w = default_workcell(scene)
+    world_motion(scene, plan, w)
+    t0 = time.perf_counter()
+    m = world_motion(scene, plan, w)
+    elapsed = time.perf_counter() - t0
+    print(f"\nt-shape: {len(plan.poses)} knots, {len(m.times)} samples, {elapsed * 1e3:.1f} ms")
+    assert elapsed < 1.0
