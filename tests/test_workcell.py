@@ -188,3 +188,21 @@ def test_default_workcell_serves_every_pusher(name):
                 assert c.name == "table"        # a line pusher from below rests on the table
         assert c.friction >= pc.friction
         assert np.isclose(np.linalg.norm(a.frame[3:]), 1) and np.allclose(a.frame[:3], c.frame[:3])
+
+
+def test_the_documented_keys_are_the_loaders_and_the_example_loads():
+    import re
+
+    from regrasp.workcell.file import KEYS
+
+    doc = (regrasp.examples.ROOT.parents[2] / "docs" / "workcell-file.md").read_text()
+    documented = set(re.findall(r"^\| `([a-z_.\[\]]+)` \|", doc, re.M))
+    accepted = set()
+    for table, (req, opt) in KEYS.items():
+        accepted |= {f"{table}.{k}" if table else k for k in req | opt}
+    accepted |= {"table", "robot", "object", "features"}
+    assert documented == accepted
+    block = re.search(r"```toml\n(.*?)```", doc, re.S).group(1)
+    w = Workcell.from_toml(block)
+    assert {k: v for k, v in w.to_dict().items() if k != "description"} == \
+        {k: v for k, v in Workcell.load(EXAMPLE).to_dict().items() if k != "description"}
