@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 import regrasp
 from regrasp import ArgumentError, SceneError
 from regrasp.execution.assignment import assign, pusher_contact
-from regrasp.workcell import Workcell, default_workcell
+from regrasp.workcell import Feature, Workcell, default_workcell
 from regrasp.workcell.description import BOUNDS
 
 EXAMPLE = regrasp.examples.ROOT / "workcells" / "workcell-ur5e.toml"
@@ -206,3 +206,31 @@ def test_the_documented_keys_are_the_loaders_and_the_example_loads():
     w = Workcell.from_toml(block)
     assert {k: v for k, v in w.to_dict().items() if k != "description"} == \
         {k: v for k, v in Workcell.load(EXAMPLE).to_dict().items() if k != "description"}
+
+
+unit_quats = st.lists(st.floats(-1, 1), min_size=4, max_size=4).filter(lambda q: np.linalg.norm(q) > 0.1)
+
+
+@settings(max_examples=60, deadline=None)
+@given(unit_quats, st.lists(st.floats(0.01, 0.5), min_size=3, max_size=3),
+       st.lists(st.floats(-1, 1), min_size=3, max_size=3))
+def test_block_contacts_lie_on_the_block_for_any_pose(q, size, at):
+    from regrasp.workcell.description import block_contacts
+
+    q = np.asarray(q) / np.linalg.norm(q)
+    f = Feature("b", "block", [*at, *q], 0.5, size)
+    R, c, h = rot(q), np.asarray(at), np.asarray(size) / 2
+    cs = block_contacts(f)
+    assert [k.kind for k in cs].count("face") == 6 and [k.kind for k in cs].count("edge") == 12
+    for k in cs:
+        Rk = rot(k.frame[3:])
+        assert np.allclose(Rk.T @ Rk, np.eye(3), atol=1e-9) and np.isclose(np.linalg.det(Rk), 1)
+        local = R.T @ (k.frame[:3] - c)                              # in the block's frame
+        assert np.max(np.abs(local) / h) == pytest.approx(1.0)      # on the surface
+        n = R.T @ Rk[:, 2]                                           # push direction, block frame
+        on = np.isclose(np.abs(local), h, rtol=1e-9, atol=1e-12)
+        assert np.allclose(n, np.where(on, np.sign(local), 0) / np.sqrt(on.sum()), atol=1e-9)
+        if k.kind == "edge":
+            assert np.isclose(k.length, 2 * h[~on][0])
+            ends = [k.frame[:3] + s * k.length / 2 * Rk[:, 0] for s in (-1, 1)]
+            assert all(np.max(np.abs(R.T @ (e - c)) / h) == pytest.approx(1.0) for e in ends)

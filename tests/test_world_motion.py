@@ -5,6 +5,8 @@ import time
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.linalg import expm
 
 import regrasp
@@ -248,3 +250,26 @@ def test_time_to_turn_a_plan_into_a_world_trajectory():
     elapsed = time.perf_counter() - t0
     print(f"\nt-shape: {len(plan.poses)} knots, {len(m.times)} samples, {elapsed * 1e3:.1f} ms")
     assert elapsed < 1.0
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.floats(-np.pi, np.pi), st.floats(0.02, 0.2), st.floats(-0.3, 0.3), st.floats(0.02, 0.2))
+def test_any_fixture_block_either_renders_the_plan_exactly_or_refuses_naming_the_push(yaw, side, y, height):
+    scene, plan = plan_of("block-low-friction")
+    block = Feature("fixture", "block", [0.5, y, 0.75 + height / 2, np.cos(yaw / 2), 0, 0, np.sin(yaw / 2)], 0.9,
+                    [side, side, height])
+    w = Workcell("w", Table(0.75, [1.2, 0.8], 0.9, [0.5, 0]), (block,), Robot("ur5e", [0, 0, 0.75, 1, 0, 0, 0]))
+    # the side pusher (a line) needs a block edge at least as long as it: the block's longest
+    longest = np.linalg.norm(np.diff(scene.pusher("left").points, axis=0))
+    try:
+        m = world_motion(scene, plan, w)
+    except ArgumentError as e:
+        assert e.field.startswith("plan.path[") and "no feature" in str(e) and "`left`" in str(e)
+        assert max(side, height) < longest
+        return
+    assert max(side, height) >= longest
+    for a in m.assignments:
+        F = T(a.frame)
+        for k, Pk in pusher_matrices(scene, plan, a).items():
+            j = next(j for kk, j in m.knots if kk == k and m.push[j] == a.index)
+            assert np.abs(T(m.gripper[j]) @ Pk - F).max() < 1e-9

@@ -4,7 +4,8 @@ quaternion ``[w, x, y, z]``), body twists ``[vx, vy, vz, wx, wy, wz]`` (m/s, rad
 -theta about +y. The SE(3) algebra itself (compose, inverse, log, exp) is the core's
 (``_core.se3_*``); here: quaternions (matrix, rotating vectors, from a matrix, slerp, angle),
 planar poses (their quaternion and 3-D pose, compose, inverse, rotate), the frame of a normal,
-and twists between poses and frames."""
+twists between poses and frames, and 3-D poses in numpy (compose, inverse, integrate a twist,
+from a frame, map points, interpolate, a turn about z)."""
 
 from __future__ import annotations
 
