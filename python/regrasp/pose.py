@@ -50,10 +50,12 @@ def quat_from_matrix(R) -> np.ndarray:
     return -q if q[0] < 0 else q
 
 
-def slerp(a, b, s: float) -> np.ndarray:
+def slerp(a, b, s) -> np.ndarray:
     """The quaternion a fraction ``s`` in [0, 1] of the way from ``a`` to ``b`` along the
-    shortest rotation between them (spherical linear interpolation)."""
+    shortest rotation between them (spherical linear interpolation); ``s`` may be an array (n,),
+    giving (n, 4)."""
     a, b = np.asarray(a, float) / np.linalg.norm(a), np.asarray(b, float) / np.linalg.norm(b)
+    s = np.asarray(s, float)[..., None]
     d = float(a @ b)
     if d < 0:
         b, d = -b, -d
@@ -62,7 +64,7 @@ def slerp(a, b, s: float) -> np.ndarray:
     else:
         th = np.arccos(d)
         q = (np.sin((1 - s) * th) * a + np.sin(s * th) * b) / np.sin(th)
-    return q / np.linalg.norm(q)
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
 def quat_angle(a, b) -> float:
@@ -170,11 +172,29 @@ def transform(pose, v) -> np.ndarray:
     return quat_rotate(pose[3:], v) + pose[:3]
 
 
-def interpolate(a, b, s: float) -> np.ndarray:
+def interpolate(a, b, s) -> np.ndarray:
     """The pose a fraction ``s`` in [0, 1] of the way from pose ``a`` to pose ``b`` (m, unit
-    quaternion), the position along the straight line and the rotation by :func:`slerp`."""
+    quaternion), the position along the straight line and the rotation by :func:`slerp`; ``s``
+    may be an array (n,), giving (n, 7)."""
     a, b = np.asarray(a, float), np.asarray(b, float)
-    return np.concatenate([a[:3] + s * (b[:3] - a[:3]), slerp(a[3:], b[3:], s)])
+    return np.concatenate([a[:3] + np.asarray(s, float)[..., None] * (b[:3] - a[:3]), slerp(a[3:], b[3:], s)], axis=-1)
+
+
+def quat_multiply(a, b) -> np.ndarray:
+    """The product ``a b`` of quaternions ``[w, x, y, z]`` (rows of (n, 4) arrays, or single ones)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    w1, v1, w2, v2 = a[..., :1], a[..., 1:], b[..., :1], b[..., 1:]
+    return np.concatenate([w1 * w2 - np.sum(v1 * v2, axis=-1, keepdims=True),
+                           w1 * v2 + w2 * v1 + np.cross(v1, v2)], axis=-1)
+
+
+def compose_rows(a, b) -> np.ndarray:
+    """Row by row ``a[i] ∘ b[i]`` of two (n, 7) arrays of poses (m, unit quaternion)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    w, u, p = a[:, 3:4], a[:, 4:], b[:, :3]
+    rotated = p + 2 * np.cross(u, np.cross(u, p) + w * p)  # R(a's quaternion) p
+    q = quat_multiply(a[:, 3:], b[:, 3:])
+    return np.concatenate([a[:, :3] + rotated, q / np.linalg.norm(q, axis=1, keepdims=True)], axis=1)
 
 
 def z_turn(phi: float) -> np.ndarray:

@@ -167,8 +167,14 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
         if np.linalg.norm(to[:3] - a[:3]) < 1e-12 and P.quat_angle(a[3:], to[3:]) < 1e-12:
             return
         n, T = steps(a, to, v, w)
-        for i in range(1, n + 1):
-            emit(P.interpolate(a, to, i / n) if i < n else to, Oh, label, k, T / n)
+        Gs = P.interpolate(a, to, np.arange(1, n + 1) / n)
+        Gs[-1] = to
+        t0 = S["t"][-1]
+        S["t"] += list(t0 + T * np.arange(1, n + 1) / n)
+        S["G"] += list(Gs)
+        S["O"] += [np.asarray(Oh, float)] * n
+        S["label"] += [label] * n
+        S["push"] += [k] * n
 
     def lifted(G):
         return np.r_[G[:2], max(G[2], safe), G[3:]]
@@ -204,7 +210,7 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
     move(lifted(S["G"][-1]), O[-1], "transfer", -1, timing.move_speed, timing.move_turn)
 
     G, Oh = np.array(S["G"]), np.array(S["O"])
-    W = np.array([P.compose(g, o) for g, o in zip(G, Oh)])
+    W = P.compose_rows(G, Oh)
     return WorldMotion(np.array(S["t"][:len(G)]), G, W, Oh, S["label"], np.array(S["push"], int),
                        np.full(len(G), force), assignments, knots, float(safe), workcell, timing)
 
