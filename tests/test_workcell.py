@@ -234,3 +234,25 @@ def test_block_contacts_lie_on_the_block_for_any_pose(q, size, at):
             assert np.isclose(k.length, 2 * h[~on][0])
             ends = [k.frame[:3] + s * k.length / 2 * Rk[:, 0] for s in (-1, 1)]
             assert all(np.max(np.abs(R.T @ (e - c)) / h) == pytest.approx(1.0) for e in ends)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from(["name", "table", "features", "robot", "object", "description"]),
+       st.sampled_from([None, 3, "", "x", [], [1.0], {"a": 1}, float("nan")]))
+def test_constructing_a_workcell_with_bad_parts_names_the_part(part, value):
+    w = Workcell.load(EXAMPLE)
+    kw = {"name": w.name, "table": w.table, "features": w.features, "robot": w.robot, "object": w.object,
+          "description": None} | {part: value}
+    try:
+        Workcell(**kw)
+    except SceneError as e:
+        assert e.field == part
+        return
+    assert (part, value) in (("description", None), ("description", ""), ("description", "x"), ("features", []),
+                             ("name", "x"))
+
+
+def test_default_workcell_needs_a_scene():
+    with pytest.raises(ArgumentError) as e:
+        default_workcell("t-shape")
+    assert e.value.field == "scene"

@@ -185,9 +185,10 @@ def test_approach_retreat_and_transfers_clear_the_features(name):
         assert world[2].min() > top + tm.clearance - 1e-9
     # during every transfer, the next (or last) push's contact point stays at least the clearance
     # from its feature's contact point
+    frames = {a.index: pusher_matrices(scene, plan, a) for a in m.assignments}
     for j in np.flatnonzero(labels == "transfer"):
         a = next((a for a in m.assignments if np.any(m.push[j:] == a.index)), m.assignments[-1])
-        Pk = pusher_matrices(scene, plan, a)[a.first if np.any(m.push[j:] == a.index) else a.last]
+        Pk = frames[a.index][a.first if np.any(m.push[j:] == a.index) else a.last]
         d = np.linalg.norm((T(m.gripper[j]) @ Pk)[:3, 3] - a.frame[:3])
         assert d >= tm.clearance - 1e-9
 
@@ -273,3 +274,18 @@ def test_any_fixture_block_either_renders_the_plan_exactly_or_refuses_naming_the
         for k, Pk in pusher_matrices(scene, plan, a).items():
             j = next(j for kk, j in m.knots if kk == k and m.push[j] == a.index)
             assert np.abs(T(m.gripper[j]) @ Pk - F).max() < 1e-9
+
+
+BAD_ARGS = [None, 3, "x", float("nan"), [], [1.0] * 6, [float("inf")] * 7, {"a": 1}, np.zeros((2, 7))]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from(["scene", "plan", "workcell", "timing", "start"]), st.sampled_from(BAD_ARGS))
+def test_bad_arguments_give_errors_naming_them(arg, value):
+    scene, plan = plan_of("block-low-friction")
+    kw = {"scene": scene, "plan": plan, "workcell": None, "timing": Timing(), "start": None} | {arg: value}
+    if arg in ("workcell", "start") and value is None:
+        return                            # the defaults
+    with pytest.raises(ArgumentError) as e:
+        world_motion(**kw)
+    assert e.value.field.split(".")[0] == arg, (arg, value, e.value.field)

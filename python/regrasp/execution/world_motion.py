@@ -135,6 +135,11 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
     ``timing``; ``start``: the gripper's world pose (m, unit quaternion) to begin from (default:
     above the first push's pre-contact pose, at the safe height). ArgumentError naming the push
     when no feature serves it."""
+    from ..scene.planar import Scene
+    from ..scene.spatial import Scene3D
+
+    if not isinstance(scene, (Scene, Scene3D)):
+        raise ArgumentError(f"invalid `scene`: a regrasp Scene or Scene3D (got {type(scene).__name__})", "scene")
     if scene.dimension == 2 and scene.kind != "grasp":
         raise ArgumentError("invalid `scene`: a surface scene has no gripper to move (a [grasp] scene is needed)", "scene")
     if not isinstance(timing, Timing):

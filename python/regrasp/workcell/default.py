@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ArgumentError
 from .description import Feature, ObjectStart, Robot, Table, Workcell
 
 #: The default layout, stated once: table top height [m], table size [m] and centre [m] (world
@@ -41,6 +42,11 @@ def pusher_extent(scene) -> tuple[float, float]:
 def default_workcell(scene) -> Workcell:
     """The default workcell for ``scene`` (planar or 3-D; see the module's doc): named
     ``default-SCENE``, the object starting in the hand."""
+    from ..scene.planar import Scene
+    from ..scene.spatial import Scene3D
+
+    if not isinstance(scene, (Scene, Scene3D)):
+        raise ArgumentError(f"invalid `scene`: a regrasp Scene or Scene3D (got {type(scene).__name__})", "scene")
     size, mu = pusher_extent(scene)
     side = max(BLOCK_SIDE, BLOCK_MARGIN * size)
     friction = max(FRICTION, mu)

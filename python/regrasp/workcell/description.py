@@ -233,6 +233,13 @@ class Workcell:
 
     def __post_init__(self):
         check_name(self.name, "name")
+        for f_, t_ in (("table", Table), ("robot", Robot), ("object", ObjectStart)):
+            if not isinstance(getattr(self, f_), t_):
+                raise _fail(f_, f"must be a {t_.__name__}", type(getattr(self, f_)).__name__)
+        if not isinstance(self.features, (list, tuple)) or not all(isinstance(f, Feature) for f in self.features):
+            raise _fail("features", "must be a sequence of Feature", self.features)
+        if self.description is not None and not isinstance(self.description, str):
+            raise _fail("description", "must be a string", self.description)
         object.__setattr__(self, "features", tuple(self.features))
         seen: dict = {}
         for i, f in enumerate(self.features):
