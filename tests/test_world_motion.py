@@ -110,7 +110,12 @@ def test_gripper_renders_the_plan_with_the_fixed_feature(name):
         F = T(a.frame)
         c = contacts[a.feature]
         assert np.allclose(F[:3, 3], c.frame[:3], atol=1e-12)                  # at the feature's contact
-        assert np.allclose(F[:3, 2], rot(c.frame[3:])[:, 2], atol=1e-12)      # pushing its way
+        C = rot(c.frame[3:])
+        if c.kind == "edge":                                                    # along the edge, pushing
+            assert np.isclose(abs(F[:3, 0] @ C[:, 0]), 1)                       # within its cone
+            assert np.arccos(np.clip(F[:3, 2] @ C[:, 2], -1, 1)) <= c.cone + 1e-9
+        else:
+            assert np.allclose(F[:3, 2], C[:, 2], atol=1e-12)                   # pushing its way
         for k, Pk in pusher_matrices(scene, plan, a).items():
             kk, j = next(knots)
             assert kk == k and m.push[j] == a.index
@@ -289,3 +294,25 @@ def test_bad_arguments_give_errors_naming_them(arg, value):
     with pytest.raises(ArgumentError) as e:
         world_motion(**kw)
     assert e.value.field.split(".")[0] == arg, (arg, value, e.value.field)
+
+
+@pytest.mark.parametrize("name, most", [("pivot-single-3d", np.radians(5.0)), ("offset-3d", 1e-9),
+                                        ("block-tilted-gripper", np.pi)])
+def test_gravity_tilt_is_reported_and_kept_small_by_the_edge_cone(name, most):
+    scene, plan = plan_of(name)
+    m = world_motion(scene, plan)
+    g = scene._core.gravity if scene.dimension == 3 else [scene.gravity[0][0], 0, scene.gravity[0][1]]
+    g = np.asarray(g) / np.linalg.norm(g)
+    for a in m.assignments:
+        j = next(j for k, j in m.knots if k == a.first and m.push[j] == a.index)
+        world_g = rot(m.gripper[j][3:]) @ g
+        tilt = np.arccos(np.clip(-world_g[2], -1, 1))
+        assert tilt == pytest.approx(a.tilt, abs=1e-9)
+        assert tilt <= most + 1e-9, (a.pusher, np.degrees(tilt))
+        if a.feature == "table" and scene.dimension == 2:
+            # the table pushes straight up: the tilt is the angle between the pusher's normal
+            # (turned by the object's pose) and the scene's "up"
+            n = scene.pusher(a.pusher).normal
+            th = plan.poses[a.first][2]
+            n = [np.cos(th) * n[0] - np.sin(th) * n[1], 0, np.sin(th) * n[0] + np.cos(th) * n[1]]
+            assert tilt == pytest.approx(np.arccos(np.clip(-np.dot(n, g), -1, 1)), abs=1e-9)

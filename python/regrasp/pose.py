@@ -5,7 +5,7 @@ quaternion ``[w, x, y, z]``), body twists ``[vx, vy, vz, wx, wy, wz]`` (m/s, rad
 (``_core.se3_*``); here: quaternions (matrix, rotating vectors, from a matrix, slerp, angle),
 planar poses (their quaternion and 3-D pose, compose, inverse, rotate), the frame of a normal,
 twists between poses and frames, and 3-D poses in numpy (compose, inverse, integrate a twist,
-from a frame, map points, interpolate, a turn about z)."""
+from a frame, map points, interpolate, a turn about x or z)."""
 
 from __future__ import annotations
 
@@ -200,3 +200,8 @@ def compose_rows(a, b) -> np.ndarray:
 def z_turn(phi: float) -> np.ndarray:
     """The pose (no translation) of a turn by ``phi`` [rad] about +z."""
     return np.array([0.0, 0.0, 0.0, np.cos(phi / 2), 0.0, 0.0, np.sin(phi / 2)])
+
+
+def x_turn(beta: float) -> np.ndarray:
+    """The pose (no translation) of a turn by ``beta`` [rad] about +x."""
+    return np.array([0.0, 0.0, 0.0, np.cos(beta / 2), np.sin(beta / 2), 0.0, 0.0])

@@ -79,7 +79,7 @@ class Assignment:
     """Push ``index`` of a plan: pusher ``pusher`` moves the object from ``path[first]`` to
     ``path[last]``; it is rendered by the workcell contact ``feature`` (a :class:`Contact`'s
     name) whose contact frame in the world is ``frame`` (m, unit quaternion; the contact's frame
-    turned about its +z as chosen); ``tilt`` [rad]: the angle between the scene's gravity and the
+    turned about its x within its cone, then about its z, as chosen); ``tilt`` [rad]: the angle between the scene's gravity and the
     world's −z at the push's start; ``contact``: the pusher's contact at ``path[first]``."""
     index: int
     pusher: str
@@ -115,17 +115,25 @@ def gravity_in_gripper(scene) -> np.ndarray:
     return g / ng if ng > 0 else np.array([0.0, 0.0, -1.0])
 
 
-def _turns(c: Contact, pusher_frame, gravity: np.ndarray) -> list[float]:
-    """The candidate turns [rad] of contact ``c``'s frame about its +z for a pusher whose contact
-    frame in the gripper frame is ``pusher_frame`` (m, quaternion): the one that best aligns the
-    gripper-frame ``gravity`` with the world's −z first, then the quarter turns."""
-    if c.kind == "edge":
-        return [0.0, np.pi]
-    # G = F Rz(phi) Pc⁻¹: maximize a · Rz(phi) b, a = −e_z in the contact frame, b = gravity in Pc
+def _turns(c: Contact, pusher_frame, gravity: np.ndarray) -> list[tuple[float, float]]:
+    """The candidate ``(beta, phi)`` [rad] of contact ``c``'s frame, turned by ``beta`` about its x
+    (within its cone) then by ``phi`` about its z, for a pusher whose contact frame in the gripper
+    frame is ``pusher_frame`` (m, quaternion): those that best align the gripper-frame ``gravity``
+    with the world's −z first, then the plain ones (an edge's half turns, a face's quarter
+    turns)."""
+    # G = F Rx(beta) Rz(phi) Pc⁻¹: maximize a · Rx(beta) Rz(phi) b, a = −e_z in the contact
+    # frame, b = gravity in Pc
     a = P.quat_matrix(c.frame[3:]).T @ np.array([0.0, 0.0, -1.0])
     b = P.quat_matrix(pusher_frame[3:]).T @ gravity
+    if c.kind == "edge":
+        out = []
+        for phi in (0.0, np.pi):
+            v = np.array([np.cos(phi) * b[0] - np.sin(phi) * b[1], np.sin(phi) * b[0] + np.cos(phi) * b[1], b[2]])
+            best = float(np.arctan2(a[2] * v[1] - a[1] * v[2], a[1] * v[1] + a[2] * v[2]))
+            out += [(float(np.clip(best, -c.cone, c.cone)), phi), (-c.cone, phi), (c.cone, phi), (0.0, phi)]
+        return out
     phi = float(np.arctan2(a[1] * b[0] - a[0] * b[1], a[0] * b[0] + a[1] * b[1]))
-    return [phi] + [k * np.pi / 2 for k in range(4)]
+    return [(0.0, phi)] + [(0.0, k * np.pi / 2) for k in range(4)]
 
 
 def serves(c: Contact, pc: PusherContact, phi: float = 0.0, from_below: bool = False) -> str | None:
@@ -166,12 +174,12 @@ def assign(scene, poses, pushers: list, workcell: Workcell) -> list[Assignment]:
         below = float(P.quat_rotate(Pc[3:], [0.0, 0, 1]) @ -g) >= np.cos(FROM_BELOW) - 1e-12
         best, reasons = None, {}
         for c in contacts:
-            for phi in _turns(c, Pc, g):
+            for beta, phi in _turns(c, Pc, g):
                 why = serves(c, pc, phi, below)
                 if why is not None:
                     reasons.setdefault(c.kind, (c.name, why))
                     continue
-                F = P.compose(c.frame, P.z_turn(phi))
+                F = P.compose(c.frame, P.x_turn(beta), P.z_turn(phi))
                 G = P.compose(F, P.inverse(Pc))
                 tilt = float(np.arccos(np.clip(P.quat_rotate(G[3:], g) @ [0, 0, -1.0], -1, 1)))
                 if best is None or tilt < best[0] - 1e-9:

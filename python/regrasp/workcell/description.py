@@ -34,6 +34,9 @@ FEATURE_KINDS = ("edge", "corner", "block", "face")
 OBJECT_STARTS = ("table", "hand")
 #: Height [m] above the table top at or below which a contact is not offered.
 ON_TABLE = 1e-6
+#: How far [rad] an object's face touching a block edge stays from lying flat on either of the
+#: block's faces (where the line contact would become a face contact).
+EDGE_MARGIN = np.radians(5.0)
 
 
 def _fail(field_: str, what: str, got) -> SceneError:
@@ -181,13 +184,16 @@ class Contact:
     direction it pushes, +x: along an edge); ``length`` [m] of an edge (0 otherwise); ``extent``
     ``[x, y]`` [m]: a face's half-sizes along the frame's x and y (zeros otherwise);
     ``friction``; ``name``: the feature's name, a block's part as ``NAME.faces[i]``,
-    ``NAME.edges[i]``, ``NAME.corners[i]``."""
+    ``NAME.edges[i]``, ``NAME.corners[i]``; ``cone`` [rad]: how far the push direction may turn
+    about an edge (about the frame's x) either way and stay a line contact on it (a block edge:
+    45° less :data:`EDGE_MARGIN`, the object's face between the block's two faces; else 0)."""
     name: str
     kind: str
     frame: np.ndarray
     friction: float
     length: float = 0.0
     extent: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    cone: float = 0.0
 
 
 def _frame(z, x, origin) -> np.ndarray:
@@ -215,7 +221,9 @@ def block_contacts(f: Feature) -> list[Contact]:
     counts: dict = {}
     for group, kind, fr, length, extent in local:
         i = counts[group] = counts.get(group, -1) + 1
-        out.append(Contact(f"{f.name}.{group}[{i}]", kind, P.compose(f.pose, fr), f.friction, float(length), extent))
+        cone = np.pi / 4 - EDGE_MARGIN if kind == "edge" else 0.0
+        out.append(Contact(f"{f.name}.{group}[{i}]", kind, P.compose(f.pose, fr), f.friction, float(length), extent,
+                           cone))
     return out
 
 
