@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 import regrasp
 from regrasp import ArgumentError, SceneError
 from regrasp.execution.assignment import assign, pusher_contact
-from regrasp.workcell import Feature, Workcell, default_workcell
+from regrasp.workcell import Feature, Workcell, bundled, default_workcell
 from regrasp.workcell.description import BOUNDS
 
 EXAMPLE = regrasp.examples.ROOT / "workcells" / "workcell-ur5e.toml"
@@ -33,6 +33,10 @@ def test_example_loads_and_round_trips(tmp_path):
     w = Workcell.load(EXAMPLE)
     assert w.robot.name == "ur5e" and w.object.on == "table" and len(w.features) == 4
     assert Workcell.from_toml(w.to_toml()).to_dict() == w.to_dict()
+    assert Workcell.from_toml(w.to_toml()) == w and w != default_workcell(regrasp.load_scene(regrasp.examples.path("t-shape")))
+    assert bundled() == EXAMPLE and bundled("workcell-ur5e.toml") == EXAMPLE
+    with pytest.raises(ArgumentError, match="workcell-ur5e"):
+        bundled("nope")
     w.save(tmp_path / "w.toml")
     assert Workcell.load(tmp_path / "w.toml").to_dict() == w.to_dict()
     # the file's numbers are read as written (independent of the writer)

@@ -3,11 +3,12 @@ robot and the object's start; its TOML file (docs/workcell-file.md) and the defa
 a scene::
 
     from regrasp.workcell import Workcell, default_workcell
-    w = Workcell.load("workcell-ur5e.toml")   # or default_workcell(scene)
+    w = Workcell.load(bundled("workcell-ur5e"))   # or default_workcell(scene)
     w.contacts()                               # what it offers pushers, world frame
 """
 
 from .default import default_workcell
 from .description import Contact, Feature, ObjectStart, Robot, Table, Workcell
+from .file import bundled
 
-__all__ = ["Contact", "Feature", "ObjectStart", "Robot", "Table", "Workcell", "default_workcell"]
+__all__ = ["Contact", "Feature", "ObjectStart", "Robot", "Table", "Workcell", "bundled", "default_workcell"]

@@ -90,7 +90,7 @@ def check_name(x, field_: str) -> str:
     return x
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Table:
     """The table: its top surface at height ``height`` [m] (world z), a rectangle of ``size``
     ``[x, y]`` [m] centred at ``center`` ``[x, y]`` [m], object-table friction ``friction``."""
@@ -106,7 +106,7 @@ class Table:
         object.__setattr__(self, "center", check_numbers(self.center, 2, "table.center", "coordinate"))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Feature:
     """A fixed feature in the world frame: ``kind`` ``"edge"`` (a segment of ``length`` [m] along
     the pose's x axis, centred at its origin, pushing along its z axis), ``"corner"`` (the pose's
@@ -147,7 +147,7 @@ class Feature:
             raise _fail(f"{f}.length", "applies only to an edge", self.length)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Robot:
     """The robot: its model ``name`` (e.g. ``"ur5e"``) and its base ``base`` pose (m, unit
     quaternion) in the world."""
@@ -159,7 +159,7 @@ class Robot:
         object.__setattr__(self, "base", check_pose(self.base, "robot.base"))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ObjectStart:
     """Where the object starts: ``on`` ``"table"`` at ``pose`` (m, unit quaternion; world frame),
     or ``"hand"`` (held at the scene's ``task.start``; no pose)."""
@@ -177,7 +177,7 @@ class ObjectStart:
             raise _fail("object.pose", "does not apply when the object starts in the hand", self.pose)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Contact:
     """What a feature offers a pusher: ``kind`` ``"corner"``, ``"edge"`` or ``"face"``; ``frame``
     (m, unit quaternion): its contact frame in the world (origin: the contact point, +z: the
@@ -227,7 +227,7 @@ def block_contacts(f: Feature) -> list[Contact]:
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Workcell:
     """A workcell (docs/workcell-file.md): ``name``, the ``table``, the fixed ``features`` (a
     tuple of :class:`Feature`), the ``robot`` and the object's start (``object``). Read and
@@ -254,6 +254,12 @@ class Workcell:
             if f.name in seen:
                 raise _fail(f"features[{i}].name", f"repeats features[{seen[f.name]}].name", f.name)
             seen[f.name] = i
+
+    def __eq__(self, other) -> bool:
+        """Workcells are equal when their files are (:meth:`to_dict`)."""
+        return isinstance(other, Workcell) and self.to_dict() == other.to_dict()
+
+    __hash__ = None  # type: ignore[assignment]
 
     def feature(self, name: str) -> Feature:
         """The feature called ``name``."""

@@ -14,6 +14,9 @@ import numpy as np
 from ..errors import ArgumentError, SceneError
 from .description import Feature, ObjectStart, Robot, Table, Workcell
 
+#: The folder of the bundled workcell files (``workcell-ur5e.toml``).
+BUNDLED = Path(__file__).resolve().parents[1] / "examples" / "workcells"
+
 #: The keys of each table of the file: (required, optional).
 KEYS = {
     "": ({"name", "table", "robot"}, {"description", "features", "object"}),
@@ -81,6 +84,16 @@ def load(path) -> Workcell:
     except (OSError, UnicodeDecodeError, TypeError, ValueError) as e:
         raise ArgumentError(f"invalid `workcell`: cannot read {str(path)!r}: {e}", "workcell") from None
     return from_toml(text)
+
+
+def bundled(name: str = "workcell-ur5e") -> Path:
+    """The path of bundled workcell file ``name`` (``.toml`` optional); ArgumentError listing them
+    when there is none."""
+    names = sorted(p.stem for p in BUNDLED.glob("*.toml"))
+    stem = str(name).removesuffix(".toml")
+    if stem not in names:
+        raise ArgumentError(f"invalid `name`: no bundled workcell {name!r}; the workcells: {', '.join(names)}", "name")
+    return BUNDLED / f"{stem}.toml"
 
 
 def _floats(a) -> list:
