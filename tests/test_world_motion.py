@@ -316,3 +316,55 @@ def test_gravity_tilt_is_reported_and_kept_small_by_the_edge_cone(name, most):
             th = plan.poses[a.first][2]
             n = [np.cos(th) * n[0] - np.sin(th) * n[1], 0, np.sin(th) * n[0] + np.cos(th) * n[1]]
             assert tilt == pytest.approx(np.arccos(np.clip(-np.dot(n, g), -1, 1)), abs=1e-9)
+
+
+def test_max_tilt_refuses_pushes_that_would_turn_gravity():
+    scene, plan = plan_of("t-shape")
+    m = world_motion(scene, plan)
+    worst = max(m.assignments, key=lambda a: a.tilt)
+    assert worst.pusher == "top" and worst.tilt > np.radians(80)   # nothing pushes down in the default cell
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, plan, max_tilt=np.radians(45))
+    assert "`top`" in str(e.value) and "max_tilt" in str(e.value)
+    assert e.value.field == f"plan.path[{worst.first + 1}].pusher"
+    ok = world_motion(scene, plan, max_tilt=worst.tilt + 1e-9)
+    assert [a.feature for a in ok.assignments] == [a.feature for a in m.assignments]
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, plan, max_tilt=-1.0)
+    assert e.value.field == "max_tilt"
+
+
+@pytest.mark.parametrize("name", ["block-low-friction", "block-xztheta", "pivot-3d", "offset-3d", "block-3d"])
+def test_the_object_meets_the_feature_and_its_penetration_is_measured(name):
+    """Convex objects: the pusher's own points lie on the feature's contact plane at the knots; the
+    reported penetration is the deepest object point behind that plane during the push, and it
+    is 0 when every step of the push sticks (the pusher moves with the object)."""
+    scene, plan = plan_of(name)
+    m = world_motion(scene, plan)
+    pts = object_points(scene)
+    labels = np.array(m.labels)
+    for a, reported in zip(m.assignments, m.penetration):
+        F = T(a.frame)
+        deepest = 0.0
+        for j in np.flatnonzero((m.push == a.index) & (labels == "push")):
+            local = (np.linalg.inv(F) @ T(m.object[j]) @ np.c_[pts, np.ones(len(pts))].T)[:3]
+            deepest = max(deepest, -local[2].min())
+        assert reported == pytest.approx(deepest, abs=1e-12)
+        sticks = all(plan.dimension == 2 or plan.pusher_twists[k] is None or np.allclose(
+            plan.pusher_twists[k], regrasp.pose.twist_between(plan.poses[k - 1], plan.poses[k]), atol=1e-9)
+            for k in range(a.first + 1, a.last + 1))
+        if sticks:
+            assert reported < 1e-9, (a.pusher, reported)
+        for k, j in m.knots:
+            if m.push[j] != a.index:
+                continue
+            if scene.dimension == 2:
+                pp = scene.pusher(a.pusher).points
+                pp = np.column_stack([pp[:, 0], np.zeros(len(pp)), pp[:, 1]])
+            else:
+                pp = np.asarray(scene._core.pusher_spec(a.pusher, list(plan.poses[k]))[0])
+            local = (np.linalg.inv(F) @ T(m.object[j]) @ np.c_[pp, np.ones(len(pp))].T)[:3]
+            if sticks or k == a.first:
+                assert np.abs(local[2]).max() < 1e-9
+    if name == "pivot-3d":                 # the pivot turns the object against its patch pusher
+        assert max(m.penetration) > 1e-4

@@ -159,11 +159,14 @@ def serves(c: Contact, pc: PusherContact, phi: float = 0.0, from_below: bool = F
     return f"the face ({2 * c.extent[0]:g} x {2 * c.extent[1]:g} m) does not hold the pusher's points"
 
 
-def assign(scene, poses, pushers: list, workcell: Workcell) -> list[Assignment]:
+def assign(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = np.pi) -> list[Assignment]:
     """The feature of ``workcell`` for each push of a plan (``poses``: the plan's path poses,
     planar (n, 3) (m, m, rad) or 3-D (n, 7) (m, quaternion); ``pushers``: its pusher names,
-    ``pushers[0]`` None), by the rules of the module's doc. ArgumentError (field
-    ``plan.path[i].pusher``) when no feature serves a push."""
+    ``pushers[0]`` None), by the rules of the module's doc; a contact that would turn the scene's
+    gravity more than ``max_tilt`` [rad] from the world's −z does not serve (default π: any).
+    ArgumentError (field ``plan.path[i].pusher``) when no feature serves a push."""
+    if isinstance(max_tilt, bool) or not isinstance(max_tilt, (int, float)) or not 0 <= max_tilt <= np.pi:
+        raise ArgumentError(f"invalid `max_tilt`: an angle in [0, pi] rad (got {max_tilt!r:.40})", "max_tilt")
     g = gravity_in_gripper(scene)
     contacts = workcell.contacts()
     out = []
@@ -182,6 +185,10 @@ def assign(scene, poses, pushers: list, workcell: Workcell) -> list[Assignment]:
                 F = P.compose(c.frame, P.x_turn(beta), P.z_turn(phi))
                 G = P.compose(F, P.inverse(Pc))
                 tilt = float(np.arccos(np.clip(P.quat_rotate(G[3:], g) @ [0, 0, -1.0], -1, 1)))
+                if tilt > max_tilt + 1e-12:
+                    reasons.setdefault("tilt", (c.name, f"the plan's gravity would be {np.degrees(tilt):.1f}° off the "
+                                                        f"world's, more than max_tilt {np.degrees(max_tilt):.1f}°"))
+                    continue
                 if best is None or tilt < best[0] - 1e-9:
                     best = (tilt, c, F)
         if best is None:

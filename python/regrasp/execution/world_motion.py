@@ -60,7 +60,11 @@ class WorldMotion:
     (one of :data:`LABELS` per sample); ``push`` (n,) the push index of approach, push and retreat samples (−1 in transfers);
     ``grip_force`` (n,) [N] per finger. ``assignments``: the feature of each push; ``knots``:
     ``(path index, sample index)`` of each plan knot of each push (a knot shared by two pushes
-    appears once for each); ``safe_height`` [m] of transfers; ``workcell``; ``timing``."""
+    appears once for each); ``safe_height`` [m] of transfers; ``workcell``; ``timing``;
+    ``penetration`` [m] per push: how far the object's points (:func:`object_points`) go behind
+    the feature's contact plane during the push (0 for a sticking push of a convex object; a
+    plan whose object turns against its pusher, e.g. a pivot on a patch, can go through a face
+    larger than the patch)."""
     times: np.ndarray
     gripper: np.ndarray
     object: np.ndarray
@@ -73,6 +77,7 @@ class WorldMotion:
     safe_height: float
     workcell: Workcell
     timing: Timing = field(default_factory=Timing)
+    penetration: list = field(default_factory=list)
 
     @property
     def duration(self) -> float:
@@ -81,7 +86,7 @@ class WorldMotion:
 
     def to_dict(self) -> dict:
         """The motion as JSON-ready lists: per-sample arrays, and per push its pusher, feature,
-        path indices, feature frame (m, unit quaternion) and gravity tilt [rad]."""
+        path indices, feature frame (m, unit quaternion), gravity tilt [rad] and penetration [m]."""
         return {
             "workcell": self.workcell.name,
             "duration_s": self.duration,
@@ -89,7 +94,8 @@ class WorldMotion:
             "in_hand": self.in_hand.tolist(), "labels": list(self.labels), "push": self.push.tolist(),
             "grip_force": self.grip_force.tolist(),
             "pushes": [{"pusher": a.pusher, "feature": a.feature, "first": a.first, "last": a.last,
-                        "frame": a.frame.tolist(), "tilt": a.tilt} for a in self.assignments],
+                        "frame": a.frame.tolist(), "tilt": a.tilt, "penetration": d}
+                       for a, d in zip(self.assignments, self.penetration)],
             "knots": [list(k) for k in self.knots],
             "safe_height": self.safe_height,
         }
@@ -129,12 +135,14 @@ def grip_force(scene) -> float:
     return float(scene.grip_force if scene.dimension == 2 else scene._core.grip_force)
 
 
-def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing = Timing(), start=None) -> WorldMotion:
+def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing = Timing(), start=None,
+                 max_tilt: float = np.pi) -> WorldMotion:
     """The gripper's world motion executing ``plan`` (a :class:`~regrasp.Plan` of ``scene``) in
     ``workcell`` (default: :func:`~regrasp.workcell.default_workcell` of the scene), timed by
     ``timing``; ``start``: the gripper's world pose (m, unit quaternion) to begin from (default:
-    above the first push's pre-contact pose, at the safe height). ArgumentError naming the push
-    when no feature serves it."""
+    above the first push's pre-contact pose, at the safe height); ``max_tilt`` [rad]: the most a
+    push may turn the plan's gravity from the world's (see :func:`~regrasp.execution.assign`).
+    ArgumentError naming the push when no feature serves it."""
     from ..scene.planar import Scene
     from ..scene.spatial import Scene3D
 
@@ -153,7 +161,7 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
     pts = object_points(scene)
     reach = max(float(np.max(np.linalg.norm(P.transform(o, pts), axis=1))) for o in O)
     safe = workcell.top() + timing.clearance + reach
-    assignments = assign(scene, poses, pushers, workcell)
+    assignments = assign(scene, poses, pushers, workcell, max_tilt)
     force = grip_force(scene)
 
     S: dict = {"t": [0.0], "G": [], "O": [], "label": [], "push": []}
@@ -216,8 +224,14 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
 
     G, Oh = np.array(S["G"]), np.array(S["O"])
     W = P.compose_rows(G, Oh)
-    return WorldMotion(np.array(S["t"][:len(G)]), G, W, Oh, S["label"], np.array(S["push"], int),
-                       np.full(len(G), force), assignments, knots, float(safe), workcell, timing)
+    labels, push = S["label"], np.array(S["push"], int)
+    depth = []
+    for a in assignments:
+        js = [j for j in np.flatnonzero(push == a.index) if labels[j] == "push"]
+        rel = P.compose_rows(np.repeat(P.inverse(a.frame)[None], len(js), axis=0), W[js])
+        depth.append(max(0.0, -min(float(P.transform(r, pts)[:, 2].min()) for r in rel)))
+    return WorldMotion(np.array(S["t"][:len(G)]), G, W, Oh, labels, push, np.full(len(G), force), assignments,
+                       knots, float(safe), workcell, timing, depth)
 
 
 def _moved(O, xi, s: float, Pk) -> np.ndarray:
