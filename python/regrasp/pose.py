@@ -4,7 +4,8 @@ quaternion ``[w, x, y, z]``), body twists ``[vx, vy, vz, wx, wy, wz]`` (m/s, rad
 -theta about +y. The SE(3) algebra itself (compose, inverse, log, exp) is the core's
 (``_core.se3_*``); here: quaternions (matrix, rotating vectors, from a matrix, slerp, angle),
 planar poses (their quaternion and 3-D pose, compose, inverse, rotate), the frame of a normal,
-and twists between poses and frames."""
+twists between poses and frames, and 3-D poses in numpy (compose, inverse, integrate a twist,
+from a frame, map points, interpolate, a turn about x or z)."""
 
 from __future__ import annotations
 
@@ -49,10 +50,12 @@ def quat_from_matrix(R) -> np.ndarray:
     return -q if q[0] < 0 else q
 
 
-def slerp(a, b, s: float) -> np.ndarray:
+def slerp(a, b, s) -> np.ndarray:
     """The quaternion a fraction ``s`` in [0, 1] of the way from ``a`` to ``b`` along the
-    shortest rotation between them (spherical linear interpolation)."""
+    shortest rotation between them (spherical linear interpolation); ``s`` may be an array (n,),
+    giving (n, 4)."""
     a, b = np.asarray(a, float) / np.linalg.norm(a), np.asarray(b, float) / np.linalg.norm(b)
+    s = np.asarray(s, float)[..., None]
     d = float(a @ b)
     if d < 0:
         b, d = -b, -d
@@ -61,7 +64,7 @@ def slerp(a, b, s: float) -> np.ndarray:
     else:
         th = np.arccos(d)
         q = (np.sin((1 - s) * th) * a + np.sin(s * th) * b) / np.sin(th)
-    return q / np.linalg.norm(q)
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
 def quat_angle(a, b) -> float:
@@ -133,3 +136,72 @@ def twist_between(a, b) -> list:
     """The constant body twist (m/s, rad/s) taking pose ``a`` to pose ``b`` (m, unit quaternion)
     in unit time (SE(3) log, the core's)."""
     return list(_core.se3_log([float(x) for x in a], [float(x) for x in b]))
+
+
+# --- SE(3) poses (the core's algebra, numpy in and out) ----------------------------------------
+
+
+def compose(*poses) -> np.ndarray:
+    """The composition ``a ∘ b ∘ ...`` of poses ``[x, y, z, qw, qx, qy, qz]`` (m, unit quaternion)."""
+    out = [float(x) for x in poses[0]]
+    for p in poses[1:]:
+        out = _core.se3_compose(out, [float(x) for x in p])
+    return np.array(out)
+
+
+def inverse(a) -> np.ndarray:
+    """The inverse of pose ``a`` ``[x, y, z, qw, qx, qy, qz]`` (m, unit quaternion)."""
+    return np.array(_core.se3_inverse([float(x) for x in a]))
+
+
+def integrate(pose, twist, t: float = 1.0) -> np.ndarray:
+    """``pose ∘ exp(t · twist)``: pose (m, unit quaternion), body twist (m/s, rad/s), ``t`` [s]."""
+    return np.array(_core.se3_integrate([float(x) for x in pose], [float(x) for x in twist], float(t)))
+
+
+def from_frame(R, p) -> np.ndarray:
+    """The pose ``[x, y, z, qw, qx, qy, qz]`` of the frame with rotation matrix ``R`` (columns: its
+    axes) and origin ``p`` [m]."""
+    return np.concatenate([np.asarray(p, float), quat_from_matrix(R)])
+
+
+def transform(pose, v) -> np.ndarray:
+    """Point(s) ``v`` [m] (shape (3,) or (n, 3)) of a frame mapped by its pose (m, unit quaternion)
+    into the reference frame: ``R v + p``."""
+    pose = np.asarray(pose, float)
+    return quat_rotate(pose[3:], v) + pose[:3]
+
+
+def interpolate(a, b, s) -> np.ndarray:
+    """The pose a fraction ``s`` in [0, 1] of the way from pose ``a`` to pose ``b`` (m, unit
+    quaternion), the position along the straight line and the rotation by :func:`slerp`; ``s``
+    may be an array (n,), giving (n, 7)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return np.concatenate([a[:3] + np.asarray(s, float)[..., None] * (b[:3] - a[:3]), slerp(a[3:], b[3:], s)], axis=-1)
+
+
+def quat_multiply(a, b) -> np.ndarray:
+    """The product ``a b`` of quaternions ``[w, x, y, z]`` (rows of (n, 4) arrays, or single ones)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    w1, v1, w2, v2 = a[..., :1], a[..., 1:], b[..., :1], b[..., 1:]
+    return np.concatenate([w1 * w2 - np.sum(v1 * v2, axis=-1, keepdims=True),
+                           w1 * v2 + w2 * v1 + np.cross(v1, v2)], axis=-1)
+
+
+def compose_rows(a, b) -> np.ndarray:
+    """Row by row ``a[i] ∘ b[i]`` of two (n, 7) arrays of poses (m, unit quaternion)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    w, u, p = a[:, 3:4], a[:, 4:], b[:, :3]
+    rotated = p + 2 * np.cross(u, np.cross(u, p) + w * p)  # R(a's quaternion) p
+    q = quat_multiply(a[:, 3:], b[:, 3:])
+    return np.concatenate([a[:, :3] + rotated, q / np.linalg.norm(q, axis=1, keepdims=True)], axis=1)
+
+
+def z_turn(phi: float) -> np.ndarray:
+    """The pose (no translation) of a turn by ``phi`` [rad] about +z."""
+    return np.array([0.0, 0.0, 0.0, np.cos(phi / 2), 0.0, 0.0, np.sin(phi / 2)])
+
+
+def x_turn(beta: float) -> np.ndarray:
+    """The pose (no translation) of a turn by ``beta`` [rad] about +x."""
+    return np.array([0.0, 0.0, 0.0, np.cos(beta / 2), np.sin(beta / 2), 0.0, 0.0])

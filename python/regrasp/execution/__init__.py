@@ -1,0 +1,13 @@
+"""Execution in the world: which workcell feature renders each push of a plan
+(:mod:`~regrasp.execution.assignment`) and the gripper's timed world-frame trajectory that
+executes the plan (:mod:`~regrasp.execution.world_motion`)::
+
+    from regrasp.execution import world_motion
+    motion = world_motion(scene, plan)          # default workcell; or workcell=Workcell.load(...)
+    motion.times, motion.gripper, motion.labels, motion.assignments
+"""
+
+from .assignment import Assignment, PusherContact, assign, pusher_contact
+from .world_motion import Timing, WorldMotion, world_motion
+
+__all__ = ["Assignment", "PusherContact", "Timing", "WorldMotion", "assign", "pusher_contact", "world_motion"]

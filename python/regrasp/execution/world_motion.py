@@ -1,0 +1,247 @@
+"""The gripper's world-frame SE(3) trajectory that executes a plan in a workcell, pure kinematics
+(no arm): each push is rendered by a fixed feature (:mod:`regrasp.execution.assignment`), the
+gripper moving so that the feature, fixed in the world, makes the planned virtual-pusher motion
+(thesis Fig 1-7).
+
+At a plan knot k of a push, with ``P_k`` the pusher's contact frame in the gripper frame and
+``F`` the feature's contact frame in the world, the gripper's world pose is ``G_k = F ∘ P_k⁻¹``
+(so ``G_k ∘ P_k = F``). Over step k the pusher moves in the gripper frame by the step's pusher
+twist ξ (3-D plans' ``pusher_twist``, expressed in the object frame at the step's start ``O``;
+otherwise the object's own twist, a sticking pusher): ``P(s) = O exp(s ξ) O⁻¹ P_{k-1}``, s in
+[0, 1]. A sticking pusher keeps the object still in the world while the gripper moves around it.
+
+Around each push: a transfer down to a pre-contact pose ``timing.clearance`` away from the
+feature along its push direction, the approach, the push, the retreat by the clearance, and a
+transfer up to the safe height (every feature's top + clearance + the object's reach from the
+gripper origin), over (the switch-over's turn is made there) and down to the next push."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import pose as P
+from ..errors import ArgumentError
+from ..workcell.default import default_workcell
+from ..workcell.description import Workcell
+from .assignment import Assignment, assign
+
+#: Sample labels, in the order a push meets them.
+LABELS = ("start", "transfer", "approach", "push", "retreat")
+
+
+@dataclass(frozen=True)
+class Timing:
+    """Speeds and spacing of a world motion, stated once: the gripper's speed while pushing,
+    approaching and retreating (``push_speed`` [m/s], ``push_turn`` [rad/s]) and in free transfers
+    (``move_speed`` [m/s], ``move_turn`` [rad/s]); the ``clearance`` [m] of pre-contact poses; the
+    longest time between samples ``sample_period`` [s]."""
+    push_speed: float = 0.01
+    push_turn: float = 0.2
+    move_speed: float = 0.1
+    move_turn: float = 1.0
+    clearance: float = 0.02
+    sample_period: float = 0.02
+
+    def __post_init__(self):
+        for k in ("push_speed", "push_turn", "move_speed", "move_turn", "clearance", "sample_period"):
+            v = getattr(self, k)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and 0 < v <= 1e3):
+                raise ArgumentError(f"invalid `timing.{k}`: a number in (0, 1000] (got {v!r:.40})", f"timing.{k}")
+
+
+@dataclass
+class WorldMotion:
+    """A timed world-frame motion of the gripper holding the object, per sample: ``times`` (n,)
+    [s]; ``gripper`` (n, 7) the gripper's world pose (m, unit quaternion); ``object`` (n, 7) the
+    object's world pose; ``in_hand`` (n, 7) the object's pose in the gripper frame; ``labels``
+    (one of :data:`LABELS` per sample); ``push`` (n,) the push index of approach, push and retreat samples (−1 in transfers);
+    ``grip_force`` (n,) [N] per finger. ``assignments``: the feature of each push; ``knots``:
+    ``(path index, sample index)`` of each plan knot of each push (a knot shared by two pushes
+    appears once for each); ``safe_height`` [m] of transfers; ``workcell``; ``timing``;
+    ``penetration`` [m] per push: how far the object's points (:func:`object_points`) go behind
+    the feature's contact plane during the push (0 for a sticking push of a convex object; a
+    plan whose object turns against its pusher, e.g. a pivot on a patch, can go through a face
+    larger than the patch)."""
+    times: np.ndarray
+    gripper: np.ndarray
+    object: np.ndarray
+    in_hand: np.ndarray
+    labels: list
+    push: np.ndarray
+    grip_force: np.ndarray
+    assignments: list
+    knots: list
+    safe_height: float
+    workcell: Workcell
+    timing: Timing = field(default_factory=Timing)
+    penetration: list = field(default_factory=list)
+
+    @property
+    def duration(self) -> float:
+        """The motion's duration [s]."""
+        return float(self.times[-1])
+
+    def to_dict(self) -> dict:
+        """The motion as JSON-ready lists: per-sample arrays, and per push its pusher, feature,
+        path indices, feature frame (m, unit quaternion), gravity tilt [rad] and penetration [m]."""
+        return {
+            "workcell": self.workcell.name,
+            "duration_s": self.duration,
+            "times": self.times.tolist(), "gripper": self.gripper.tolist(), "object": self.object.tolist(),
+            "in_hand": self.in_hand.tolist(), "labels": list(self.labels), "push": self.push.tolist(),
+            "grip_force": self.grip_force.tolist(),
+            "pushes": [{"pusher": a.pusher, "feature": a.feature, "first": a.first, "last": a.last,
+                        "frame": a.frame.tolist(), "tilt": a.tilt, "penetration": d}
+                       for a, d in zip(self.assignments, self.penetration)],
+            "knots": [list(k) for k in self.knots],
+            "safe_height": self.safe_height,
+        }
+
+
+def _plan_arrays(scene, plan):
+    from ..planning.plan import Plan
+
+    if not isinstance(plan, Plan):
+        raise ArgumentError(f"invalid `plan`: a regrasp Plan (got {type(plan).__name__})", "plan")
+    plan.check_for(scene)
+    dim = scene.dimension
+    poses = np.asarray(plan.poses, float)
+    if dim == 2:
+        O = np.array([P.planar_to_spatial(q) for q in poses])
+    else:
+        O = poses.copy()
+        O[:, 3:] /= np.linalg.norm(O[:, 3:], axis=1, keepdims=True)
+    twists = plan.pusher_twists if dim == 3 else [None] * len(poses)
+    return poses, O, list(plan.pushers), twists
+
+
+def object_points(scene) -> np.ndarray:
+    """Points (k, 3) [m] of the object in its frame whose reach bounds the object's: the planar
+    outline (in the x-z plane), a mesh's or box's vertices, a sphere's centre ± radius on each axis."""
+    if scene.dimension == 2:
+        out = np.asarray(scene.outline, float)
+        return np.column_stack([out[:, 0], np.zeros(len(out)), out[:, 1]])
+    r = scene._core.sphere
+    if r is not None:
+        return np.vstack([np.eye(3) * r, -np.eye(3) * r])
+    return np.asarray(scene.mesh()[0], float)
+
+
+def grip_force(scene) -> float:
+    """The scene's grip force per finger [N]."""
+    return float(scene.grip_force if scene.dimension == 2 else scene._core.grip_force)
+
+
+def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing = Timing(), start=None,
+                 max_tilt: float = np.pi) -> WorldMotion:
+    """The gripper's world motion executing ``plan`` (a :class:`~regrasp.Plan` of ``scene``) in
+    ``workcell`` (default: :func:`~regrasp.workcell.default_workcell` of the scene), timed by
+    ``timing``; ``start``: the gripper's world pose (m, unit quaternion) to begin from (default:
+    above the first push's pre-contact pose, at the safe height); ``max_tilt`` [rad]: the most a
+    push may turn the plan's gravity from the world's (see :func:`~regrasp.execution.assign`).
+    ArgumentError naming the push when no feature serves it."""
+    from ..scene.planar import Scene
+    from ..scene.spatial import Scene3D
+
+    if not isinstance(scene, (Scene, Scene3D)):
+        raise ArgumentError(f"invalid `scene`: a regrasp Scene or Scene3D (got {type(scene).__name__})", "scene")
+    if scene.dimension == 2 and scene.kind != "grasp":
+        raise ArgumentError("invalid `scene`: a surface scene has no gripper to move (a [grasp] scene is needed)", "scene")
+    if not isinstance(timing, Timing):
+        raise ArgumentError(f"invalid `timing`: a Timing (got {type(timing).__name__})", "timing")
+    workcell = default_workcell(scene) if workcell is None else workcell
+    if not isinstance(workcell, Workcell):
+        raise ArgumentError(f"invalid `workcell`: a Workcell (got {type(workcell).__name__})", "workcell")
+    poses, O, pushers, twists = _plan_arrays(scene, plan)
+    if len(poses) < 2:
+        raise ArgumentError("invalid `plan`: it has no pushes (one path entry)", "plan.path")
+    pts = object_points(scene)
+    reach = max(float(np.max(np.linalg.norm(P.transform(o, pts), axis=1))) for o in O)
+    safe = workcell.top() + timing.clearance + reach
+    assignments = assign(scene, poses, pushers, workcell, max_tilt)
+    force = grip_force(scene)
+
+    S: dict = {"t": [0.0], "G": [], "O": [], "label": [], "push": []}
+
+    def emit(G, Oh, label, k, dt):
+        S["t"].append(S["t"][-1] + dt)
+        S["G"].append(np.asarray(G, float)), S["O"].append(np.asarray(Oh, float))
+        S["label"].append(label), S["push"].append(k)
+
+    def steps(a, b, v, w) -> tuple[int, float]:
+        T = max(np.linalg.norm(b[:3] - a[:3]) / v, P.quat_angle(a[3:], b[3:]) / w, timing.sample_period)
+        return max(1, math.ceil(T / timing.sample_period - 1e-9)), T
+
+    def move(to, Oh, label, k, v, w):
+        a = S["G"][-1]
+        if np.linalg.norm(to[:3] - a[:3]) < 1e-12 and P.quat_angle(a[3:], to[3:]) < 1e-12:
+            return
+        n, T = steps(a, to, v, w)
+        Gs = P.interpolate(a, to, np.arange(1, n + 1) / n)
+        Gs[-1] = to
+        t0 = S["t"][-1]
+        S["t"] += list(t0 + T * np.arange(1, n + 1) / n)
+        S["G"] += list(Gs)
+        S["O"] += [np.asarray(Oh, float)] * n
+        S["label"] += [label] * n
+        S["push"] += [k] * n
+
+    def lifted(G):
+        return np.r_[G[:2], max(G[2], safe), G[3:]]
+
+    knots = []
+    for a in assignments:
+        Pk = P.compose(O[a.first], a.contact.frame)
+        G0 = P.compose(a.frame, P.inverse(Pk))
+        away = timing.clearance * P.quat_rotate(a.frame[3:], [0.0, 0, 1])
+        pre = np.r_[G0[:3] + away, G0[3:]]
+        if not S["G"]:
+            s0 = lifted(pre) if start is None else _check_start(start)
+            S["G"].append(s0), S["O"].append(O[a.first]), S["label"].append("start"), S["push"].append(-1)
+        move(lifted(S["G"][-1]), O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
+        move(lifted(pre), O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
+        move(pre, O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
+        move(G0, O[a.first], "approach", a.index, timing.push_speed, timing.push_turn)
+        knots.append((a.first, len(S["G"]) - 1))
+        for k in range(a.first + 1, a.last + 1):
+            xo = np.array(P.twist_between(O[k - 1], O[k]))
+            xp = xo if twists[k] is None else np.asarray(twists[k], float)
+            Gk_end = P.compose(a.frame, P.inverse(_moved(O[k - 1], xp, 1.0, Pk)))
+            n, T = steps(S["G"][-1], Gk_end, timing.push_speed, timing.push_turn)
+            for i in range(1, n + 1):
+                s = i / n
+                Ps = _moved(O[k - 1], xp, s, Pk)
+                Os = O[k] if i == n else P.integrate(O[k - 1], xo, s)
+                emit(P.compose(a.frame, P.inverse(Ps)), Os, "push", a.index, T / n)
+            Pk = _moved(O[k - 1], xp, 1.0, Pk)
+            knots.append((k, len(S["G"]) - 1))
+        Gend = S["G"][-1]
+        move(np.r_[Gend[:3] + away, Gend[3:]], O[a.last], "retreat", a.index, timing.push_speed, timing.push_turn)
+    move(lifted(S["G"][-1]), O[-1], "transfer", -1, timing.move_speed, timing.move_turn)
+
+    G, Oh = np.array(S["G"]), np.array(S["O"])
+    W = P.compose_rows(G, Oh)
+    labels, push = S["label"], np.array(S["push"], int)
+    depth = []
+    for a in assignments:
+        js = [j for j in np.flatnonzero(push == a.index) if labels[j] == "push"]
+        rel = P.compose_rows(np.repeat(P.inverse(a.frame)[None], len(js), axis=0), W[js])
+        depth.append(max(0.0, -min(float(P.transform(r, pts)[:, 2].min()) for r in rel)))
+    return WorldMotion(np.array(S["t"][:len(G)]), G, W, Oh, labels, push, np.full(len(G), force), assignments,
+                       knots, float(safe), workcell, timing, depth)
+
+
+def _moved(O, xi, s: float, Pk) -> np.ndarray:
+    """The pusher frame ``Pk`` (gripper frame) moved by ``s`` of the pusher twist ``xi`` (m/s,
+    rad/s) expressed in the object frame ``O`` (m, unit quaternion): ``O exp(s xi) O⁻¹ Pk``."""
+    return P.compose(P.integrate(O, xi, s), P.inverse(O), Pk)
+
+
+def _check_start(start) -> np.ndarray:
+    s0 = np.asarray(start, float) if isinstance(start, (list, tuple, np.ndarray)) else None
+    if s0 is None or s0.shape != (7,) or not np.all(np.isfinite(s0)) or np.linalg.norm(s0[3:]) < 1e-6:
+        raise ArgumentError(f"invalid `start`: a pose [x, y, z, qw, qx, qy, qz] (m, quaternion) (got {start!r:.80})", "start")
+    return np.r_[s0[:3], s0[3:] / np.linalg.norm(s0[3:])]

@@ -1,0 +1,58 @@
+"""The default workcell of a scene, used when none is given: a table with the robot on it and one
+fixture block beside the robot that offers every pusher of the scene a contact (a block edge at
+least as long as each line pusher, block corners for point pushers, block faces for patches; the
+table top for planes and pushers from below)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ArgumentError
+from .description import Feature, ObjectStart, Robot, Table, Workcell
+
+#: The default layout, stated once: table top height [m], table size [m] and centre [m] (world
+#: x-y), the robot (a UR5e at the world origin on the table top), the block's centre [m] (world
+#: x-y), its smallest side [m] and how much longer [×] its sides are than the largest pusher, and
+#: the least friction of table and block.
+TABLE_HEIGHT = 0.75
+TABLE_SIZE = (1.2, 0.8)
+TABLE_CENTER = (0.5, 0.0)
+ROBOT = "ur5e"
+BLOCK_CENTER = (0.5, 0.25)
+BLOCK_SIDE = 0.1
+BLOCK_MARGIN = 1.5
+FRICTION = 0.5
+
+
+def pusher_extent(scene) -> tuple[float, float]:
+    """The largest distance [m] between two contact points of one pusher of ``scene`` (a
+    :class:`~regrasp.Scene` or :class:`~regrasp.Scene3D`; a plane's points at the task's start),
+    and the largest pusher friction coefficient."""
+    if scene.dimension == 2:
+        specs = [(np.asarray(p.points, float), p.friction) for p in scene.pushers]
+    else:
+        specs = []
+        for name in scene.pusher_names:
+            pts, _, mu = scene._core.pusher_spec(name)
+            specs.append((np.asarray(pts, float), mu))
+    size = max((float(np.max(np.linalg.norm(p[:, None] - p[None], axis=-1))) for p, _ in specs), default=0.0)
+    return size, max(mu for _, mu in specs)
+
+
+def default_workcell(scene) -> Workcell:
+    """The default workcell for ``scene`` (planar or 3-D; see the module's doc): named
+    ``default-SCENE``, the object starting in the hand."""
+    from ..scene.planar import Scene
+    from ..scene.spatial import Scene3D
+
+    if not isinstance(scene, (Scene, Scene3D)):
+        raise ArgumentError(f"invalid `scene`: a regrasp Scene or Scene3D (got {type(scene).__name__})", "scene")
+    size, mu = pusher_extent(scene)
+    side = max(BLOCK_SIDE, BLOCK_MARGIN * size)
+    friction = max(FRICTION, mu)
+    table = Table(TABLE_HEIGHT, list(TABLE_SIZE), friction, list(TABLE_CENTER))
+    block = Feature("fixture", "block", [*BLOCK_CENTER, TABLE_HEIGHT + side / 2, 1.0, 0.0, 0.0, 0.0], friction,
+                    [side] * 3)
+    robot = Robot(ROBOT, [0.0, 0.0, TABLE_HEIGHT, 1.0, 0.0, 0.0, 0.0])
+    return Workcell(f"default-{scene.name}", table, (block,), robot, ObjectStart("hand"),
+                    f"generated for scene {scene.name}: a table and a fixture block")

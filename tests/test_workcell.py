@@ -1,0 +1,262 @@
+"""The workcell file, its contacts and the default workcell (regrasp.workcell)."""
+
+import copy
+import itertools
+import tomllib
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import regrasp
+from regrasp import ArgumentError, SceneError
+from regrasp.execution.assignment import assign, pusher_contact
+from regrasp.workcell import Feature, Workcell, bundled, default_workcell
+from regrasp.workcell.description import BOUNDS
+
+EXAMPLE = regrasp.examples.ROOT / "workcells" / "workcell-ur5e.toml"
+
+
+def example_dict():
+    return tomllib.loads(EXAMPLE.read_text())
+
+
+def rot(q):
+    w, x, y, z = np.asarray(q) / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def test_example_loads_and_round_trips(tmp_path):
+    w = Workcell.load(EXAMPLE)
+    assert w.robot.name == "ur5e" and w.object.on == "table" and len(w.features) == 4
+    assert Workcell.from_toml(w.to_toml()).to_dict() == w.to_dict()
+    assert Workcell.from_toml(w.to_toml()) == w and w != default_workcell(regrasp.load_scene(regrasp.examples.path("t-shape")))
+    assert bundled() == EXAMPLE and bundled("workcell-ur5e.toml") == EXAMPLE
+    with pytest.raises(ArgumentError, match="workcell-ur5e"):
+        bundled("nope")
+    w.save(tmp_path / "w.toml")
+    assert Workcell.load(tmp_path / "w.toml").to_dict() == w.to_dict()
+    # the file's numbers are read as written (independent of the writer)
+    d = example_dict()
+    assert w.table.height == d["table"]["height"]
+    assert np.allclose(w.feature("fixture").pose, d["features"][0]["pose"])
+
+
+def test_contacts_of_a_block_are_its_faces_edges_and_corners():
+    w = Workcell.load(EXAMPLE)
+    f = w.feature("fixture")
+    c, h = f.pose[:3], f.size / 2
+    cs = {c_.name: c_ for c_ in w.contacts() if c_.name.startswith("fixture.")}
+    # the bottom face, its 4 edges and 4 corners rest on the table: not offered
+    assert len(cs) == 26 - 9
+    verts = np.array(list(itertools.product(*[(-s, s) for s in h]))) + c
+    for name, k in cs.items():
+        R, o = rot(k.frame[3:]), k.frame[:3]
+        assert np.allclose(R.T @ R, np.eye(3)) and np.isclose(np.linalg.det(R), 1)
+        rel = (o - c) / h                       # in units of the half sizes
+        on = np.isclose(np.abs(rel), 1)
+        if k.kind == "corner":
+            assert on.all() and np.allclose(R[:, 2], np.sign(rel) / np.sqrt(3))
+            assert np.min(np.linalg.norm(verts - o, axis=1)) < 1e-12
+        elif k.kind == "edge":
+            assert on.sum() == 2 and np.isclose(k.length, 2 * h[~on][0])
+            assert np.allclose(np.abs(R[:, 0]), (~on).astype(float))          # along the free axis
+            assert np.allclose(R[:, 2], np.where(on, np.sign(rel), 0) / np.sqrt(2))
+        else:
+            assert on.sum() == 1 and np.allclose(R[:, 2], np.where(on, np.sign(rel), 0))
+            assert np.isclose(np.prod(2 * k.extent), np.prod(2 * h[~on]))
+        assert o[2] > w.table.height                                          # above the table top
+    table = w.contacts()[0]
+    assert table.name == "table" and np.allclose(table.frame, [0.5, 0, 0.75, 1, 0, 0, 0])
+
+
+def leaves(d, path=""):
+    """(dotted path, container, key) of every value of the file's dict, numbers of arrays too."""
+    items = d.items() if isinstance(d, dict) else enumerate(d)
+    for k, v in items:
+        p = (f"{path}.{k}" if path else k) if isinstance(d, dict) else f"{path}[{k}]"
+        yield p, d, k
+        if isinstance(v, (dict, list)):
+            yield from leaves(v, p)
+
+
+PATHS = [p for p, _, _ in leaves(example_dict())]
+BAD = [float("nan"), float("inf"), -float("inf"), 1e300, -1e300, -1.0, 0.0, "x", "", True, [], [1.0], {"a": 1}, None]
+
+
+def mutate(path, value):
+    d = example_dict()
+    for p, parent, k in leaves(d):
+        if p == path:
+            if value is None:
+                del parent[k]
+            else:
+                parent[k] = value
+            return d
+    raise AssertionError(path)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.sampled_from(PATHS), st.sampled_from(BAD))
+def test_mutations_are_refused_naming_the_field(path, value):
+    d = mutate(path, value)
+    try:
+        w = Workcell.from_dict(d)
+    except SceneError as e:
+        assert e.field and f"`{e.field}`" in str(e)
+        # the error names the mutated field, or a field inside it, or the table that lost a key
+        parent = path.rsplit(".", 1)[0] if "." in path else ""
+        assert e.field.startswith(path) or e.field.startswith(parent.split("[")[0]) or path.startswith(e.field), (path, e.field)
+        return
+    # accepted: then the value was valid there, and the workcell round-trips
+    assert Workcell.from_toml(w.to_toml()).to_dict() == w.to_dict()
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.sampled_from(["", "table", "robot", "object", "features[0]", "features[2]"]), st.text(min_size=1, max_size=8))
+def test_unknown_keys_are_refused(where, key):
+    d = example_dict()
+    target = d
+    for part in [p for p in where.replace("[", ".").replace("]", "").split(".") if p]:
+        target = target[int(part)] if part.isdigit() else target[part]
+    if key in target:
+        return
+    target[key] = 1.0
+    with pytest.raises(SceneError) as e:
+        Workcell.from_dict(d)
+    assert e.value.field == (f"{where}.{key}" if where else key)
+    assert "unknown field" in str(e.value)
+
+
+def test_specific_errors():
+    d = example_dict()
+    d["features"][1]["pose"][3:] = [0, 0, 0, 0]
+    with pytest.raises(SceneError, match="quaternion") as e:
+        Workcell.from_dict(d)
+    assert e.value.field == "features[1].pose"
+    d = example_dict()
+    d["features"][2]["name"] = "fixture"
+    with pytest.raises(SceneError, match="repeats") as e:
+        Workcell.from_dict(d)
+    assert e.value.field == "features[2].name"
+    d = example_dict()
+    d["features"][0]["length"] = 0.1
+    with pytest.raises(SceneError) as e:
+        Workcell.from_dict(d)
+    assert e.value.field == "features[0].length"
+    d = example_dict()
+    d["object"] = {"on": "hand", "pose": [0, 0, 0, 1, 0, 0, 0]}
+    with pytest.raises(SceneError) as e:
+        Workcell.from_dict(d)
+    assert e.value.field == "object.pose"
+    with pytest.raises(SceneError) as e:
+        Workcell.from_toml("name = [")
+    assert e.value.field == "(toml)"
+    with pytest.raises(ArgumentError):
+        Workcell.load("/nonexistent/w.toml")
+    lo, hi, _ = BOUNDS["size"]
+    d = example_dict()
+    d["table"]["size"] = [hi * 2, 1.0]
+    with pytest.raises(SceneError, match=r"\[0.0001, 10\] m") as e:
+        Workcell.from_dict(d)
+    assert e.value.field == "table.size[0]"
+
+
+@pytest.mark.parametrize("name", regrasp.examples.names())
+def test_default_workcell_serves_every_pusher(name):
+    scene = regrasp.load_scene(regrasp.examples.path(name))
+    w = default_workcell(scene)
+    assert Workcell.from_toml(w.to_toml()).to_dict() == w.to_dict()
+    start = scene.task.start if scene.dimension == 2 and scene.task else (
+        scene.task[0] if scene.dimension == 3 else np.zeros(3))
+    contacts = {c.name: c for c in w.contacts()}
+    for p in scene.pusher_names:
+        (a,) = assign(scene, [start, start], [None, p], w)
+        c, pc = contacts[a.feature], pusher_contact(scene, p, start)
+        # independent check of the kinds and sizes from the scene's own pusher points
+        pts = (np.asarray(scene.pusher(p).points) if scene.dimension == 2
+               else np.asarray(scene._core.pusher_spec(p, list(start))[0]))
+        plane = scene.dimension == 3 and scene._core.is_plane(p)
+        if plane or len(pts) >= 3:
+            assert c.kind == "face"
+        elif len(pts) == 1:
+            assert c.kind == "corner"
+        else:
+            assert c.kind in ("edge", "face")
+            if c.kind == "edge":
+                assert c.length >= np.linalg.norm(pts[1] - pts[0]) - 1e-12
+            else:
+                assert c.name == "table"        # a line pusher from below rests on the table
+        assert c.friction >= pc.friction
+        assert np.isclose(np.linalg.norm(a.frame[3:]), 1) and np.allclose(a.frame[:3], c.frame[:3])
+
+
+def test_the_documented_keys_are_the_loaders_and_the_example_loads():
+    import re
+
+    from regrasp.workcell.file import KEYS
+
+    doc = (regrasp.examples.ROOT.parents[2] / "docs" / "workcell-file.md").read_text()
+    documented = set(re.findall(r"^\| `([a-z_.\[\]]+)` \|", doc, re.M))
+    accepted = set()
+    for table, (req, opt) in KEYS.items():
+        accepted |= {f"{table}.{k}" if table else k for k in req | opt}
+    accepted |= {"table", "robot", "object", "features"}
+    assert documented == accepted
+    block = re.search(r"```toml\n(.*?)```", doc, re.S).group(1)
+    w = Workcell.from_toml(block)
+    assert {k: v for k, v in w.to_dict().items() if k != "description"} == \
+        {k: v for k, v in Workcell.load(EXAMPLE).to_dict().items() if k != "description"}
+
+
+unit_quats = st.lists(st.floats(-1, 1), min_size=4, max_size=4).filter(lambda q: np.linalg.norm(q) > 0.1)
+
+
+@settings(max_examples=60, deadline=None)
+@given(unit_quats, st.lists(st.floats(0.01, 0.5), min_size=3, max_size=3),
+       st.lists(st.floats(-1, 1), min_size=3, max_size=3))
+def test_block_contacts_lie_on_the_block_for_any_pose(q, size, at):
+    from regrasp.workcell.description import block_contacts
+
+    q = np.asarray(q) / np.linalg.norm(q)
+    f = Feature("b", "block", [*at, *q], 0.5, size)
+    R, c, h = rot(q), np.asarray(at), np.asarray(size) / 2
+    cs = block_contacts(f)
+    assert [k.kind for k in cs].count("face") == 6 and [k.kind for k in cs].count("edge") == 12
+    for k in cs:
+        Rk = rot(k.frame[3:])
+        assert np.allclose(Rk.T @ Rk, np.eye(3), atol=1e-9) and np.isclose(np.linalg.det(Rk), 1)
+        local = R.T @ (k.frame[:3] - c)                              # in the block's frame
+        assert np.max(np.abs(local) / h) == pytest.approx(1.0)      # on the surface
+        n = R.T @ Rk[:, 2]                                           # push direction, block frame
+        on = np.isclose(np.abs(local), h, rtol=1e-9, atol=1e-12)
+        assert np.allclose(n, np.where(on, np.sign(local), 0) / np.sqrt(on.sum()), atol=1e-9)
+        if k.kind == "edge":
+            assert np.isclose(k.length, 2 * h[~on][0])
+            ends = [k.frame[:3] + s * k.length / 2 * Rk[:, 0] for s in (-1, 1)]
+            assert all(np.max(np.abs(R.T @ (e - c)) / h) == pytest.approx(1.0) for e in ends)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from(["name", "table", "features", "robot", "object", "description"]),
+       st.sampled_from([None, 3, "", "x", [], [1.0], {"a": 1}, float("nan")]))
+def test_constructing_a_workcell_with_bad_parts_names_the_part(part, value):
+    w = Workcell.load(EXAMPLE)
+    kw = {"name": w.name, "table": w.table, "features": w.features, "robot": w.robot, "object": w.object,
+          "description": None} | {part: value}
+    try:
+        Workcell(**kw)
+    except SceneError as e:
+        assert e.field == part
+        return
+    assert (part, value) in (("description", None), ("description", ""), ("description", "x"), ("features", []),
+                             ("name", "x"))
+
+
+def test_default_workcell_needs_a_scene():
+    with pytest.raises(ArgumentError) as e:
+        default_workcell("t-shape")
+    assert e.value.field == "scene"
