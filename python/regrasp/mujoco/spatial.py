@@ -28,9 +28,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _core, progress
+from .. import progress
 from ..errors import ArgumentError
-from ..pose import quat_from_matrix, tangents, twist_between
+from ..pose import compose, integrate, inverse, quat_from_matrix, tangents, twist_between
 from .model import (FEATURE_BITS, OBJECT_BITS, PAD_BITS, Contact, Driver, Rig, add_driven_body, add_geom,
                     add_grip_motors, add_pad_sphere, add_pads, new_spec, plan_dict, set_inertial)
 
@@ -40,21 +40,6 @@ GAP = 0.002
 PLANE_HALF = 0.15  # m, half the side of a plane feature (a floor or a wall)
 PAD_BALL = 0.001  # m, the small spheres of a ring pad
 IDENTITY = np.r_[0.0, 0, 0, 1, 0, 0, 0]
-
-
-def compose(a, b) -> np.ndarray:
-    """Pose a ∘ b ([x, y, z, qw, qx, qy, qz])."""
-    return np.array(_core.se3_compose(list(map(float, a)), list(map(float, b))))
-
-
-def inverse(a) -> np.ndarray:
-    """The inverse of a pose ``a`` ``[x, y, z, qw, qx, qy, qz]`` (m, unit quaternion)."""
-    return np.array(_core.se3_inverse(list(map(float, a))))
-
-
-def _exp(u, t) -> np.ndarray:
-    """exp of body twist u over time t, as a pose."""
-    return np.array(_core.se3_integrate(list(IDENTITY), list(map(float, u)), float(t)))
 
 
 def _shift(v) -> np.ndarray:
@@ -269,7 +254,7 @@ class SpatialExecution(Rig):
         D = compose(inverse(A), self.P)
         n = int(round(1.0 / self.dt))
         for k in range(1, n + 1):
-            self.P = compose(A, compose(_exp(u, k / n), D))
+            self.P = compose(A, compose(integrate(IDENTITY, u, k / n), D))
             self.place(self.P)
         return self.in_grasp()
 
