@@ -25,6 +25,7 @@ from regrasp.pose import quat_angle, quat_from_matrix  # noqa: E402
 from regrasp.robot.creep import OBJECT, hold_box  # noqa: E402
 from regrasp.robot.ik import IKError, ik_path, solve_ik, table_distance  # noqa: E402
 from regrasp.robot.model import ROBOTS, TCP, build  # noqa: E402
+from regrasp.robot.pads import Pads  # noqa: E402
 from regrasp.robot.tracking import track  # noqa: E402
 
 BOX = dict(size=(0.04, 0.04, 0.04), mass=0.1, friction=0.5)
@@ -37,13 +38,13 @@ def robot():
     return build()
 
 
-def box_scene() -> Scene:
-    """The held box as a regrasp scene (40 mm square, 0.1 kg, pads μ 0.5): its mechanics give the
-    holding limit independently of MuJoCo."""
+def box_scene(pad_radius: float = 0.01) -> Scene:
+    """The held box as a regrasp scene (0.1 kg, pads μ 0.5; the outline only needs to hold the
+    pad): its mechanics give the holding limit independently of MuJoCo."""
     return Scene.from_dict({
-        "name": "held-box", "object": {"outline": [[-0.02, -0.02], [0.02, -0.02], [0.02, 0.02], [-0.02, 0.02]], "mass": 0.1},
-        "grasp": {"force": 5.0, "friction": 0.5, "pad_radius": 0.01}, "gravity": {"direction": [0, -1], "g": 9.81},
-        "pushers": [{"name": "bottom", "friction": 0.5, "points": [[-0.01, -0.02], [0.01, -0.02]], "normal": [0, 1]}],
+        "name": "held-box", "object": {"outline": [[-0.04, -0.04], [0.04, -0.04], [0.04, 0.04], [-0.04, 0.04]], "mass": 0.1},
+        "grasp": {"force": 5.0, "friction": 0.5, "pad_radius": pad_radius}, "gravity": {"direction": [0, -1], "g": 9.81},
+        "pushers": [{"name": "bottom", "friction": 0.5, "points": [[-0.01, -0.04], [0.01, -0.04]], "normal": [0, 1]}],
         "task": {"start": [0, 0, 0], "goal": [0.002, 0, 0], "tolerance": [0.001, 0.001, 0.01]}})
 
 
@@ -103,12 +104,19 @@ def test_tcp_between_the_pads_and_grip_force_holds():
         assert np.all(np.abs(mid) < 1e-3), mid
 
 
-def test_creep_above_the_holding_limit_and_slip_below():
-    limit = box_scene().hold_grip_force([0.0, 0.0, 0.0])
-    assert limit == pytest.approx(0.1 * 9.81 / (2 * 0.5))
-    held = hold_box(2.0 * limit, duration=2.0, **BOX)
+@pytest.mark.parametrize("offset", [0.0, 0.01])
+def test_creep_above_the_holding_limit_and_slip_below(offset):
+    """1.2 times regrasp's holding limit holds (creep under the bounds), 0.8 times slips; with
+    the box's centre ``offset`` [m] across the pads, the limit surface of the disc pad with the
+    grid's torsional capacity (radius 1.5 × the grid's mean distance from its centre)."""
+    pts = Pads().points()[:, [0, 2]]
+    radius = 1.5 * np.linalg.norm(pts - pts.mean(axis=0), axis=1).mean()
+    limit = box_scene(radius).hold_grip_force([offset, 0.0, 0.0])
+    if offset == 0.0:
+        assert limit == pytest.approx(0.1 * 9.81 / (2 * 0.5))
+    held = hold_box(1.2 * limit, duration=2.0, offset=(offset, 0.0), **BOX)
     assert held.slip < SLIP_BOUND and held.rotation < ROTATION_BOUND, held
-    dropped = hold_box(0.8 * limit, duration=0.5, **BOX)
+    dropped = hold_box(0.8 * limit, duration=1.0, offset=(offset, 0.0), **BOX)
     assert dropped.slip > 0.005, dropped
 
 

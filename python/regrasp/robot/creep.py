@@ -79,7 +79,7 @@ def hold_box(grip_force: float, size=(0.04, 0.04, 0.04), mass: float = 0.1, fric
         mujoco.mj_step(m, d)
     start = relative(robot, body)
     n = int(round(duration / m.opt.timestep))
-    last = max(1, int(0.1 / m.opt.timestep))
+    last = min(n, max(1, int(0.1 / m.opt.timestep)))
     forces = np.zeros(2)
     for k in range(n):
         grip.update()
