@@ -81,11 +81,48 @@ def test_registry_and_model(robot):
     assert e.value.field == "robot"
 
 
-def test_base_pose_moves_the_robot():
-    a, b = build(table=None), build(table=None, base_pose=(0.1, -0.2, 0.3, 0, 0, 0, 1))
-    pa, pb = a.tcp_pose(), b.tcp_pose()
-    # a half turn about z, then the shift: an independent composition
-    assert np.allclose(pb[:3], [-pa[0] + 0.1, -pa[1] - 0.2, pa[2] + 0.3], atol=1e-6)
+unit = st.floats(-1.0, 1.0)
+
+
+@settings(max_examples=8, deadline=None)
+@given(st.tuples(st.floats(-0.5, 0.5), st.floats(-0.5, 0.5), st.floats(0.0, 0.5)), st.tuples(unit, unit, unit, unit))
+def test_base_pose_moves_the_robot(shift, quat):
+    """The TCP's world pose is the base pose composed with the TCP's pose in the base frame (the
+    core's SE(3) compose: an independent check)."""
+    from regrasp import _core
+
+    if np.linalg.norm(quat) < 0.1:
+        return
+    base = np.array([*shift, *quat]) / [1, 1, 1, *[np.linalg.norm(quat)] * 4]
+    local = build(table=None).tcp_pose()
+    got = build(table=None, base_pose=base).tcp_pose()
+    want = np.array(_core.se3_compose(base, local))
+    assert np.allclose(got[:3], want[:3], atol=1e-6) and quat_angle(got[3:], want[3:]) < 1e-6
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.sampled_from(["base_pose", "grasp_width", "pad_friction", "robot"]),
+       st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.lists(st.floats(allow_nan=True), max_size=8),
+                 st.text(max_size=5)))
+def test_build_refuses_bad_input_naming_it(field, value):
+    kwargs = {"name" if field == "robot" else field: value}
+    try:
+        if field == "robot":
+            ok = value in ROBOTS
+        elif field == "base_pose":
+            p = np.asarray(value, float)
+            ok = p.shape == (7,) and np.all(np.isfinite(p)) and np.linalg.norm(p[3:]) > 1e-9
+        elif field == "grasp_width":
+            ok = isinstance(value, float) and 0 < value < 0.085
+        else:
+            ok = isinstance(value, float) and np.isfinite(value) and value > 0
+    except (TypeError, ValueError):
+        ok = False
+    if ok:
+        return
+    with pytest.raises(ArgumentError) as e:
+        build(table=None, **kwargs)
+    assert e.value.field == field
 
 
 def test_tcp_between_the_pads_and_grip_force_holds():
@@ -184,3 +221,12 @@ def test_tracking_a_joint_trajectory():
     assert t.max_error < 0.005 and t.tcp_error < 0.002, t
     # independent: the arm ends where the trajectory ends
     assert np.allclose(r.data.qpos[r.arm_qpos], qs[-1], atol=1e-3)
+
+
+@pytest.mark.parametrize("field, kwargs", [("grip_force", {"grip_force": -1.0}), ("mass", {"grip_force": 1.0, "mass": 0.0}),
+                                           ("size", {"grip_force": 1.0, "size": (0.04, 0.04)}),
+                                           ("duration", {"grip_force": 1.0, "duration": "2"})])
+def test_hold_box_refuses_bad_input_naming_it(field, kwargs):
+    with pytest.raises(ArgumentError) as e:
+        hold_box(**kwargs)
+    assert e.value.field == field

@@ -42,13 +42,17 @@ def hold_box(grip_force: float, size=(0.04, 0.04, 0.04), mass: float = 0.1, fric
     centre from the TCP along the TCP's (x, z) (a torque on the pads)."""
     mujoco = need("mujoco", "robot")
     from .grip import GripController, pad_forces
-    from .model import DEFAULT_ROBOT, build
+    from .model import DEFAULT_ROBOT, build, is_number
 
-    size = np.asarray(size, float)
-    if size.shape != (3,) or not np.all(size > 0):
+    try:
+        size = np.asarray(size, float)
+    except (TypeError, ValueError):
+        size = np.zeros(0)
+    if size.shape != (3,) or not np.all(np.isfinite(size) & (size > 0)):
         raise ArgumentError(f"invalid `size`: 3 lengths > 0 m (got {size!r})", "size")
-    if not (mass > 0 and friction > 0 and duration > 0):
-        raise ArgumentError("invalid `mass`/`friction`/`duration`: each > 0", "mass")
+    for name_, value in (("grip_force", grip_force), ("mass", mass), ("friction", friction), ("duration", duration)):
+        if not (is_number(value) and value > 0):
+            raise ArgumentError(f"invalid `{name_}`: a number > 0 (got {value!r})", name_)
     name = robot_name or DEFAULT_ROBOT
     probe = build(name, grasp_width=float(size[1]), pad_friction=friction)
     if q is not None:

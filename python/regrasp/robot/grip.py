@@ -45,18 +45,25 @@ def contact_normal_forces(model, data, groups) -> np.ndarray:
     return out
 
 
-@lru_cache(maxsize=32)
-def pad_state(grasp_width: float) -> tuple:
+def pad_state(grasp_width: float, robot_name: str = "") -> tuple:
     """(gain, bias, height) of the gripper closed on a fixed box ``grasp_width`` [m] wide, gravity
     off: a pad's normal force is ``gain · u + bias`` [N] at grip actuator force ``u`` [N]
     (``gain`` [N/N] the linkage's force ratio, ``bias`` [N] the linkage spring's share, both
     measured at two actuator forces), ``height`` [m] the pads' centres along the 2F-85 base's z
-    (where the TCP goes)."""
+    (where the TCP goes). ``robot_name``: the robot's gripper (the default robot's by default).
+    Measured once per width and robot."""
+    from .model import DEFAULT_ROBOT
+
+    return _pad_state(float(grasp_width), robot_name or DEFAULT_ROBOT)
+
+
+@lru_cache(maxsize=32)
+def _pad_state(grasp_width: float, robot_name: str) -> tuple:
     mujoco = need("mujoco", "robot")
-    from .model import DEFAULT_ROBOT, ROBOTS, gripper_spec
+    from .model import ROBOTS, gripper_spec
     from .pads import LENGTH, Pads
 
-    kind = ROBOTS[DEFAULT_ROBOT]
+    kind = ROBOTS[robot_name]
     g = gripper_spec(kind, Pads(), 0.5)
     g.option.timestep, g.option.gravity, g.option.impratio, g.option.noslip_iterations = 5e-4, [0, 0, 0], 20, 20
     # a tall box: the pads meet it wherever the linkage puts them
@@ -85,15 +92,15 @@ def pad_state(grasp_width: float) -> tuple:
 
 def grip_command(robot, grip_force: float) -> float:
     """The grip actuator's force [N] that makes each pad press with ``grip_force`` [N] on an
-    object as wide as the robot's grasp width (through the measured linkage map :func:`pad_state`; below the linkage spring's share the
-    actuator pulls the fingers back)."""
+    object as wide as the robot's grasp width (through the measured linkage map
+    :func:`pad_state`; below the linkage spring's share the actuator pulls the fingers back)."""
     if not (np.isfinite(grip_force) and grip_force >= 0):
         raise ArgumentError(f"invalid `grip_force`: >= 0 N (got {grip_force!r})", "grip_force")
-    gain, bias, _ = pad_state(robot.grasp_width)
+    gain, bias, _ = pad_state(robot.grasp_width, robot.name)
     u = (grip_force - bias) / gain
     if u > GRIP_RANGE:
         raise ArgumentError(f"invalid `grip_force`: {grip_force} N is more than the gripper's "
-                            f"{GRIP_RANGE * pad_state(robot.grasp_width)[0]:.0f} N", "grip_force")
+                            f"{GRIP_RANGE * pad_state(robot.grasp_width, robot.name)[0]:.0f} N", "grip_force")
     return u
 
 
@@ -125,7 +132,7 @@ class GripController:
         self.robot, self.data = robot, data if data is not None else robot.data
         self.grip_force, self.tau, self.period = float(grip_force), float(tau), float(period)
         self.u = self.feedforward = grip_command(robot, grip_force)
-        self.gain = pad_state(robot.grasp_width)[0]
+        self.gain = pad_state(robot.grasp_width, robot.name)[0]
         self.next = self.data.time
         self.data.ctrl[robot.grip_actuator] = self.u
 

@@ -11,6 +11,7 @@ import numpy as np
 from ..errors import ArgumentError
 from ..extras import need
 from ..pose import quat_angle
+from .model import check_pose
 
 POSITION_TOLERANCE = 1e-3  # m, a reached TCP position
 ANGLE_TOLERANCE = 0.01  # rad, a reached TCP orientation
@@ -28,13 +29,6 @@ class IKError(ArgumentError):
     def __init__(self, message: str, field: str, reason: str):
         super().__init__(message, field)
         self.reason = reason
-
-
-def _check_pose(pose, field: str) -> np.ndarray:
-    p = np.asarray(pose, float)
-    if p.shape != (7,) or not np.all(np.isfinite(p)) or np.linalg.norm(p[3:]) < 1e-9:
-        raise ArgumentError(f"invalid `{field}`: [x, y, z, qw, qx, qy, qz] (m) with a nonzero quaternion (got {pose!r})", field)
-    return np.concatenate([p[:3], p[3:] / np.linalg.norm(p[3:])])
 
 
 def pose_error(a, b) -> tuple:
@@ -62,7 +56,7 @@ def solve_ik(robot, target_pose, q_init=None, field: str = "pose") -> np.ndarray
     limits and ``MIN_DISTANCE`` off the table. Raises :class:`IKError` (its ``field`` is
     ``field``) saying why when none is found."""
     mink = need("mink", "robot")
-    target = _check_pose(target_pose, field)
+    target = check_pose(target_pose, field)
     m = robot.model
     q0 = robot.q if q_init is None else np.asarray(q_init, float)
     if q0.shape != robot.arm_qpos.shape:

@@ -20,8 +20,8 @@ robosuite's assets (``pip install --no-deps robosuite``, its ``models/assets``) 
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field
-from functools import lru_cache
 from importlib.resources import files
 from typing import Callable, Optional
 
@@ -176,17 +176,15 @@ def build(name: str = DEFAULT_ROBOT, base_pose=(0, 0, 0, 1, 0, 0, 0), table: Opt
     ``add(spec)``, when given, adds bodies and geoms to the ``mujoco.MjSpec`` before it is
     compiled (a workcell's features, an object)."""
     mujoco = need("mujoco", "robot")
-    if name not in ROBOTS:
+    if not isinstance(name, str) or name not in ROBOTS:
         raise ArgumentError(f"invalid `robot`: unknown robot {name!r} (known: {', '.join(ROBOTS)})", "robot")
     kind = ROBOTS[name]
-    pose = np.asarray(base_pose, float)
-    if pose.shape != (7,) or not np.all(np.isfinite(pose)) or np.linalg.norm(pose[3:]) < 1e-9:
-        raise ArgumentError(f"invalid `base_pose`: [x, y, z, qw, qx, qy, qz] (m) with a nonzero quaternion (got {base_pose!r})", "base_pose")
-    if not (np.isfinite(grasp_width) and 0.0 < grasp_width < 0.085):
+    pose = check_pose(base_pose, "base_pose")
+    if not (is_number(grasp_width) and 0.0 < grasp_width < 0.085):
         raise ArgumentError(f"invalid `grasp_width`: in (0, 0.085) m, the 2F-85's opening (got {grasp_width!r})", "grasp_width")
-    if not (np.isfinite(pad_friction) and pad_friction > 0):
-        raise ArgumentError(f"invalid `pad_friction`: > 0 (got {pad_friction!r})", "pad_friction")
-    spec = robot_spec(kind, pose, table, pads, pad_friction, grasp_width, contact)
+    if not (is_number(pad_friction) and pad_friction > 0):
+        raise ArgumentError(f"invalid `pad_friction`: a number > 0 (got {pad_friction!r})", "pad_friction")
+    spec = robot_spec(kind, name, pose, table, pads, pad_friction, grasp_width, contact)
     if add is not None:
         add(spec)
     model = spec.compile()
@@ -208,8 +206,26 @@ def build(name: str = DEFAULT_ROBOT, base_pose=(0, 0, 0, 1, 0, 0, 0), table: Opt
     return robot
 
 
-def robot_spec(kind: RobotKind, base_pose, table, pads: Pads, pad_friction: float, grasp_width: float, contact: Contact):
-    """The ``mujoco.MjSpec`` of the robot (not compiled), for :func:`build` (its arguments:
+def is_number(x) -> bool:
+    """Whether ``x`` is a finite real number (not a bool)."""
+    return isinstance(x, numbers.Real) and not isinstance(x, bool) and bool(np.isfinite(x))
+
+
+def check_pose(pose, field: str) -> np.ndarray:
+    """``pose`` as a pose ``[x, y, z, qw, qx, qy, qz]`` (m) with its quaternion normalized, or an
+    ArgumentError naming ``field``."""
+    try:
+        p = np.asarray(pose, float)
+    except (TypeError, ValueError):
+        p = np.zeros(0)
+    if p.shape != (7,) or not np.all(np.isfinite(p)) or np.linalg.norm(p[3:]) < 1e-9:
+        raise ArgumentError(f"invalid `{field}`: [x, y, z, qw, qx, qy, qz] (m) with a nonzero quaternion (got {pose!r})", field)
+    return np.concatenate([p[:3], p[3:] / np.linalg.norm(p[3:])])
+
+
+def robot_spec(kind: RobotKind, name: str, base_pose, table, pads: Pads, pad_friction: float, grasp_width: float,
+               contact: Contact):
+    """The ``mujoco.MjSpec`` of the robot ``name`` of kind ``kind`` (not compiled), for :func:`build` (its arguments:
     ``base_pose`` ``[x, y, z, qw, qx, qy, qz]`` (m), ``grasp_width`` [m])."""
     mujoco = need("mujoco", "robot")
     spec = mujoco.MjSpec()
@@ -233,7 +249,7 @@ def robot_spec(kind: RobotKind, base_pose, table, pads: Pads, pad_friction: floa
     for child in (arm, gripper):  # the parent's options rule; say so, so that attach does not warn
         child.option.impratio, child.option.integrator = spec.option.impratio, spec.option.integrator
         child.option.cone = spec.option.cone
-    base = w.add_frame(pos=base_pose[:3], quat=base_pose[3:] / np.linalg.norm(base_pose[3:]))
+    base = w.add_frame(pos=base_pose[:3], quat=base_pose[3:])
     base.attach_body(arm.body("base"), ARM_PREFIX, "")
     flange = spec.site(ARM_PREFIX + "attachment_site")
     flange.attach_body(gripper.body("base_mount"), GRIPPER_PREFIX, "")
@@ -247,7 +263,7 @@ def robot_spec(kind: RobotKind, base_pose, table, pads: Pads, pad_friction: floa
             g.contype, g.conaffinity = ROBOT_BITS
     # the TCP: midway between the pads' faces at the grasp width, the axes of the 2F-85's base
     spec.body(GRIPPER_PREFIX + kind.gripper_base).add_site(
-        name=TCP, pos=[0, 0, tcp_height(grasp_width)], size=[0.004, 0, 0], rgba=[1, 0, 0, 1], group=1)
+        name=TCP, pos=[0, 0, tcp_height(grasp_width, name)], size=[0.004, 0, 0], rgba=[1, 0, 0, 1], group=1)
     return spec
 
 
@@ -274,11 +290,10 @@ def gripper_spec(kind: RobotKind, pads: Pads, pad_friction: float):
     return g
 
 
-@lru_cache(maxsize=32)
-def tcp_height(grasp_width: float) -> float:
+def tcp_height(grasp_width: float, robot_name: str = "") -> float:
     """Height [m] along the 2F-85 base's z of the pads' centres when their faces are
-    ``grasp_width`` [m] apart: measured once per width on the bare gripper (the linkage lifts the
+    ``grasp_width`` [m] apart (on robot ``robot_name``'s gripper): measured once per width on the bare gripper (the linkage lifts the
     pads as it closes: 0.141 m open, 0.155 m closed)."""
     from .grip import pad_state
 
-    return pad_state(grasp_width)[2]
+    return pad_state(grasp_width, robot_name)[2]
