@@ -230,3 +230,42 @@ def test_hold_box_refuses_bad_input_naming_it(field, kwargs):
     with pytest.raises(ArgumentError) as e:
         hold_box(**kwargs)
     assert e.value.field == field
+
+
+def test_ik_keeps_clear_of_an_added_obstacle():
+    """A block added through build(add=...) is avoided like the table; a TCP pose inside it is
+    refused as a collision (checked by MuJoCo's geom distance)."""
+    def add(spec):
+        spec.worldbody.add_geom(name="block", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.05, 0.05, 0.1], pos=[0.45, 0.1, 0.1])
+
+    r = build(add=add)
+    home = np.array(ROBOTS["ur5e-2f85"].home)
+    near = fk(r, home)
+    near[:3] = [0.45, 0.1, 0.3]  # 0.1 m above the block's top, pointing down at it
+    q = solve_ik(r, near, home, avoid=["block"])
+    assert table_distance(r, q, avoid=["block"]) > 0
+    inside = near.copy()
+    inside[2] = 0.12
+    with pytest.raises(IKError) as e:
+        solve_ik(r, inside, home, avoid=["block"])
+    assert e.value.reason == "collision"
+
+
+def test_ik_with_a_held_object():
+    """The fingers closed on a box and its free joint are frozen: IK moves only the arm."""
+    r = hold_box(5.0, duration=0.05, **BOX).robot
+    others = np.delete(r.data.qpos.copy(), r.arm_qpos)
+    target = r.tcp_pose()
+    target[:3] += [0.1, 0.05, -0.1]
+    q = solve_ik(r, target)
+    assert np.linalg.norm(fk_with(r, q)[:3] - target[:3]) <= 1e-3
+    assert np.array_equal(np.delete(r.data.qpos, r.arm_qpos), others)  # the robot's state untouched
+
+
+def fk_with(robot, q) -> np.ndarray:
+    """The TCP pose at arm ``q`` with the rest of the state as it is now (a fresh MjData)."""
+    d = mujoco.MjData(robot.model)
+    d.qpos[:] = robot.data.qpos
+    d.qpos[robot.arm_qpos] = q
+    mujoco.mj_kinematics(robot.model, d)
+    return d.site_xpos[robot.tcp].copy()
