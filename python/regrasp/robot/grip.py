@@ -80,7 +80,8 @@ def _pad_state(grasp_width: float, robot_name: str) -> tuple:
             mujoco.mj_step(m, d)
         f.append(contact_normal_forces(m, d, pads))
         if not np.all(f[-1] > 0):
-            raise ArgumentError(f"invalid `grasp_width`: the pads do not reach a {grasp_width * 1e3:.1f} mm box", "grasp_width")
+            raise ArgumentError(f"invalid `grasp_width`: the pads do not reach a {grasp_width * 1e3:.1f} mm box",
+                                "grasp_width")
     (u1, u2), (f1, f2) = CALIBRATION_FORCES, (f[0].mean(), f[1].mean())
     gain = (f2 - f1) / (u2 - u1)
     base = m.body(kind.gripper_base).id

@@ -64,14 +64,15 @@ def solve_ik(robot, target_pose, q_init=None, field: str = "pose", avoid=()) -> 
     """Arm joint positions [rad] that put the TCP at world ``target_pose``
     ``[x, y, z, qw, qx, qy, qz]`` (m) within ``POSITION_TOLERANCE`` and ``ANGLE_TOLERANCE``,
     starting from ``q_init`` [rad] (the arm's joint positions now by default), within the joint
-    limits and ``MIN_DISTANCE`` off the table and the geoms ``avoid`` (ids or names). Raises :class:`IKError` (its ``field`` is
-    ``field``) saying why when none is found."""
+    limits and ``MIN_DISTANCE`` off the table and the geoms ``avoid`` (ids or names). Raises
+    :class:`IKError` (its ``field`` is ``field``) saying why when none is found."""
     mink = need("mink", "robot")
     target = check_pose(target_pose, field)
     m = robot.model
     q0 = robot.q if q_init is None else np.asarray(q_init, float)
     if q0.shape != robot.arm_qpos.shape:
-        raise ArgumentError(f"invalid `q_init`: {len(robot.arm_qpos)} joint positions [rad] (got shape {q0.shape})", "q_init")
+        raise ArgumentError(f"invalid `q_init`: {len(robot.arm_qpos)} joint positions [rad] (got shape {q0.shape})",
+                            "q_init")
     full = robot.data.qpos.copy()
     # the frozen joints inside their ranges (a closed finger linkage may sit a hair outside,
     # which would make the joint-limit constraint infeasible); they do not move the TCP
@@ -127,8 +128,8 @@ def solve_ik(robot, target_pose, q_init=None, field: str = "pose", avoid=()) -> 
 def ik_path(robot, poses, q_init=None, avoid=()) -> np.ndarray:
     """Arm joint positions [rad], shape (n, 6), reaching each of the TCP world ``poses`` (n, 7)
     ``[x, y, z, qw, qx, qy, qz]`` (m) in turn, each solution seeding the next (so the path stays
-    on one IK branch), clear of the table and ``avoid`` (:func:`solve_ik`). Raises :class:`IKError` naming ``poses[i]`` and why at the first pose that
-    cannot be reached."""
+    on one IK branch), clear of the table and ``avoid`` (:func:`solve_ik`). Raises
+    :class:`IKError` naming ``poses[i]`` and why at the first pose that cannot be reached."""
     P = np.asarray(poses, float)
     if P.ndim != 2 or P.shape[1] != 7 or len(P) == 0:
         raise ArgumentError(f"invalid `poses`: shape (n >= 1, 7) (got {P.shape})", "poses")

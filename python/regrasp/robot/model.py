@@ -8,8 +8,8 @@ gripper frame: its origin midway between the two pads' contact faces (at the pad
 the grasp width ``grasp_width``), **y the grasp axis** (from the left pad towards the right
 pad), **z the approach axis** (from the palm along the fingers), x = y × z. Against the 2F-85's
 own frames: the TCP's axes are those of the 2F-85's ``base`` body (whose y is the axis along
-which the fingers close), offset along its z by the pads' height (≈ 0.153 m from the
-``base_mount`` at a 40 mm grasp; Menagerie's ``pinch`` site is at 0.145 m + 0.0038 m). The
+which the fingers close), offset along its z by the pads' height (0.142 m at a 40 mm grasp,
+:func:`tcp_height`; Menagerie's ``pinch`` site, 0.145 m, is not used). The
 2F-85's ``base`` is turned −90° about z from its ``base_mount``, which sits on the UR5e's
 ``attachment_site`` (the flange: its z along the last link's axis).
 
@@ -181,7 +181,8 @@ def build(name: str = DEFAULT_ROBOT, base_pose=(0, 0, 0, 1, 0, 0, 0), table: Opt
     kind = ROBOTS[name]
     pose = check_pose(base_pose, "base_pose")
     if not (is_number(grasp_width) and 0.0 < grasp_width < 0.085):
-        raise ArgumentError(f"invalid `grasp_width`: in (0, 0.085) m, the 2F-85's opening (got {grasp_width!r})", "grasp_width")
+        raise ArgumentError(f"invalid `grasp_width`: in (0, 0.085) m, the 2F-85's opening (got {grasp_width!r})",
+                            "grasp_width")
     if not (is_number(pad_friction) and pad_friction > 0):
         raise ArgumentError(f"invalid `pad_friction`: a number > 0 (got {pad_friction!r})", "pad_friction")
     spec = robot_spec(kind, name, pose, table, pads, pad_friction, grasp_width, contact)
@@ -219,7 +220,8 @@ def check_pose(pose, field: str) -> np.ndarray:
     except (TypeError, ValueError):
         p = np.zeros(0)
     if p.shape != (7,) or not np.all(np.isfinite(p)) or np.linalg.norm(p[3:]) < 1e-9:
-        raise ArgumentError(f"invalid `{field}`: [x, y, z, qw, qx, qy, qz] (m) with a nonzero quaternion (got {pose!r})", field)
+        raise ArgumentError(f"invalid `{field}`: [x, y, z, qw, qx, qy, qz] (m) with a nonzero quaternion "
+                            f"(got {pose!r})", field)
     return np.concatenate([p[:3], p[3:] / np.linalg.norm(p[3:])])
 
 
@@ -292,8 +294,8 @@ def gripper_spec(kind: RobotKind, pads: Pads, pad_friction: float):
 
 def tcp_height(grasp_width: float, robot_name: str = "") -> float:
     """Height [m] along the 2F-85 base's z of the pads' centres when their faces are
-    ``grasp_width`` [m] apart (on robot ``robot_name``'s gripper): measured once per width on the bare gripper (the linkage lifts the
-    pads as it closes: 0.141 m open, 0.155 m closed)."""
+    ``grasp_width`` [m] apart, on robot ``robot_name``'s gripper: measured once per width on the
+    bare gripper (the linkage lifts the pads as it closes: 0.139 m at 60 mm, 0.144 m at 20 mm)."""
     from .grip import pad_state
 
     return pad_state(grasp_width, robot_name)[2]
