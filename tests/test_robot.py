@@ -269,3 +269,21 @@ def fk_with(robot, q) -> np.ndarray:
     d.qpos[robot.arm_qpos] = q
     mujoco.mj_kinematics(robot.model, d)
     return d.site_xpos[robot.tcp].copy()
+
+
+def test_a_held_box_stays_while_the_arm_moves():
+    """The arm swings a held box (5 N, 5 times the holding limit) along a 1 s trajectory: the box
+    moves with the TCP (its pose relative to the TCP, from MuJoCo's bodies, changes < 1 mm)."""
+    from regrasp.robot.creep import relative
+    from regrasp.robot.grip import GripController
+
+    r = hold_box(5.0, duration=0.2, **BOX).robot
+    body = r.model.body(OBJECT).id
+    before = relative(r, body)
+    q0 = r.q
+    t = track(r, [0.0, 1.0], np.array([q0, q0 + [0.4, -0.2, 0.2, 0.3, 0.0, 0.6]]), settle=0.2,
+              grip=GripController(r, 5.0))
+    after = relative(r, body)
+    assert t.max_error < 0.005
+    assert np.linalg.norm(after[:3] - before[:3]) < 1e-3 and quat_angle(after[3:], before[3:]) < 0.02
+    assert np.linalg.norm(r.data.xpos[body] - r.data.site_xpos[r.tcp]) < 0.005  # and it went along

@@ -53,10 +53,12 @@ def smooth(times, qs, dt: float) -> tuple:
     return np.array(out_t), np.array(out_q)
 
 
-def track(robot, times, qs, settle: float = 0.5) -> Tracking:
+def track(robot, times, qs, settle: float = 0.5, grip=None) -> Tracking:
     """Runs the arm along joint positions ``qs`` (n, 6) [rad] at ``times`` (n,) [s] (increasing;
     eased between waypoints, :func:`smooth`) from ``qs[0]``, then ``settle`` [s] more, under
-    position control, and measures the :class:`Tracking` errors (against the eased reference)."""
+    position control (the trajectory's clock starts now, at ``times[0]``), and measures the :class:`Tracking` errors (against the eased reference).
+    ``grip``: a :class:`~regrasp.robot.grip.GripController` updated every step (an object held
+    meanwhile)."""
     mujoco = need("mujoco", "robot")
     times, qs = np.asarray(times, float), np.asarray(qs, float)
     if times.ndim != 1 or len(times) < 2 or np.any(np.diff(times) <= 0):
@@ -65,17 +67,21 @@ def track(robot, times, qs, settle: float = 0.5) -> Tracking:
         raise ArgumentError(f"invalid `qs`: shape ({len(times)}, {len(robot.arm_qpos)}) [rad] (got {qs.shape})", "qs")
     m, d = robot.model, robot.data
     ref_t, ref_q = smooth(times, qs, 0.01)
-    robot.set_q(qs[0])
+    if np.max(np.abs(robot.q - qs[0])) > 1e-6:
+        robot.set_q(qs[0])
     kp = m.actuator_gainprm[robot.arm_actuators, 0]
     kv = -m.actuator_biasprm[robot.arm_actuators, 2]
     errs, tcp_err = [], 0.0
     data_ref = mujoco.MjData(m)
-    end = times[-1] + settle
-    while d.time - times[0] < end - times[0]:
-        q_ref, v_ref = reference(ref_t, ref_q, d.time)
+    start = d.time  # the trajectory's times[0] is now
+    clock = lambda: times[0] + d.time - start  # noqa: E731
+    while clock() < times[-1] + settle:
+        q_ref, v_ref = reference(ref_t, ref_q, clock())
         d.ctrl[robot.arm_actuators] = q_ref + kv / kp * v_ref
+        if grip is not None:
+            grip.update()
         mujoco.mj_step(m, d)
-        q_ref, _ = reference(ref_t, ref_q, d.time)
+        q_ref, _ = reference(ref_t, ref_q, clock())
         errs.append(np.abs(d.qpos[robot.arm_qpos] - q_ref))
         if len(errs) % 20 == 0:
             data_ref.qpos[:] = d.qpos
