@@ -81,6 +81,25 @@ def test_registry_and_model(robot):
     assert e.value.field == "robot"
 
 
+def test_tcp_is_regrasps_gripper_frame(robot):
+    """regrasp's gripper frame: the palm on the TCP's +z side, the fingers' tips on its -z side,
+    the left pad at +y (read from the compiled model's bodies and pad geoms); at home the
+    fingers point down (TCP z = world +z)."""
+    m, d = robot.model, robot.data
+    R, p = d.site_xmat[robot.tcp].reshape(3, 3), d.site_xpos[robot.tcp]
+    local = lambda x: R.T @ (x - p)  # noqa: E731
+    assert local(d.xpos[m.body("gripper/base_mount").id])[2] > 0.1  # the palm / flange side
+    assert local(d.xpos[m.body("arm/wrist_3_link").id])[2] > 0.1
+    for side, sign in zip(robot.pad_geoms, (1, -1)):
+        pts = np.array([local(d.geom_xpos[g]) for g in side])
+        assert pts[:, 2].max() > 0.015  # the pad's root row towards the palm (fingers open here)
+        # the fingertip row: the pad sphere farthest from the finger's root (the pad body's origin)
+        tip = max(side, key=lambda g: np.linalg.norm(d.geom_xpos[g] - d.xpos[m.geom_bodyid[g]]))
+        assert local(d.geom_xpos[tip])[2] < 0.0
+        assert np.all(sign * pts[:, 1] > 0.015)
+    assert R[:, 2] @ [0, 0, 1] > 0.999
+
+
 unit = st.floats(-1.0, 1.0)
 
 
@@ -127,7 +146,7 @@ def test_build_refuses_bad_input_naming_it(field, value):
 
 def test_tcp_between_the_pads_and_grip_force_holds():
     """At 3 requested forces the box (held under gravity) feels each within ±10 % on both sides
-    (from the box's own contacts); the TCP is midway between the pads, y from left to right."""
+    (from the box's own contacts); the TCP is midway between the pads, y pointing at the left pad (regrasp's left pad at +y)."""
     for force in (2.0, 5.0, 20.0):
         c = hold_box(force, duration=0.5, **BOX)
         r = c.robot
@@ -136,7 +155,7 @@ def test_tcp_between_the_pads_and_grip_force_holds():
         d = r.data
         R, p = d.site_xmat[r.tcp].reshape(3, 3), d.site_xpos[r.tcp]
         centres = [np.mean([R.T @ (d.geom_xpos[g] - p) for g in side], axis=0) for side in r.pad_geoms]
-        assert centres[0][1] < -0.015 and centres[1][1] > 0.015  # y: left pad to right pad
+        assert centres[0][1] > 0.015 and centres[1][1] < -0.015  # left pad at +y, right pad at -y
         mid = (centres[0] + centres[1]) / 2
         assert np.all(np.abs(mid) < 1e-3), mid
 

@@ -4,11 +4,13 @@ downloaded): the gripper attached to the arm's flange, the arm's base at a world
 force-driven fingers (:mod:`.grip`), distributed-contact pads (:mod:`.pads`) and a TCP site.
 
 Frames. World: z up, the table's top at ``Table.top``. The **TCP site** ``tcp`` is regrasp's
-gripper frame: its origin midway between the two pads' contact faces (at the pads' centres for
-the grasp width ``grasp_width``), **y the grasp axis** (from the left pad towards the right
-pad), **z the approach axis** (from the palm along the fingers), x = y × z. Against the 2F-85's
-own frames: the TCP's axes are those of the 2F-85's ``base`` body (whose y is the axis along
-which the fingers close), offset along its z by the pads' height (0.142 m at a 40 mm grasp,
+gripper frame (docs/scene-file.md): its origin midway between the two pads' contact faces (at
+the pads' centres for the grasp width ``grasp_width``), **y the grasp axis** pointing at the
+left pad (the 2F-85's ``left_pad`` touches the object from +y, as regrasp's left pad), **z from
+the fingers towards the palm** (the fingers point along −z, the palm is on the +z side),
+x = y × z. Against the 2F-85's own frames: the TCP is the 2F-85's ``base`` body turned 180°
+about its x (``TCP_QUAT``: y and z flipped; ``base``'s y points at the right pad, its z along
+the fingers), offset along ``base``'s z by the pads' height (0.142 m at a 40 mm grasp,
 :func:`tcp_height`; Menagerie's ``pinch`` site, 0.145 m, is not used). The
 2F-85's ``base`` is turned −90° about z from its ``base_mount``, which sits on the UR5e's
 ``attachment_site`` (the flange: its z along the last link's axis).
@@ -33,6 +35,7 @@ from ..mujoco.model import Contact
 from .pads import Pads, add_pads
 
 TCP = "tcp"  # the name of the TCP site (regrasp's gripper frame)
+TCP_QUAT = (0.0, 1.0, 0.0, 0.0)  # the TCP's orientation in the 2F-85 base's frame: 180° about x
 TABLE = "table"  # the name of the table's geom
 GRASP_WIDTH = 0.04  # m, the default distance between the pads' faces that places the TCP
 ARM_PREFIX, GRIPPER_PREFIX = "arm/", "gripper/"
@@ -263,9 +266,9 @@ def robot_spec(kind: RobotKind, name: str, base_pose, table, pads: Pads, pad_fri
             continue
         if g.contype or g.conaffinity:
             g.contype, g.conaffinity = ROBOT_BITS
-    # the TCP: midway between the pads' faces at the grasp width, the axes of the 2F-85's base
+    # the TCP: midway between the pads' faces at the grasp width, regrasp's gripper axes
     spec.body(GRIPPER_PREFIX + kind.gripper_base).add_site(
-        name=TCP, pos=[0, 0, tcp_height(grasp_width, name)], size=[0.004, 0, 0], rgba=[1, 0, 0, 1], group=1)
+        name=TCP, pos=[0, 0, tcp_height(grasp_width, name)], quat=list(TCP_QUAT), size=[0.004, 0, 0], rgba=[1, 0, 0, 1], group=1)
     return spec
 
 
