@@ -23,7 +23,7 @@ except MissingExtraError as e:
 from regrasp import Scene  # noqa: E402
 from regrasp.pose import quat_angle, quat_from_matrix  # noqa: E402
 from regrasp.robot.creep import OBJECT, hold_box  # noqa: E402
-from regrasp.robot.ik import IKError, ik_path, solve_ik, table_distance  # noqa: E402
+from regrasp.robot.ik import MAX_JUMP, MIN_DISTANCE, IKError, IKSolver, ik_path, solve_ik, table_distance  # noqa: E402
 from regrasp.robot.model import ROBOTS, TCP, build  # noqa: E402
 from regrasp.robot.pads import Pads  # noqa: E402
 from regrasp.robot.tracking import track  # noqa: E402
@@ -196,9 +196,10 @@ def test_ik_reaches_poses_made_by_forward_kinematics(robot):
         target = fk(robot, q)
         sol = solve_ik(robot, target, home)
         got = fk(robot, sol)
-        assert np.linalg.norm(got[:3] - target[:3]) <= 1e-3 and quat_angle(got[3:], target[3:]) <= 0.01
+        # converged (1e-5 m / 1e-5 rad), not merely accepted (1 mm / 0.01 rad)
+        assert np.linalg.norm(got[:3] - target[:3]) <= 2e-5 and quat_angle(got[3:], target[3:]) <= 2e-5
         assert np.all(sol >= lo) and np.all(sol <= hi)
-        assert table_distance(robot, sol) > 0
+        assert table_distance(robot, sol) >= MIN_DISTANCE
         done += 1
 
 
@@ -262,12 +263,44 @@ def test_ik_keeps_clear_of_an_added_obstacle():
     near = fk(r, home)
     near[:3] = [0.45, 0.1, 0.3]  # 0.1 m above the block's top, pointing down at it
     q = solve_ik(r, near, home, avoid=["block"])
-    assert table_distance(r, q, avoid=["block"]) > 0
+    assert table_distance(r, q, avoid=["block"]) >= MIN_DISTANCE
     inside = near.copy()
     inside[2] = 0.12
     with pytest.raises(IKError) as e:
         solve_ik(r, inside, home, avoid=["block"])
     assert e.value.reason == "collision"
+
+
+def test_ik_checks_the_final_clearance_itself(robot):
+    """Without mink's collision limit (as if it had tunnelled) a TCP pose that reaches (to 1e-5)
+    with the gripper 3 mm off the table (< MIN_DISTANCE) is still refused: the solution's
+    clearance is checked; 8 mm off the table is accepted."""
+    home = np.array(ROBOTS["ur5e-2f85"].home)
+    low = fk(robot, home)
+    solver = IKSolver(robot)
+    solver.limits = solver.limits[:2]  # joint and speed limits only
+    low[:3] = [0.45, 0.0, 0.015]  # the open fingers' lowest geom 8 mm above the table's top
+    assert table_distance(robot, solver.solve(low, home)) == pytest.approx(0.008, abs=1e-3)
+    low[2] = 0.010  # 3 mm
+    with pytest.raises(IKError) as e:
+        solver.solve(low, home)
+    assert e.value.reason == "collision" and e.value.field == "pose" and "3.0 mm" in str(e.value)
+
+
+def test_ik_path_rejects_a_joint_jump_naming_the_pose(robot):
+    """Consecutive poses 1 rad apart about the TCP's z turn the wrist by ≈ 1 rad > MAX_JUMP: the
+    path is refused at that pose; the same turn in 0.1 rad steps is accepted."""
+    from regrasp.pose import compose, z_turn
+
+    home = np.array(ROBOTS["ur5e-2f85"].home)
+    a = fk(robot, home)
+    turn = lambda phi: compose(a, z_turn(phi))  # noqa: E731
+    with pytest.raises(IKError) as e:
+        ik_path(robot, [a, turn(1.0)], home)
+    assert e.value.field == "poses[1]" and e.value.reason == "jump" and "poses[1]" in str(e.value)
+    path = ik_path(robot, [turn(phi) for phi in np.linspace(0, 1.0, 11)], home)
+    assert np.abs(np.diff(path, axis=0)).max() <= MAX_JUMP
+    assert quat_angle(fk(robot, path[-1])[3:], turn(1.0)[3:]) <= 2e-5
 
 
 def test_ik_with_a_held_object():

@@ -1,8 +1,11 @@
 """Inverse kinematics of the arm with ``mink`` (differential IK on MuJoCo, solved as a QP with
 DAQP): the TCP site brought to a world pose, the arm's joint limits respected (a configuration
 limit) and the arm and gripper kept off the table (mink's collision-avoidance limit); every
-other degree of freedom (the fingers, a held object) frozen. :func:`ik_path` chains solutions
-through a list of TCP poses, each seeded by the previous one, and checks each."""
+other degree of freedom (the fingers, a held object) frozen. Each solve iterates to 1e-5 m /
+1e-5 rad and accepts within 1 mm / 0.01 rad; the solution's clearance is then checked exactly
+(mink's collision limit is linearised and can tunnel). :class:`IKSolver` is set up once and
+reused; :func:`ik_path` chains solutions through a list of TCP poses with one solver, each
+seeded by the previous one, and refuses a joint jump over ``MAX_JUMP`` (a branch flip)."""
 
 from __future__ import annotations
 
@@ -13,13 +16,17 @@ from ..extras import need
 from ..pose import quat_angle
 from .model import check_pose
 
-POSITION_TOLERANCE = 1e-3  # m, a reached TCP position
-ANGLE_TOLERANCE = 0.01  # rad, a reached TCP orientation
-MIN_DISTANCE = 0.005  # m, the closest the arm and gripper may come to the table
+POSITION_TOLERANCE = 1e-3  # m, the accept/reject bound on a solution's TCP position error
+ANGLE_TOLERANCE = 0.01  # rad, the accept/reject bound on a solution's TCP orientation error
+CONVERGED_POSITION = 1e-5  # m, the differential IK iterates until the TCP is this close ...
+CONVERGED_ANGLE = 1e-5  # rad, ... and this well turned (or MAX_ITERATIONS)
+MIN_DISTANCE = 0.005  # m, the closest the arm and gripper may come to the table and obstacles
+LIMIT_DISTANCE = MIN_DISTANCE + 0.002  # m, mink's collision limit (a margin: it is linearised and can tunnel)
 MAX_ITERATIONS = 300  # of the differential IK
 IK_DT = 0.05  # s, the differential IK's integration step
 MAX_SPEED = np.pi  # rad/s, a joint's speed in the differential IK (a step turns it at most MAX_SPEED · IK_DT)
 LIMIT_MARGIN = 1e-3  # rad, a joint this close to its range's end is at its limit
+MAX_JUMP = 0.5  # rad, the largest joint change between consecutive poses of an ik_path (more: a branch flip)
 
 
 class IKError(ArgumentError):
@@ -60,82 +67,127 @@ def table_distance(robot, q, avoid=()) -> float:
     return min(mujoco.mj_geomDistance(robot.model, d, g, o, 0.1, None) for g in robot.robot_geoms for o in obstacles)
 
 
+class IKSolver:
+    """Differential IK (mink) of ``robot``'s arm, set up once and reused for many poses: one
+    mink ``Configuration`` with a frame task on the TCP, the joint limits, a joint speed limit
+    (``MAX_SPEED``) and a collision limit (``LIMIT_DISTANCE``) between the arm's and gripper's
+    collision geoms and the table and the geoms ``avoid`` (ids or names); every other degree
+    of freedom (the fingers, a held object) frozen at the robot's state when it is made."""
+
+    def __init__(self, robot, avoid=()):
+        mink = need("mink", "robot")
+        mujoco = need("mujoco", "robot")
+        from .model import ARM_PREFIX
+
+        self.robot, self.mink = robot, mink
+        m = robot.model
+        full = robot.data.qpos.copy()
+        # the frozen joints inside their ranges (a closed finger linkage may sit a hair outside,
+        # which would make the joint-limit constraint infeasible); they do not move the TCP
+        for j in range(m.njnt):
+            bounded = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
+            if m.jnt_limited[j] and int(m.jnt_type[j]) in bounded:
+                a = m.jnt_qposadr[j]
+                full[a] = np.clip(full[a], m.jnt_range[j, 0] + 1e-6, m.jnt_range[j, 1] - 1e-6)
+        self.full = full
+        self.config = mink.Configuration(m, full)
+        self.site = m.site(robot.tcp).name
+        self.task = mink.FrameTask(frame_name=self.site, frame_type="site", position_cost=1.0,
+                                   orientation_cost=1.0, lm_damping=1e-3)
+        others = [i for i in range(m.nv) if i not in set(robot.arm_dof.tolist())]
+        self.constraints = [mink.DofFreezingTask(m, dof_indices=others)] if others else None
+        self.limits = [mink.ConfigurationLimit(m),
+                       mink.VelocityLimit(m, {ARM_PREFIX + j: MAX_SPEED for j in robot.arm_joints})]
+        self.avoid = tuple(avoid)
+        self.obstacles = obstacle_geoms(robot, avoid)
+        if self.obstacles:
+            self.limits.append(mink.CollisionAvoidanceLimit(m, [(list(robot.robot_geoms), self.obstacles)],
+                                                            minimum_distance_from_collisions=LIMIT_DISTANCE,
+                                                            collision_detection_distance=0.05))
+
+    def tcp_pose(self) -> np.ndarray:
+        """The TCP's world pose ``[x, y, z, qw, qx, qy, qz]`` (m) at the configuration now."""
+        T = self.config.get_transform_frame_to_world(self.site, "site").wxyz_xyz
+        return np.concatenate([T[4:], T[:4]])
+
+    def solve(self, target_pose, q_init, field: str = "pose") -> np.ndarray:
+        """Arm joint positions [rad] putting the TCP at world ``target_pose``
+        ``[x, y, z, qw, qx, qy, qz]`` (m), from ``q_init`` [rad]: iterates to ``CONVERGED_POSITION``
+        / ``CONVERGED_ANGLE``, accepts within ``POSITION_TOLERANCE`` / ``ANGLE_TOLERANCE`` when the
+        solution is within the joint limits and ``MIN_DISTANCE`` off the obstacles
+        (:func:`table_distance`, checked exactly); else raises :class:`IKError` naming ``field``."""
+        mink, robot = self.mink, self.robot
+        target = check_pose(target_pose, field)
+        q0 = np.asarray(q_init, float)
+        if q0.shape != robot.arm_qpos.shape:
+            raise ArgumentError(f"invalid `q_init`: {len(robot.arm_qpos)} joint positions [rad] (got shape {q0.shape})",
+                                "q_init")
+        full = self.full.copy()
+        full[robot.arm_qpos] = q0
+        self.config.update(full)
+        self.task.set_target(mink.SE3(np.concatenate([target[3:], target[:3]])))
+        for _ in range(MAX_ITERATIONS):
+            reached = pose_error(self.tcp_pose(), target)
+            if reached[0] <= CONVERGED_POSITION and reached[1] <= CONVERGED_ANGLE:
+                break
+            try:
+                v = mink.solve_ik(self.config, [self.task], IK_DT, "daqp", damping=1e-3, limits=self.limits,
+                                  constraints=self.constraints)
+            except mink.NoSolutionFound:  # the limits admit no step from here: classified below
+                break
+            self.config.integrate_inplace(v, IK_DT)
+        q = self.config.q[robot.arm_qpos].copy()
+        reached = pose_error(self.tcp_pose(), target)
+        rng = robot.joint_limits()
+        inside = np.all((q >= rng[:, 0] - 1e-9) & (q <= rng[:, 1] + 1e-9))
+        gap = table_distance(robot, q, self.avoid) if self.obstacles else float("inf")
+        if reached[0] <= POSITION_TOLERANCE and reached[1] <= ANGLE_TOLERANCE and inside and gap >= MIN_DISTANCE:
+            return q
+        at_limit = [robot.arm_joints[i] for i in range(len(q)) if min(q[i] - rng[i, 0], rng[i, 1] - q[i]) < LIMIT_MARGIN]
+        beyond = robot.reach(target)
+        if beyond > 0:
+            reason, why = "unreachable", f"{beyond * 1e3:.0f} mm beyond the arm's reach"
+        elif gap < MIN_DISTANCE + 1e-3:
+            reason, why = "collision", f"the arm or gripper {gap * 1e3:.1f} mm from the table or an obstacle"
+        elif at_limit:
+            reason, why = "joint limit", f"joint {', '.join(at_limit)} at its limit"
+        else:
+            reason, why = "unreachable", "no arm configuration found"
+        raise IKError(f"invalid `{field}`: the TCP cannot reach {np.round(target, 4).tolist()} ({reason}: {why}; "
+                      f"closest {reached[0] * 1e3:.1f} mm, {reached[1]:.3f} rad away)", field, reason)
+
+
 def solve_ik(robot, target_pose, q_init=None, field: str = "pose", avoid=()) -> np.ndarray:
     """Arm joint positions [rad] that put the TCP at world ``target_pose``
-    ``[x, y, z, qw, qx, qy, qz]`` (m) within ``POSITION_TOLERANCE`` and ``ANGLE_TOLERANCE``,
-    starting from ``q_init`` [rad] (the arm's joint positions now by default), within the joint
-    limits and ``MIN_DISTANCE`` off the table and the geoms ``avoid`` (ids or names). Raises
+    ``[x, y, z, qw, qx, qy, qz]`` (m) (converged to ``CONVERGED_POSITION`` / ``CONVERGED_ANGLE``,
+    accepted within ``POSITION_TOLERANCE`` and ``ANGLE_TOLERANCE``), starting from ``q_init``
+    [rad] (the arm's joint positions now by default), within the joint limits and
+    ``MIN_DISTANCE`` off the table and the geoms ``avoid`` (ids or names). Raises
     :class:`IKError` (its ``field`` is ``field``) saying why when none is found."""
-    mink = need("mink", "robot")
-    target = check_pose(target_pose, field)
-    m = robot.model
-    q0 = robot.q if q_init is None else np.asarray(q_init, float)
-    if q0.shape != robot.arm_qpos.shape:
-        raise ArgumentError(f"invalid `q_init`: {len(robot.arm_qpos)} joint positions [rad] (got shape {q0.shape})",
-                            "q_init")
-    full = robot.data.qpos.copy()
-    # the frozen joints inside their ranges (a closed finger linkage may sit a hair outside,
-    # which would make the joint-limit constraint infeasible); they do not move the TCP
-    for j in range(m.njnt):
-        if m.jnt_limited[j] and m.jnt_type[j] in (2, 3):  # hinge, slide
-            a = m.jnt_qposadr[j]
-            full[a] = np.clip(full[a], m.jnt_range[j, 0] + 1e-6, m.jnt_range[j, 1] - 1e-6)
-    full[robot.arm_qpos] = q0
-    config = mink.Configuration(m, full)
-    task = mink.FrameTask(frame_name=m.site(robot.tcp).name, frame_type="site", position_cost=1.0,
-                          orientation_cost=1.0, lm_damping=1e-3)
-    task.set_target(mink.SE3(np.concatenate([target[3:], target[:3]])))
-    posture = mink.PostureTask(m, cost=1e-3)
-    posture.set_target(full)
-    others = [i for i in range(m.nv) if i not in set(robot.arm_dof.tolist())]
-    constraints = [mink.DofFreezingTask(m, dof_indices=others)] if others else None
-    limits = [mink.ConfigurationLimit(m), mink.VelocityLimit(m, {"arm/" + j: MAX_SPEED for j in robot.arm_joints})]
-    obstacles = obstacle_geoms(robot, avoid)
-    if obstacles:
-        limits.append(mink.CollisionAvoidanceLimit(m, [(list(robot.robot_geoms), obstacles)],
-                                                   minimum_distance_from_collisions=MIN_DISTANCE,
-                                                   collision_detection_distance=0.05))
-    for _ in range(MAX_ITERATIONS):
-        q = config.q[robot.arm_qpos]
-        reached = pose_error(robot.tcp_pose(q), target)
-        if reached[0] <= POSITION_TOLERANCE and reached[1] <= ANGLE_TOLERANCE:
-            break
-        try:
-            v = mink.solve_ik(config, [task, posture], IK_DT, "daqp", damping=1e-3, limits=limits, constraints=constraints)
-        except mink.NoSolutionFound:  # the limits admit no step from here: classified below
-            break
-        config.integrate_inplace(v, IK_DT)
-    q = config.q[robot.arm_qpos].copy()
-    reached = pose_error(robot.tcp_pose(q), target)
-    if reached[0] <= POSITION_TOLERANCE and reached[1] <= ANGLE_TOLERANCE:
-        return q
-    rng = robot.joint_limits()
-    at_limit = [robot.arm_joints[i] for i in range(len(q)) if min(q[i] - rng[i, 0], rng[i, 1] - q[i]) < LIMIT_MARGIN]
-    gap = table_distance(robot, q, avoid)
-    beyond = robot.reach(target)
-    if beyond > 0:
-        reason, why = "unreachable", f"{beyond * 1e3:.0f} mm beyond the arm's reach"
-    elif at_limit:
-        reason, why = "joint limit", f"joint {', '.join(at_limit)} at its limit"
-    elif gap < MIN_DISTANCE + 1e-3:
-        reason, why = "collision", f"the arm or gripper {gap * 1e3:.1f} mm from the table or an obstacle"
-    else:
-        reason, why = "unreachable", "no arm configuration found"
-    raise IKError(f"invalid `{field}`: the TCP cannot reach {np.round(target, 4).tolist()} ({reason}: {why}; "
-                  f"closest {reached[0] * 1e3:.1f} mm, {reached[1]:.3f} rad away)", field, reason)
+    return IKSolver(robot, avoid).solve(target_pose, robot.q if q_init is None else q_init, field)
 
 
-def ik_path(robot, poses, q_init=None, avoid=()) -> np.ndarray:
+def ik_path(robot, poses, q_init=None, avoid=(), max_jump: float = MAX_JUMP) -> np.ndarray:
     """Arm joint positions [rad], shape (n, 6), reaching each of the TCP world ``poses`` (n, 7)
-    ``[x, y, z, qw, qx, qy, qz]`` (m) in turn, each solution seeding the next (so the path stays
-    on one IK branch), clear of the table and ``avoid`` (:func:`solve_ik`). Raises
-    :class:`IKError` naming ``poses[i]`` and why at the first pose that cannot be reached."""
+    ``[x, y, z, qw, qx, qy, qz]`` (m) in turn with one :class:`IKSolver`, each solution seeding
+    the next, clear of the table and ``avoid``. Raises :class:`IKError` naming ``poses[i]`` at
+    the first pose that cannot be reached (its ``reason`` as :func:`solve_ik`'s) or whose
+    solution moves a joint more than ``max_jump`` [rad] from the previous one's (``q_init``'s
+    for ``poses[0]``; reason ``"jump"``: a branch flip, or poses sampled too far apart)."""
     P = np.asarray(poses, float)
     if P.ndim != 2 or P.shape[1] != 7 or len(P) == 0:
         raise ArgumentError(f"invalid `poses`: shape (n >= 1, 7) (got {P.shape})", "poses")
+    solver = IKSolver(robot, avoid)
     q = robot.q if q_init is None else np.asarray(q_init, float)
     out = []
     for i, p in enumerate(P):
-        q = solve_ik(robot, p, q, field=f"poses[{i}]", avoid=avoid)
+        nxt = solver.solve(p, q, field=f"poses[{i}]")
+        jump = np.abs(nxt - q)
+        if jump.max() > max_jump:
+            j = int(np.argmax(jump))
+            raise IKError(f"invalid `poses[{i}]`: joint {robot.arm_joints[j]} jumps {jump[j]:.3f} rad from the "
+                          f"previous pose's solution (more than {max_jump} rad: a branch flip, or poses too far "
+                          f"apart)", f"poses[{i}]", "jump")
+        q = nxt
         out.append(q)
     return np.array(out)
