@@ -184,6 +184,65 @@ def fk(robot, q) -> np.ndarray:
     return np.concatenate([d.site_xpos[robot.tcp], quat_from_matrix(d.site_xmat[robot.tcp].reshape(3, 3))])
 
 
+def test_the_grip_loop_counts_only_the_object(robot):
+    """Pads pressed into the table while holding a box: ``pad_forces`` on the box (read from
+    ``efc_force``, vectorised) equals the sum of ``mj_contactForce``'s normal forces over the
+    pad–box contacts (an independent reading), the pads' table contacts (> 1 N) are not counted
+    in it, nor in what the grip loop feeds back."""
+    from regrasp.robot.grip import contact_normal_forces, pad_forces
+
+    free = build(table=None)
+    home = np.array(ROBOTS["ur5e-2f85"].home)
+    p = free.tcp_pose(home)
+    p[:3] = [0.45, 0.0, 0.017]  # the pads' tips ≈ 2 mm into the table
+    c = hold_box(5.0, duration=0.3, q=solve_ik(free, p, home), size=(0.04, 0.04, 0.02), mass=0.1, friction=0.5)
+    r = c.robot
+    on_box, on_table = pad_forces(r, [OBJECT]), pad_forces(r, ["table"])
+    assert np.all(on_table > 1.0), on_table  # a mixed contact state indeed
+    m, d, box = r.model, r.data, r.model.geom(OBJECT).id
+    want, f6 = np.zeros(2), np.zeros(6)
+    for i in range(d.ncon):
+        g = {d.contact[i].geom1, d.contact[i].geom2}
+        for side in (0, 1):
+            if box in g and g & set(r.pad_geoms[side]):
+                mujoco.mj_contactForce(m, d, i, f6)
+                want[side] += f6[0]
+    assert np.allclose(on_box, want, rtol=1e-9), (on_box, want)
+    assert np.allclose(contact_normal_forces(r.model, r.data, r.pad_geoms), on_box + on_table)
+    from regrasp.robot.grip import GripController
+
+    assert np.array_equal(GripController(r, 5.0, [OBJECT]).forces(d), on_box)  # what the loop feeds back
+
+
+def test_calibration_follows_the_robots_settings():
+    """The linkage map is measured with the robot's own contact settings (a pyramidal cone and a
+    1 ms step give another cache entry, its normal force summed over the cone's edges) and agrees
+    within 5 % (the same linkage)."""
+    from regrasp.mujoco.model import SOFT
+    from regrasp.robot.grip import _pad_state, pad_state, robot_pad_state
+
+    base = pad_state(0.04)
+    before = _pad_state.cache_info().currsize
+    soft = robot_pad_state(build(table=None, contact=SOFT))
+    assert _pad_state.cache_info().currsize == before + 1
+    assert soft[0] == pytest.approx(base[0], rel=0.05) and soft[2] == pytest.approx(base[2], abs=1e-3)
+    assert robot_pad_state(build(table=None)) == base
+
+
+@settings(max_examples=10, deadline=None)
+@given(st.one_of(st.text(max_size=4), st.integers(-5, 10**6), st.lists(st.integers(-3, 10**6), max_size=3)))
+def test_pad_forces_refuses_bad_object_geoms(robot, objects):
+    from regrasp.robot.grip import pad_forces
+
+    ids = objects if isinstance(objects, list) else [objects]
+    names = {robot.model.geom(i).name for i in range(robot.model.ngeom)}
+    if all((isinstance(g, str) and g in names) or (isinstance(g, int) and 0 <= g < robot.model.ngeom) for g in ids):
+        return
+    with pytest.raises(ArgumentError) as e:
+        pad_forces(robot, objects)
+    assert e.value.field == "objects"
+
+
 def test_ik_reaches_poses_made_by_forward_kinematics(robot):
     rng = np.random.default_rng(7)
     home = np.array(ROBOTS["ur5e-2f85"].home)
@@ -334,7 +393,7 @@ def test_a_held_box_stays_while_the_arm_moves():
     before = relative(r, body)
     q0 = r.q
     t = track(r, [0.0, 1.0], np.array([q0, q0 + [0.4, -0.2, 0.2, 0.3, 0.0, 0.6]]), settle=0.2,
-              grip=GripController(r, 5.0))
+              grip=GripController(r, 5.0, [OBJECT]))
     after = relative(r, body)
     assert t.max_error < 0.005
     assert np.linalg.norm(after[:3] - before[:3]) < 1e-3 and quat_angle(after[3:], before[3:]) < 0.02

@@ -2,9 +2,14 @@
 its driver tendon (:func:`regrasp.robot.model.gripper_spec`); the map from the actuator's force
 to each pad's normal force through the linkage is measured on the bare gripper closing on a
 fixed box (:func:`pad_state`: affine, ≈ 9 N of pad force per N of actuator force at a 40 mm
-grasp plus the linkage spring's ≈ 0.7 N), and
-:func:`set_grip_force` commands a per-finger grip force through it (feed-forward; no force
-sensor is needed). :func:`pad_forces` measures the pads' normal forces in MuJoCo."""
+grasp plus the linkage spring's ≈ 0.02 N), with the robot's own pads, pad friction and contact
+settings (timestep included), and :func:`set_grip_force` commands a per-finger grip force through
+it (feed-forward). The feed-forward map alone gives ≈ +0.5 N under a held 0.1 kg box (2.53 N for
+2 N, 5.53 N for 5 N, 20.49 N for 20 N: the load moves the pads through the linkage), so
+:class:`GripController` closes a loop on the pads' normal force **as MuJoCo reports it** — an
+ideal tactile sensor that a real 2F-85 lacks (it has none; its current is a coarse proxy).
+:func:`pad_forces` measures the pads' normal forces on the held object only.
+"""
 
 from __future__ import annotations
 
@@ -14,6 +19,7 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..extras import need
+from ..pose import inverse, transform
 
 GRIP_RANGE = 20.0  # N, the grip actuator's force range (≈ 180 N per pad at a 40 mm grasp)
 CALIBRATION_FORCES = (1.0, 5.0)  # N, the actuator forces at which pad_state measures the (affine) map
@@ -22,63 +28,121 @@ MIN_CORRECTION = 1.0  # N, or this much when more
 CALIBRATION_TIME = 1.0  # s, simulated to let the gripper settle on the box
 
 
-def pad_forces(robot, data=None) -> np.ndarray:
-    """The total normal contact force [N] on the (left, right) pad now (``data``: the robot's by
-    default)."""
-    mujoco = need("mujoco", "robot")
+def geom_ids(model, geoms, field: str = "objects") -> np.ndarray:
+    """The geom ids of ``geoms`` (ids or names) in ``model``, or an ArgumentError naming ``field``."""
+    out = []
+    for g in geoms if not isinstance(geoms, (str, int, np.integer)) else [geoms]:
+        try:
+            i = model.geom(g).id if isinstance(g, str) else int(g)
+        except (KeyError, TypeError, ValueError):
+            i = -1
+        if not 0 <= i < model.ngeom:
+            raise ArgumentError(f"invalid `{field}`: geom ids or names of the model (got {g!r})", field)
+        out.append(i)
+    return np.array(out, int)
+
+
+def pad_forces(robot, objects, data=None) -> np.ndarray:
+    """The total normal contact force [N] of the (left, right) pad on the geoms ``objects``
+    (ids or names: the held object's) now (``data``: the robot's by default); a pad's contacts
+    with anything else (a feature, the table) do not count."""
     m, d = robot.model, data if data is not None else robot.data
-    return contact_normal_forces(m, d, robot.pad_geoms)
+    return contact_normal_forces(m, d, robot.pad_geoms, geom_ids(m, objects))
 
 
-def contact_normal_forces(model, data, groups) -> np.ndarray:
-    """The total normal contact force [N] on each group of geom ids in ``groups``."""
-    mujoco = need("mujoco", "robot")
-    out = np.zeros(len(groups))
-    f6 = np.zeros(6)
-    sets = [set(g) for g in groups]
-    for i in range(data.ncon):
-        c = data.contact[i]
-        for k, s in enumerate(sets):
-            if c.geom1 in s or c.geom2 in s:
-                mujoco.mj_contactForce(model, data, i, f6)
-                out[k] += f6[0]
-    return out
+def contact_normal_forces(model, data, groups, others=None) -> np.ndarray:
+    """The total normal contact force [N] on each group of geom ids in ``groups`` from its
+    contacts with the geoms ``others`` (ids; None: any geom) (:class:`ContactForces`)."""
+    return ContactForces(model, groups, others)(data)
 
 
-def pad_state(grasp_width: float, robot_name: str = "") -> tuple:
+class ContactForces:
+    """Sums normal contact forces [N] per group of geom ids ``groups`` of ``model`` over the
+    group's contacts with the geoms ``others`` (ids; None: any geom), vectorised: the geoms'
+    labels looked up once, the forces read from the constraint forces (``efc_force`` at each
+    contact's ``efc_address``: an elliptic cone's normal row, the sum of a pyramidal cone's
+    edges, as ``mj_contactForce``). Call it with a ``mujoco.MjData``."""
+
+    def __init__(self, model, groups, others=None):
+        mujoco = need("mujoco", "robot")
+        self.count = len(groups)
+        self.label = np.full(model.ngeom, -1)
+        for j, group in enumerate(groups):
+            self.label[np.asarray(group, int)] = j
+        self.other = np.ones(model.ngeom, bool) if others is None else np.zeros(model.ngeom, bool)
+        if others is not None:
+            self.other[np.asarray(others, int)] = True
+        self.elliptic = int(model.opt.cone) == int(mujoco.mjtCone.mjCONE_ELLIPTIC)
+
+    def __call__(self, data) -> np.ndarray:
+        """The total normal force [N] on each group now, shape (len(groups),)."""
+        n = data.ncon
+        if n == 0:
+            return np.zeros(self.count)
+        c = data.contact
+        g1, g2, adr = c.geom1, c.geom2, c.efc_address
+        live = adr >= 0
+        if self.elliptic:
+            f = np.where(live, data.efc_force[np.maximum(adr, 0)], 0.0)
+        else:  # pyramidal: the normal force is the sum of the 2 (dim - 1) edges' forces
+            dim = c.dim
+            rows = np.where(dim > 1, 2 * (dim - 1), 1)
+            k = np.arange(rows.max())
+            idx = np.minimum(np.maximum(adr, 0)[:, None] + k, data.nefc - 1)
+            f = np.where(live, np.where(k < rows[:, None], data.efc_force[idx], 0.0).sum(axis=1), 0.0)
+        a, b = self.label[g1], self.label[g2]
+        s1, s2 = (a >= 0) & self.other[g2], (b >= 0) & self.other[g1]
+        return (np.bincount(a[s1], f[s1], self.count) + np.bincount(b[s2], f[s2], self.count)).astype(float)
+
+
+def pad_state(grasp_width: float, robot_name: str = "", pads=None, pad_friction: float = None,
+              contact=None) -> tuple:
     """(gain, bias, height) of the gripper closed on a fixed box ``grasp_width`` [m] wide, gravity
     off: a pad's normal force is ``gain · u + bias`` [N] at grip actuator force ``u`` [N]
     (``gain`` [N/N] the linkage's force ratio, ``bias`` [N] the linkage spring's share, both
     measured at two actuator forces), ``height`` [m] the pads' centres along the 2F-85 base's z
-    (where the TCP goes). ``robot_name``: the robot's gripper (the default robot's by default).
-    Measured once per width and robot."""
+    (where the TCP goes). Measured with robot ``robot_name``'s gripper (the default robot's by
+    default), its ``pads`` (a :class:`~regrasp.robot.pads.Pads`), ``pad_friction`` and MuJoCo
+    ``contact`` settings (``regrasp.mujoco.model.Contact``: timestep, cone, impratio, no-slip);
+    the defaults: :func:`~regrasp.robot.model.build`'s. Measured once per distinct set of these."""
+    from ..mujoco.model import Contact
     from .model import DEFAULT_ROBOT
+    from .pads import PAD_FRICTION, Pads
 
-    return _pad_state(float(grasp_width), robot_name or DEFAULT_ROBOT)
+    return _pad_state(float(grasp_width), robot_name or DEFAULT_ROBOT, pads or Pads(),
+                      float(PAD_FRICTION if pad_friction is None else pad_friction), contact or Contact())
+
+
+def robot_pad_state(robot) -> tuple:
+    """:func:`pad_state` (gain [N/N], bias [N], height [m]) for ``robot``'s own grasp width,
+    gripper, pads, pad friction and contact settings."""
+    return pad_state(robot.grasp_width, robot.name, robot.pads, robot.pad_friction, robot.contact)
 
 
 @lru_cache(maxsize=32)
-def _pad_state(grasp_width: float, robot_name: str) -> tuple:
+def _pad_state(grasp_width: float, robot_name: str, pads, pad_friction: float, contact) -> tuple:
     mujoco = need("mujoco", "robot")
-    from .model import ROBOTS, gripper_spec
-    from .pads import LENGTH, Pads
+    from .model import ROBOTS, gripper_spec, set_options
+    from .pads import LENGTH
 
     kind = ROBOTS[robot_name]
-    g = gripper_spec(kind, Pads(), 0.5)
-    g.option.timestep, g.option.gravity, g.option.impratio, g.option.noslip_iterations = 5e-4, [0, 0, 0], 20, 20
+    g = gripper_spec(kind, pads, pad_friction)
+    set_options(g, contact)
+    g.option.gravity = [0, 0, 0]
     # a tall box: the pads meet it wherever the linkage puts them
     g.worldbody.add_geom(name="calibration_box", type=mujoco.mjtGeom.mjGEOM_BOX, size=[grasp_width / 2, 0.03, 0.035],
                          pos=[0, 0, 0.16])
     m = g.compile()
     d = mujoco.MjData(m)
-    pads = tuple(tuple(i for i in range(m.ngeom) if m.geom_bodyid[i] == m.body(b).id and m.geom_contype[i])
-                 for b in kind.pad_bodies)
+    pad_geoms = tuple(tuple(i for i in range(m.ngeom) if m.geom_bodyid[i] == m.body(b).id and m.geom_contype[i])
+                      for b in kind.pad_bodies)
+    box = [m.geom("calibration_box").id]
     f = []
     for u in CALIBRATION_FORCES:
         d.ctrl[m.actuator("grip").id] = u
         for _ in range(int(CALIBRATION_TIME / m.opt.timestep)):
             mujoco.mj_step(m, d)
-        f.append(contact_normal_forces(m, d, pads))
+        f.append(contact_normal_forces(m, d, pad_geoms, box))
         if not np.all(f[-1] > 0):
             raise ArgumentError(f"invalid `grasp_width`: the pads do not reach a {grasp_width * 1e3:.1f} mm box",
                                 "grasp_width")
@@ -86,9 +150,14 @@ def _pad_state(grasp_width: float, robot_name: str) -> tuple:
     gain = (f2 - f1) / (u2 - u1)
     base = m.body(kind.gripper_base).id
     pad = m.body(kind.pad_bodies[1]).id
-    centre = d.xpos[pad] + d.xmat[pad].reshape(3, 3) @ [0, 0, LENGTH / 2]
-    local = d.xmat[base].reshape(3, 3).T @ (centre - d.xpos[base])
+    centre = transform(body_pose(d, pad), [0.0, 0.0, LENGTH / 2])
+    local = transform(inverse(body_pose(d, base)), centre)
     return float(gain), float(f1 - gain * u1), float(local[2])
+
+
+def body_pose(data, body: int) -> np.ndarray:
+    """The world pose ``[x, y, z, qw, qx, qy, qz]`` (m) of MuJoCo body ``body`` now."""
+    return np.concatenate([data.xpos[body], data.xquat[body]])
 
 
 def grip_command(robot, grip_force: float) -> float:
@@ -97,11 +166,11 @@ def grip_command(robot, grip_force: float) -> float:
     :func:`pad_state`; below the linkage spring's share the actuator pulls the fingers back)."""
     if not (np.isfinite(grip_force) and grip_force >= 0):
         raise ArgumentError(f"invalid `grip_force`: >= 0 N (got {grip_force!r})", "grip_force")
-    gain, bias, _ = pad_state(robot.grasp_width, robot.name)
+    gain, bias, _ = robot_pad_state(robot)
     u = (grip_force - bias) / gain
     if u > GRIP_RANGE:
         raise ArgumentError(f"invalid `grip_force`: {grip_force} N is more than the gripper's "
-                            f"{GRIP_RANGE * pad_state(robot.grasp_width, robot.name)[0]:.0f} N", "grip_force")
+                            f"{GRIP_RANGE * gain:.0f} N", "grip_force")
     return u
 
 
@@ -119,8 +188,9 @@ def open_gripper(robot, data=None) -> None:
 
 
 class GripController:
-    """Holds a per-finger grip force ``grip_force`` [N]: the feed-forward :func:`grip_command`
-    plus an integral correction on the pads' measured normal force (their mean), with time
+    """Holds a per-finger grip force ``grip_force`` [N] on the geoms ``objects`` (ids or names:
+    the held object's): the feed-forward :func:`grip_command` plus an integral correction on the
+    pads' normal force on ``objects`` (their mean; MuJoCo's contact force, an ideal sensor), with time
     constant ``tau`` [s], updated every ``period`` [s] while both pads touch, bounded to
     ``CORRECTION`` of the requested force (at least ``MIN_CORRECTION``: an impact's spike must
     not open the hand). Why a loop: a load along the pads moves them through the linkage — under
@@ -129,11 +199,13 @@ class GripController:
     default (a 2 kHz loop, τ = 5 ms) up to ≈ 1.05 times. Call :meth:`update` before each
     ``mj_step``."""
 
-    def __init__(self, robot, grip_force: float, tau: float = 0.005, period: float = 0.0005, data=None):
+    def __init__(self, robot, grip_force: float, objects, tau: float = 0.005, period: float = 0.0005, data=None):
         self.robot, self.data = robot, data if data is not None else robot.data
+        self.objects = geom_ids(robot.model, objects)
+        self.forces = ContactForces(robot.model, robot.pad_geoms, self.objects)
         self.grip_force, self.tau, self.period = float(grip_force), float(tau), float(period)
         self.u = self.feedforward = grip_command(robot, grip_force)
-        self.gain = pad_state(robot.grasp_width, robot.name)[0]
+        self.gain = robot_pad_state(robot)[0]
         self.next = self.data.time
         self.data.ctrl[robot.grip_actuator] = self.u
 
@@ -143,7 +215,7 @@ class GripController:
         if d.time + 1e-12 < self.next:
             return
         self.next = d.time + self.period
-        f = pad_forces(self.robot, d)
+        f = self.forces(d)
         if np.all(f > 0):
             self.u += self.period / self.tau * (self.grip_force - f.mean()) / self.gain
             bound = max(CORRECTION * self.grip_force, MIN_CORRECTION) / self.gain

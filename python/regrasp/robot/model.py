@@ -32,7 +32,7 @@ import numpy as np
 from ..errors import ArgumentError
 from ..extras import need
 from ..mujoco.model import Contact
-from .pads import Pads, add_pads
+from .pads import PAD_FRICTION, Pads, add_pads
 
 TCP = "tcp"  # the name of the TCP site (regrasp's gripper frame)
 TCP_QUAT = (0.0, 1.0, 0.0, 0.0)  # the TCP's orientation in the 2F-85 base's frame: 180° about x
@@ -104,7 +104,8 @@ class Robot:
     ``grip_actuator``: the fingers' force actuator (:mod:`.grip`); ``tcp``: the TCP site's id;
     ``pad_geoms``: the contact geoms of the (left, right) pad; ``robot_geoms``: every collision
     geom of the arm and the gripper; ``table``: the table geom's id (−1: none); ``grasp_width``
-    [m] the pad distance at which the TCP was placed; ``pads`` the contact grid."""
+    [m] the pad distance at which the TCP was placed; ``pads`` the contact grid, ``pad_friction``
+    its Coulomb friction, ``contact`` the MuJoCo settings it was built with."""
 
     name: str
     kind: RobotKind
@@ -121,6 +122,8 @@ class Robot:
     table: int
     grasp_width: float
     pads: Pads = field(default_factory=Pads)
+    pad_friction: float = PAD_FRICTION
+    contact: Contact = field(default_factory=Contact)
 
     @property
     def q(self) -> np.ndarray:
@@ -169,7 +172,7 @@ class Robot:
 
 
 def build(name: str = DEFAULT_ROBOT, base_pose=(0, 0, 0, 1, 0, 0, 0), table: Optional[Table] = Table(),
-          pads: Pads = Pads(), pad_friction: float = 0.5, grasp_width: float = GRASP_WIDTH,
+          pads: Pads = Pads(), pad_friction: float = PAD_FRICTION, grasp_width: float = GRASP_WIDTH,
           contact: Contact = Contact(), add: Optional[Callable] = None) -> Robot:
     """The robot ``name`` (:data:`ROBOTS`) compiled: its base at world ``base_pose``
     ``[x, y, z, qw, qx, qy, qz]`` (m), on ``table`` (None: no table), with distributed-contact
@@ -201,11 +204,11 @@ def build(name: str = DEFAULT_ROBOT, base_pose=(0, 0, 0, 1, 0, 0, 0), table: Opt
     body_of = lambda b: model.body(GRIPPER_PREFIX + b).id  # noqa: E731
     pad_geoms = tuple(tuple(g for g in range(model.ngeom) if model.geom_bodyid[g] == body_of(b) and model.geom_contype[g])
                       for b in kind.pad_bodies)
-    robot_geoms = tuple(g for g in range(model.ngeom) if model.geom(g).name.startswith(("arm/", "gripper/"))
+    robot_geoms = tuple(g for g in range(model.ngeom) if model.geom(g).name.startswith((ARM_PREFIX, GRIPPER_PREFIX))
                         and (model.geom_contype[g] or model.geom_conaffinity[g]))
     table_id = model.geom(TABLE).id if table is not None else -1
     robot = Robot(name, kind, model, data, arm_joints, arm_qpos, arm_dof, arm_act, grip, model.site(TCP).id,
-                  pad_geoms, robot_geoms, table_id, grasp_width, pads)
+                  pad_geoms, robot_geoms, table_id, grasp_width, pads, float(pad_friction), contact)
     robot.set_q(kind.home)
     return robot
 
@@ -234,11 +237,7 @@ def robot_spec(kind: RobotKind, name: str, base_pose, table, pads: Pads, pad_fri
     ``base_pose`` ``[x, y, z, qw, qx, qy, qz]`` (m), ``grasp_width`` [m])."""
     mujoco = need("mujoco", "robot")
     spec = mujoco.MjSpec()
-    spec.option.timestep = contact.timestep
-    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC if contact.cone == "elliptic" else mujoco.mjtCone.mjCONE_PYRAMIDAL
-    spec.option.impratio = contact.impratio
-    spec.option.noslip_iterations = contact.noslip_iterations
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    set_options(spec, contact)
     w = spec.worldbody
     if table is not None:
         top, size = np.asarray(table.top, float), np.asarray(table.size, float)
@@ -268,8 +267,19 @@ def robot_spec(kind: RobotKind, name: str, base_pose, table, pads: Pads, pad_fri
             g.contype, g.conaffinity = ROBOT_BITS
     # the TCP: midway between the pads' faces at the grasp width, regrasp's gripper axes
     spec.body(GRIPPER_PREFIX + kind.gripper_base).add_site(
-        name=TCP, pos=[0, 0, tcp_height(grasp_width, name)], quat=list(TCP_QUAT), size=[0.004, 0, 0], rgba=[1, 0, 0, 1], group=1)
+        name=TCP, pos=[0, 0, tcp_height(grasp_width, name, pads, pad_friction, contact)], quat=list(TCP_QUAT), size=[0.004, 0, 0], rgba=[1, 0, 0, 1], group=1)
     return spec
+
+
+def set_options(spec, contact: Contact) -> None:
+    """Sets a ``mujoco.MjSpec``'s options from the ``contact`` settings (timestep [s], cone,
+    impratio, no-slip iterations) and the implicit-fast integrator."""
+    mujoco = need("mujoco", "robot")
+    spec.option.timestep = contact.timestep
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC if contact.cone == "elliptic" else mujoco.mjtCone.mjCONE_PYRAMIDAL
+    spec.option.impratio = contact.impratio
+    spec.option.noslip_iterations = contact.noslip_iterations
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
 
 
 def gripper_spec(kind: RobotKind, pads: Pads, pad_friction: float):
@@ -295,10 +305,13 @@ def gripper_spec(kind: RobotKind, pads: Pads, pad_friction: float):
     return g
 
 
-def tcp_height(grasp_width: float, robot_name: str = "") -> float:
+def tcp_height(grasp_width: float, robot_name: str = "", pads: Pads = Pads(), pad_friction: float = PAD_FRICTION,
+               contact: Contact = Contact()) -> float:
     """Height [m] along the 2F-85 base's z of the pads' centres when their faces are
-    ``grasp_width`` [m] apart, on robot ``robot_name``'s gripper: measured once per width on the
-    bare gripper (the linkage lifts the pads as it closes: 0.139 m at 60 mm, 0.144 m at 20 mm)."""
+    ``grasp_width`` [m] apart, on robot ``robot_name``'s gripper with ``pads``, ``pad_friction``
+    and ``contact`` settings: measured once per setting on the bare gripper
+    (:func:`~regrasp.robot.grip.pad_state`; the linkage lifts the pads as it closes: 0.139 m at
+    60 mm, 0.144 m at 20 mm)."""
     from .grip import pad_state
 
-    return pad_state(grasp_width, robot_name)[2]
+    return pad_state(grasp_width, robot_name, pads, pad_friction, contact)[2]

@@ -16,6 +16,7 @@ from ..extras import need
 FACE_Y = -0.0066  # m
 HALF_WIDTH = 0.011  # m
 LENGTH = 0.0375  # m
+PAD_FRICTION = 0.5  # the pads' default Coulomb friction (and a held test object's, robot.creep)
 
 
 @dataclass(frozen=True)
