@@ -300,6 +300,24 @@ def test_tracking_a_joint_trajectory():
     assert t.max_error < 0.005 and t.tcp_error < 0.002, t
     # independent: the arm ends where the trajectory ends
     assert np.allclose(r.data.qpos[r.arm_qpos], qs[-1], atol=1e-3)
+    # no teleport: a trajectory that starts elsewhere is refused, and the arm has not moved
+    before = r.data.qpos.copy()
+    with pytest.raises(ArgumentError) as e:
+        track(r, [0.0, 1.0], qs[:2])
+    assert e.value.field == "qs[0]" and "shoulder_pan_joint" in str(e.value)
+    assert np.array_equal(r.data.qpos, before)
+
+
+def test_smooth_eases_long_segments_and_is_linear_on_short_ones():
+    """A 1 s segment sampled every 10 ms follows smoothstep (zero speed at its ends); a segment
+    shorter than the spacing keeps only its waypoints (linear)."""
+    from regrasp.robot.tracking import smooth
+
+    t, q = smooth([0.0, 1.0], np.array([np.zeros(6), np.ones(6)]), 0.01)
+    s = t / 1.0
+    assert np.allclose(q[:, 0], s * s * (3 - 2 * s)) and q[1, 0] < 0.01 * 0.01 * 3.01
+    t, q = smooth([0.0, 0.005], np.array([np.zeros(6), np.ones(6)]), 0.01)
+    assert np.allclose(t, [0.0, 0.005]) and np.allclose(q[:, 0], [0.0, 1.0])
 
 
 @pytest.mark.parametrize("field, kwargs", [("grip_force", {"grip_force": -1.0}), ("mass", {"grip_force": 1.0, "mass": 0.0}),

@@ -12,6 +12,9 @@ import numpy as np
 from ..errors import ArgumentError
 from ..extras import need
 
+START_TOLERANCE = 0.005  # rad, the largest joint error between the arm now and a trajectory's start
+SAMPLE = 0.01  # s, the eased reference's sample spacing
+
 
 @dataclass(frozen=True)
 class Tracking:
@@ -37,8 +40,9 @@ def reference(times, qs, t: float) -> tuple:
 
 def smooth(times, qs, dt: float) -> tuple:
     """The joint trajectory through ``qs`` (n, 6) [rad] at ``times`` (n,) [s] resampled every
-    ``dt`` [s] with each segment eased (smoothstep: zero speed at every waypoint), as
-    (times, qs)."""
+    ``dt`` [s] or less with each segment eased (smoothstep: zero speed at every waypoint), as
+    (times, qs). A segment of ``dt`` or shorter gets no inner sample: :func:`reference` is then
+    linear across it (no easing; the waypoints of a densely sampled path are passed at speed)."""
     times, qs = np.asarray(times, float), np.asarray(qs, float)
     out_t, out_q = [], []
     for i in range(len(times) - 1):
@@ -58,7 +62,9 @@ def track(robot, times, qs, settle: float = 0.5, grip=None) -> Tracking:
     eased between waypoints, :func:`smooth`) from ``qs[0]``, then ``settle`` [s] more, under
     position control (the trajectory's clock starts now, at ``times[0]``), and measures the :class:`Tracking` errors (against the eased reference).
     ``grip``: a :class:`~regrasp.robot.grip.GripController` updated every step (an object held
-    meanwhile)."""
+    meanwhile). The arm must already be at ``qs[0]`` (within ``START_TOLERANCE``): it is never
+    teleported there (that would leave a held object behind); else an ArgumentError naming
+    ``qs[0]`` and the start error (move there first, e.g. with a track from ``robot.q``)."""
     mujoco = need("mujoco", "robot")
     times, qs = np.asarray(times, float), np.asarray(qs, float)
     if times.ndim != 1 or len(times) < 2 or np.any(np.diff(times) <= 0):
@@ -66,9 +72,13 @@ def track(robot, times, qs, settle: float = 0.5, grip=None) -> Tracking:
     if qs.shape != (len(times), len(robot.arm_qpos)):
         raise ArgumentError(f"invalid `qs`: shape ({len(times)}, {len(robot.arm_qpos)}) [rad] (got {qs.shape})", "qs")
     m, d = robot.model, robot.data
-    ref_t, ref_q = smooth(times, qs, 0.01)
-    if np.max(np.abs(robot.q - qs[0])) > 1e-6:
-        robot.set_q(qs[0])
+    start_error = np.abs(robot.q - qs[0])
+    if start_error.max() > START_TOLERANCE:
+        j = int(np.argmax(start_error))
+        raise ArgumentError(f"invalid `qs[0]`: the arm is {start_error[j]:.4f} rad from it at joint "
+                            f"{robot.arm_joints[j]} (more than {START_TOLERANCE} rad; move there first: "
+                            f"track from robot.q)", "qs[0]")
+    ref_t, ref_q = smooth(times, qs, SAMPLE)
     kp = m.actuator_gainprm[robot.arm_actuators, 0]
     kv = -m.actuator_biasprm[robot.arm_actuators, 2]
     errs, tcp_err = [], 0.0
