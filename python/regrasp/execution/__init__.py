@@ -8,6 +8,7 @@ executes the plan (:mod:`~regrasp.execution.world_motion`)::
 """
 
 from .assignment import Assignment, PusherContact, assign, pusher_contact
+from .trajectory import PushRecord, Trajectory
 from .world_motion import Timing, WorldMotion, world_motion
 
-__all__ = ["Assignment", "PusherContact", "Timing", "WorldMotion", "assign", "pusher_contact", "world_motion"]
+__all__ = ["Assignment", "PusherContact", "PushRecord", "Timing", "Trajectory", "WorldMotion", "assign", "pusher_contact", "world_motion"]

@@ -75,7 +75,7 @@ class WorldMotion:
     ``penetration`` [m] per push: how far the object's points (:func:`edge_points`) go behind
     the feature's contact plane (within a face's rectangle) during the push (0 for a sticking push of a convex object; a
     plan whose object turns against its pusher, e.g. a pivot on a patch, can go through a face
-    larger than the patch)."""
+    larger than the patch); ``scene``: the scene's name."""
     times: np.ndarray
     gripper: np.ndarray
     object: np.ndarray
@@ -89,11 +89,23 @@ class WorldMotion:
     workcell: Workcell
     timing: Timing = field(default_factory=Timing)
     penetration: list = field(default_factory=list)
+    scene: str = ""
 
     @property
     def duration(self) -> float:
         """The motion's duration [s]."""
         return float(self.times[-1])
+
+    def to_trajectory(self):
+        """The motion as a :class:`~regrasp.execution.trajectory.Trajectory` of a free gripper
+        (robot None, no joints), for the trajectory file (docs/trajectory-file.md)."""
+        from .trajectory import PushRecord, Trajectory
+
+        return Trajectory(self.scene or "scene", self.workcell.name, None, [], self.times.copy(),
+                          np.zeros((len(self.times), 0)), self.gripper.copy(), self.grip_force.copy(),
+                          list(self.labels), self.push.copy(),
+                          [PushRecord(a.pusher, a.feature, a.first, a.last, a.frame.copy(), a.tilt, d)
+                           for a, d in zip(self.assignments, self.penetration)])
 
     def to_dict(self) -> dict:
         """The motion as JSON-ready lists: per-sample arrays, and per push its pusher, feature,
@@ -294,7 +306,7 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
                 f"{PENETRATION_LIMIT * 1e3:g} mm (a smaller feature, e.g. a face just larger than the pusher, "
                 f"lets it pivot)", f"plan.path[{a.first + 1}].pusher")
     return WorldMotion(np.array(S["t"][:len(G)]), G, W, Oh, labels, push, np.full(len(G), force), assignments,
-                       knots, float(safe), workcell, timing, depth)
+                       knots, float(safe), workcell, timing, depth, scene.name)
 
 
 def _behind(pts, extent) -> float:
