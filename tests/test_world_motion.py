@@ -277,9 +277,20 @@ def test_any_fixture_block_either_renders_the_plan_exactly_or_refuses_naming_the
     try:
         m = world_motion(scene, plan, w)
     except ArgumentError as e:
-        # a horizontal edge would turn gravity by 90°: only the block's vertical edges serve
-        assert e.field.startswith("plan.path[") and "no feature" in str(e) and "`left`" in str(e)
-        assert height < longest
+        assert e.field.startswith("plan.path[") and "`left`" in str(e)
+        if "no feature" in str(e):
+            # a horizontal edge would turn gravity by 90°: only the block's vertical edges serve
+            assert height < longest
+            return
+        # the object would go below the table: the same block 1 m higher renders the push with
+        # the object lower than 1 m above the table top (checked with 4 x 4 matrices)
+        assert "below the table top" in str(e) and height >= longest
+        high = Feature("fixture", "block", block.pose + [0, 0, 1, 0, 0, 0, 0], 0.9, [side, side, height])
+        m = world_motion(scene, plan, Workcell("w", w.table, (high,), w.robot))
+        a = next(a for a in m.assignments if a.pusher == "left")
+        pts = np.c_[object_points(scene), np.ones(len(object_points(scene)))].T
+        low = min((T(m.object[j]) @ pts)[2].min() for j in np.flatnonzero(m.push == a.index))
+        assert low - 1.0 < 0.75 - PENETRATION_LIMIT
         return
     assert height >= longest
     for a in m.assignments:
@@ -332,12 +343,19 @@ def test_max_tilt_refuses_pushes_that_would_turn_gravity():
     assert [(a.pusher, a.feature) for a in world_motion(scene, plan).assignments][0] == ("top", "ledge")
     assert all(a.tilt <= MAX_TILT for a in world_motion(scene, plan).assignments)
     no_ledge = Workcell("no-ledge", cell.table, tuple(f for f in cell.features if f.name != "ledge"), cell.robot)
-    with pytest.raises(ArgumentError) as e:              # the default max_tilt refuses the block's edge
-        world_motion(scene, plan, no_ledge)
-    assert "`top`" in str(e.value) and "max_tilt 10.0°" in str(e.value)
+    # without it, the raised block's underside edges push down, 45° less the edge cone off vertical
+    under = world_motion(scene, plan, no_ledge).assignments[0]
+    assert under.pusher == "top" and under.tilt == pytest.approx(np.radians(5.0), abs=1e-6)
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, plan, no_ledge, max_tilt=np.radians(4.0))
+    assert "`top`" in str(e.value) and "max_tilt 4.0°" in str(e.value)
+    # a tall block standing on the table offers no underside edge: nothing pushes down
+    f = cell.feature("fixture")
+    tall = Feature("fixture", "block", [*f.pose[:2], 0.75 + 0.2, 1, 0, 0, 0], f.friction, [f.size[0], f.size[1], 0.4])
+    no_ledge = Workcell("tall", cell.table, (tall,), cell.robot)
     m = world_motion(scene, plan, no_ledge, max_tilt=np.pi)
     worst = max(m.assignments, key=lambda a: a.tilt)
-    assert worst.pusher == "top" and worst.tilt > np.radians(80)   # nothing else pushes down
+    assert worst.pusher == "top" and worst.tilt > np.radians(80)
     with pytest.raises(ArgumentError) as e:
         world_motion(scene, plan, no_ledge, max_tilt=np.radians(45))
     assert "`top`" in str(e.value) and "max_tilt" in str(e.value)

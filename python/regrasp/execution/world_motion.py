@@ -17,7 +17,8 @@ gripper origin), over (the switch-over's turn is made there) and down to the nex
 feature that pushes downward (a ledge), the transfers go down and up beside it, moved
 horizontally across the feature by twice the object's reach and the clearance.
 
-A push whose object goes deeper than :data:`PENETRATION_LIMIT` into its feature (its points
+A push whose object goes below the table top (during its approach, push or retreat) is refused,
+naming the push, as is one whose object goes deeper than :data:`PENETRATION_LIMIT` into its feature (its points
 along its edges, :func:`edge_points`, behind the contact plane, within a face's rectangle) is
 refused, naming the push."""
 
@@ -299,6 +300,13 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
         js = [j for j in np.flatnonzero(push == a.index) if labels[j] == "push"]
         rel = P.compose_rows(np.repeat(P.inverse(a.frame)[None], len(js), axis=0), W[js])
         depth.append(max(0.0, -min(_behind(P.transform(r, pts), extents[a.feature]) for r in rel)))
+        near = np.flatnonzero(push == a.index)
+        low = min(float(P.transform(W[j], pts)[:, 2].min()) for j in near) - workcell.table.height
+        if low < -PENETRATION_LIMIT and a.feature != "table":
+            raise ArgumentError(
+                f"push {a.index} (pusher `{a.pusher}`, plan path[{a.first}] to path[{a.last}]): the object goes "
+                f"{-low * 1e3:.1f} mm below the table top of workcell `{workcell.name}` at feature `{a.feature}` "
+                f"(a feature higher above the table serves it)", f"plan.path[{a.first + 1}].pusher")
         if depth[-1] > PENETRATION_LIMIT:
             raise ArgumentError(
                 f"push {a.index} (pusher `{a.pusher}`, plan path[{a.first}] to path[{a.last}]): the object goes "

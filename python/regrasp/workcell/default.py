@@ -1,5 +1,5 @@
 """The default workcell of a scene, used when none is given: a table with the robot on it, a
-fixture block beside the robot that offers every pusher of the scene a contact (a block edge at
+fixture block (raised on a post) beside the robot that offers every pusher of the scene a contact (a block edge at
 least as long as each line pusher, block corners for point pushers, block faces for patches; the
 table top for planes and pushers from below), a ledge (a horizontal edge high above the table
 that pushes downward, so a pusher that pushes the object along the scene's gravity needs no
@@ -22,6 +22,9 @@ TABLE_SIZE = (1.2, 0.8)
 TABLE_CENTER = (0.5, 0.0)
 ROBOT = "ur5e"
 BLOCK_CENTER = (0.5, 0.25)
+#: How high [m] above the table top the block's underside is (it stands on a post, not
+#: modelled), so that an object pushed against its side edges stays clear of the table.
+BLOCK_LIFT = 0.1
 BLOCK_SIDE = 0.1
 BLOCK_MARGIN = 1.5
 FRICTION = 0.5
@@ -78,7 +81,7 @@ def default_workcell(scene) -> Workcell:
     side = max(BLOCK_SIDE, BLOCK_MARGIN * size)
     friction = max(FRICTION, mu)
     table = Table(TABLE_HEIGHT, list(TABLE_SIZE), friction, list(TABLE_CENTER))
-    block = Feature("fixture", "block", [*BLOCK_CENTER, TABLE_HEIGHT + side / 2, 1.0, 0.0, 0.0, 0.0], friction,
+    block = Feature("fixture", "block", [*BLOCK_CENTER, TABLE_HEIGHT + BLOCK_LIFT + side / 2, 1.0, 0.0, 0.0, 0.0], friction,
                     [side] * 3)
     ledge = Feature("ledge", "edge", [*LEDGE_CENTER, TABLE_HEIGHT + LEDGE_HEIGHT, 0.0, 1.0, 0.0, 0.0], friction,
                     length=side, index=1)
