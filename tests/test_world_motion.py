@@ -5,7 +5,7 @@ import time
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.linalg import expm
 
@@ -267,6 +267,8 @@ def test_time_to_turn_a_plan_into_a_world_trajectory():
 
 @settings(max_examples=25, deadline=None)
 @given(st.floats(-np.pi, np.pi), st.floats(0.02, 0.2), st.floats(-0.3, 0.3), st.floats(0.02, 0.2))
+@example(0.0, 0.125, 0.0, 0.0625)                  # the object would go below the table top
+@example(0.0, 0.125, 0.0, 0.03)                    # the edges too short
 def test_any_fixture_block_either_renders_the_plan_exactly_or_refuses_naming_the_push(yaw, side, y, height):
     scene, plan = plan_of("block-low-friction")
     block = Feature("fixture", "block", [0.5, y, 0.75 + height / 2, np.cos(yaw / 2), 0, 0, np.sin(yaw / 2)], 0.9,
