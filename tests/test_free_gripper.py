@@ -108,6 +108,14 @@ def test_the_workcell_is_in_the_model_where_the_file_says():
     assert dist == pytest.approx(FEATURE_RADIUS, abs=1e-9) and model.geom_size[g][1] == pytest.approx(ledge.length / 2)
     assert np.isclose(abs(axis @ rot(ledge.pose[3:])[:, 0]), 1)
     assert model.opt.gravity[2] < 0 and np.allclose(model.opt.gravity[:2], 0)
+    # the block edge that renders `bar-right` has a capsule whose surface touches the contact point
+    a = next(a for a in m.assignments if a.pusher == "bar-right")
+    g = model.geom(f"{a.feature}-push{a.index}").id
+    axis = data.geom_xmat[g].reshape(3, 3)[:, 2]
+    off = a.frame[:3] - data.geom_xpos[g]
+    assert np.linalg.norm(off - (off @ axis) * axis) == pytest.approx(FEATURE_RADIUS, abs=1e-9)
+    assert np.isclose(abs(axis @ rot(a.frame[3:])[:, 0]), 1)
+    assert (off / np.linalg.norm(off)) @ rot(a.frame[3:])[:, 2] == pytest.approx(1)   # behind it
 
 
 def test_bad_arguments_are_refused_naming_them():

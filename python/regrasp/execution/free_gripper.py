@@ -5,7 +5,9 @@ The model (``mujoco.MjSpec``): world gravity along −z (the scene's magnitude);
 whose top is the table top) and every workcell feature as fixed geoms with the workcell's
 friction — a block as its box, an edge as a capsule of radius :data:`FEATURE_RADIUS` along it
 and a corner as a sphere of that radius, both just behind the contact, a face as a plate
-:data:`PLATE_DEPTH` thick behind it; the object and the pads of ``regrasp.mujoco`` (the planar
+:data:`PLATE_DEPTH` thick behind it; a block edge that renders a push also gets such a capsule,
+just behind the push's contact frame (MuJoCo's box-edge contact with a face lets a sticking line
+push slip: block-high-friction slips 1.6 mm down a bare box edge and holds on the capsule); the object and the pads of ``regrasp.mujoco`` (the planar
 model's pads and lamina for a planar scene, the 3-D model's pads and object otherwise), the pads
 on a driven 6-DoF gripper body (``regrasp.mujoco.model.add_driven_body``) squeezed with the
 motion's grip force. The object starts in the hand at the motion's first world pose; the
@@ -93,6 +95,15 @@ def build(scene, motion: WorldMotion, workcell: Workcell | None = None):
         g = float(np.linalg.norm(scene._core.gravity))
     spec = M.new_spec(f"{scene.name}-free-gripper", [0.0, 0.0, -g], M.Contact())
     add_workcell_geoms(spec, workcell)
+    names = {f.name for f in workcell.features}
+    lengths = {c.name: c.length for c in workcell.contacts()}
+    for a in motion.assignments:
+        if ".edges[" in a.feature and a.feature.split(".")[0] in names and a.feature in lengths:
+            x = P.quat_rotate(a.frame[3:], [lengths[a.feature] / 2, 0.0, 0])
+            c = a.frame[:3] - P.quat_rotate(a.frame[3:], [0.0, 0, 1]) * FEATURE_RADIUS
+            mu = workcell.feature(a.feature.split(".")[0]).friction
+            M.add_geom(spec.worldbody, "capsule", [FEATURE_RADIUS], M.FEATURE_BITS, [mu], name=f"{a.feature}-push{a.index}",
+                       fromto=np.r_[c - x, c + x], condim=3)
     gripper = M.add_driven_body(spec.worldbody, "gripper", spatial=True)
     if scene.dimension == 2:
         M.add_object(spec, scene, [0.0, 0.0, 0.0])
