@@ -174,7 +174,7 @@ def test_default_workcell_serves_every_pusher(name):
         scene.task[0] if scene.dimension == 3 else np.zeros(3))
     contacts = {c.name: c for c in w.contacts()}
     for p in scene.pusher_names:
-        (a,) = assign(scene, [start, start], [None, p], w)
+        (a,) = assign(scene, [start, start], [None, p], w, max_tilt=np.pi)  # kinds and sizes; tilt: test_world_motion
         c, pc = contacts[a.feature], pusher_contact(scene, p, start)
         # independent check of the kinds and sizes from the scene's own pusher points
         pts = (np.asarray(scene.pusher(p).points) if scene.dimension == 2

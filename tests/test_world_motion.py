@@ -5,14 +5,15 @@ import time
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.linalg import expm
 
 import regrasp
 from regrasp import ArgumentError, Plan
 from regrasp.execution import Timing, world_motion
-from regrasp.execution.world_motion import LABELS, object_points
+from regrasp.execution.assignment import MAX_TILT
+from regrasp.execution.world_motion import LABELS, PENETRATION_LIMIT, edge_points, object_points
 from regrasp.workcell import Table, Workcell, default_workcell
 from regrasp.workcell.description import Feature, Robot
 
@@ -96,12 +97,18 @@ def pusher_matrices(scene, plan, a):
 
 
 CASES = ["block-low-friction", "t-shape", "block-tilted-gripper", "pivot-3d", "ball-roll-3d", "offset-3d"]
+# block-tilted-gripper's gravity is 30° off its pushers' normals: rendered only with any tilt allowed
+TILT = {"block-tilted-gripper": np.pi}
+
+
+def motion(name, **kw):
+    scene, plan = plan_of(name)
+    return scene, plan, world_motion(scene, plan, **({"max_tilt": TILT[name]} if name in TILT else {}) | kw)
 
 
 @pytest.mark.parametrize("name", CASES)
 def test_gripper_renders_the_plan_with_the_fixed_feature(name):
-    scene, plan = plan_of(name)
-    m = world_motion(scene, plan)
+    scene, plan, m = motion(name)
     contacts = {c.name: c for c in m.workcell.contacts()}
     assert [(a.first, a.last) for a in m.assignments][0][0] == 0
     assert m.assignments[-1].last == len(plan.poses) - 1
@@ -132,7 +139,7 @@ def test_gripper_renders_the_plan_with_the_fixed_feature(name):
 def test_the_motion_is_continuous_timed_and_held(name):
     scene, plan = plan_of(name)
     tm = Timing()
-    m = world_motion(scene, plan, timing=tm)
+    scene, plan, m = motion(name, timing=tm)
     n = len(m.times)
     assert m.gripper.shape == m.object.shape == m.in_hand.shape == (n, 7) and len(m.labels) == n
     assert set(m.labels) <= set(LABELS) and m.labels[0] == "start" and m.labels.count("start") == 1
@@ -154,7 +161,7 @@ def test_the_motion_is_continuous_timed_and_held(name):
     assert len(json["times"]) == n and json["duration_s"] == m.duration > 0
 
 
-@pytest.mark.parametrize("name", ["block-low-friction", "pivot-3d"])
+@pytest.mark.parametrize("name", ["block-low-friction", "pivot-3d", "t-shape"])
 def test_approach_retreat_and_transfers_clear_the_features(name):
     scene, plan = plan_of(name)
     tm = Timing(clearance=0.03)
@@ -260,6 +267,8 @@ def test_time_to_turn_a_plan_into_a_world_trajectory():
 
 @settings(max_examples=25, deadline=None)
 @given(st.floats(-np.pi, np.pi), st.floats(0.02, 0.2), st.floats(-0.3, 0.3), st.floats(0.02, 0.2))
+@example(0.0, 0.125, 0.0, 0.0625)                  # the object would go below the table top
+@example(0.0, 0.125, 0.0, 0.03)                    # the edges too short
 def test_any_fixture_block_either_renders_the_plan_exactly_or_refuses_naming_the_push(yaw, side, y, height):
     scene, plan = plan_of("block-low-friction")
     block = Feature("fixture", "block", [0.5, y, 0.75 + height / 2, np.cos(yaw / 2), 0, 0, np.sin(yaw / 2)], 0.9,
@@ -270,10 +279,22 @@ def test_any_fixture_block_either_renders_the_plan_exactly_or_refuses_naming_the
     try:
         m = world_motion(scene, plan, w)
     except ArgumentError as e:
-        assert e.field.startswith("plan.path[") and "no feature" in str(e) and "`left`" in str(e)
-        assert max(side, height) < longest
+        assert e.field.startswith("plan.path[") and "`left`" in str(e)
+        if "no feature" in str(e):
+            # a horizontal edge would turn gravity by 90°: only the block's vertical edges serve
+            assert height < longest
+            return
+        # the object would go below the table: the same block 1 m higher renders the push with
+        # the object lower than 1 m above the table top (checked with 4 x 4 matrices)
+        assert "below the table top" in str(e) and height >= longest
+        high = Feature("fixture", "block", block.pose + [0, 0, 1, 0, 0, 0, 0], 0.9, [side, side, height])
+        m = world_motion(scene, plan, Workcell("w", w.table, (high,), w.robot))
+        a = next(a for a in m.assignments if a.pusher == "left")
+        pts = np.c_[object_points(scene), np.ones(len(object_points(scene)))].T
+        low = min((T(m.object[j]) @ pts)[2].min() for j in np.flatnonzero(m.push == a.index))
+        assert low - 1.0 < 0.75 - PENETRATION_LIMIT
         return
-    assert max(side, height) >= longest
+    assert height >= longest
     for a in m.assignments:
         F = T(a.frame)
         for k, Pk in pusher_matrices(scene, plan, a).items():
@@ -299,8 +320,7 @@ def test_bad_arguments_give_errors_naming_them(arg, value):
 @pytest.mark.parametrize("name, most", [("pivot-single-3d", np.radians(5.0)), ("offset-3d", 1e-9),
                                         ("block-tilted-gripper", np.pi)])
 def test_gravity_tilt_is_reported_and_kept_small_by_the_edge_cone(name, most):
-    scene, plan = plan_of(name)
-    m = world_motion(scene, plan)
+    scene, plan, m = motion(name)
     g = scene._core.gravity if scene.dimension == 3 else [scene.gravity[0][0], 0, scene.gravity[0][1]]
     g = np.asarray(g) / np.linalg.norm(g)
     for a in m.assignments:
@@ -320,14 +340,29 @@ def test_gravity_tilt_is_reported_and_kept_small_by_the_edge_cone(name, most):
 
 def test_max_tilt_refuses_pushes_that_would_turn_gravity():
     scene, plan = plan_of("t-shape")
-    m = world_motion(scene, plan)
-    worst = max(m.assignments, key=lambda a: a.tilt)
-    assert worst.pusher == "top" and worst.tilt > np.radians(80)   # nothing pushes down in the default cell
+    cell = default_workcell(scene)
+    # the default cell's ledge pushes t-shape's `top` down: no tilt
+    assert [(a.pusher, a.feature) for a in world_motion(scene, plan).assignments][0] == ("top", "ledge")
+    assert all(a.tilt <= MAX_TILT for a in world_motion(scene, plan).assignments)
+    no_ledge = Workcell("no-ledge", cell.table, tuple(f for f in cell.features if f.name != "ledge"), cell.robot)
+    # without it, the raised block's underside edges push down, 45° less the edge cone off vertical
+    under = world_motion(scene, plan, no_ledge).assignments[0]
+    assert under.pusher == "top" and under.tilt == pytest.approx(np.radians(5.0), abs=1e-6)
     with pytest.raises(ArgumentError) as e:
-        world_motion(scene, plan, max_tilt=np.radians(45))
+        world_motion(scene, plan, no_ledge, max_tilt=np.radians(4.0))
+    assert "`top`" in str(e.value) and "max_tilt 4.0°" in str(e.value)
+    # a tall block standing on the table offers no underside edge: nothing pushes down
+    f = cell.feature("fixture")
+    tall = Feature("fixture", "block", [*f.pose[:2], 0.75 + 0.2, 1, 0, 0, 0], f.friction, [f.size[0], f.size[1], 0.4])
+    no_ledge = Workcell("tall", cell.table, (tall,), cell.robot)
+    m = world_motion(scene, plan, no_ledge, max_tilt=np.pi)
+    worst = max(m.assignments, key=lambda a: a.tilt)
+    assert worst.pusher == "top" and worst.tilt > np.radians(80)
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, plan, no_ledge, max_tilt=np.radians(45))
     assert "`top`" in str(e.value) and "max_tilt" in str(e.value)
     assert e.value.field == f"plan.path[{worst.first + 1}].pusher"
-    ok = world_motion(scene, plan, max_tilt=worst.tilt + 1e-9)
+    ok = world_motion(scene, plan, no_ledge, max_tilt=worst.tilt + 1e-9)
     assert [a.feature for a in ok.assignments] == [a.feature for a in m.assignments]
     with pytest.raises(ArgumentError) as e:
         world_motion(scene, plan, max_tilt=-1.0)
@@ -341,14 +376,23 @@ def test_the_object_meets_the_feature_and_its_penetration_is_measured(name):
     is 0 when every step of the push sticks (the pusher moves with the object)."""
     scene, plan = plan_of(name)
     m = world_motion(scene, plan)
-    pts = object_points(scene)
+    pts = edge_points(scene)
+    assert len(pts) > len(object_points(scene))
     labels = np.array(m.labels)
+    contacts = {c.name: c for c in m.workcell.contacts()}
     for a, reported in zip(m.assignments, m.penetration):
         F = T(a.frame)
+        c = contacts[a.feature]
         deepest = 0.0
         for j in np.flatnonzero((m.push == a.index) & (labels == "push")):
             local = (np.linalg.inv(F) @ T(m.object[j]) @ np.c_[pts, np.ones(len(pts))].T)[:3]
-            deepest = max(deepest, -local[2].min())
+            if c.kind == "face":            # only points over the face's rectangle (turned by phi)
+                r = np.linalg.norm(local[:2], axis=0)
+                ang = np.arctan2(local[1], local[0]) + np.arctan2(*(np.linalg.inv(T(c.frame)) @ F)[[1, 0], 0])
+                inside = (np.abs(r * np.cos(ang)) <= c.extent[0] + 1e-9) & (np.abs(r * np.sin(ang)) <= c.extent[1] + 1e-9)
+                local = local[:, inside]
+            if local.shape[1]:
+                deepest = max(deepest, -local[2].min())
         assert reported == pytest.approx(deepest, abs=1e-12)
         sticks = all(plan.dimension == 2 or plan.pusher_twists[k] is None or np.allclose(
             plan.pusher_twists[k], regrasp.pose.twist_between(plan.poses[k - 1], plan.poses[k]), atol=1e-9)
@@ -366,5 +410,39 @@ def test_the_object_meets_the_feature_and_its_penetration_is_measured(name):
             local = (np.linalg.inv(F) @ T(m.object[j]) @ np.c_[pp, np.ones(len(pp))].T)[:3]
             if sticks or k == a.first:
                 assert np.abs(local[2]).max() < 1e-9
-    if name == "pivot-3d":                 # the pivot turns the object against its patch pusher
-        assert max(m.penetration) > 1e-4
+    if name == "pivot-3d":                 # the pivot swings the object past the small plate
+        assert m.assignments[0].feature == "plate" and m.penetration[0] < PENETRATION_LIMIT
+
+
+def test_a_push_through_a_large_face_is_refused_naming_it():
+    """pivot-3d turns its object about its patch pusher: on the fixture block's 10 cm face (the
+    plate removed) the object would go 1.45 mm into the block."""
+    scene, plan = plan_of("pivot-3d")
+    cell = default_workcell(scene)
+    plate = cell.feature("plate")
+    assert plate.size[0] < 0.05                          # sized to the patch, not the block
+    no_plate = Workcell("no-plate", cell.table, tuple(f for f in cell.features if f.name != "plate"), cell.robot)
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, plan, no_plate)
+    assert "`corner`" in str(e.value) and "mm into feature `fixture.faces" in str(e.value)
+    assert e.value.field == "plan.path[1].pusher"
+
+
+def test_under_the_ledge_transfers_go_beside_it():
+    """t-shape's `top` is pushed down by the ledge: the object reaches under it from the side, and
+    no transfer sample puts the object across the ledge's edge line (checked in the edge's frame)."""
+    scene, plan = plan_of("t-shape")
+    m = world_motion(scene, plan)
+    ledge = m.workcell.feature("ledge")
+    Linv = np.linalg.inv(T(ledge.pose))
+    pts = np.c_[object_points(scene), np.ones(len(object_points(scene)))].T
+    labels = np.array(m.labels)
+    crossed = 0
+    for j in np.flatnonzero(labels != "push"):
+        local = (Linv @ T(m.object[j]) @ pts)[:3]
+        over = local[0].max() > -ledge.length / 2 and local[0].min() < ledge.length / 2
+        if over and local[1].min() < 0 < local[1].max() and local[2].min() < 0 < local[2].max():
+            crossed += 1
+    assert crossed == 0
+    a = m.assignments[0]
+    assert a.feature == "ledge" and rot(a.frame[3:])[2, 2] == pytest.approx(-1)   # pushing down

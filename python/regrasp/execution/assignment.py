@@ -12,9 +12,10 @@ direction it pushes the object) and +x along a line pusher's segment. A feature'
   its points;
 * the feature's friction is at least the pusher's (the plan's sticking relies on it).
 
-Among the contacts that serve it, the one that keeps the scene's gravity (fixed in the gripper
-frame) closest to the world's −z at the push's start wins (ties: the first in
-:meth:`Workcell.contacts` order); the contact frame's free turn about its +z (a corner's or a
+A contact serves only when it keeps the scene's gravity (fixed in the gripper frame, as the
+plan's mechanics assumed it) within ``max_tilt`` (default :data:`MAX_TILT`) of the world's −z at
+the push's start. Among the contacts that serve it, the one that keeps gravity closest wins
+(ties: for a patch the smaller face, then the first in :meth:`Workcell.contacts` order); the contact frame's free turn about its +z (a corner's or a
 face's any angle, an edge's half turn) is chosen for the same reason. When none serves a push,
 an ArgumentError names the push (its index, pusher and the plan's path entries) and why."""
 
@@ -33,6 +34,9 @@ FIT_TOL = 1e-9
 #: What each kind of pusher needs (for error messages).
 NEEDS = {"point": "a corner", "line": "an edge at least as long as it (or, pushing from below, a face)",
          "patch": "a face that holds its points", "plane": "a face that holds its contact points"}
+#: The default most [rad] a push may turn the plan's gravity (fixed in the gripper frame) away
+#: from the world's −z: the plan's mechanics assumed the scene's gravity.
+MAX_TILT = float(np.radians(10.0))
 #: A line pusher pushes from below when its normal is within this angle [rad] of −gravity.
 FROM_BELOW = np.pi / 4
 
@@ -159,11 +163,12 @@ def serves(c: Contact, pc: PusherContact, phi: float = 0.0, from_below: bool = F
     return f"the face ({2 * c.extent[0]:g} x {2 * c.extent[1]:g} m) does not hold the pusher's points"
 
 
-def assign(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = np.pi) -> list[Assignment]:
+def assign(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = MAX_TILT) -> list[Assignment]:
     """The feature of ``workcell`` for each push of a plan (``poses``: the plan's path poses,
     planar (n, 3) (m, m, rad) or 3-D (n, 7) (m, quaternion); ``pushers``: its pusher names,
     ``pushers[0]`` None), by the rules of the module's doc; a contact that would turn the scene's
-    gravity more than ``max_tilt`` [rad] from the world's −z does not serve (default π: any).
+    gravity more than ``max_tilt`` [rad] from the world's −z does not serve (default
+    :data:`MAX_TILT`; π: any).
     ArgumentError (field ``plan.path[i].pusher``) when no feature serves a push."""
     if isinstance(max_tilt, bool) or not isinstance(max_tilt, (int, float)) or not 0 <= max_tilt <= np.pi:
         raise ArgumentError(f"invalid `max_tilt`: an angle in [0, pi] rad (got {max_tilt!r:.40})", "max_tilt")
@@ -189,8 +194,9 @@ def assign(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = np
                     reasons.setdefault("tilt", (c.name, f"the plan's gravity would be {np.degrees(tilt):.1f}° off the "
                                                         f"world's, more than max_tilt {np.degrees(max_tilt):.1f}°"))
                     continue
-                if best is None or tilt < best[0] - 1e-9:
-                    best = (tilt, c, F)
+                area = float(np.prod(c.extent)) if pc.kind == "patch" else 0.0
+                if best is None or tilt < best[0] - 1e-9 or (tilt < best[0] + 1e-9 and area < best[3]):
+                    best = (tilt, c, F, area)
         if best is None:
             why = "; ".join(f"{n}: {r}" for n, r in reasons.values()) or "the workcell offers no contact"
             raise ArgumentError(

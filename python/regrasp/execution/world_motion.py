@@ -13,7 +13,14 @@ otherwise the object's own twist, a sticking pusher): ``P(s) = O exp(s ξ) O⁻�
 Around each push: a transfer down to a pre-contact pose ``timing.clearance`` away from the
 feature along its push direction, the approach, the push, the retreat by the clearance, and a
 transfer up to the safe height (every feature's top + clearance + the object's reach from the
-gripper origin), over (the switch-over's turn is made there) and down to the next push."""
+gripper origin), over (the switch-over's turn is made there) and down to the next push. Under a
+feature that pushes downward (a ledge), the transfers go down and up beside it, moved
+horizontally across the feature by twice the object's reach and the clearance.
+
+A push whose object goes below the table top (during its approach, push or retreat) is refused,
+naming the push, as is one whose object goes deeper than :data:`PENETRATION_LIMIT` into its feature (its points
+along its edges, :func:`edge_points`, behind the contact plane, within a face's rectangle) is
+refused, naming the push."""
 
 from __future__ import annotations
 
@@ -26,8 +33,13 @@ from .. import pose as P
 from ..errors import ArgumentError
 from ..workcell.default import default_workcell
 from ..workcell.description import Workcell
-from .assignment import Assignment, assign
+from .assignment import MAX_TILT, Assignment, assign
 
+#: The deepest [m] the object may go into a feature during a push (the plan is rendered exactly
+#: only if it does not go through it).
+PENETRATION_LIMIT = 0.5e-3
+#: A feature pushes downward when its push direction is within this angle [rad] of the world's −z.
+DOWNWARD = np.pi / 3
 #: Sample labels, in the order a push meets them.
 LABELS = ("start", "transfer", "approach", "push", "retreat")
 
@@ -61,10 +73,10 @@ class WorldMotion:
     ``grip_force`` (n,) [N] per finger. ``assignments``: the feature of each push; ``knots``:
     ``(path index, sample index)`` of each plan knot of each push (a knot shared by two pushes
     appears once for each); ``safe_height`` [m] of transfers; ``workcell``; ``timing``;
-    ``penetration`` [m] per push: how far the object's points (:func:`object_points`) go behind
-    the feature's contact plane during the push (0 for a sticking push of a convex object; a
+    ``penetration`` [m] per push: how far the object's points (:func:`edge_points`) go behind
+    the feature's contact plane (within a face's rectangle) during the push (0 for a sticking push of a convex object; a
     plan whose object turns against its pusher, e.g. a pivot on a patch, can go through a face
-    larger than the patch)."""
+    larger than the patch); ``scene``: the scene's name."""
     times: np.ndarray
     gripper: np.ndarray
     object: np.ndarray
@@ -78,11 +90,23 @@ class WorldMotion:
     workcell: Workcell
     timing: Timing = field(default_factory=Timing)
     penetration: list = field(default_factory=list)
+    scene: str = ""
 
     @property
     def duration(self) -> float:
         """The motion's duration [s]."""
         return float(self.times[-1])
+
+    def to_trajectory(self):
+        """The motion as a :class:`~regrasp.execution.trajectory.Trajectory` of a free gripper
+        (robot None, no joints), for the trajectory file (docs/trajectory-file.md)."""
+        from .trajectory import PushRecord, Trajectory
+
+        return Trajectory(self.scene or "scene", self.workcell.name, None, [], self.times.copy(),
+                          np.zeros((len(self.times), 0)), self.gripper.copy(), self.grip_force.copy(),
+                          list(self.labels), self.push.copy(),
+                          [PushRecord(a.pusher, a.feature, a.first, a.last, a.frame.copy(), a.tilt, d)
+                           for a, d in zip(self.assignments, self.penetration)])
 
     def to_dict(self) -> dict:
         """The motion as JSON-ready lists: per-sample arrays, and per push its pusher, feature,
@@ -130,19 +154,49 @@ def object_points(scene) -> np.ndarray:
     return np.asarray(scene.mesh()[0], float)
 
 
+#: The spacing [m] of the points along the object's edges at which its penetration is measured.
+EDGE_SPACING = 1e-3
+
+
+def edge_points(scene) -> np.ndarray:
+    """Points (k, 3) [m] of the object in its frame along its edges, ``EDGE_SPACING`` apart: the
+    planar outline's sides (x-z plane), a mesh's triangle edges, a sphere's 3 great circles."""
+    if scene.dimension == 3 and scene._core.sphere is not None:
+        r = scene._core.sphere
+        a = np.linspace(0, 2 * np.pi, max(8, int(2 * np.pi * r / EDGE_SPACING)), endpoint=False)
+        c, s_ = r * np.cos(a), r * np.sin(a)
+        z = np.zeros_like(a)
+        return np.vstack([np.c_[c, s_, z], np.c_[c, z, s_], np.c_[z, c, s_]])
+    if scene.dimension == 2:
+        v = object_points(scene)
+        edges = [(v[i], v[(i + 1) % len(v)]) for i in range(len(v))]
+    else:
+        v, t = scene.mesh()
+        v, t = np.asarray(v, float), np.asarray(t, int)
+        edges = {tuple(sorted((int(a), int(b)))) for tri in t for a, b in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0]))}
+        edges = [(v[a], v[b]) for a, b in sorted(edges)]
+    out = [v]
+    for a, b in edges:
+        n = max(1, int(np.ceil(np.linalg.norm(b - a) / EDGE_SPACING)))
+        out.append(a + np.linspace(0, 1, n + 1)[:, None] * (b - a))
+    return np.vstack(out)
+
+
 def grip_force(scene) -> float:
     """The scene's grip force per finger [N]."""
     return float(scene.grip_force if scene.dimension == 2 else scene._core.grip_force)
 
 
 def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing = Timing(), start=None,
-                 max_tilt: float = np.pi) -> WorldMotion:
+                 max_tilt: float = MAX_TILT) -> WorldMotion:
     """The gripper's world motion executing ``plan`` (a :class:`~regrasp.Plan` of ``scene``) in
     ``workcell`` (default: :func:`~regrasp.workcell.default_workcell` of the scene), timed by
     ``timing``; ``start``: the gripper's world pose (m, unit quaternion) to begin from (default:
     above the first push's pre-contact pose, at the safe height); ``max_tilt`` [rad]: the most a
-    push may turn the plan's gravity from the world's (see :func:`~regrasp.execution.assign`).
-    ArgumentError naming the push when no feature serves it."""
+    push may turn the plan's gravity from the world's (default
+    :data:`~regrasp.execution.assignment.MAX_TILT`; see :func:`~regrasp.execution.assign`).
+    ArgumentError naming the push when no feature serves it or the object would go deeper than
+    :data:`PENETRATION_LIMIT` into its feature."""
     from ..scene.planar import Scene
     from ..scene.spatial import Scene3D
 
@@ -192,6 +246,16 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
     def lifted(G):
         return np.r_[G[:2], max(G[2], safe), G[3:]]
 
+    def beside(G, a):
+        """``G`` moved horizontally across a downward-pushing feature (None for other features)."""
+        z = P.quat_rotate(a.frame[3:], [0.0, 0, 1])
+        if z[2] > -np.cos(DOWNWARD):
+            return None
+        d = P.quat_rotate(a.frame[3:], [0.0, 1, 0])
+        d = np.r_[d[:2], 0.0]
+        d = d / np.linalg.norm(d) if np.linalg.norm(d) > 1e-9 else np.r_[1.0, 0, 0]
+        return np.r_[G[:3] + (2 * reach + timing.clearance) * d, G[3:]]
+
     knots = []
     for a in assignments:
         Pk = P.compose(O[a.first], a.contact.frame)
@@ -201,9 +265,10 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
         if not S["G"]:
             s0 = lifted(pre) if start is None else _check_start(start)
             S["G"].append(s0), S["O"].append(O[a.first]), S["label"].append("start"), S["push"].append(-1)
+        side = beside(pre, a)
         move(lifted(S["G"][-1]), O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
-        move(lifted(pre), O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
-        move(pre, O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
+        for to in ([lifted(pre)] if side is None else [lifted(side), side]) + [pre]:
+            move(to, O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
         move(G0, O[a.first], "approach", a.index, timing.push_speed, timing.push_turn)
         knots.append((a.first, len(S["G"]) - 1))
         for k in range(a.first + 1, a.last + 1):
@@ -220,18 +285,44 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
             knots.append((k, len(S["G"]) - 1))
         Gend = S["G"][-1]
         move(np.r_[Gend[:3] + away, Gend[3:]], O[a.last], "retreat", a.index, timing.push_speed, timing.push_turn)
+        side = beside(S["G"][-1], a)
+        if side is not None:
+            move(side, O[a.last], "transfer", -1, timing.move_speed, timing.move_turn)
     move(lifted(S["G"][-1]), O[-1], "transfer", -1, timing.move_speed, timing.move_turn)
 
     G, Oh = np.array(S["G"]), np.array(S["O"])
     W = P.compose_rows(G, Oh)
     labels, push = S["label"], np.array(S["push"], int)
+    pts = edge_points(scene)
     depth = []
+    extents = {c.name: c.extent for c in workcell.contacts()}
     for a in assignments:
         js = [j for j in np.flatnonzero(push == a.index) if labels[j] == "push"]
         rel = P.compose_rows(np.repeat(P.inverse(a.frame)[None], len(js), axis=0), W[js])
-        depth.append(max(0.0, -min(float(P.transform(r, pts)[:, 2].min()) for r in rel)))
+        depth.append(max(0.0, -min(_behind(P.transform(r, pts), extents[a.feature]) for r in rel)))
+        near = np.flatnonzero(push == a.index)
+        low = min(float(P.transform(W[j], pts)[:, 2].min()) for j in near) - workcell.table.height
+        if low < -PENETRATION_LIMIT and a.feature != "table":
+            raise ArgumentError(
+                f"push {a.index} (pusher `{a.pusher}`, plan path[{a.first}] to path[{a.last}]): the object goes "
+                f"{-low * 1e3:.1f} mm below the table top of workcell `{workcell.name}` at feature `{a.feature}` "
+                f"(a feature higher above the table serves it)", f"plan.path[{a.first + 1}].pusher")
+        if depth[-1] > PENETRATION_LIMIT:
+            raise ArgumentError(
+                f"push {a.index} (pusher `{a.pusher}`, plan path[{a.first}] to path[{a.last}]): the object goes "
+                f"{depth[-1] * 1e3:.2f} mm into feature `{a.feature}` of workcell `{workcell.name}`, more than "
+                f"{PENETRATION_LIMIT * 1e3:g} mm (a smaller feature, e.g. a face just larger than the pusher, "
+                f"lets it pivot)", f"plan.path[{a.first + 1}].pusher")
     return WorldMotion(np.array(S["t"][:len(G)]), G, W, Oh, labels, push, np.full(len(G), force), assignments,
-                       knots, float(safe), workcell, timing, depth)
+                       knots, float(safe), workcell, timing, depth, scene.name)
+
+
+def _behind(pts, extent) -> float:
+    """The lowest z [m] of ``pts`` (k, 3) in a contact frame (0 when none is lower), counting
+    only those within a face's half-sizes ``extent`` (an edge's or corner's zeros: all)."""
+    if np.any(np.asarray(extent) > 0):
+        pts = pts[np.all(np.abs(pts[:, :2]) <= np.asarray(extent) + 1e-9, axis=1)]
+    return float(pts[:, 2].min()) if len(pts) else 0.0
 
 
 def _moved(O, xi, s: float, Pk) -> np.ndarray:

@@ -1,7 +1,10 @@
-"""The default workcell of a scene, used when none is given: a table with the robot on it and one
-fixture block beside the robot that offers every pusher of the scene a contact (a block edge at
+"""The default workcell of a scene, used when none is given: a table with the robot on it, a
+fixture block (raised on a post) beside the robot that offers every pusher of the scene a contact (a block edge at
 least as long as each line pusher, block corners for point pushers, block faces for patches; the
-table top for planes and pushers from below)."""
+table top for planes and pushers from below), a ledge (a horizontal edge high above the table
+that pushes downward, so a pusher that pushes the object along the scene's gravity needs no
+tilt) and a plate (a small face, just large enough for the scene's largest patch pusher, so an
+object pivoting on a patch does not swing into a larger face)."""
 
 from __future__ import annotations
 
@@ -19,9 +22,23 @@ TABLE_SIZE = (1.2, 0.8)
 TABLE_CENTER = (0.5, 0.0)
 ROBOT = "ur5e"
 BLOCK_CENTER = (0.5, 0.25)
+#: How high [m] above the table top the block's underside is (it stands on a post, not
+#: modelled), so that an object pushed against its side edges stays clear of the table.
+BLOCK_LIFT = 0.1
 BLOCK_SIDE = 0.1
 BLOCK_MARGIN = 1.5
 FRICTION = 0.5
+#: The ledge: its edge's centre [m] (world x-y), its height above the table top [m]; it runs
+#: along world x and pushes along world −z, its length as the block's side.
+LEDGE_CENTER = (0.5, -0.25)
+LEDGE_HEIGHT = 0.3
+#: The plate: its centre [m] (world x-y), height of its centre above the table [m]; it faces
+#: world +x and is square, its side ``PLATE_MARGIN`` [×] the largest patch's diameter (at least
+#: ``PLATE_MIN`` [m]).
+PLATE_CENTER = (0.75, 0.25)
+PLATE_HEIGHT = 0.15
+PLATE_MARGIN = 1.02
+PLATE_MIN = 0.005
 
 
 def pusher_extent(scene) -> tuple[float, float]:
@@ -39,6 +56,19 @@ def pusher_extent(scene) -> tuple[float, float]:
     return size, max(mu for _, mu in specs)
 
 
+def patch_extent(scene) -> float:
+    """The largest diameter [m] of a patch pusher of ``scene`` (3 or more contact points, planes
+    left out) about its points' centroid (twice the farthest point's distance); 0 without one."""
+    if scene.dimension == 2:
+        return 0.0
+    out = 0.0
+    for name in scene.pusher_names:
+        pts = np.asarray(scene._core.pusher_spec(name)[0], float)
+        if len(pts) >= 3 and not scene._core.is_plane(name):
+            out = max(out, 2 * float(np.max(np.linalg.norm(pts - pts.mean(axis=0), axis=1))))
+    return out
+
+
 def default_workcell(scene) -> Workcell:
     """The default workcell for ``scene`` (planar or 3-D; see the module's doc): named
     ``default-SCENE``, the object starting in the hand."""
@@ -51,8 +81,17 @@ def default_workcell(scene) -> Workcell:
     side = max(BLOCK_SIDE, BLOCK_MARGIN * size)
     friction = max(FRICTION, mu)
     table = Table(TABLE_HEIGHT, list(TABLE_SIZE), friction, list(TABLE_CENTER))
-    block = Feature("fixture", "block", [*BLOCK_CENTER, TABLE_HEIGHT + side / 2, 1.0, 0.0, 0.0, 0.0], friction,
+    block = Feature("fixture", "block", [*BLOCK_CENTER, TABLE_HEIGHT + BLOCK_LIFT + side / 2, 1.0, 0.0, 0.0, 0.0], friction,
                     [side] * 3)
+    ledge = Feature("ledge", "edge", [*LEDGE_CENTER, TABLE_HEIGHT + LEDGE_HEIGHT, 0.0, 1.0, 0.0, 0.0], friction,
+                    length=side, index=1)
+    features = [block, ledge]
+    patch = patch_extent(scene)
+    if patch > 0:
+        r = np.sqrt(0.5)  # the face's +z along world +x: a quarter turn about y
+        features.append(Feature("plate", "face", [*PLATE_CENTER, TABLE_HEIGHT + PLATE_HEIGHT, r, 0.0, r, 0.0], friction,
+                                [max(PLATE_MIN, PLATE_MARGIN * patch)] * 2, index=2))
     robot = Robot(ROBOT, [0.0, 0.0, TABLE_HEIGHT, 1.0, 0.0, 0.0, 0.0])
-    return Workcell(f"default-{scene.name}", table, (block,), robot, ObjectStart("hand"),
-                    f"generated for scene {scene.name}: a table and a fixture block")
+    return Workcell(f"default-{scene.name}", table, tuple(features), robot, ObjectStart("hand"),
+                    f"generated for scene {scene.name}: a table, a fixture block, a ledge"
+                    + (" and a plate" if patch > 0 else ""))

@@ -1,0 +1,193 @@
+"""A world motion (:func:`~regrasp.execution.world_motion`) executed in MuJoCo by a free-flying
+gripper in the workcell: the baseline the arm (``regrasp.robot``) is compared with.
+
+The model (``mujoco.MjSpec``): world gravity along −z (the scene's magnitude); the table (a box
+whose top is the table top) and every workcell feature as fixed geoms with the workcell's
+friction — a block as its box, an edge as a capsule of radius :data:`FEATURE_RADIUS` along it
+and a corner as a sphere of that radius, both just behind the contact, a face as a plate
+:data:`PLATE_DEPTH` thick behind it; a block edge that renders a push also gets such a capsule,
+just behind the push's contact frame (MuJoCo's box-edge contact with a face lets a sticking line
+push slip: block-high-friction slips 1.6 mm down a bare box edge and holds on the capsule); the object and the pads of ``regrasp.mujoco`` (the planar
+model's pads and lamina for a planar scene, the 3-D model's pads and object otherwise), the pads
+on a driven 6-DoF gripper body (``regrasp.mujoco.model.add_driven_body``) squeezed with the
+motion's grip force. The object starts in the hand at the motion's first world pose; the
+gripper follows the motion's samples (poses interpolated within each sample interval, one
+MuJoCo step at a time). Measured: the object's pose in the gripper frame all along; success
+when its final pose is within the scene's goal tolerance of the plan's goal."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import pose as P
+from ..errors import ArgumentError
+from ..extras import need
+from ..workcell.description import Workcell
+from .world_motion import WorldMotion
+
+#: Radius [m] of the capsule of an edge feature and of the sphere of a corner feature.
+FEATURE_RADIUS = 0.003
+#: Thickness [m] of a face feature's plate and of the table's box.
+PLATE_DEPTH = 0.01
+#: Time [s] the gripper holds still at the start before the motion (the pads settle).
+SETTLE = 0.2
+
+
+@dataclass
+class FreeGripperResult:
+    """A free-gripper execution: ``success`` (the final in-hand pose within the scene's goal
+    tolerance of the plan's goal); ``goal_error``: planar ``[x, z, theta]`` (m, m, rad) or 3-D
+    ``[position, angle]`` (m, rad) differences; ``max_creep`` [m] and ``max_creep_angle`` [rad]:
+    the most the object moved in the gripper frame within a run of non-push samples (transfer,
+    approach, retreat), from where it was at the run's start; ``duration`` [s] simulated;
+    ``times`` (n,) [s], ``in_hand`` (n, 7) (m, unit quaternion) the object's measured pose in the
+    gripper frame at each motion sample; ``planned`` (n, 7) the motion's; ``gripper`` and
+    ``object`` (n, 7) the measured world poses of the gripper and the object."""
+    success: bool
+    goal_error: np.ndarray
+    max_creep: float
+    max_creep_angle: float
+    duration: float
+    times: np.ndarray
+    in_hand: np.ndarray
+    planned: np.ndarray
+    gripper: np.ndarray
+    object: np.ndarray
+
+
+def add_workcell_geoms(spec, workcell: Workcell):
+    """The table and every feature of ``workcell`` as fixed geoms of ``spec``'s world body (see
+    the module's doc), colliding with the object only."""
+    from ..mujoco.model import FEATURE_BITS, add_geom
+
+    w, t = spec.worldbody, workcell.table
+    kw = dict(bits=FEATURE_BITS, condim=3)
+    add_geom(w, "box", [t.size[0] / 2, t.size[1] / 2, PLATE_DEPTH / 2], friction=[t.friction], name="table",
+             pos=[t.center[0], t.center[1], t.height - PLATE_DEPTH / 2], **kw)
+    for f in workcell.features:
+        back = P.quat_rotate(f.pose[3:], [0.0, 0, 1])
+        if f.kind == "block":
+            add_geom(w, "box", np.asarray(f.size) / 2, friction=[f.friction], name=f.name, pos=f.pose[:3],
+                     quat=f.pose[3:], **kw)
+        elif f.kind == "face":
+            add_geom(w, "box", [f.size[0] / 2, f.size[1] / 2, PLATE_DEPTH / 2], friction=[f.friction], name=f.name,
+                     pos=f.pose[:3] - back * PLATE_DEPTH / 2, quat=f.pose[3:], **kw)
+        elif f.kind == "edge":
+            x = P.quat_rotate(f.pose[3:], [f.length / 2, 0.0, 0])
+            c = f.pose[:3] - back * FEATURE_RADIUS
+            add_geom(w, "capsule", [FEATURE_RADIUS], friction=[f.friction], name=f.name, fromto=np.r_[c - x, c + x], **kw)
+        else:
+            add_geom(w, "sphere", [FEATURE_RADIUS], friction=[f.friction], name=f.name,
+                     pos=f.pose[:3] - back * FEATURE_RADIUS, **kw)
+
+
+def build(scene, motion: WorldMotion, workcell: Workcell | None = None):
+    """The model (a ``mujoco.MjSpec``; see the module's doc) of ``motion`` executed for ``scene``
+    in ``workcell`` (default: the motion's)."""
+    from ..mujoco import model as M
+
+    workcell = motion.workcell if workcell is None else workcell
+    if scene.dimension == 2:
+        g = scene.gravity[1]
+    else:
+        g = float(np.linalg.norm(scene._core.gravity))
+    spec = M.new_spec(f"{scene.name}-free-gripper", [0.0, 0.0, -g], M.Contact())
+    add_workcell_geoms(spec, workcell)
+    names = {f.name for f in workcell.features}
+    lengths = {c.name: c.length for c in workcell.contacts()}
+    for a in motion.assignments:
+        if ".edges[" in a.feature and a.feature.split(".")[0] in names and a.feature in lengths:
+            x = P.quat_rotate(a.frame[3:], [lengths[a.feature] / 2, 0.0, 0])
+            c = a.frame[:3] - P.quat_rotate(a.frame[3:], [0.0, 0, 1]) * FEATURE_RADIUS
+            mu = workcell.feature(a.feature.split(".")[0]).friction
+            M.add_geom(spec.worldbody, "capsule", [FEATURE_RADIUS], M.FEATURE_BITS, [mu], name=f"{a.feature}-push{a.index}",
+                       fromto=np.r_[c - x, c + x], condim=3)
+    gripper = M.add_driven_body(spec.worldbody, "gripper", spatial=True)
+    if scene.dimension == 2:
+        M.add_object(spec, scene, [0.0, 0.0, 0.0])
+        M.add_planar_pads(gripper, scene)
+    else:
+        from ..mujoco.spatial import _add_object, _add_pads
+
+        v, t = scene.mesh()
+        v, t = np.asarray(v, float), np.asarray(t, int)
+        _add_object(spec, scene, motion.in_hand[0], (v, t), 1.0)
+        _add_pads(gripper, scene, motion.in_hand[0], v, 1.0, "point")
+    M.add_grip_motors(spec)
+    return spec
+
+
+def _tolerance_error(scene, plan, q) -> tuple[np.ndarray, bool]:
+    """The goal error of in-hand pose ``q`` (m, unit quaternion) and whether it is within the
+    scene's goal tolerance (the plan's last pose when the scene has no task)."""
+    goal = np.asarray(plan.poses[-1], float)
+    if scene.dimension == 2:
+        R = P.quat_matrix(q[3:])
+        got = np.array([q[0], q[2], np.arctan2(R[2, 0], R[0, 0])])
+        err = got - goal
+        err[2] = (err[2] + np.pi) % (2 * np.pi) - np.pi
+        tol = scene.task.tolerance if scene.task is not None else np.array([1e-3, 1e-3, 0.0175])
+        return err, bool(np.all(np.abs(err) <= tol))
+    goal = np.r_[goal[:3], goal[3:] / np.linalg.norm(goal[3:])]
+    err = np.array([float(np.linalg.norm(q[:3] - goal[:3])), P.quat_angle(q[3:], goal[3:])])
+    tol = scene.task[2]
+    return err, bool(np.all(np.abs(q[:3] - goal[:3]) <= tol[:3]) and err[1] <= tol[3])
+
+
+def execute_free_gripper(scene, plan, motion: WorldMotion, workcell: Workcell | None = None) -> FreeGripperResult:
+    """Executes ``motion`` (the :class:`WorldMotion` of ``plan`` for ``scene``) in MuJoCo with a
+    free-flying gripper in ``workcell`` (default: the motion's; another one, e.g. with a feature
+    removed, checks that the feature does the pushing) and measures it (see
+    :class:`FreeGripperResult`)."""
+    mujoco = need("mujoco", "mujoco")
+    from ..mujoco.model import Contact, Driver, Rig
+
+    if not isinstance(motion, WorldMotion):
+        raise ArgumentError(f"invalid `motion`: a WorldMotion (got {type(motion).__name__})", "motion")
+    if workcell is not None and not isinstance(workcell, Workcell):
+        raise ArgumentError(f"invalid `workcell`: a Workcell (got {type(workcell).__name__})", "workcell")
+    rig = Rig(build(scene, motion, workcell), Contact(), float(motion.grip_force[0]))
+    m, d = rig.model, rig.data
+    drv = Driver(m, "gripper")
+    obj = m.body("object").id
+    jadr = int(m.jnt_qposadr[m.body_jntadr[obj]])
+    drv.set(d, motion.gripper[0])
+    d.qpos[jadr:jadr + 7] = motion.object[0]
+    mujoco.mj_forward(m, d)
+
+    Gs, Ws = [], []
+
+    def in_hand() -> np.ndarray:
+        Gs.append(np.asarray(d.qpos[drv.qadr], float).copy())
+        Ws.append(np.r_[d.xpos[obj], d.xquat[obj]])
+        return P.compose(P.inverse(Gs[-1]), Ws[-1])
+
+    for _ in range(int(round(SETTLE / rig.dt))):
+        drv.move(d, motion.gripper[0], rig.dt)
+        rig.step()
+    Gs.clear(), Ws.clear()
+    out = [in_hand()]
+    for i in range(1, len(motion.times)):
+        n = max(1, int(round((motion.times[i] - motion.times[i - 1]) / rig.dt)))
+        a, b = motion.gripper[i - 1], motion.gripper[i]
+        for s in np.arange(1, n + 1) / n:
+            drv.move(d, P.interpolate(a, b, [s])[0] if s < 1 else b, rig.dt)
+            rig.step()
+        out.append(in_hand())
+    H = np.array(out)
+    creep, turn = 0.0, 0.0
+    labels = list(motion.labels)
+    start = None
+    for i, lab in enumerate(labels):
+        if lab == "push":
+            start = None
+            continue
+        if start is None:
+            start = i
+        creep = max(creep, float(np.linalg.norm(H[i, :3] - H[start, :3])))
+        turn = max(turn, P.quat_angle(H[i, 3:], H[start, 3:]))
+    err, ok = _tolerance_error(scene, plan, H[-1])
+    return FreeGripperResult(ok, err, creep, turn, float(d.time), motion.times.copy(), H, motion.in_hand.copy(),
+                             np.array(Gs), np.array(Ws))

@@ -1,0 +1,264 @@
+"""The trajectory file (docs/trajectory-file.md): a timed world-frame motion of the gripper (and,
+with a robot, its joints) with the grip force, each sample labelled, and the feature of each
+push. :class:`Trajectory` reads and writes it (JSON, written atomically); a
+:class:`~regrasp.execution.WorldMotion` makes one with ``to_trajectory()``. The loader is
+strict: a SceneError names the field at fault as a path (``samples[3].t``)."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ArgumentError, SceneError
+from .world_motion import LABELS
+
+#: The file's ``format`` and ``version``.
+FORMAT = "regrasp-trajectory"
+VERSION = 1
+#: How far [−] a quaternion's norm may be from 1 in the file.
+UNIT_TOL = 1e-6
+#: The keys of the file, of a sample and of an assignment (all required).
+KEYS = ("format", "version", "scene", "workcell", "robot", "joint_names", "samples", "assignments")
+SAMPLE_KEYS = ("t", "q", "gripper_pose", "grip_force", "label", "push")
+ASSIGNMENT_KEYS = ("pusher", "feature", "first", "last", "frame", "tilt", "penetration")
+
+
+def _fail(where: str, what: str, got) -> SceneError:
+    return SceneError(f"trajectory field `{where}`: {what} (got {got!r:.80})", where)
+
+
+def _number(x, where: str, lo: float = -math.inf, hi: float = math.inf) -> float:
+    if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
+        raise _fail(where, "must be a number", x)
+    v = float(x)
+    if not math.isfinite(v) or not lo <= v <= hi:
+        raise _fail(where, f"must be finite and in [{lo:g}, {hi:g}]", x)
+    return v
+
+
+def _integer(x, where: str, lo: int, hi: int) -> int:
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or not lo <= int(x) <= hi:
+        raise _fail(where, f"must be an integer in [{lo}, {hi}]", x)
+    return int(x)
+
+
+def _name(x, where: str) -> str:
+    if not isinstance(x, str) or not x.strip():
+        raise _fail(where, "must be a non-blank string", x)
+    return x
+
+
+def _vector(x, n: int, where: str) -> np.ndarray:
+    if isinstance(x, np.ndarray):
+        x = x.tolist()
+    if not isinstance(x, (list, tuple)) or len(x) != n:
+        raise _fail(where, f"expected {n} numbers", f"{len(x)} numbers" if isinstance(x, (list, tuple)) else x)
+    return np.array([_number(v, f"{where}[{i}]") for i, v in enumerate(x)], float)
+
+
+def _pose(x, where: str) -> np.ndarray:
+    p = _vector(x, 7, where)
+    if abs(np.linalg.norm(p[3:]) - 1) > UNIT_TOL:
+        raise _fail(where, f"the quaternion [qw, qx, qy, qz] must have unit norm (within {UNIT_TOL:g})",
+                    float(np.linalg.norm(p[3:])))
+    return p
+
+
+def _keys(d, keys, where: str):
+    if not isinstance(d, dict):
+        raise _fail(where or "(file)", "must be a JSON object", type(d).__name__)
+    pre = f"{where}." if where else ""
+    for k in d:
+        if k not in keys:
+            raise _fail(f"{pre}{k}", f"unknown key (the keys: {', '.join(keys)})", k)
+    for k in keys:
+        if k not in d:
+            raise _fail(f"{pre}{k}", "is required", None)
+
+
+@dataclass(frozen=True)
+class PushRecord:
+    """The feature of push ``index``: ``pusher``, the workcell contact ``feature`` (a
+    :class:`~regrasp.workcell.Contact` name), the plan's path indices ``first``/``last``, the
+    contact ``frame`` in the world (m, unit quaternion), the gravity ``tilt`` [rad] and the
+    ``penetration`` [m] (as in :class:`~regrasp.execution.WorldMotion`)."""
+    pusher: str
+    feature: str
+    first: int
+    last: int
+    frame: np.ndarray
+    tilt: float
+    penetration: float
+
+
+@dataclass(eq=False)
+class Trajectory:
+    """A trajectory file's content: ``scene`` (its name), ``workcell`` (its name), ``robot`` (its
+    model name, None for a free gripper), ``joint_names`` (empty for a free gripper); per sample
+    (n of them): ``times`` (n,) [s], strictly increasing; ``q`` (n, len(joint_names)) joint
+    positions [rad]; ``gripper`` (n, 7) the gripper's world pose (m, unit quaternion);
+    ``grip_force`` (n,) [N] per finger; ``labels`` (one of :data:`~regrasp.execution.world_motion.LABELS` each); ``push`` (n,)
+    the push index (−1: none, ``null`` in the file); ``assignments``: a :class:`PushRecord` per
+    push. Checked on construction (SceneError naming the field)."""
+    scene: str
+    workcell: str
+    robot: str | None
+    joint_names: list
+    times: np.ndarray
+    q: np.ndarray
+    gripper: np.ndarray
+    grip_force: np.ndarray
+    labels: list
+    push: np.ndarray
+    assignments: list = field(default_factory=list)
+
+    def __post_init__(self):
+        checked = _from_dict(self.to_dict(check=False))
+        for k in ("times", "q", "gripper", "grip_force", "push", "labels", "assignments", "joint_names"):
+            setattr(self, k, getattr(checked, k))
+
+    def __len__(self) -> int:
+        """The number of samples."""
+        return len(self.times)
+
+    def __eq__(self, other) -> bool:
+        """Trajectories are equal when their files are."""
+        return isinstance(other, Trajectory) and self.to_dict() == other.to_dict()
+
+    __hash__ = None  # type: ignore[assignment]
+
+    @property
+    def duration(self) -> float:
+        """The last sample's time [s]."""
+        return float(self.times[-1])
+
+    def to_dict(self, check: bool = True) -> dict:
+        """The file's content as JSON-ready lists (see docs/trajectory-file.md)."""
+        def lst(x):
+            return x.tolist() if isinstance(x, (np.ndarray, np.generic)) else x
+
+        n = len(self.times) if hasattr(self.times, "__len__") else 0
+
+        def row(a, i):
+            try:
+                return lst(a[i])
+            except (IndexError, TypeError, KeyError):
+                return None
+
+        samples = [{"t": row(self.times, i), "q": row(self.q, i), "gripper_pose": row(self.gripper, i),
+                    "grip_force": row(self.grip_force, i), "label": row(self.labels, i),
+                    "push": None if row(self.push, i) is None or row(self.push, i) == -1 else row(self.push, i)}
+                   for i in range(n)]
+        return {"format": FORMAT, "version": VERSION, "scene": self.scene, "workcell": self.workcell,
+                "robot": self.robot, "joint_names": list(self.joint_names) if isinstance(self.joint_names,
+                                                                                          (list, tuple)) else self.joint_names,
+                "samples": samples,
+                "assignments": [{"pusher": a.pusher, "feature": a.feature, "first": a.first, "last": a.last,
+                                 "frame": lst(a.frame), "tilt": a.tilt, "penetration": a.penetration}
+                                if isinstance(a, PushRecord) else a for a in self.assignments]}
+
+    def to_json(self) -> str:
+        """The file's JSON text: a key per line, a sample or an assignment per line."""
+        d = self.to_dict()
+        lines = []
+        for k, v in d.items():
+            if k in ("samples", "assignments"):
+                rows = ",\n  ".join(json.dumps(r) for r in v)
+                lines.append(f' "{k}": [\n  {rows}\n ]' if v else f' "{k}": []')
+            else:
+                lines.append(f" {json.dumps(k)}: {json.dumps(v)}")
+        return "{\n" + ",\n".join(lines) + "\n}"
+
+    def save(self, path) -> Path:
+        """Writes the file to ``path`` atomically (:func:`regrasp.files.write_text`)."""
+        from ..files import as_path, write_text
+
+        return write_text(as_path(path, "path"), self.to_json() + "\n")
+
+    @classmethod
+    def from_dict(cls, d) -> "Trajectory":
+        """The trajectory of a dict laid out as the file; SceneError naming the field at fault."""
+        return _from_dict(d)
+
+    @classmethod
+    def from_json(cls, text: str) -> "Trajectory":
+        """The trajectory of the file's JSON text (SceneError ``(json)`` for a syntax error)."""
+        if not isinstance(text, str):
+            raise ArgumentError(f"invalid `text`: the trajectory file's text, a str (got {type(text).__name__})", "text")
+        try:
+            d = json.loads(text, parse_constant=lambda c: (_ for _ in ()).throw(ValueError(f"{c} is not allowed")))
+        except ValueError as e:
+            raise SceneError(f"trajectory file: not valid JSON: {e}", "(json)") from None
+        return _from_dict(d)
+
+    @classmethod
+    def load(cls, path) -> "Trajectory":
+        """The trajectory file at ``path``; ArgumentError when it cannot be read."""
+        from ..files import as_path
+
+        p = as_path(path, "path")
+        try:
+            text = p.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as e:
+            raise ArgumentError(f"invalid `path`: cannot read {str(p)!r}: {e}", "path") from None
+        return cls.from_json(text)
+
+
+def _from_dict(d) -> Trajectory:
+    _keys(d, KEYS, "")
+    if d["format"] != FORMAT:
+        raise _fail("format", f"must be {FORMAT!r}", d["format"])
+    if isinstance(d["version"], bool) or d["version"] != VERSION:
+        raise _fail("version", f"must be {VERSION}", d["version"])
+    scene, workcell = _name(d["scene"], "scene"), _name(d["workcell"], "workcell")
+    robot = None if d["robot"] is None else _name(d["robot"], "robot")
+    joints = d["joint_names"]
+    if not isinstance(joints, list):
+        raise _fail("joint_names", "must be a list of joint names", joints)
+    joints = [_name(j, f"joint_names[{i}]") for i, j in enumerate(joints)]
+    if len(set(joints)) != len(joints):
+        raise _fail("joint_names", "must not repeat a name", joints)
+    if robot is None and joints:
+        raise _fail("joint_names", "must be empty for a free gripper (robot null)", joints)
+    if robot is not None and not joints:
+        raise _fail("joint_names", f"must name the joints of robot {robot!r}", joints)
+    A = d["assignments"]
+    if not isinstance(A, list):
+        raise _fail("assignments", "must be a list", A)
+    records = []
+    for k, a in enumerate(A):
+        w = f"assignments[{k}]"
+        _keys(a, ASSIGNMENT_KEYS, w)
+        first = _integer(a["first"], f"{w}.first", 0, 10**9)
+        last = _integer(a["last"], f"{w}.last", first + 1, 10**9)
+        records.append(PushRecord(_name(a["pusher"], f"{w}.pusher"), _name(a["feature"], f"{w}.feature"), first, last,
+                                  _pose(a["frame"], f"{w}.frame"), _number(a["tilt"], f"{w}.tilt", 0.0, math.pi),
+                                  _number(a["penetration"], f"{w}.penetration", 0.0)))
+    S = d["samples"]
+    if not isinstance(S, list) or not S:
+        raise _fail("samples", "must be a non-empty list", S)
+    t, q, g, f, lab, push = [], [], [], [], [], []
+    for i, s in enumerate(S):
+        w = f"samples[{i}]"
+        _keys(s, SAMPLE_KEYS, w)
+        t.append(_number(s["t"], f"{w}.t", 0.0))
+        if i and t[-1] <= t[-2]:
+            raise _fail(f"{w}.t", f"times must increase strictly (samples[{i - 1}].t is {t[-2]!r})", s["t"])
+        q.append(_vector(s["q"], len(joints), f"{w}.q"))
+        g.append(_pose(s["gripper_pose"], f"{w}.gripper_pose"))
+        f.append(_number(s["grip_force"], f"{w}.grip_force", 0.0))
+        if s["label"] not in LABELS:
+            raise _fail(f"{w}.label", f"must be one of {', '.join(LABELS)}", s["label"])
+        lab.append(s["label"])
+        push.append(-1 if s["push"] is None else _integer(s["push"], f"{w}.push", 0, max(len(records) - 1, 0)))
+        if s["push"] is not None and not records:
+            raise _fail(f"{w}.push", "must be null: there are no assignments", s["push"])
+    tr = Trajectory.__new__(Trajectory)
+    tr.scene, tr.workcell, tr.robot, tr.joint_names = scene, workcell, robot, joints
+    tr.times, tr.q, tr.gripper = np.array(t), np.array(q, float).reshape(len(t), len(joints)), np.array(g)
+    tr.grip_force, tr.labels, tr.push, tr.assignments = np.array(f), lab, np.array(push, int), records
+    return tr
