@@ -109,12 +109,12 @@ def build(scene, motion: WorldMotion, workcell: Workcell | None = None):
         M.add_object(spec, scene, [0.0, 0.0, 0.0])
         M.add_planar_pads(gripper, scene)
     else:
-        from ..mujoco.spatial import _add_object, _add_pads
+        from ..mujoco.spatial import add_object3d, add_pads3d
 
         v, t = scene.mesh()
         v, t = np.asarray(v, float), np.asarray(t, int)
-        _add_object(spec, scene, motion.in_hand[0], (v, t), 1.0)
-        _add_pads(gripper, scene, motion.in_hand[0], v, 1.0, "point")
+        add_object3d(spec, scene, motion.in_hand[0], (v, t), 1.0)
+        add_pads3d(gripper, scene, motion.in_hand[0], v, 1.0, "point")
     M.add_grip_motors(spec)
     return spec
 

@@ -79,7 +79,7 @@ def add_feature_geoms(body, scene, name: str, friction: float):
     return add_geom(body, "box", [e1, e2, 0.0015], pos=c - n * 0.0015, quat=_quat(t1, t2, n), **kw)
 
 
-def _add_object(spec, scene, s0, mesh, mass_scale: float):
+def add_object3d(spec, scene, s0, mesh, mass_scale: float):
     """The object at pose ``s0`` on a free joint: a sphere or the scene's convex ``mesh``
     (vertices, triangles)."""
     m = scene.mass * mass_scale
@@ -96,7 +96,7 @@ def _add_object(spec, scene, s0, mesh, mass_scale: float):
     return add_geom(body, "mesh", [], meshname="obj", **kw)
 
 
-def _add_pads(parent, scene, s0, vertices, friction_scale: float, pad: str):
+def add_pads3d(parent, scene, s0, vertices, friction_scale: float, pad: str):
     """The pads at the object's extreme points (of its mesh's ``vertices``) along ±Y at pose
     ``s0``: one contact each (:func:`add_pad_sphere`, torsional friction (2/3) r μ) or,
     ``pad="ring"``, 8 point contacts on a ring at 2/3 of the pad's radius (the quasi-static
@@ -127,8 +127,8 @@ def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, ma
     v, t = scene.mesh()
     v, t = np.asarray(v, float), np.asarray(t, int)
     spec = new_spec(scene.name, np.asarray(scene._core.gravity, float), contact)
-    _add_object(spec, scene, s0, (v, t), mass_scale)
-    _add_pads(add_driven_body(spec.worldbody, "gripper", spatial=True) if world else spec.worldbody, scene, s0, v,
+    add_object3d(spec, scene, s0, (v, t), mass_scale)
+    add_pads3d(add_driven_body(spec.worldbody, "gripper", spatial=True) if world else spec.worldbody, scene, s0, v,
               friction_scale, pad)
     for i, p in enumerate(scene.pusher_names):
         _, _, fr = scene._core.pusher_spec(p)
