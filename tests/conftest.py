@@ -100,3 +100,23 @@ def run_cli(*args) -> tuple:
         except SystemExit as e:
             status = e.code
     return status, out.getvalue(), err.getvalue()
+
+
+def rotation_matrix(q):
+    """The test suite's own rotation matrix of a quaternion [w, x, y, z] (the textbook formula,
+    independent of regrasp.pose), for checks of poses against 4 x 4 matrices."""
+    import numpy as np
+
+    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def pose_matrix(pose):
+    """The 4 x 4 matrix of a pose [x, y, z, qw, qx, qy, qz] (m, unit quaternion)."""
+    import numpy as np
+
+    m = np.eye(4)
+    m[:3, :3], m[:3, 3] = rotation_matrix(pose[3:]), pose[:3]
+    return m

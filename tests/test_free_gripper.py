@@ -11,21 +11,10 @@ from regrasp.execution import world_motion
 from regrasp.execution.free_gripper import FEATURE_RADIUS, build, execute_free_gripper
 from regrasp.workcell import Workcell
 
+from .conftest import rotation_matrix as rot, pose_matrix as T
+
 pytest.importorskip("mujoco")
 RUNS: dict = {}
-
-
-def rot(q):
-    w, x, y, z = np.asarray(q) / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
-def T(pose):
-    m = np.eye(4)
-    m[:3, :3], m[:3, 3] = rot(pose[3:]), pose[:3]
-    return m
 
 
 def run(name, drop=None):

@@ -15,18 +15,13 @@ from regrasp.execution.assignment import assign, pusher_contact
 from regrasp.workcell import Feature, Workcell, bundled, default_workcell
 from regrasp.workcell.description import BOUNDS
 
+from .conftest import rotation_matrix as rot
+
 EXAMPLE = regrasp.examples.ROOT / "workcells" / "workcell-ur5e.toml"
 
 
 def example_dict():
     return tomllib.loads(EXAMPLE.read_text())
-
-
-def rot(q):
-    w, x, y, z = np.asarray(q) / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
 def test_example_loads_and_round_trips(tmp_path):

@@ -17,6 +17,8 @@ from regrasp.execution.world_motion import LABELS, PENETRATION_LIMIT, edge_point
 from regrasp.workcell import Table, Workcell, default_workcell
 from regrasp.workcell.description import Feature, Robot
 
+from .conftest import rotation_matrix as rot, pose_matrix as T
+
 EXAMPLE_WORKCELL = regrasp.examples.ROOT / "workcells" / "workcell-ur5e.toml"
 PLANS: dict = {}
 
@@ -26,20 +28,6 @@ def plan_of(name):
         scene = regrasp.load_scene(regrasp.examples.path(name))
         PLANS[name] = (scene, regrasp.plan(scene, seed=0))
     return PLANS[name]
-
-
-def rot(q):
-    w, x, y, z = np.asarray(q) / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
-def T(pose):
-    """4 x 4 matrix of a 7-vector pose."""
-    m = np.eye(4)
-    m[:3, :3], m[:3, 3] = rot(pose[3:]), pose[:3]
-    return m
 
 
 def T_planar(q):
