@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ArgumentError, SceneError
+from ..fields import FieldCheck
 from .world_motion import LABELS
 
 #: The file's ``format`` and ``version``.
@@ -27,37 +28,9 @@ SAMPLE_KEYS = ("t", "q", "gripper_pose", "grip_force", "label", "push")
 ASSIGNMENT_KEYS = ("pusher", "feature", "first", "last", "frame", "tilt", "penetration")
 
 
-def _fail(where: str, what: str, got) -> SceneError:
-    return SceneError(f"trajectory field `{where}`: {what} (got {got!r:.80})", where)
-
-
-def _number(x, where: str, lo: float = -math.inf, hi: float = math.inf) -> float:
-    if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
-        raise _fail(where, "must be a number", x)
-    v = float(x)
-    if not math.isfinite(v) or not lo <= v <= hi:
-        raise _fail(where, f"must be finite and in [{lo:g}, {hi:g}]", x)
-    return v
-
-
-def _integer(x, where: str, lo: int, hi: int) -> int:
-    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or not lo <= int(x) <= hi:
-        raise _fail(where, f"must be an integer in [{lo}, {hi}]", x)
-    return int(x)
-
-
-def _name(x, where: str) -> str:
-    if not isinstance(x, str) or not x.strip():
-        raise _fail(where, "must be a non-blank string", x)
-    return x
-
-
-def _vector(x, n: int, where: str) -> np.ndarray:
-    if isinstance(x, np.ndarray):
-        x = x.tolist()
-    if not isinstance(x, (list, tuple)) or len(x) != n:
-        raise _fail(where, f"expected {n} numbers", f"{len(x)} numbers" if isinstance(x, (list, tuple)) else x)
-    return np.array([_number(v, f"{where}[{i}]") for i, v in enumerate(x)], float)
+_CHECK = FieldCheck("trajectory")
+_fail, _number, _integer, _name, _vector, _keys = (_CHECK.fail, _CHECK.number, _CHECK.integer, _CHECK.name,
+                                                   _CHECK.vector, _CHECK.keys)
 
 
 def _pose(x, where: str) -> np.ndarray:
@@ -66,18 +39,6 @@ def _pose(x, where: str) -> np.ndarray:
         raise _fail(where, f"the quaternion [qw, qx, qy, qz] must have unit norm (within {UNIT_TOL:g})",
                     float(np.linalg.norm(p[3:])))
     return p
-
-
-def _keys(d, keys, where: str):
-    if not isinstance(d, dict):
-        raise _fail(where or "(file)", "must be a JSON object", type(d).__name__)
-    pre = f"{where}." if where else ""
-    for k in d:
-        if k not in keys:
-            raise _fail(f"{pre}{k}", f"unknown key (the keys: {', '.join(keys)})", k)
-    for k in keys:
-        if k not in d:
-            raise _fail(f"{pre}{k}", "is required", None)
 
 
 @dataclass(frozen=True)

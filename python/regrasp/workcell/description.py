@@ -19,6 +19,7 @@ import numpy as np
 
 from .. import pose as P
 from ..errors import SceneError
+from ..fields import FieldCheck
 
 #: The bounds of a workcell file's numbers (inclusive), stated once: (low, high, unit).
 BOUNDS = {
@@ -39,43 +40,27 @@ ON_TABLE = 1e-6
 EDGE_MARGIN = np.radians(5.0)
 
 
-def _fail(field_: str, what: str, got) -> SceneError:
-    return SceneError(f"workcell field `{field_}`: {what} (got {got!r:.80})", field_)
+_CHECK = FieldCheck("workcell")
+_fail = _CHECK.fail
 
 
 def check_number(x, field_: str, kind: str) -> float:
     """``x`` as a float when it is a finite number within ``BOUNDS[kind]``; else a SceneError
     naming ``field_`` (its unit is that of the bound, e.g. [m])."""
-    lo, hi, unit = BOUNDS[kind]
-    if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
-        raise _fail(field_, "must be a number", x)
-    v = float(x)
-    if not np.isfinite(v) or not lo <= v <= hi:
-        raise _fail(field_, f"must be finite and in [{lo:g}, {hi:g}]{' ' + unit if unit else ''}", x)
-    return v
+    return _CHECK.number(x, field_, *BOUNDS[kind])
 
 
 def check_numbers(x, n: int, field_: str, kind: str) -> np.ndarray:
     """``x`` as an array of ``n`` floats each within ``BOUNDS[kind]`` (units as that bound), else a
     SceneError naming ``field_`` (a component as ``field_[i]``)."""
-    if isinstance(x, np.ndarray):
-        x = x.tolist()
-    if not isinstance(x, (list, tuple)) or len(x) != n:
-        got = f"{len(x)} numbers" if isinstance(x, (list, tuple)) else x
-        raise _fail(field_, f"expected {n} numbers", got)
-    return np.array([check_number(v, f"{field_}[{i}]", kind) for i, v in enumerate(x)])
+    return _CHECK.vector(x, n, field_, *BOUNDS[kind])
 
 
 def check_pose(x, field_: str) -> np.ndarray:
     """A pose ``[x, y, z, qw, qx, qy, qz]`` (m, quaternion; normalized unless within 1e-12 of
     unit norm), else a SceneError naming ``field_``."""
-    if isinstance(x, np.ndarray):
-        x = x.tolist()
-    if not isinstance(x, (list, tuple)) or len(x) != 7:
-        got = f"{len(x)} numbers" if isinstance(x, (list, tuple)) else x
-        raise _fail(field_, "expected 7 numbers [x, y, z, qw, qx, qy, qz]", got)
-    p = check_numbers(list(x[:3]), 3, field_, "coordinate")
-    q = np.array([check_number(v, f"{field_}[{i + 3}]", "coordinate") for i, v in enumerate(x[3:])])
+    v = _CHECK.vector(x, 7, field_, *BOUNDS["coordinate"], what="[x, y, z, qw, qx, qy, qz]")
+    p, q = v[:3], v[3:]
     lo, hi, _ = BOUNDS["quaternion_norm"]
     nq = float(np.linalg.norm(q))
     if not lo <= nq <= hi:
@@ -85,9 +70,7 @@ def check_pose(x, field_: str) -> np.ndarray:
 
 def check_name(x, field_: str) -> str:
     """A non-blank string, else a SceneError naming ``field_``."""
-    if not isinstance(x, str) or not x.strip():
-        raise _fail(field_, "must be a non-blank string", x)
-    return x
+    return _CHECK.name(x, field_)
 
 
 @dataclass(frozen=True, eq=False)
