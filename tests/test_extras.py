@@ -201,10 +201,11 @@ def test_bench_json_without_reference_is_valid_json(blocker):
         import sys
         from regrasp import bench
         import regrasp.cli
-        full_run, planner, plan3d = bench.run, bench.run_planner, bench.run_plan3d
+        full_run, planner, plan3d, wm = bench.run, bench.run_planner, bench.run_plan3d, bench.run_world_motion
         bench.run = lambda **kw: full_run(**{**kw, "n": 300, "reps": 1, "baseline_reps": 1})
         bench.run_planner = lambda: planner(seeds=1, time_limit=5.0, examples=("block-high-friction",))
         bench.run_plan3d = lambda: plan3d(seeds=1, examples=("offset-3d",))
+        bench.run_world_motion = lambda: wm(reps=1, examples=("block-low-friction",))
         sys.exit(regrasp.cli.main(["bench", "--quick", "--json"]))
     ''')
     r = run(blocker, ["-c", code], ("casadi", "scipy", "mujoco"))
@@ -213,4 +214,5 @@ def test_bench_json_without_reference_is_valid_json(blocker):
     skipped = res["plan3d_offset-3d"]
     assert skipped["baseline_median_s"] is None and skipped["ratio"] is None, skipped
     assert "regrasp[reference]" in skipped["baseline"]
-    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_", "mujoco_")) for k in res), sorted(res)
+    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_", "mujoco_", "ik_")) for k in res), sorted(res)
+    assert res["world_motion_block-low-friction"]["median_s"] > 0  # needs no extra

@@ -65,6 +65,8 @@ def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, sc
         ("MuJoCo", lambda: _unless_missing("MuJoCo's speed", run_mujoco)),
         ("MPC", lambda: _unless_missing("the MPC step against SciPy", run_mpc)),
         ("3-D planner", run_plan3d),
+        ("world motion", run_world_motion),
+        ("arm IK", lambda: _unless_missing("the arm's inverse kinematics", run_ik)),
     ]
     results = {}
     with progress.bar(len(benchmarks), "bench", unit="benchmark") as bar:
@@ -193,6 +195,46 @@ def run_mujoco(steps: int = 4000) -> dict:
             "baseline": "the same push in MuJoCo (quasi-static: 20 steps of 50 ms)",
         },
     }
+
+
+#: the examples whose seed-0 plans `run_world_motion` turns into world motions (default workcells)
+WORLD_MOTION_EXAMPLES = ("block-low-friction", "t-shape", "block-xztheta", "pivot-3d", "offset-3d")
+
+
+def run_world_motion(reps: int = 5, examples=WORLD_MOTION_EXAMPLES) -> dict:
+    """Time to turn a plan into the gripper's world-frame motion in its default workcell
+    (:func:`regrasp.execution.world_motion`: push assignment, knots, timed samples), per example:
+    the median over ``reps`` [s]; issue 15's target is under 100 ms."""
+    from .execution import world_motion
+    from .planning.plan import plan
+    from .scene import load_scene
+    from .workcell import default_workcell
+
+    out = {}
+    for name in examples:
+        scene = load_scene(bundled.path(name))
+        p, cell = plan(scene, seed=0), default_workcell(scene)
+        t = _median_time(lambda: world_motion(scene, p, cell), reps)
+        out[f"world_motion_{name}"] = {"median_s": t, "baseline_median_s": None, "ratio": None,
+                                       "baseline": f"none: target < 100 ms ({len(p.poses) - 1} plan steps)"}
+    return out
+
+
+def run_ik(poses: int = 40, reps: int = 3) -> dict:
+    """The UR5e + 2F-85's inverse kinematics along a path (:func:`regrasp.robot.ik.ik_path`): the
+    gripper from its home pose 1 mm per pose along world x and down; median time per pose [s]."""
+    need("mujoco", "robot")  # before mink, which imports it
+    need("mink", "robot")
+    from .robot.ik import ik_path
+    from .robot.model import build
+
+    robot = build()
+    q0 = robot.q
+    home = robot.tcp_pose(q0)
+    path = [np.r_[home[:3] + 1e-3 * k * np.array([1.0, 0.0, -0.5]), home[3:]] for k in range(1, poses + 1)]
+    t = _median_time(lambda: ik_path(robot, path, q0), reps)
+    return {"ik_path_per_pose": {"median_s": t / poses, "baseline_median_s": None, "ratio": None,
+                                 "baseline": f"none: {poses} poses 1.1 mm apart (mink, DAQP; accept 1 mm / 0.01 rad)"}}
 
 
 def _mpc_qp_scipy(scene: Scene, q, steps, targets, settings: dict):
