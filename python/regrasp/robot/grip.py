@@ -215,9 +215,9 @@ class GripController:
         if d.time + 1e-12 < self.next:
             return
         self.next = d.time + self.period
-        f = self.forces(d)
-        if np.all(f > 0):
-            self.u += self.period / self.tau * (self.grip_force - f.mean()) / self.gain
+        f = self.forces(d).tolist()
+        if min(f) > 0:
+            self.u += self.period / self.tau * (self.grip_force - sum(f) / len(f)) / self.gain
             bound = max(CORRECTION * self.grip_force, MIN_CORRECTION) / self.gain
-            self.u = float(np.clip(self.u, self.feedforward - bound, self.feedforward + bound))
+            self.u = min(max(self.u, self.feedforward - bound), self.feedforward + bound)
         d.ctrl[self.robot.grip_actuator] = self.u

@@ -14,6 +14,9 @@ from ..extras import need
 
 START_TOLERANCE = 0.005  # rad, the largest joint error between the arm now and a trajectory's start
 SAMPLE = 0.01  # s, the eased reference's sample spacing
+INTEGRAL_TIME = 0.04  # s, the joint loop's integral time (a stiff servo, as an industrial arm's: no static error under load)
+INTEGRAL_BOUND = 0.05  # rad, the integral term's bound (anti-windup)
+CONTROL_PERIOD = 0.002  # s, the joint servo's period (500 Hz, a UR's controller); the grip loop runs faster
 
 
 @dataclass(frozen=True)
@@ -31,11 +34,11 @@ class Tracking:
 def reference(times, qs, t: float) -> tuple:
     """(q [rad], q̇ [rad/s]) of the piecewise-linear joint trajectory through ``qs`` (n, 6) at
     ``times`` (n,) [s] at time ``t`` [s] (held at its ends)."""
-    i = int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2))
+    i = min(max(int(np.searchsorted(times, t, side="right")) - 1, 0), len(times) - 2)
     h = times[i + 1] - times[i]
-    s = float(np.clip((t - times[i]) / h, 0.0, 1.0))
-    moving = times[0] <= t <= times[-1]
-    return qs[i] + s * (qs[i + 1] - qs[i]), (qs[i + 1] - qs[i]) / h if moving else np.zeros(qs.shape[1])
+    s = min(max((t - times[i]) / h, 0.0), 1.0)
+    dq = qs[i + 1] - qs[i]
+    return qs[i] + s * dq, dq / h if times[0] <= t <= times[-1] else np.zeros(qs.shape[1])
 
 
 def smooth(times, qs, dt: float) -> tuple:
@@ -57,12 +60,13 @@ def smooth(times, qs, dt: float) -> tuple:
     return np.array(out_t), np.array(out_q)
 
 
-def track(robot, times, qs, settle: float = 0.5, grip=None) -> Tracking:
+def track(robot, times, qs, settle: float = 0.5, grip=None, ease: bool = True, observe=None) -> Tracking:
     """Runs the arm along joint positions ``qs`` (n, 6) [rad] at ``times`` (n,) [s] (increasing;
     eased between waypoints, :func:`smooth`) from ``qs[0]``, then ``settle`` [s] more, under
-    position control (the trajectory's clock starts now, at ``times[0]``), and measures the :class:`Tracking` errors (against the eased reference).
+    position control (PD + feed-forward + integral, :data:`CONTROL_PERIOD`; the trajectory's clock starts now, at ``times[0]``), and measures the :class:`Tracking` errors (against the eased reference).
     ``grip``: a :class:`~regrasp.robot.grip.GripController` updated every step (an object held
-    meanwhile). The arm must already be at ``qs[0]`` (within ``START_TOLERANCE``): it is never
+    meanwhile). ``ease``: False follows ``qs`` piecewise linearly (a densely sampled path, passed
+    at speed). ``observe(t)``: called after every control period (:data:`CONTROL_PERIOD`) with the trajectory's clock ``t`` [s]. The arm must already be at ``qs[0]`` (within ``START_TOLERANCE``): it is never
     teleported there (that would leave a held object behind); else an ArgumentError naming
     ``qs[0]`` and the start error (move there first, e.g. with a track from ``robot.q``)."""
     mujoco = need("mujoco", "robot")
@@ -78,22 +82,30 @@ def track(robot, times, qs, settle: float = 0.5, grip=None) -> Tracking:
         raise ArgumentError(f"invalid `qs[0]`: the arm is {start_error[j]:.4f} rad from it at joint "
                             f"{robot.arm_joints[j]} (more than {START_TOLERANCE} rad; move there first: "
                             f"track from robot.q)", "qs[0]")
-    ref_t, ref_q = smooth(times, qs, SAMPLE)
+    ref_t, ref_q = smooth(times, qs, SAMPLE) if ease else (times, qs)
     kp = m.actuator_gainprm[robot.arm_actuators, 0]
     kv = -m.actuator_biasprm[robot.arm_actuators, 2]
     errs, tcp_err = [], 0.0
+    integral = np.zeros(len(robot.arm_qpos))
     data_ref = mujoco.MjData(m)
+    steps = max(1, int(round(CONTROL_PERIOD / m.opt.timestep)))
+    period = steps * m.opt.timestep
     start = d.time  # the trajectory's times[0] is now
     clock = lambda: times[0] + d.time - start  # noqa: E731
     while clock() < times[-1] + settle:
         q_ref, v_ref = reference(ref_t, ref_q, clock())
-        d.ctrl[robot.arm_actuators] = q_ref + kv / kp * v_ref
-        if grip is not None:
-            grip.update()
-        mujoco.mj_step(m, d)
+        integral += period / INTEGRAL_TIME * (q_ref - d.qpos[robot.arm_qpos])
+        np.clip(integral, -INTEGRAL_BOUND, INTEGRAL_BOUND, out=integral)
+        d.ctrl[robot.arm_actuators] = q_ref + kv / kp * v_ref + integral
+        for _ in range(steps):
+            if grip is not None:
+                grip.update()
+            mujoco.mj_step(m, d)
+        if observe is not None:
+            observe(clock())
         q_ref, _ = reference(ref_t, ref_q, clock())
         errs.append(np.abs(d.qpos[robot.arm_qpos] - q_ref))
-        if len(errs) % 20 == 0:
+        if len(errs) % 5 == 0:
             data_ref.qpos[:] = d.qpos
             data_ref.qpos[robot.arm_qpos] = q_ref
             mujoco.mj_kinematics(m, data_ref)
