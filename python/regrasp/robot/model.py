@@ -79,6 +79,18 @@ ROBOTS = {
 }
 #: The default robot.
 DEFAULT_ROBOT = "ur5e-2f85"
+#: Other names of the robots (a workcell file's ``robot.name``, e.g. ``"ur5e"``).
+ALIASES = {"ur5e": "ur5e-2f85"}
+
+
+def robot_name(name) -> str:
+    """The registry name (:data:`ROBOTS`) of robot ``name`` or its alias (:data:`ALIASES`), or an
+    ArgumentError naming ``robot`` and listing the known names."""
+    if isinstance(name, str) and name in ROBOTS:
+        return name
+    if isinstance(name, str) and name in ALIASES:
+        return ALIASES[name]
+    raise ArgumentError(f"invalid `robot`: unknown robot {name!r} (known: {', '.join([*ROBOTS, *ALIASES])})", "robot")
 
 
 @dataclass(frozen=True)
@@ -174,7 +186,7 @@ class Robot:
 def build(name: str = DEFAULT_ROBOT, base_pose=(0, 0, 0, 1, 0, 0, 0), table: Optional[Table] = Table(),
           pads: Pads = Pads(), pad_friction: float = PAD_FRICTION, grasp_width: float = GRASP_WIDTH,
           contact: Contact = Contact(), add: Optional[Callable] = None) -> Robot:
-    """The robot ``name`` (:data:`ROBOTS`) compiled: its base at world ``base_pose``
+    """The robot ``name`` (:data:`ROBOTS` or :data:`ALIASES`) compiled: its base at world ``base_pose``
     ``[x, y, z, qw, qx, qy, qz]`` (m), on ``table`` (None: no table), with distributed-contact
     ``pads`` of Coulomb friction ``pad_friction``, the TCP between the pads at grasp width
     ``grasp_width`` [m], MuJoCo ``contact`` settings (``regrasp.mujoco.model.Contact``), the
@@ -182,8 +194,7 @@ def build(name: str = DEFAULT_ROBOT, base_pose=(0, 0, 0, 1, 0, 0, 0), table: Opt
     ``add(spec)``, when given, adds bodies and geoms to the ``mujoco.MjSpec`` before it is
     compiled (a workcell's features, an object)."""
     mujoco = need("mujoco", "robot")
-    if not isinstance(name, str) or name not in ROBOTS:
-        raise ArgumentError(f"invalid `robot`: unknown robot {name!r} (known: {', '.join(ROBOTS)})", "robot")
+    name = robot_name(name)
     kind = ROBOTS[name]
     pose = check_pose(base_pose, "base_pose")
     if not (is_number(grasp_width) and 0.0 < grasp_width < 0.085):

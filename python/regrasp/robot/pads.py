@@ -19,26 +19,51 @@ LENGTH = 0.0375  # m
 PAD_FRICTION = 0.5  # the pads' default Coulomb friction (and a held test object's, robot.creep)
 
 
+PAD_SOLREF = (0.02, 1.0)  # a compliant (silicone) pad: every sphere of the grid bears load (a stiffer one
+# lets a tilt of a few mrad put the whole grip on one row)
+PAD_SOLIMP = (0.9, 0.95, 0.003, 0.5, 2.0)
+TIP_SOLREF = (0.005, 1.0)  # a scene's pad (Pads.of_scene), a small firm tip: with 0.02 s a held lamina turned
+# ≈ 1.4 mrad/s under a 13 mN·m gravity torque (10 % of the tip's torsional capacity), with 0.005 s ≈ 0.3 mrad/s
+
+
 @dataclass(frozen=True)
 class Pads:
     """The pads' contact grid: ``columns`` across (x) by ``rows`` along the finger (z) spheres of
     radius ``radius`` [m], spread over the real pad face (22 mm x 37.5 mm), the outer spheres'
-    centres ``radius`` inside its edges."""
+    centres ``radius`` inside its edges. With a ``shape`` — a scene's pad, ``("circle", r, r)``
+    or ``("rectangle", width, height)`` [m] (``Scene.pad``): a rubber tip of that shape centred on
+    the face — the grid spans the shape (clipped to the face) and keeps the spheres inside it.
+    ``solref`` (s, −): the spheres' MuJoCo contact stiffness (:data:`PAD_SOLREF`)."""
 
     columns: int = 3
     rows: int = 7
     radius: float = 0.001
+    shape: tuple | None = None
+    solref: tuple = PAD_SOLREF
 
     def points(self) -> np.ndarray:
-        """The spheres' centres in the pad body's frame, shape (columns · rows, 3) [m]."""
-        xs = np.linspace(-HALF_WIDTH + self.radius, HALF_WIDTH - self.radius, self.columns)
-        zs = np.linspace(self.radius, LENGTH - self.radius, self.rows)
-        return np.array([[x, FACE_Y + self.radius, z] for z in zs for x in xs])
+        """The spheres' centres in the pad body's frame, shape (k, 3) [m] (k = columns · rows
+        without a ``shape``)."""
+        hx, hz = HALF_WIDTH, LENGTH / 2
+        if self.shape is not None:
+            kind, a, b = self.shape
+            hx, hz = (min(a, HALF_WIDTH), min(a, LENGTH / 2)) if kind == "circle" else \
+                (min(a / 2, HALF_WIDTH), min(b / 2, LENGTH / 2))
+        xs = np.linspace(-hx + self.radius, hx - self.radius, self.columns)
+        zs = np.linspace(-hz + self.radius, hz - self.radius, self.rows)
+        pts = np.array([[x, z] for z in zs for x in xs])
+        if self.shape is not None and self.shape[0] == "circle":
+            pts = pts[np.hypot(pts[:, 0], pts[:, 1]) <= min(self.shape[1], hx, hz) - self.radius + 1e-12]
+        return np.column_stack([pts[:, 0], np.full(len(pts), FACE_Y + self.radius), pts[:, 1] + LENGTH / 2])
 
-
-PAD_SOLREF = (0.02, 1.0)  # a compliant (silicone) pad: every sphere of the grid bears load (a stiffer one
-# lets a tilt of a few mrad put the whole grip on one row)
-PAD_SOLIMP = (0.9, 0.95, 0.003, 0.5, 2.0)
+    @classmethod
+    def of_scene(cls, scene) -> "Pads":
+        """The grid of a scene's pad (``Scene.pad``, or a 3-D scene's disc of ``pad_radius``):
+        5 x 5 spheres over the pad's shape (a circle keeps the 13 inside it)."""
+        pad = scene.pad if scene.dimension == 2 else ("circle", scene._core.pad_radius, scene._core.pad_radius)
+        if pad is None:
+            return cls()
+        return cls(5, 5, 0.001, (str(pad[0]), float(pad[1]), float(pad[2])), TIP_SOLREF)
 
 
 def add_pads(spec, body, pads: Pads, friction: float) -> None:
@@ -50,5 +75,5 @@ def add_pads(spec, body, pads: Pads, friction: float) -> None:
             spec.delete(g)
     for i, p in enumerate(pads.points()):
         body.add_geom(name=f"{body.name}_contact{i}", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[pads.radius, 0, 0],
-                      pos=p, condim=3, friction=[friction, 0, 0], priority=2, solref=PAD_SOLREF, solimp=PAD_SOLIMP,
+                      pos=p, condim=3, friction=[friction, 0, 0], priority=2, solref=pads.solref, solimp=PAD_SOLIMP,
                       mass=0, rgba=[0.2, 0.2, 0.2, 1], group=3)
