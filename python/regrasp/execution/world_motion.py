@@ -40,8 +40,18 @@ from .assignment import MAX_TILT, Assignment, assign
 PENETRATION_LIMIT = 0.5e-3
 #: A feature pushes downward when its push direction is within this angle [rad] of the world's −z.
 DOWNWARD = np.pi / 3
+#: A free move (transfer, approach, retreat) follows the minimum-jerk profile s(τ) = 10τ³ − 15τ⁴ + 6τ⁵
+#: (zero speed and acceleration at both ends: no jolt on the held object); its peak speed is this
+#: many times its mean, so its duration is stretched by it to keep the peak at the Timing's speed.
+EASE_PEAK = 1.875
 #: Sample labels, in the order a push meets them.
 LABELS = ("start", "transfer", "approach", "push", "retreat")
+
+
+def eased(tau):
+    """The minimum-jerk progress s(τ) = 10τ³ − 15τ⁴ + 6τ⁵ in [0, 1] at times τ in [0, 1] (of a move)."""
+    tau = np.asarray(tau, float)
+    return tau ** 3 * (10 - 15 * tau + 6 * tau ** 2)
 
 
 @dataclass(frozen=True)
@@ -49,16 +59,18 @@ class Timing:
     """Speeds and spacing of a world motion, stated once: the gripper's speed while pushing,
     approaching and retreating (``push_speed`` [m/s], ``push_turn`` [rad/s]) and in free transfers
     (``move_speed`` [m/s], ``move_turn`` [rad/s]); the ``clearance`` [m] of pre-contact poses; the
-    longest time between samples ``sample_period`` [s]."""
+    longest time between samples ``sample_period`` [s]; the ``dwell`` [s] held at each push's end
+    (a real arm lags its reference under the push's load: it settles there before retreating)."""
     push_speed: float = 0.01
     push_turn: float = 0.2
     move_speed: float = 0.1
     move_turn: float = 1.0
     clearance: float = 0.02
     sample_period: float = 0.02
+    dwell: float = 0.25
 
     def __post_init__(self):
-        for k in ("push_speed", "push_turn", "move_speed", "move_turn", "clearance", "sample_period"):
+        for k in ("push_speed", "push_turn", "move_speed", "move_turn", "clearance", "sample_period", "dwell"):
             v = getattr(self, k)
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and 0 < v <= 1e3):
                 raise ArgumentError(f"invalid `timing.{k}`: a number in (0, 1000] (got {v!r:.40})", f"timing.{k}")
@@ -233,8 +245,8 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
         a = S["G"][-1]
         if np.linalg.norm(to[:3] - a[:3]) < 1e-12 and P.quat_angle(a[3:], to[3:]) < 1e-12:
             return
-        n, T = steps(a, to, v, w)
-        Gs = P.interpolate(a, to, np.arange(1, n + 1) / n)
+        n, T = steps(a, to, v / EASE_PEAK, w / EASE_PEAK)
+        Gs = P.interpolate(a, to, eased(np.arange(1, n + 1) / n))
         Gs[-1] = to
         t0 = S["t"][-1]
         S["t"] += list(t0 + T * np.arange(1, n + 1) / n)
@@ -284,6 +296,8 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
             Pk = _moved(O[k - 1], xp, 1.0, Pk)
             knots.append((k, len(S["G"]) - 1))
         Gend = S["G"][-1]
+        for _ in range(math.ceil(timing.dwell / timing.sample_period - 1e-9)):  # hold: the arm settles on the push's end
+            emit(Gend, O[a.last], "push", a.index, timing.dwell / math.ceil(timing.dwell / timing.sample_period - 1e-9))
         move(np.r_[Gend[:3] + away, Gend[3:]], O[a.last], "retreat", a.index, timing.push_speed, timing.push_turn)
         side = beside(S["G"][-1], a)
         if side is not None:
