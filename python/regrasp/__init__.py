@@ -13,7 +13,7 @@ Quick use::
 """
 
 from ._core import __version__
-from .errors import ArgumentError, GraspError, InternalError, MissingExtraError, RegraspError, SceneError
+from .errors import ArgumentError, ExecutionError, GraspError, InternalError, MissingExtraError, RegraspError, SceneError
 from .planning.plan import Plan, plan, planner_defaults
 from .scene import load_scene
 from .scene.planar import Classification, GravityFreeCone, MotionCone, MotionConeBatch, Pusher, Scene, Task
@@ -26,6 +26,7 @@ __all__ = [
     "__version__",
     "examples",
     "ArgumentError",
+    "ExecutionError",
     "GraspError",
     "InternalError",
     "MissingExtraError",

@@ -23,6 +23,12 @@ class GraspError(RegraspError, RuntimeError):
     """The grasp cannot hold the object against gravity at the requested pose."""
 
 
+class ExecutionError(RegraspError, RuntimeError):
+    """A valid plan cannot be executed in the world: no feature of the workcell serves a push, or
+    the arm cannot follow the motion (its reach, a joint limit, a collision). The message names
+    the push and why; ``field`` the part of the world at fault (``workcell``, ``robot``)."""
+
+
 class InternalError(RegraspError, RuntimeError):
     """A bug in regrasp: please report it with the input. (A Rust panic caught at the boundary;
     the message carries the panic's message and location.)"""

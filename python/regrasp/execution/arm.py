@@ -1,0 +1,271 @@
+"""A world motion (:func:`~regrasp.execution.world_motion`) executed by a real arm and gripper
+in MuJoCo (:mod:`regrasp.robot`: the UR5e + Robotiq 2F-85): the joint-space trajectory by
+inverse kinematics, then the arm under joint position control, the fingers force-controlled,
+holding the object against the workcell's fixed features.
+
+The model: the robot (its base at the workcell's ``robot.base``, no table of its own), the
+table and every feature as fixed geoms colliding with the object and the robot
+(:func:`~regrasp.execution.free_gripper.add_workcell_geoms`), and the object on a free joint
+(:func:`regrasp.mujoco.model.add_object`: the planar scene's lamina, 12 mm thick; a 3-D scene's
+mesh). The pads are the 2F-85's, a grid of point contacts of the scene's pad shape
+(:meth:`~regrasp.robot.pads.Pads.of_scene`) with the scene's finger friction; the limit surface
+comes from MuJoCo's contacts. The TCP is midway between the pads, which close on the object's
+extreme points across the grasp (its width sets the TCP, :func:`grasp_of`); the regrasp gripper
+frame is the TCP shifted by the grasp's centre.
+
+The joint trajectory: the TCP's world poses along the motion (every sample) by
+:func:`~regrasp.robot.ik.ik_path` from the arm's solution for the first pose (from its home
+joints), clear of the table and the features; a pose the arm cannot reach (its reach, a joint
+limit, a collision, a branch flip) fails the execution with an :class:`~regrasp.errors.ExecutionError`
+naming the push (or the transfer before it) and why. The object starts in the hand: held at the
+motion's first in-hand pose while the fingers close, then let go."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import pose as P
+from ..errors import ArgumentError, ExecutionError
+from ..extras import need
+from .world_motion import WorldMotion
+
+#: Time [s] the fingers close on the object held in place (at least, at most, until both pads
+#: press within :data:`SETTLED` of the grip force).
+CLOSE_TIME = (0.3, 1.5)
+SETTLED = 0.05
+#: Period [s] of the grip force loop during an execution (1 kHz; the fingers' loop of
+#: :class:`~regrasp.robot.grip.GripController` is 2 kHz by default: half the cost per step,
+#: the same holding within 0.01 N).
+GRIP_PERIOD = 0.001
+#: Time [s] the arm holds still after the motion before the object's pose is measured.
+SETTLE = 0.3
+
+
+@dataclass(frozen=True)
+class Scales:
+    """Factors on the finger (pad) friction, the grip force and the object's mass, and on every
+    feature's and the table's friction (a perturbed world: ±10 % draws for the statistics)."""
+    finger_friction: float = 1.0
+    grip: float = 1.0
+    mass: float = 1.0
+    feature_friction: float = 1.0
+
+
+@dataclass
+class ArmTrajectory:
+    """The arm's joint-space trajectory of a world motion: ``robot`` (registry name),
+    ``joint_names``, per motion sample ``times`` (n,) [s] and ``q`` (n, 6) [rad]; ``tcp`` (7,)
+    the TCP's pose in regrasp's gripper frame (m, unit quaternion); ``grasp_width`` [m]."""
+    robot: str
+    joint_names: list
+    times: np.ndarray
+    q: np.ndarray
+    tcp: np.ndarray
+    grasp_width: float
+
+
+@dataclass
+class ArmResult:
+    """An arm execution: ``success`` (the object's final in-hand pose within the scene's goal
+    tolerance of the plan's goal); ``goal_error`` (planar ``[x, z, theta]`` (m, m, rad) or 3-D
+    ``[position, angle]`` (m, rad)); ``max_creep`` [m] / ``max_creep_angle`` [rad]: the most the
+    object moved in the gripper frame within a run of non-push samples; ``duration`` [s]
+    simulated; ``tracking`` (:class:`~regrasp.robot.tracking.Tracking`); ``trajectory`` (the
+    :class:`ArmTrajectory` sent); ``times`` (n,) [s], ``in_hand`` (n, 7) the object's measured
+    pose in the gripper frame per motion sample, ``planned`` (n, 7) the motion's; ``q`` (n, 6)
+    [rad] the arm's measured joints."""
+    success: bool
+    goal_error: np.ndarray
+    max_creep: float
+    max_creep_angle: float
+    duration: float
+    tracking: object
+    trajectory: ArmTrajectory
+    times: np.ndarray
+    in_hand: np.ndarray
+    planned: np.ndarray
+    q: np.ndarray
+
+
+def grasp_of(scene, in_hand) -> tuple[float, float]:
+    """(width [m], centre [m]) of the grasp at in-hand pose ``in_hand`` (m, unit quaternion):
+    the distance between the object's extreme points along the gripper's y (the pads' faces) and
+    their midpoint's y. Planar: the lamina (:data:`regrasp.mujoco.model.THICKNESS`), centred."""
+    from ..mujoco.model import THICKNESS
+
+    if scene.dimension == 2:
+        return THICKNESS, 0.0
+    R = scene._core.sphere
+    if R:
+        return 2 * R, float(in_hand[1])
+    v = np.asarray(scene.mesh()[0], float)
+    y = P.transform(in_hand, v)[:, 1]
+    return float(y.max() - y.min()), float((y.max() + y.min()) / 2)
+
+
+def _pad_friction(scene) -> float:
+    return scene._core.friction_scale / (2 * scene.grip_force) if scene.dimension == 2 else scene._core.grip_friction
+
+
+def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Scales = Scales()):
+    """The robot (:func:`regrasp.robot.model.build`) in ``motion``'s workcell with the object on
+    a free joint at the motion's first world pose, the pads of the scene's pad shape and finger
+    friction; returns (robot, the object's body id, its geom ids, the TCP in the gripper frame)."""
+    from ..mujoco.model import add_object
+    from ..robot.model import build, robot_name
+    from ..robot.pads import Pads
+    from .free_gripper import add_workcell_geoms
+
+    wc = motion.workcell
+    name = robot_name(robot if robot is not None else wc.robot.name)
+    width, centre = grasp_of(scene, motion.in_hand[0])
+    scaled = _scaled_workcell(wc, scales.feature_friction)
+
+    def add(spec):
+        add_workcell_geoms(spec, scaled)
+        if scene.dimension == 2:
+            add_object(spec, scene, [0.0, 0.0, 0.0], mass_scale=scales.mass)
+        else:
+            from ..mujoco.spatial import add_object3d
+
+            v, t = scene.mesh()
+            add_object3d(spec, scene, motion.object[0], (np.asarray(v, float), np.asarray(t, int)), scales.mass)
+
+    try:
+        r = build(name, base_pose=wc.robot.base, table=None, pads=Pads.of_scene(scene),
+                  pad_friction=_pad_friction(scene) * scales.finger_friction, grasp_width=width, add=add)
+    except ArgumentError as e:
+        if e.field == "grasp_width":
+            raise ExecutionError(f"the object is {width * 1e3:.1f} mm wide across the grasp: the 2F-85 opens "
+                                 f"85 mm", "grasp_width") from None
+        raise
+    m = r.model
+    body = m.body("object").id
+    geoms = [g for g in range(m.ngeom) if m.geom_bodyid[g] == body]
+    return r, body, geoms, np.array([0.0, centre, 0.0, 1.0, 0.0, 0.0, 0.0])
+
+
+def _scaled_workcell(wc, k: float):
+    """``wc`` with every feature's and the table's friction times ``k``."""
+    if k == 1.0:
+        return wc
+    from dataclasses import replace
+
+    return replace(wc, table=replace(wc.table, friction=wc.table.friction * k),
+                   features=tuple(replace(f, friction=f.friction * k) for f in wc.features))
+
+
+def where(motion: WorldMotion, i: int) -> str:
+    """Names sample ``i`` of ``motion`` for a message: the push it belongs to (its pusher and
+    feature) or the transfer before push k (or after the last)."""
+    k = int(motion.push[i])
+    t = f"t = {motion.times[i]:.2f} s"
+    if k >= 0:
+        a = motion.assignments[k]
+        return f"push {k} ({motion.labels[i]}, pusher {a.pusher} on {a.feature}, {t})"
+    nxt = [int(p) for p in motion.push[i:] if p >= 0]
+    return f"the transfer before push {nxt[0]} ({t})" if nxt else f"the final transfer ({t})"
+
+
+def solve_arm(robot, motion: WorldMotion, tcp) -> ArmTrajectory:
+    """The arm's :class:`ArmTrajectory` putting the TCP at ``motion.gripper ∘ tcp`` at every
+    sample, clear of the table and the workcell's features; from the solution for the first pose
+    found from the arm's home. Raises ExecutionError naming the push (see the module's doc)."""
+    from ..robot.ik import IKError, ik_path, solve_ik
+
+    m = robot.model
+    avoid = [g for g in range(m.ngeom) if m.geom_bodyid[g] == 0 and (m.geom_contype[g] or m.geom_conaffinity[g])]
+    targets = P.compose_rows(motion.gripper, np.broadcast_to(tcp, motion.gripper.shape))
+    try:
+        q0 = solve_ik(robot, targets[0], robot.kind.home, field="poses[0]", avoid=avoid)
+        q = ik_path(robot, targets, q0, avoid=avoid)
+    except IKError as e:
+        i = int(e.field.split("[")[1].rstrip("]")) if "[" in (e.field or "") else 0
+        why = str(e).split(": ", 1)[1] if ": " in str(e) else str(e)
+        raise ExecutionError(f"the arm cannot execute {where(motion, i)}: {why}", "robot") from None
+    return ArmTrajectory(robot.name, [robot.kind.arm_joints[j] for j in range(len(robot.kind.arm_joints))],
+                         motion.times.copy(), q, np.asarray(tcp, float), robot.grasp_width)
+
+
+def close_on(robot, body: int, geoms, grip_force: float):
+    """Closes the fingers on the object (held in place) until both pads press within
+    :data:`SETTLED` of ``grip_force`` [N] (:data:`CLOSE_TIME`); returns the grip controller."""
+    mujoco = need("mujoco", "robot")
+    from ..robot.grip import GripController, pad_forces
+
+    m, d = robot.model, robot.data
+    jq, jv = m.jnt_qposadr[m.body_jntadr[body]], m.jnt_dofadr[m.body_jntadr[body]]
+    hold = d.qpos[jq:jq + 7].copy()
+    grip = GripController(robot, grip_force, geoms, period=GRIP_PERIOD)
+    t0 = d.time
+    while d.time - t0 < CLOSE_TIME[1]:
+        if d.time - t0 >= CLOSE_TIME[0] and np.all(np.abs(pad_forces(robot, geoms) - grip_force) <= SETTLED * grip_force):
+            break
+        d.qpos[jq:jq + 7], d.qvel[jv:jv + 6] = hold, 0.0
+        d.ctrl[robot.arm_actuators] = d.qpos[robot.arm_qpos]
+        grip.update()
+        mujoco.mj_step(m, d)
+    return grip
+
+
+def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scales: Scales = Scales(),
+                observe=None, trajectory: ArmTrajectory | None = None) -> ArmResult:
+    """Executes ``motion`` (the :class:`WorldMotion` of ``plan`` for ``scene``) with the arm
+    ``robot`` (default: the workcell's) in MuJoCo, in a world perturbed by ``scales``, and
+    measures it (:class:`ArmResult`). ``observe(robot)``: called after every control period
+    (e.g. a video recorder). ``trajectory``: the arm's joint trajectory when already solved
+    (:func:`solve_arm`, e.g. for repeated runs in perturbed worlds). Raises ExecutionError when
+    the arm cannot follow the motion."""
+    mujoco = need("mujoco", "robot")
+    from ..robot.grip import body_pose
+    from ..robot.tracking import track
+    from .free_gripper import _tolerance_error
+
+    if not isinstance(motion, WorldMotion):
+        raise ArgumentError(f"invalid `motion`: a WorldMotion (got {type(motion).__name__})", "motion")
+    r, body, geoms, tcp = build_robot(scene, motion, robot, scales)
+    traj = solve_arm(r, motion, tcp) if trajectory is None else trajectory
+    m, d = r.model, r.data
+    r.set_q(traj.q[0])
+    jq = m.jnt_qposadr[m.body_jntadr[body]]
+    d.qpos[jq:jq + 7] = P.compose(P.compose(r.tcp_pose(), P.inverse(tcp)), motion.in_hand[0])
+    mujoco.mj_forward(m, d)
+    grip = close_on(r, body, geoms, float(motion.grip_force[0]) * scales.grip)
+    untcp = P.inverse(tcp)
+    samples, qs, k = [], [], [0]
+
+    def in_hand() -> np.ndarray:
+        return P.compose(P.inverse(P.compose(r.tcp_pose(), untcp)), body_pose(d, body))
+
+    def record(t: float) -> None:
+        while k[0] < len(motion.times) and t >= motion.times[k[0]] - 1e-9:
+            samples.append(in_hand())
+            qs.append(r.q)
+            k[0] += 1
+        if observe is not None:
+            observe(r)
+
+    tracking = track(r, traj.times, traj.q, settle=SETTLE, grip=grip, ease=False, observe=record)
+    while len(samples) < len(motion.times):
+        record(np.inf)
+    H = np.array(samples)
+    H[-1] = in_hand()  # after settling
+    creep, turn = _creep(motion, H)
+    err, ok = _tolerance_error(scene, plan, H[-1])
+    return ArmResult(ok, err, creep, turn, float(d.time), tracking, traj, motion.times.copy(), H,
+                     motion.in_hand.copy(), np.array(qs))
+
+
+def _creep(motion: WorldMotion, H) -> tuple[float, float]:
+    """(m, rad): the most the object moved in the gripper frame within a run of non-push samples."""
+    creep, turn, start = 0.0, 0.0, None
+    for i, lab in enumerate(motion.labels):
+        if lab == "push":
+            start = None
+            continue
+        start = i if start is None else start
+        creep = max(creep, float(np.linalg.norm(H[i, :3] - H[start, :3])))
+        turn = max(turn, P.quat_angle(H[i, 3:], H[start, 3:]))
+    return creep, turn

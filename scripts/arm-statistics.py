@@ -1,0 +1,49 @@
+#!/usr/bin/env python3
+"""Prints the README's table of the arm's success (regrasp.execution.campaign): every bundled
+example (or those named), ``--runs`` executions each with friction, grip force and mass drawn
+within ±``--spread``, ``--workers`` processes.
+
+    python scripts/arm-statistics.py --runs 20 --spread 0.1 --workers 2 [--json out.json] [NAME ...]
+"""
+
+import argparse
+import json
+import sys
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+
+def main() -> int:
+    import regrasp
+    from regrasp.execution.campaign import example
+
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("names", nargs="*", help="bundled examples (default: all with a task)")
+    ap.add_argument("--runs", type=int, default=20)
+    ap.add_argument("--spread", type=float, default=0.1)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--json", help="also write the outcomes here")
+    a = ap.parse_args()
+    names = a.names or regrasp.examples.names()
+    with ProcessPoolExecutor(a.workers) as pool:
+        outs = list(pool.map(example, names, [a.runs] * len(names), [a.spread] * len(names), [a.seed] * len(names)))
+    print(f"| example | success (±{a.spread:.0%}, {a.runs} runs) | median goal error | max creep [mm] | wall [s] |")
+    print("|---|---|---|---|---|")
+    for o in outs:
+        if o.refused:
+            print(f"| {o.name} | refused: {o.refused} | | | {o.seconds:.0f} |")
+            continue
+        e = np.median(np.abs(np.array(o.errors)), axis=0)
+        err = (f"{e[0] * 1e3:.2f} mm, {e[1] * 1e3:.2f} mm, {np.degrees(e[2]):.2f}°" if len(e) == 3
+               else f"{e[0] * 1e3:.2f} mm, {np.degrees(e[1]):.2f}°")
+        print(f"| {o.name} | {o.successes}/{o.runs} | {err} | {max(o.max_creep) * 1e3:.2f} | {o.seconds:.0f} |")
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump([o.__dict__ for o in outs], f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
