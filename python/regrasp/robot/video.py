@@ -37,7 +37,7 @@ GIF_TICK = 0.01  # s, the resolution of a GIF frame's duration
 @dataclass(frozen=True)
 class Camera:
     """A free camera looking at world point ``target`` [m] (None: between the robot's base and
-    its TCP, or the model's centre) from ``distance`` [m], turned ``azimuth`` [deg] about the
+    its TCP when the recorder is made, or the model's centre; the view stays put) from ``distance`` [m], turned ``azimuth`` [deg] about the
     world's z (0: looking along +x; 210: from the front (+x), on the +y side) and raised by
     ``elevation`` [deg] (negative: looking down)."""
 
@@ -89,6 +89,8 @@ class Recorder:
             raise ArgumentError(f"invalid `size`: width and height in [16, 8192] px (got {size!r})", "size")
         self.model, self.data, self.fps, self.size = model, data, float(fps), (width, height)
         self._camera = self._make_camera(model, camera)
+        target = getattr(self._camera, "target", None)  # the default fixed now: the view does not follow the TCP
+        self._target = default_camera(model, data) if target is None else np.asarray(target, float)
         vis = model.vis.global_
         vis.offwidth, vis.offheight = max(vis.offwidth, width), max(vis.offheight, height)
         try:
@@ -112,6 +114,11 @@ class Recorder:
         camera = Camera() if camera is None else camera
         if not isinstance(camera, Camera):
             raise ArgumentError(f"invalid `camera`: a Camera, or a camera's name or id (got {camera!r})", "camera")
+        target = camera.target
+        if target is not None and (np.shape(target) != (3,) or not np.all(np.isfinite(np.asarray(target, float)))):
+            raise ArgumentError(f"invalid `camera.target`: a world point (x, y, z) [m] (got {target!r})", "camera.target")
+        if not (np.isfinite(camera.distance) and camera.distance > 0):
+            raise ArgumentError(f"invalid `camera.distance`: > 0 m (got {camera.distance!r})", "camera.distance")
         return camera
 
     def _view(self, mujoco):
@@ -121,7 +128,7 @@ class Recorder:
             return c
         cam = mujoco.MjvCamera()
         cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-        cam.lookat[:] = default_camera(self.model, self.data) if c.target is None else np.asarray(c.target, float)
+        cam.lookat[:] = self._target
         cam.distance, cam.azimuth, cam.elevation = c.distance, c.azimuth, c.elevation
         return cam
 
