@@ -145,6 +145,9 @@ def test_motion_page_data_round_trips(name):
     ys = np.array([v @ rotation_matrix(q[3:])[1] + q[1] for q in m.in_hand])
     assert J["top"] == pytest.approx(ys.max()) and J["bot"] == pytest.approx(ys.min()) and J["top"] > J["bot"]
     assert set(S["labels"]) >= {"transfer", "approach", "push", "retreat"}
+    # the camera's framing holds the gripper's whole path and the workcell
+    pts = np.vstack([m.gripper[:, :3]] + [f["vertices"] for f in d["features"]])
+    assert np.all(np.abs(pts - d["center"]) <= d["extent"] + 1e-12)
 
 
 @pytest.mark.skipif(NODE is None, reason="needs node to run the page's script")

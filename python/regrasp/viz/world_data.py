@@ -173,6 +173,15 @@ def motion_description(view, motion) -> dict:
                       "object": np.asarray(motion.object, float).tolist(), "labels": list(motion.labels),
                       "push": np.asarray(motion.push, int).tolist()},
              pushes=pushes)
+    return _framed(d, np.asarray(motion.gripper, float)[:, :3])
+
+
+def _framed(d: dict, pts) -> dict:
+    """``d`` with its framing (``center``, ``extent`` [m]) grown to hold the points ``pts`` [m]."""
+    c, e = np.asarray(d["center"]), d["extent"]
+    pts = np.vstack([np.asarray(pts, float), c - e, c + e])
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    d["center"], d["extent"] = ((lo + hi) / 2).tolist(), float((hi - lo).max() / 2)
     return d
 
 
