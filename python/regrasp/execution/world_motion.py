@@ -109,6 +109,20 @@ class WorldMotion:
         """The motion's duration [s]."""
         return float(self.times[-1])
 
+    def html(self, scene=None) -> str:
+        """The motion's browser view, a self-contained HTML page (see
+        :func:`regrasp.viz.viewer.motion_html`): with ``scene``, the gripper holding its object;
+        without, the gripper as its axes."""
+        from ..viz.viewer import motion_html
+
+        return motion_html(scene, self)
+
+    def _repr_html_(self) -> str:
+        """Jupyter's display: the motion's browser view in a frame (the gripper as its axes)."""
+        from ..viz.viewer import iframe
+
+        return iframe(self.html())
+
     def to_trajectory(self):
         """The motion as a :class:`~regrasp.execution.trajectory.Trajectory` of a free gripper
         (robot None, no joints), for the trajectory file (docs/trajectory-file.md)."""

@@ -6,7 +6,12 @@ parallel gripper (fingers, pads, palm) at the grasp's width, the object at the p
 (slerp between knots; play/pause, step slider, speed), the pushers as small bodies on the object
 (the one in contact red, its contact points marked), the gripper's axes (x red, y green, z blue),
 gravity (g) and the goal (dashed). Drag to orbit, wheel to zoom. Planar scenes are shown as
-their outline extruded across the jaw direction (see :mod:`regrasp.viz.view_data`)."""
+their outline extruded across the jaw direction (see :mod:`regrasp.viz.view_data`).
+
+The world view (:func:`workcell_html`, :func:`motion_html`; ``world_viewer.js``) draws a workcell
+in the world frame (table, features, the robot's base, world axes) and a world motion along its
+times: the gripper holding the object, its path coloured by label, the feature of each push
+highlighted while it pushes (see :mod:`regrasp.viz.world_data`)."""
 
 from __future__ import annotations
 
@@ -22,6 +27,8 @@ from ..planning.plan import as_plan
 from .view_data import planar_description, spatial_description
 
 SCRIPT = Path(__file__).with_name("viewer.js")
+#: The world view's script (a workcell, a world motion).
+WORLD_SCRIPT = Path(__file__).with_name("world_viewer.js")
 
 PAGE = r"""<!doctype html>
 <html><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
@@ -102,11 +109,17 @@ def write_html(scene, plan, path) -> Path:
     return write_text(p, text)
 
 
+def iframe(text: str, height: int = 480) -> str:
+    """The page ``text`` in an ``<iframe srcdoc>`` of ``height`` [px] filling the cell's width
+    (its script runs in the frame): what ``_repr_html_`` shows in Jupyter."""
+    return (f'<iframe srcdoc="{html.escape(text, quote=True)}" style="width:100%;height:{int(height)}px;'
+            f'border:1px solid #ddd" sandbox="allow-scripts"></iframe>')
+
+
 def notebook_html(scene, plan=None, height: int = 480) -> str:
     """The page in an ``<iframe srcdoc>`` of ``height`` [px] filling the cell's width: what
     ``_repr_html_`` of scenes and plans shows in Jupyter (its script runs in the frame)."""
-    return (f'<iframe srcdoc="{html.escape(page(scene, plan), quote=True)}" style="width:100%;height:{int(height)}px;'
-            f'border:1px solid #ddd" sandbox="allow-scripts"></iframe>')
+    return iframe(page(scene, plan), height)
 
 
 def plan_html(plan, scene=None) -> str:
@@ -120,3 +133,119 @@ def plan_html(plan, scene=None) -> str:
     body = "".join(f"<tr><th style='text-align:left'>{k}</th><td>{html.escape(str(v))}</td></tr>"
                    for k, v in rows if v is not None)
     return f"<table><caption>regrasp plan ({plan.dimension}-D)</caption>{body}</table>"
+
+
+WORLD_PAGE = r"""<!doctype html>
+<html><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
+<title>regrasp: __TITLE__</title>
+<style>
+html,body{height:100%;margin:0}
+body{font-family:system-ui,sans-serif;background:#fff;display:flex;flex-direction:column;overflow:hidden}
+#bar{padding:6px 8px;display:flex;gap:10px;align-items:center;flex-wrap:wrap;background:#f4f4f4;border-bottom:1px solid #ddd}
+#tbox{flex:1;min-width:120px;display:flex;flex-direction:column}
+#t{width:100%;margin:0}
+#strip{height:5px;width:100%}
+#info{font-size:13px;color:#333}
+#wrap{position:relative;flex:1;min-height:200px}
+#c{position:absolute;left:0;top:0;width:100%;height:100%;display:block;cursor:grab}
+#legend{position:absolute;right:8px;top:8px;font-size:12px;background:rgba(255,255,255,0.85);padding:4px 8px;
+ border:1px solid #ddd;line-height:1.5;pointer-events:none}
+#legend i{display:inline-block;width:12px;height:10px;margin-right:5px;vertical-align:middle}
+#selftest{display:none}
+</style></head><body>
+<div id="bar"><button id="play">play</button>
+<div id="tbox"><input id="t" type="range" min="0" max="__DURATION__" value="0" step="any" title="time [s]"><div id="strip"></div></div>
+<label>speed <select id="speed"><option>0.25</option><option>0.5</option><option selected>1</option><option>2</option><option>4</option></select></label>
+<label><input id="follow" type="checkbox"> follow the gripper</label>
+<span id="info"></span></div>
+<div id="wrap"><canvas id="c" width="900" height="620"></canvas>
+<div id="legend"><b>world frame</b> (drag: orbit, wheel: zoom)<br>
+<i style="background:#c8aa82"></i>table, <i style="background:#a0a5b4"></i>features<br>
+<i style="background:#e62828"></i>feature pushing<br>
+<i style="background:#ffb43c"></i>robot base<br>
+<span class="held"><i style="background:#9ebff0"></i>object, <i style="background:#6e6e78"></i>jaws<br></span>
+<span class="moving">gripper path: <span style="color:#888">transfer</span>, <span style="color:#1f77b4">approach</span>,
+<span style="color:#d62728">push</span>, <span style="color:#2ca02c">retreat</span><br></span>
+<span style="color:#d62728">x</span> <span style="color:#2ca02c">y</span> <span style="color:#1f5fd6">z</span> world axes</div></div>
+<script id="data" type="application/json">__DATA__</script>
+<script>
+__SCRIPT__</script></body></html>
+"""
+
+
+def world_page(d: dict, title: str) -> str:
+    """The self-contained HTML page (a str) of world-view data ``d``
+    (:mod:`regrasp.viz.world_data`) titled ``title``."""
+    text = json.dumps(d, allow_nan=False).replace("</", "<\\/")
+    duration = max(float(d["samples"]["times"][-1]), 0.0)
+    return (WORLD_PAGE.replace("__TITLE__", html.escape(title)).replace("__DURATION__", f"{duration!r}")
+            .replace("__SCRIPT__", WORLD_SCRIPT.read_text()).replace("__DATA__", text))
+
+
+def _check_workcell(workcell):
+    from ..workcell.description import Workcell
+
+    if not isinstance(workcell, Workcell):
+        raise ArgumentError(f"invalid `workcell`: a Workcell (got {type(workcell).__name__})", "workcell")
+
+
+def workcell_description_of(workcell, scene=None) -> dict:
+    """The world view's data of ``workcell`` (see :mod:`regrasp.viz.world_data`); with ``scene``
+    (a :class:`~regrasp.Scene` or :class:`~regrasp.Scene3D`) its object where the workcell starts
+    it: on the table, or held at the scene's start by the gripper above the table's centre at
+    the safe height (every feature's top + the default clearance + the object's reach) [m]."""
+    from ..execution.world_motion import Timing
+    from .world_data import still_description, workcell_description
+
+    _check_workcell(workcell)
+    if scene is None:
+        d = workcell_description(workcell)
+        d.update(scene=None, object=None, gripper=None, pushes=[],
+                 samples={"times": [0.0], "gripper": [None], "object": [None], "labels": ["start"], "push": [-1]})
+        return d
+    v = description(scene)
+    reach = float(np.linalg.norm(np.asarray(v["vertices"], float), axis=1).max())
+    hand = [*workcell.table.center, workcell.top() + Timing().clearance + reach, 1.0, 0.0, 0.0, 0.0]
+    return still_description(v, workcell, hand)
+
+
+def workcell_html(workcell, scene=None) -> str:
+    """The browser view (a self-contained HTML page, a str) of ``workcell``: the table, every
+    feature, the robot's base and the world axes; with ``scene``, its object where it starts (see
+    :func:`workcell_description_of`)."""
+    return world_page(workcell_description_of(workcell, scene), workcell.name)
+
+
+def motion_description_of(scene, motion) -> dict:
+    """The world view's data of ``motion`` (a :class:`~regrasp.execution.WorldMotion` of
+    ``scene``; None: without the object, the gripper as its axes; see
+    :func:`regrasp.viz.world_data.motion_description`)."""
+    from ..execution.world_motion import WorldMotion
+    from .world_data import motion_description
+
+    if not isinstance(motion, WorldMotion):
+        raise ArgumentError(f"invalid `motion`: a WorldMotion (got {type(motion).__name__})", "motion")
+    if scene is None:
+        return motion_description(None, motion)
+    v = description(scene)
+    if motion.scene and motion.scene != scene.name:
+        raise ArgumentError(f"invalid `scene`: the motion is of scene `{motion.scene}` (got `{scene.name}`)", "scene")
+    return motion_description(v, motion)
+
+
+def motion_html(scene, motion) -> str:
+    """The browser view (a self-contained HTML page, a str) of world motion ``motion`` of
+    ``scene`` (None: without the object, the gripper as its axes): the workcell, the gripper
+    holding the object animated along the motion's times [s]
+    (time slider, play), the gripper's path coloured by label (transfer, approach, push,
+    retreat) and the feature of each push highlighted while it pushes."""
+    name = scene.name if scene is not None else motion.scene or "motion"
+    return world_page(motion_description_of(scene, motion), f"{name} in {motion.workcell.name}")
+
+
+def write_motion_html(path, scene, motion) -> Path:
+    """Writes :func:`motion_html` of ``scene`` and ``motion`` to ``path`` (atomically; its folder
+    created, once the page is made); returns the path."""
+    p, text = Path(path), motion_html(scene, motion)
+    p.parent.mkdir(parents=True, exist_ok=True)  # atomic_write does not create folders
+    return write_text(p, text)

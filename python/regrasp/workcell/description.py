@@ -323,3 +323,16 @@ class Workcell:
         from .file import save
 
         save(self, path)
+
+    def html(self, scene=None) -> str:
+        """The workcell's browser view, a self-contained HTML page (see
+        :func:`regrasp.viz.viewer.workcell_html`); with ``scene``, its object where it starts."""
+        from ..viz.viewer import workcell_html
+
+        return workcell_html(self, scene)
+
+    def _repr_html_(self) -> str:
+        """Jupyter's display: the workcell's browser view in a frame."""
+        from ..viz.viewer import iframe
+
+        return iframe(self.html())
