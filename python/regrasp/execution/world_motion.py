@@ -123,13 +123,19 @@ class WorldMotion:
 
         return iframe(self.html())
 
-    def to_trajectory(self):
-        """The motion as a :class:`~regrasp.execution.trajectory.Trajectory` of a free gripper
-        (robot None, no joints), for the trajectory file (docs/trajectory-file.md)."""
+    def to_trajectory(self, arm=None):
+        """The motion as a :class:`~regrasp.execution.trajectory.Trajectory` for the trajectory
+        file (docs/trajectory-file.md): of a free gripper (robot None, no joints), or with
+        ``arm`` (an :class:`~regrasp.execution.arm.ArmTrajectory` of this motion) the robot's
+        name, joint names and joint positions [rad] per sample."""
         from .trajectory import PushRecord, Trajectory
 
-        return Trajectory(self.scene or "scene", self.workcell.name, None, [], self.times.copy(),
-                          np.zeros((len(self.times), 0)), self.gripper.copy(), self.grip_force.copy(),
+        if arm is not None and len(arm.q) != len(self.times):
+            raise ArgumentError(f"invalid `arm`: {len(self.times)} samples of joint positions (got {len(arm.q)})", "arm")
+        robot, names, q = (None, [], np.zeros((len(self.times), 0))) if arm is None else \
+            (arm.robot, list(arm.joint_names), np.asarray(arm.q, float))
+        return Trajectory(self.scene or "scene", self.workcell.name, robot, names, self.times.copy(),
+                          q, self.gripper.copy(), self.grip_force.copy(),
                           list(self.labels), self.push.copy(),
                           [PushRecord(a.pusher, a.feature, a.first, a.last, a.frame.copy(), a.tilt, d)
                            for a, d in zip(self.assignments, self.penetration)])

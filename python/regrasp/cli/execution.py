@@ -1,0 +1,129 @@
+"""`regrasp execute`: a plan executed in a workcell by a real arm (or a free-flying gripper) in
+MuJoCo, its timed joint trajectory exported."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ..errors import ArgumentError
+from ..planning.plan import Plan
+from . import (CANNOT, OK, add_command, add_scale_options, add_verbose, check_outputs, error3d, load, rounded,
+               scales)
+
+#: `--robot` of the free-flying gripper (the baseline rig, no arm)
+FREE_GRIPPER = "free-gripper"
+
+
+def _robots() -> list[str]:
+    from ..robot.model import ALIASES, ROBOTS
+
+    return [*ROBOTS, *ALIASES, FREE_GRIPPER]
+
+
+def _check(a) -> None:
+    """The options of `regrasp execute`, before any work."""
+    if a.robot is not None and a.robot not in _robots():
+        raise ArgumentError(f"invalid `--robot`: unknown robot {a.robot!r} (known: {', '.join(_robots())})", "--robot")
+    scales(a)
+    if a.video and a.robot == FREE_GRIPPER:
+        raise ArgumentError("invalid `--video`: the video shows the arm (not --robot free-gripper)", "--video")
+    check_outputs(a, {"trajectory": (".json",), "video": (".gif", ".mp4"), "html": (".html", ".htm")},
+                  [a.scene, a.plan, a.workcell])
+
+
+def _motion(scene, plan, a):
+    from ..execution import world_motion
+    from ..workcell.file import load as load_workcell
+
+    workcell = load_workcell(a.workcell) if a.workcell else None
+    return world_motion(scene, plan, workcell)
+
+
+def _free(scene, plan, motion, a) -> dict:
+    from ..execution import execute_free_gripper
+
+    if a.scale_friction or a.scale_grip or a.scale_mass:
+        raise ArgumentError("invalid `--scale-friction`: the free-gripper rig is not perturbed (use the arm)",
+                            "--scale-friction")
+    r = execute_free_gripper(scene, plan, motion)
+    return dict(success=r.success, goal_error=r.goal_error, max_creep=r.max_creep, max_creep_angle=r.max_creep_angle,
+                duration_s=r.duration, robot=FREE_GRIPPER), None
+
+
+def _arm(scene, plan, motion, a):
+    from ..execution.arm import Scales, execute_arm
+
+    recorder = None
+    observe = None
+    if a.video:
+        from ..robot.video import Recorder
+
+        holder = {}
+
+        def observe(robot):  # the recorder is made on the first call, once the model exists
+            if "r" not in holder:
+                holder["r"] = Recorder(robot.model, robot.data)
+            holder["r"].capture()
+    f, g, m = scales(a)
+    r = execute_arm(scene, plan, motion, a.robot if a.robot != FREE_GRIPPER else None, Scales(f, g, m, f),
+                    observe=observe)
+    if a.video:
+        recorder = holder.get("r")
+    out = dict(success=r.success, goal_error=r.goal_error, max_creep=r.max_creep, max_creep_angle=r.max_creep_angle,
+               duration_s=r.duration, robot=r.trajectory.robot,
+               tracking=dict(max_joint_error=r.tracking.max_error, rms_joint_error=r.tracking.rms_error,
+                             max_tcp_error=r.tracking.tcp_error))
+    return out, (r, recorder)
+
+
+def cmd_execute(a) -> int:
+    _check(a)
+    scene = load(a.scene, a)
+    plan = Plan.load(a.plan, scene)
+    motion = _motion(scene, plan, a)
+    out, extra = (_free if a.robot == FREE_GRIPPER else _arm)(scene, plan, motion, a)
+    written = []
+    if a.trajectory:
+        arm = extra[0].trajectory if extra else None
+        written.append(motion.to_trajectory(arm).save(a.trajectory))
+    if a.video and extra and extra[1] is not None:
+        written.append(extra[1].save(a.video))
+    if a.html:
+        from ..viz.viewer import write_motion_html
+
+        written.append(write_motion_html(a.html, scene, motion))
+    out = {**out, "workcell": motion.workcell.name, "pushes": [
+        {"pusher": p.pusher, "feature": p.feature, "tilt": p.tilt} for p in motion.assignments]}
+    if a.json:
+        print(json.dumps({k: (rounded(v) if isinstance(v, np.ndarray) else v) for k, v in out.items()},
+                         allow_nan=False))
+    else:
+        err = rounded(out["goal_error"]) if scene.dimension == 2 else error3d(out["goal_error"])
+        print(f"{scene.name}: {out['robot']} in workcell {out['workcell']}, {len(motion.assignments)} pushes "
+              f"({', '.join(f'{p.pusher} on {p.feature}' for p in motion.assignments)}), {out['duration_s']:.1f} s: "
+              f"{'success' if out['success'] else 'outside the tolerance'}, error to goal {err}; "
+              f"largest creep {out['max_creep'] * 1e3:.2f} mm")
+        for p in written:
+            print(f"wrote {p}")
+    return OK if out["success"] else CANNOT
+
+
+def add_parsers(sub) -> None:
+    e = add_command(sub, "execute", "execute a plan with a real arm in a workcell (MuJoCo) and export its joint "
+                    "trajectory", "regrasp execute block-xztheta.toml --plan plan.json --trajectory traj.json --json",
+                    cmd_execute)
+    e.add_argument("scene", help="the scene file the plan is for")
+    e.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
+    e.add_argument("--workcell", metavar="W.toml", help="the workcell file (docs/workcell-file.md; default: one "
+                   "generated for the scene)")
+    e.add_argument("--robot", metavar="NAME", help=f"the robot: one of {', '.join(_robots())} (default: the "
+                   "workcell's)")
+    e.add_argument("--trajectory", metavar="TRAJ.json", help="write the timed joint trajectory "
+                   "(docs/trajectory-file.md)")
+    e.add_argument("--video", metavar="GIF|MP4", help="a video of the arm doing it (MuJoCo's renderer)")
+    e.add_argument("--html", metavar="HTML", help="a browser view of the workcell and the world motion")
+    add_scale_options(e, "the arm's world: ")
+    e.add_argument("--json", action="store_true", help="print the result as JSON")
+    add_verbose(e)
