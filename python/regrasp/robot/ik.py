@@ -64,7 +64,7 @@ def table_distance(robot, q, avoid=()) -> float:
     d.qpos[:] = robot.data.qpos
     d.qpos[robot.arm_qpos] = q
     mujoco.mj_kinematics(robot.model, d)
-    return min(mujoco.mj_geomDistance(robot.model, d, g, o, 0.1, None) for g in robot.robot_geoms for o in obstacles)
+    return min(mujoco.mj_geomDistance(robot.model, d, g, o, 0.1, None) for g in robot.clearance_geoms for o in obstacles)
 
 
 class IKSolver:
@@ -101,7 +101,7 @@ class IKSolver:
         self.avoid = tuple(avoid)
         self.obstacles = obstacle_geoms(robot, avoid)
         if self.obstacles:
-            self.limits.append(mink.CollisionAvoidanceLimit(m, [(list(robot.robot_geoms), self.obstacles)],
+            self.limits.append(mink.CollisionAvoidanceLimit(m, [(list(robot.clearance_geoms), self.obstacles)],
                                                             minimum_distance_from_collisions=LIMIT_DISTANCE,
                                                             collision_detection_distance=0.05))
 

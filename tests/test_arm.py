@@ -1,0 +1,139 @@
+"""Plans executed by the real arm in the workcell (regrasp.execution.arm, `regrasp execute`), with
+the real engine: the joint trajectory checked by forward kinematics against the world motion,
+the measured in-hand poses against the object's and the TCP's world poses (4 x 4 matrices), the
+result against the plan's goal and the scene's tolerance; refusals name the push."""
+
+import json
+
+import numpy as np
+import pytest
+
+import regrasp
+from regrasp import ExecutionError
+from regrasp.execution import Trajectory, world_motion
+from regrasp.execution.arm import Scales, build_robot, execute_arm, grasp_of, solve_arm, where
+from regrasp.robot.ik import MAX_JUMP
+from regrasp.robot.pads import Pads
+from regrasp.workcell import Workcell
+from regrasp.workcell.description import Robot
+
+from .conftest import pose_matrix as T, run_cli
+
+pytest.importorskip("mink")
+CASES: dict = {}
+
+
+def case(name):
+    """(scene, plan, motion, robot, tcp, arm trajectory) of bundled example ``name``."""
+    if name not in CASES:
+        scene = regrasp.load_scene(regrasp.examples.path(name))
+        plan = regrasp.plan(scene, seed=0)
+        motion = world_motion(scene, plan)
+        robot, _, _, tcp = build_robot(scene, motion)
+        CASES[name] = (scene, plan, motion, robot, tcp, solve_arm(robot, motion, tcp))
+    return CASES[name]
+
+
+def test_grasp_of_a_mesh_is_its_extent_across_the_pads():
+    scene = regrasp.load_scene(regrasp.examples.path("offset-3d"))
+    start = np.asarray(scene.task[0], float)
+    width, centre = grasp_of(scene, start)
+    v = np.asarray(scene.mesh()[0], float)
+    y = (T(start) @ np.c_[v, np.ones(len(v))].T)[1]  # independent: the 4 x 4 matrix
+    assert width == pytest.approx(y.max() - y.min(), abs=1e-12)
+    assert centre == pytest.approx((y.max() + y.min()) / 2, abs=1e-12)
+    assert grasp_of(regrasp.load_scene(regrasp.examples.path("t-shape")), np.r_[0, 0, 0, 1.0, 0, 0, 0]) == (0.012, 0.0)
+
+
+def test_pads_of_a_scene_cover_its_pad_shape():
+    p = Pads.of_scene(regrasp.load_scene(regrasp.examples.path("block-xztheta"))).points()  # a 7 mm disc
+    r = np.hypot(p[:, 0], p[:, 2] - p[:, 2].mean())
+    assert len(p) == 13 and r.max() + 0.001 <= 0.007 + 1e-12 and r.min() == pytest.approx(0.0, abs=1e-12)
+    q = Pads(3, 4, 0.001, ("rectangle", 0.01, 0.02)).points()
+    assert len(q) == 12 and np.ptp(q[:, 0]) == pytest.approx(0.008) and np.ptp(q[:, 2]) == pytest.approx(0.018)
+
+
+@pytest.mark.parametrize("name", ["block-3d", "block-fixtureless"])
+def test_the_joint_trajectory_puts_the_tcp_on_the_world_motion(name):
+    scene, plan, motion, robot, tcp, arm = case(name)
+    assert arm.q.shape == (len(motion.times), 6) and list(arm.joint_names) == list(robot.arm_joints)
+    lim = robot.joint_limits()
+    assert np.all(arm.q >= lim[:, 0]) and np.all(arm.q <= lim[:, 1])
+    assert np.abs(np.diff(arm.q, axis=0)).max() <= MAX_JUMP
+    for i in range(0, len(arm.q), 37):  # independent: forward kinematics against G_i ∘ tcp as matrices
+        got = T(robot.tcp_pose(arm.q[i]))
+        want = T(motion.gripper[i]) @ T(tcp)
+        assert np.abs(got[:3, 3] - want[:3, 3]).max() < 1e-3
+        assert np.abs(got[:3, :3] - want[:3, :3]).max() < 0.01
+
+
+def test_the_arm_executes_a_3d_plan_in_the_workcell():
+    scene, plan, motion, robot, tcp, arm = case("block-3d")
+    r = execute_arm(scene, plan, motion, trajectory=arm)
+    assert r.success, r.goal_error
+    goal = np.asarray(plan.poses[-1], float)
+    assert np.linalg.norm(r.in_hand[-1][:3] - goal[:3]) == pytest.approx(r.goal_error[0], abs=1e-12)
+    assert r.goal_error[0] <= np.linalg.norm(scene.task[2][:3]) and r.max_creep < 1e-3
+    # the arm followed its joint trajectory; the object stayed near the plan all along
+    assert np.abs(r.q - arm.q).max() < 0.01 and r.tracking.tcp_error < 3e-3
+    assert np.linalg.norm(r.in_hand[:, :3] - r.planned[:, :3], axis=1).max() < 3e-3
+
+
+def test_a_world_perturbation_changes_the_world_but_not_the_trajectory():
+    scene, plan, motion, robot, tcp, arm = case("block-3d")
+    k = Scales(finger_friction=0.8, grip=0.5, mass=3.0, feature_friction=1.2)
+    scaled, body, _, _ = build_robot(scene, motion, scales=k)
+    m0, m1 = robot.model, scaled.model
+    assert m1.body_mass[body] == pytest.approx(3.0 * m0.body_mass[body])
+    pad = robot.pad_geoms[0][0]
+    assert m1.geom_friction[pad, 0] == pytest.approx(0.8 * m0.geom_friction[pad, 0])
+    fixture = m0.geom("fixture").id
+    assert m1.geom_friction[fixture, 0] == pytest.approx(1.2 * m0.geom_friction[fixture, 0])
+    heavy = execute_arm(scene, plan, motion, scales=k, trajectory=arm)
+    nominal = execute_arm(scene, plan, motion, trajectory=arm)
+    assert np.array_equal(heavy.trajectory.q, nominal.trajectory.q)
+    assert np.abs(heavy.in_hand - nominal.in_hand).max() > 1e-5
+
+
+def test_an_arm_out_of_reach_is_refused_naming_the_push():
+    scene, plan, motion, *_ = case("block-3d")
+    far = Workcell("far", motion.workcell.table, motion.workcell.features, Robot("ur5e", [3.0, 0, 0.75, 1, 0, 0, 0]))
+    m = world_motion(scene, plan, far)
+    with pytest.raises(ExecutionError, match=r"the arm cannot execute the transfer before push 0 .*unreachable") as e:
+        execute_arm(scene, plan, m)
+    assert e.value.field == "robot"
+    assert where(m, int(np.flatnonzero(m.push == 0)[0])).startswith("push 0 (approach, pusher ")
+
+
+def test_the_trajectory_file_carries_the_joints(tmp_path):
+    scene, plan, motion, robot, tcp, arm = case("block-3d")
+    path = motion.to_trajectory(arm).save(tmp_path / "t.json")
+    t = Trajectory.load(path)
+    assert t.robot == "ur5e-2f85" and t.joint_names == list(robot.arm_joints)
+    assert np.array_equal(t.q, arm.q) and np.array_equal(t.gripper, motion.gripper)
+    raw = json.loads(path.read_text())
+    assert len(raw["samples"][5]["q"]) == 6
+
+
+def test_execute_cli(tmp_path):
+    plan = tmp_path / "plan.json"
+    scene = regrasp.examples.path("block-3d")
+    assert run_cli("plan", scene, "--out", plan)[0] == 0
+    code, out, err = run_cli("execute", scene, "--plan", plan, "--trajectory", tmp_path / "traj.json", "--json")
+    assert code == 0, err
+    r = json.loads(out)
+    assert {"success", "goal_error", "max_creep", "robot", "duration_s"} <= set(r) and r["success"] is True
+    assert r["robot"] == "ur5e-2f85" and r["pushes"][0]["feature"]
+    assert Trajectory.load(tmp_path / "traj.json").q.shape[1] == 6
+    code, out, err = run_cli("execute", scene, "--plan", plan, "--robot", "free-gripper", "--json")
+    assert json.loads(out)["robot"] == "free-gripper" and code in (0, 1)
+
+
+def test_execute_cli_refusals(tmp_path):
+    scene = regrasp.examples.path("block-3d")
+    code, _, err = run_cli("execute", scene, "--plan", tmp_path / "p.json", "--robot", "kuka")
+    assert code == 2 and "--robot" in err and "ur5e-2f85" in err
+    code, _, err = run_cli("execute", scene, "--plan", tmp_path / "p.json", "--trajectory", tmp_path / "t.txt")
+    assert code == 2 and "--trajectory" in err
+    code, _, err = run_cli("execute", scene, "--plan", tmp_path / "p.json", "--trajectory", scene)
+    assert code == 2
