@@ -25,7 +25,21 @@ from .. import pose as P
 from ..workcell.shapes import Shape
 
 #: Spacing [m] of the points along the object's edges and the bodies' edges.
-SPACING = 1e-3
+SPACING = 2e-3
+
+
+#: Points are checked in runs of this many consecutive ones (spatially close, along an edge),
+#: each bounded by a ball, a run's points only where its ball comes near.
+CHUNK = 6
+
+
+def _chunks(pts) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``pts`` (k, 3) in runs of :data:`CHUNK` (the last padded with its last point): (c, CHUNK, 3),
+    the runs' centres (c, 3) and radii (c,) [m]."""
+    pad = -len(pts) % CHUNK
+    runs = np.concatenate([pts, np.repeat(pts[-1:], pad, axis=0)]).reshape(-1, CHUNK, 3)
+    c = (runs.min(axis=1) + runs.max(axis=1)) / 2
+    return runs, c, np.linalg.norm(runs - c[:, None], axis=2).max(axis=1)
 
 
 @dataclass(frozen=True)
@@ -39,13 +53,16 @@ class Solid:
     sphere: float
     reach: float
 
+    def __post_init__(self):
+        object.__setattr__(self, "runs", _chunks(self.points))   # the points in runs (see depths)
+
     def distance(self, pts) -> np.ndarray:
         """The signed distance [m] of object-frame points ``pts`` (n, 3) from the solid (< 0
         inside; outside, a lower bound: the farthest of a piece's planes)."""
         pts = np.asarray(pts, float)
         if self.sphere > 0:
             return np.linalg.norm(pts, axis=-1) - self.sphere
-        return np.min([np.max(pts @ A.T - b, axis=-1) for A, b in self.pieces], axis=0)
+        return np.min([np.max(np.einsum("nj,pj->np", pts, A) - b, axis=-1) for A, b in self.pieces], axis=0)
 
 
 def _along(a, b, spacing) -> np.ndarray:
@@ -101,27 +118,19 @@ def solid(scene) -> Solid:
     return Solid(pts, [_planes(v, t)], 0.0, float(np.max(np.linalg.norm(pts, axis=1))))
 
 
-#: Points are checked in runs of this many consecutive ones (spatially close, along an edge),
-#: each bounded by a ball, a run's points only where its ball comes near.
-CHUNK = 16
+def cores(shapes: list[Shape]) -> list:
+    """The core points of ``shapes`` in runs, for :func:`depths` (made once for many calls)."""
+    return [_chunks(s.core_points(SPACING)) for s in shapes]
 
 
-def _chunks(pts) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``pts`` (k, 3) in runs of :data:`CHUNK` (the last padded with its last point): (c, CHUNK, 3),
-    the runs' centres (c, 3) and radii (c,) [m]."""
-    pad = -len(pts) % CHUNK
-    runs = np.concatenate([pts, np.repeat(pts[-1:], pad, axis=0)]).reshape(-1, CHUNK, 3)
-    c = (runs.min(axis=1) + runs.max(axis=1)) / 2
-    return runs, c, np.linalg.norm(runs - c[:, None], axis=2).max(axis=1)
-
-
-def depths(body: Solid, shapes: list[Shape], poses) -> np.ndarray:
+def depths(body: Solid, shapes: list[Shape], poses, core_runs: list | None = None) -> np.ndarray:
     """How deep [m] the object (``body``) is in each of ``shapes`` at each of its world ``poses``
     (n, 7) (m, unit quaternion): (n, len(shapes)), > 0 inside; otherwise not in it (≤ 0, or −inf
-    where none of the points checked came near)."""
+    where none of the points checked came near); ``core_runs``: :func:`cores` of the shapes."""
     W = np.asarray(poses, float)
     out = np.full((len(W), len(shapes)), -np.inf)
-    runs, centres, radii = _chunks(body.points)
+    runs, centres, radii = body.runs
+    core_runs = cores(shapes) if core_runs is None else core_runs
     for i, s in enumerate(shapes):
         js = np.flatnonzero(s.depth(W[:, :3]) > -(body.reach + 1e-9))
         if not len(js):
@@ -129,19 +138,19 @@ def depths(body: Solid, shapes: list[Shape], poses) -> np.ndarray:
         R, t = P.quat_matrices(W[js, 3:]), W[js, :3]
         d = np.full(len(js), -np.inf)
         # the object's points in the body
-        jj, cc = np.nonzero(s.depth(centres @ R.transpose(0, 2, 1) + t[:, None]) > -radii - 1e-9)
+        jj, cc = np.nonzero(s.depth(np.einsum("nij,cj->nci", R, centres) + t[:, None]) > -radii - 1e-9)
         if len(jj):
-            world = runs[cc] @ R[jj].transpose(0, 2, 1) + t[jj, None]
+            world = np.einsum("nij,nkj->nki", R[jj], runs[cc]) + t[jj, None]
             np.maximum.at(d, jj, s.depth(world).max(axis=1))
         # the body's core points in the object: runs whose ball comes near the object's
-        cruns, ccent, crad = _chunks(s.core_points(SPACING))
+        cruns, ccent, crad = core_runs[i]
         rel = ccent[None] - t[:, None]                                              # (m, c, 3)
         jj, cc = np.nonzero(np.einsum("mci,mci->mc", rel, rel) <= (body.reach + crad + s.radius + 1e-9) ** 2)
         if len(jj):
             near = body.distance(np.einsum("ni,nij->nj", rel[jj, cc], R[jj])) <= crad[cc] + s.radius + 1e-9
             jj, cc = jj[near], cc[near]
         if len(jj):
-            local = (cruns[cc] - t[jj, None]) @ R[jj]                                # R^T (core - t)
+            local = np.einsum("nki,nij->nkj", cruns[cc] - t[jj, None], R[jj])             # R^T (core - t)
             e = s.radius - body.distance(local.reshape(-1, 3)).reshape(len(jj), CHUNK)
             np.maximum.at(d, jj, e.max(axis=1))
         out[js, i] = d

@@ -401,6 +401,7 @@ class _Check:
     def __init__(self, scene, workcell):
         self.scene, self.workcell = scene, workcell
         self.solid, self.bodies = collision.solid(scene), shapes(workcell)
+        self.cores = collision.cores(self.bodies)
         self.points = edge_points(scene)
         self.extents = {c.name: c.extent for c in workcell.contacts()}
 
@@ -443,7 +444,7 @@ def _collisions(c: _Check, W, labels, push, a, last):
     ``a``'s approach, push and retreat, more than :data:`PENETRATION_LIMIT` into its own feature
     (``last``: the push before a final transfer)."""
     names = [b.name for b in c.bodies]
-    D = collision.depths(c.solid, c.bodies, W)
+    D = collision.depths(c.solid, c.bodies, W, c.cores)
     limit = np.full(D.shape, TOUCH)
     if a is not None:
         limit[push == a.index, names.index(_body(a.feature, names))] = PENETRATION_LIMIT

@@ -59,7 +59,7 @@ class Shape:
     def depth(self, pts) -> np.ndarray:
         """How deep [m] world points ``pts`` (..., 3) are inside the body (> 0 inside; otherwise
         minus their distance from it)."""
-        local = (np.asarray(pts, float) - self.pose[:3]) @ P.quat_matrix(self.pose[3:])
+        local = np.einsum("...i,ij->...j", np.asarray(pts, float) - self.pose[:3], P.quat_matrix(self.pose[3:]))
         if self.kind == "box":
             q = np.abs(local) - self.size
             out = np.linalg.norm(np.maximum(q, 0.0), axis=-1) + np.minimum(q.max(axis=-1), 0.0)
