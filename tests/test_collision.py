@@ -267,3 +267,40 @@ def test_an_object_moved_beyond_a_bodys_plane_never_collides_with_it(name, which
     x = s.pose[:3] + (h - s.pose[:3] @ u - low + gap) * u
     D = C.depths(body, [s], np.r_[x, q][None])[0, 0]
     assert D <= 1e-9, (name, s.name, D)
+
+
+@pytest.mark.parametrize("envelope", [0.0, GRIPPER_ENVELOPE, 0.3])
+def test_transfers_at_the_safe_height_keep_the_gripper_envelope_clear(envelope):
+    """At the safe height a ball of radius ``envelope`` about the gripper's origin is at least the
+    clearance from every body (MuJoCo's distance from a sphere there), and the safe height is the
+    workcell's top + clearance + the larger of the object's reach and the envelope."""
+    scene, plan = plan_of("t-shape")
+    m = world_motion(scene, plan, envelope=envelope)
+    reach = max(np.linalg.norm(regrasp.pose.transform(q, C.solid(scene).points), axis=1).max() for q in m.in_hand)
+    assert m.safe_height == pytest.approx(m.workcell.top() + m.timing.clearance + max(reach, envelope), abs=2e-3)
+    if envelope == 0:
+        return
+    spec = mujoco.MjSpec()
+    for s in shapes(m.workcell):
+        spec.worldbody.add_geom(name=s.name, type=getattr(mujoco.mjtGeom, f"mjGEOM_{s.kind.upper()}"),
+                                size=list(s.size) + [0.0] * (3 - len(s.size)), pos=s.pose[:3], quat=s.pose[3:])
+    ball = spec.worldbody.add_body(name="ball", mocap=True)
+    ball.add_geom(name="ball", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[envelope, 0, 0])
+    mm = spec.compile()
+    d = mujoco.MjData(mm)
+    high = np.flatnonzero(np.isclose(m.gripper[:, 2], m.safe_height))
+    assert len(high) > 2
+    for j in high:
+        d.mocap_pos[0] = m.gripper[j, :3]
+        mujoco.mj_kinematics(mm, d)
+        for s in shapes(m.workcell):
+            dist = mujoco.mj_geomDistance(mm, d, mm.geom("ball").id, mm.geom(s.name).id, 1.0, None)
+            assert dist >= m.timing.clearance - 1e-9, (s.name, dist)
+
+
+@pytest.mark.parametrize("value", [None, -0.1, float("nan"), 11.0, True, "0.1"])
+def test_a_bad_envelope_is_refused_naming_it(value):
+    scene, plan = plan_of("block-low-friction")
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, plan, envelope=value)
+    assert e.value.field == "envelope"

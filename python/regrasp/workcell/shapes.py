@@ -56,6 +56,14 @@ class Shape:
             return float(np.linalg.norm(self.size))
         return float(self.size[0] + (self.size[1] if self.kind == "capsule" else 0.0))
 
+    @property
+    def top(self) -> float:
+        """The body's highest point [m] (world z)."""
+        R = P.quat_matrix(self.pose[3:])
+        if self.kind == "box":
+            return float(self.pose[2] + np.abs(R[2]) @ self.size)
+        return float(self.pose[2] + self.size[0] + (abs(R[2, 2]) * self.size[1] if self.kind == "capsule" else 0.0))
+
     def depth(self, pts) -> np.ndarray:
         """How deep [m] world points ``pts`` (..., 3) are inside the body (> 0 inside; otherwise
         minus their distance from it)."""
