@@ -304,3 +304,11 @@ def test_a_bad_envelope_is_refused_naming_it(value):
     with pytest.raises(ArgumentError) as e:
         world_motion(scene, plan, envelope=value)
     assert e.value.field == "envelope"
+
+
+def test_a_start_pose_in_a_feature_is_refused_naming_start():
+    scene, plan = plan_of("block-low-friction")
+    block = default_workcell(scene).feature("fixture")
+    with pytest.raises(ArgumentError) as e:
+        world_motion(scene, plan, start=[*block.pose[:3], 1, 0, 0, 0])
+    assert e.value.field == "start" and "feature `fixture`" in str(e.value)

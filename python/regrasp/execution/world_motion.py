@@ -13,8 +13,8 @@ otherwise the object's own twist, a sticking pusher): ``P(s) = O exp(s ξ) O⁻�
 Around each push (one builder each: :func:`_transfer`, :func:`_approach`, :func:`_push`,
 :func:`_retreat`): a transfer up to the safe height, over (the switch-over's turn is made there)
 and down to a pre-contact pose ``timing.clearance`` away from the feature along its push
-direction, the approach, the push and the retreat by the clearance. The safe height is every
-feature's top + the clearance + the larger of the object's reach from the gripper origin and the
+direction, the approach, the push and the retreat by the clearance. The safe height is the
+top of every feature's body (:meth:`Workcell.top`) + the clearance + the larger of the object's reach from the gripper origin and the
 gripper's own ``envelope`` (:data:`GRIPPER_ENVELOPE`), so that neither object nor gripper
 comes within the clearance of the workcell there. Under a feature that pushes downward (a
 ledge), the transfers go down and up beside it, moved horizontally across the feature by twice
@@ -26,7 +26,9 @@ edges, :func:`edge_points`, behind the plane, within a face's rectangle). Refuse
 or the transfer, the body hit and the depth: the object (a solid,
 :mod:`regrasp.execution.collision`) in the table or a feature's body
 (:func:`regrasp.workcell.shapes`) at any sample — deeper than :data:`TOUCH`, or, in a push's
-approach, push and retreat, deeper than :data:`PENETRATION_LIMIT` into that push's own feature."""
+approach, push and retreat, deeper than :data:`PENETRATION_LIMIT` into that push's own feature.
+A push whose motion is refused so is rendered by the next contact that serves it
+(:func:`~regrasp.execution.assignment.candidates`); the first refusal is raised when none is left."""
 
 from __future__ import annotations
 
@@ -408,6 +410,8 @@ class _Check:
     def __call__(self, S: _Samples, n0: int, a, done: list) -> float:
         """Checks samples ``n0:`` of ``S`` (push ``a``'s, or the last transfer's when ``a`` is
         None; ``done``: the pushes before); returns push ``a``'s penetration [m]."""
+        if len(S.G) <= n0:
+            return 0.0
         W = P.compose_rows(np.array(S.G[n0:]), np.array(S.O[n0:]))
         labels, push = S.label[n0:], np.array(S.push[n0:], int)
         d = 0.0 if a is None else _penetration(self, a, W[(push == a.index) & np.array([x == "push" for x in labels])])
@@ -468,6 +472,8 @@ def _collisions(c: _Check, W, labels, push, a, last):
         hit = f"goes {deepest * 1e3:.2f} mm below the table top of workcell `{c.workcell.name}`"
     else:
         hit = f"hits feature `{names[i]}` of workcell `{c.workcell.name}`, {deepest * 1e3:.2f} mm deep"
+    if labels[j] == "start":
+        raise ArgumentError(f"invalid `start`: there the object {hit}", "start")
     raise ArgumentError(f"{what}: the object {hit}", f"plan.path[{a.first + 1}].pusher")
 
 
