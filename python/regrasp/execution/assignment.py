@@ -164,16 +164,18 @@ def serves(c: Contact, pc: PusherContact, phi: float = 0.0, from_below: bool = F
     return f"the face ({2 * c.extent[0]:g} x {2 * c.extent[1]:g} m) does not hold the pusher's points"
 
 
-def candidates(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = MAX_TILT) -> list[list[Assignment]]:
+def candidates(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = MAX_TILT,
+               contacts: list | None = None) -> list[list[Assignment]]:
     """For each push of a plan (arguments as :func:`assign`: ``poses`` planar (m, m, rad) or 3-D
     (m, quaternion)), every contact of ``workcell`` that
     serves it, best first: :func:`assign`'s choice, then the others by tilt (then, for a patch,
-    by face size), each with its own best turn. ArgumentError (field ``plan.path[i].pusher``)
+    by face size), each with its own best turn (``contacts``: ``workcell.contacts()``, when
+    already made). ArgumentError (field ``plan.path[i].pusher``)
     when none serves a push."""
     if isinstance(max_tilt, bool) or not isinstance(max_tilt, (int, float)) or not 0 <= max_tilt <= np.pi:
         raise ArgumentError(f"invalid `max_tilt`: an angle in [0, pi] rad (got {max_tilt!r:.40})", "max_tilt")
     g = gravity_in_gripper(scene)
-    contacts = workcell.contacts()
+    contacts = workcell.contacts() if contacts is None else contacts
     out = []
     for k, (name, first, last) in enumerate(pushes(list(pushers))):
         pc = pusher_contact(scene, name, poses[first])

@@ -140,7 +140,7 @@ def depths(body: Solid, shapes: list[Shape], poses, core_runs: list | None = Non
         # the object's points in the body
         jj, cc = np.nonzero(s.depth(np.einsum("nij,cj->nci", R, centres) + t[:, None]) > -radii - 1e-9)
         if len(jj):
-            world = np.einsum("nij,nkj->nki", R[jj], runs[cc]) + t[jj, None]
+            world = runs[cc] @ R[jj].transpose(0, 2, 1) + t[jj, None]
             np.maximum.at(d, jj, s.depth(world).max(axis=1))
         # the body's core points in the object: runs whose ball comes near the object's
         cruns, ccent, crad = core_runs[i]
@@ -150,7 +150,7 @@ def depths(body: Solid, shapes: list[Shape], poses, core_runs: list | None = Non
             near = body.distance(np.einsum("ni,nij->nj", rel[jj, cc], R[jj])) <= crad[cc] + s.radius + 1e-9
             jj, cc = jj[near], cc[near]
         if len(jj):
-            local = np.einsum("nki,nij->nkj", cruns[cc] - t[jj, None], R[jj])             # R^T (core - t)
+            local = (cruns[cc] - t[jj, None]) @ R[jj]                                    # R^T (core - t)
             e = s.radius - body.distance(local.reshape(-1, 3)).reshape(len(jj), CHUNK)
             np.maximum.at(d, jj, e.max(axis=1))
         out[js, i] = d

@@ -360,10 +360,11 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
         raise ArgumentError("invalid `plan`: it has no pushes (one path entry)", "plan.path")
     reach = float(np.linalg.norm(P.transform_rows(O, object_points(scene)), axis=2).max())
     safe = workcell.top() + timing.clearance + max(reach, float(envelope))
-    options = candidates(scene, poses, pushers, workcell, max_tilt)
+    contacts = workcell.contacts()
+    options = candidates(scene, poses, pushers, workcell, max_tilt, contacts)
     L = _Layout(O, twists, safe, reach, timing)
     S = _Samples(timing)
-    check = _Check(scene, workcell)
+    check = _Check(scene, workcell, contacts)
     knots, assignments, depth = [], [], []
     for choices in options:
         first_error = None
@@ -400,12 +401,12 @@ class _Check:
     """The checks of a push's samples (see the module's doc): :func:`_penetration` and
     :func:`_collisions`, with the object's solid and the workcell's bodies made once."""
 
-    def __init__(self, scene, workcell):
+    def __init__(self, scene, workcell, contacts):
         self.scene, self.workcell = scene, workcell
         self.solid, self.bodies = collision.solid(scene), shapes(workcell)
         self.cores = collision.cores(self.bodies)
         self.points = edge_points(scene)
-        self.extents = {c.name: c.extent for c in workcell.contacts()}
+        self.extents = {c.name: c.extent for c in contacts}
 
     def __call__(self, S: _Samples, n0: int, a, done: list) -> float:
         """Checks samples ``n0:`` of ``S`` (push ``a``'s, or the last transfer's when ``a`` is
