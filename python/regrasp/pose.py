@@ -5,7 +5,7 @@ quaternion ``[w, x, y, z]``), body twists ``[vx, vy, vz, wx, wy, wz]`` (m/s, rad
 (``_core.se3_*``); here: quaternions (matrix, rotating vectors, from a matrix, slerp, angle),
 planar poses (their quaternion and 3-D pose, compose, inverse, rotate), the frame of a normal,
 twists between poses and frames, and 3-D poses in numpy (compose, inverse, integrate a twist,
-from a frame, map points, interpolate, a turn about x or z)."""
+from a frame, map points (by one pose or many), interpolate, a turn about x or z)."""
 
 from __future__ import annotations
 
@@ -24,6 +24,17 @@ def quat_matrix(q) -> np.ndarray:
         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
     ])
+
+
+def quat_matrices(q) -> np.ndarray:
+    """The (n, 3, 3) rotation matrices of quaternions ``q`` (n, 4) ``[w, x, y, z]`` (normalized first)."""
+    q = np.asarray(q, float)
+    w, x, y, z = (q / np.linalg.norm(q, axis=1, keepdims=True)).T
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=-1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=-1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=-1),
+    ], axis=1)
 
 
 def quat_rotate(q, v) -> np.ndarray:
@@ -170,6 +181,13 @@ def transform(pose, v) -> np.ndarray:
     into the reference frame: ``R v + p``."""
     pose = np.asarray(pose, float)
     return quat_rotate(pose[3:], v) + pose[:3]
+
+
+def transform_rows(poses, v) -> np.ndarray:
+    """Points ``v`` (k, 3) [m] of a frame mapped by each of its poses (n, 7) (m, unit quaternion):
+    (n, k, 3), ``R_i v + p_i``."""
+    poses = np.asarray(poses, float)
+    return np.asarray(v, float) @ quat_matrices(poses[:, 3:]).transpose(0, 2, 1) + poses[:, None, :3]
 
 
 def interpolate(a, b, s) -> np.ndarray:

@@ -39,6 +39,12 @@ SETTLED = 0.05
 #: :class:`~regrasp.robot.grip.GripController` is 2 kHz by default: half the cost per step,
 #: the same holding within 0.01 N).
 GRIP_PERIOD = 0.001
+#: Clearance [m] the arm and gripper keep from the table and the features while in contact
+#: (approach, push, retreat: the fingers hold the object against a feature); elsewhere the IK's
+#: ``MIN_DISTANCE``.
+CONTACT_CLEARANCE = 0.001
+#: How many choices of contacts :func:`arm_motion` tries before giving up.
+MAX_TRIES = 6
 #: Time [s] the arm holds still after the motion before the object's pose is measured.
 SETTLE = 0.3
 
@@ -171,22 +177,73 @@ def where(motion: WorldMotion, i: int) -> str:
 
 def solve_arm(robot, motion: WorldMotion, tcp) -> ArmTrajectory:
     """The arm's :class:`ArmTrajectory` putting the TCP at ``motion.gripper ∘ tcp`` at every
-    sample, clear of the table and the workcell's features; from the solution for the first pose
+    sample, clear of the table and the workcell's features (by :data:`CONTACT_CLEARANCE` in
+    contact, else the IK's ``MIN_DISTANCE``); from the solution for the first pose
     found from the arm's home. Raises ExecutionError naming the push (see the module's doc)."""
-    from ..robot.ik import IKError, ik_path, solve_ik
+    from ..robot.ik import MIN_DISTANCE, IKError, ik_path, solve_ik
 
     m = robot.model
     avoid = [g for g in range(m.ngeom) if m.geom_bodyid[g] == 0 and (m.geom_contype[g] or m.geom_conaffinity[g])]
     targets = P.compose_rows(motion.gripper, np.broadcast_to(tcp, motion.gripper.shape))
     try:
         q0 = solve_ik(robot, targets[0], robot.kind.home, field="poses[0]", avoid=avoid)
-        q = ik_path(robot, targets, q0, avoid=avoid)
+        gaps = [CONTACT_CLEARANCE if lab in ("approach", "push", "retreat") else MIN_DISTANCE for lab in motion.labels]
+        q = ik_path(robot, targets, q0, avoid=avoid, min_distance=gaps)
     except IKError as e:
         i = int(e.field.split("[")[1].rstrip("]")) if "[" in (e.field or "") else 0
         why = str(e).split(": ", 1)[1] if ": " in str(e) else str(e)
-        raise ExecutionError(f"the arm cannot execute {where(motion, i)}: {why}", "robot") from None
+        err = ExecutionError(f"the arm cannot execute {where(motion, i)}: {why}", "robot")
+        err.push = next((int(p) for p in motion.push[i:] if p >= 0), -1)  # the push it serves or leads to
+        raise err from None
     return ArmTrajectory(robot.name, [robot.kind.arm_joints[j] for j in range(len(robot.kind.arm_joints))],
                          motion.times.copy(), q, np.asarray(tcp, float), robot.grasp_width)
+
+
+@dataclass
+class ArmMotion:
+    """A plan made executable by the arm (:func:`arm_motion`): the world ``motion``, the
+    ``robot`` built for it, the object's ``body`` id and ``geoms``, the ``tcp`` in the gripper
+    frame (m, unit quaternion), the joint ``trajectory``; ``refused``: the (push, contact, why)
+    the arm could not follow, each replaced by the next contact that serves the push."""
+    motion: WorldMotion
+    robot: object
+    body: int
+    geoms: list
+    tcp: np.ndarray
+    trajectory: ArmTrajectory
+    refused: list
+
+
+def arm_motion(scene, plan, workcell=None, robot: str | None = None, scales: Scales = Scales(), timing=None,
+               max_tries: int = MAX_TRIES) -> ArmMotion:
+    """The world motion of ``plan`` in ``workcell`` (default: the scene's default workcell) that the
+    arm ``robot`` (default: the workcell's) can follow, and its joint trajectory: when the arm
+    cannot follow a push with the contact :func:`~regrasp.execution.world_motion` chose (its
+    reach, a joint limit, the fingers against the feature), the push goes to the next contact
+    that serves it, at most ``max_tries`` times. ExecutionError naming the push when none is left."""
+    from .world_motion import Timing, world_motion
+
+    refused, exclude = [], set()
+    for _ in range(max_tries):
+        try:
+            motion = world_motion(scene, plan, workcell, Timing() if timing is None else timing, exclude=exclude)
+        except ExecutionError as e:
+            if not refused:
+                raise
+            raise ExecutionError(f"{e}; where the arm could not follow: "
+                                 + "; ".join(f"push {k} on {f}: {why}" for k, f, why in refused), "robot") from None
+        r, body, geoms, tcp = build_robot(scene, motion, robot, scales)
+        try:
+            return ArmMotion(motion, r, body, geoms, tcp, solve_arm(r, motion, tcp), refused)
+        except ExecutionError as e:
+            k = getattr(e, "push", -1)
+            if k < 0:
+                raise
+            a = motion.assignments[k]
+            refused.append((k, a.feature, str(e)))
+            exclude.add((k, a.feature))
+    raise ExecutionError(f"the arm cannot follow the plan with {max_tries} choices of contacts: "
+                         + "; ".join(f"push {k} on {f}: {why}" for k, f, why in refused), "robot")
 
 
 def close_on(robot, body: int, geoms, grip_force: float):
@@ -225,7 +282,7 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
 
     if not isinstance(motion, WorldMotion):
         raise ArgumentError(f"invalid `motion`: a WorldMotion (got {type(motion).__name__})", "motion")
-    r, body, geoms, tcp = build_robot(scene, motion, robot, scales)
+    r, body, geoms, tcp = build_robot(scene, motion, robot if trajectory is None else trajectory.robot, scales)
     traj = solve_arm(r, motion, tcp) if trajectory is None else trajectory
     m, d = r.model, r.data
     r.set_q(traj.q[0])

@@ -17,7 +17,8 @@ plan's mechanics assumed it) within ``max_tilt`` (default :data:`MAX_TILT`) of t
 the push's start. Among the contacts that serve it, the one that keeps gravity closest wins
 (ties: for a patch the smaller face, then the first in :meth:`Workcell.contacts` order); the contact frame's free turn about its +z (a corner's or a
 face's any angle, an edge's half turn) is chosen for the same reason. When none serves a push,
-an ArgumentError names the push (its index, pusher and the plan's path entries) and why."""
+an ExecutionError names the push (its index, pusher and the plan's path entries) and why.
+:func:`candidates` lists the others too, for a world motion whose first choice collides."""
 
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import pose as P
-from ..errors import ArgumentError
+from ..errors import ArgumentError, ExecutionError
 from ..workcell.description import Contact, Workcell
 
 #: Geometric tolerance [m] of the fits (a footprint within a face, a segment on an edge).
@@ -163,25 +164,27 @@ def serves(c: Contact, pc: PusherContact, phi: float = 0.0, from_below: bool = F
     return f"the face ({2 * c.extent[0]:g} x {2 * c.extent[1]:g} m) does not hold the pusher's points"
 
 
-def assign(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = MAX_TILT) -> list[Assignment]:
-    """The feature of ``workcell`` for each push of a plan (``poses``: the plan's path poses,
-    planar (n, 3) (m, m, rad) or 3-D (n, 7) (m, quaternion); ``pushers``: its pusher names,
-    ``pushers[0]`` None), by the rules of the module's doc; a contact that would turn the scene's
-    gravity more than ``max_tilt`` [rad] from the world's −z does not serve (default
-    :data:`MAX_TILT`; π: any).
-    ArgumentError (field ``plan.path[i].pusher``) when no feature serves a push."""
+def candidates(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = MAX_TILT,
+               contacts: list | None = None) -> list[list[Assignment]]:
+    """For each push of a plan (arguments as :func:`assign`: ``poses`` planar (m, m, rad) or 3-D
+    (m, quaternion)), every contact of ``workcell`` that
+    serves it, best first: :func:`assign`'s choice, then the others by tilt (then, for a patch,
+    by face size), each with its own best turn (``contacts``: ``workcell.contacts()``, when
+    already made). ExecutionError (field ``plan.path[i].pusher``)
+    when none serves a push."""
     if isinstance(max_tilt, bool) or not isinstance(max_tilt, (int, float)) or not 0 <= max_tilt <= np.pi:
         raise ArgumentError(f"invalid `max_tilt`: an angle in [0, pi] rad (got {max_tilt!r:.40})", "max_tilt")
     g = gravity_in_gripper(scene)
-    contacts = workcell.contacts()
+    contacts = workcell.contacts() if contacts is None else contacts
     out = []
     for k, (name, first, last) in enumerate(pushes(list(pushers))):
         pc = pusher_contact(scene, name, poses[first])
         O = _object_pose(scene, poses[first])
         Pc = P.compose(O, pc.frame)
         below = float(P.quat_rotate(Pc[3:], [0.0, 0, 1]) @ -g) >= np.cos(FROM_BELOW) - 1e-12
-        best, reasons = None, {}
+        best, each, reasons = None, [], {}
         for c in contacts:
+            mine = None
             for beta, phi in _turns(c, Pc, g):
                 why = serves(c, pc, phi, below)
                 if why is not None:
@@ -195,16 +198,32 @@ def assign(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = MA
                                                         f"world's, more than max_tilt {np.degrees(max_tilt):.1f}°"))
                     continue
                 area = float(np.prod(c.extent)) if pc.kind == "patch" else 0.0
+                cand = (tilt, c, F, area)
                 if best is None or tilt < best[0] - 1e-9 or (tilt < best[0] + 1e-9 and area < best[3]):
-                    best = (tilt, c, F, area)
+                    best = cand
+                if mine is None or tilt < mine[0] - 1e-9 or (tilt < mine[0] + 1e-9 and area < mine[3]):
+                    mine = cand
+            if mine is not None:
+                each.append(mine)
         if best is None:
             why = "; ".join(f"{n}: {r}" for n, r in reasons.values()) or "the workcell offers no contact"
-            raise ArgumentError(
+            raise ExecutionError(
                 f"push {k} (pusher `{name}`, plan path[{first}] to path[{last}]): no feature of workcell "
                 f"`{workcell.name}` serves this {pc.kind} pusher, which needs "
                 f"{NEEDS[pc.kind]} with friction at least {pc.friction:g} ({why})", f"plan.path[{first + 1}].pusher")
-        out.append(Assignment(k, name, first, last, best[1].name, best[2], best[0], pc))
+        rest = sorted((e for e in each if e[1] is not best[1]), key=lambda e: (e[0], e[3]))
+        out.append([Assignment(k, name, first, last, e[1].name, e[2], e[0], pc) for e in [best] + rest])
     return out
+
+
+def assign(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = MAX_TILT) -> list[Assignment]:
+    """The feature of ``workcell`` for each push of a plan (``poses``: the plan's path poses,
+    planar (n, 3) (m, m, rad) or 3-D (n, 7) (m, quaternion); ``pushers``: its pusher names,
+    ``pushers[0]`` None), by the rules of the module's doc; a contact that would turn the scene's
+    gravity more than ``max_tilt`` [rad] from the world's −z does not serve (default
+    :data:`MAX_TILT`; π: any).
+    ExecutionError (field ``plan.path[i].pusher``) when no feature serves a push."""
+    return [c[0] for c in candidates(scene, poses, pushers, workcell, max_tilt)]
 
 
 def _object_pose(scene, q) -> np.ndarray:

@@ -1,13 +1,12 @@
 """A world motion (:func:`~regrasp.execution.world_motion`) executed in MuJoCo by a free-flying
 gripper in the workcell: the baseline the arm (``regrasp.robot``) is compared with.
 
-The model (``mujoco.MjSpec``): world gravity along −z (the scene's magnitude); the table (a box
-whose top is the table top) and every workcell feature as fixed geoms with the workcell's
-friction — a block as its box, an edge as a capsule of radius :data:`FEATURE_RADIUS` along it
-and a corner as a sphere of that radius, both just behind the contact, a face as a plate
-:data:`PLATE_DEPTH` thick behind it; a block edge that renders a push also gets such a capsule,
-just behind the push's contact frame (MuJoCo's box-edge contact with a face lets a sticking line
-push slip: block-high-friction slips 1.6 mm down a bare box edge and holds on the capsule); the object and the pads of ``regrasp.mujoco`` (the planar
+The model (``mujoco.MjSpec``): world gravity along −z (the scene's magnitude); the table and
+every workcell feature as fixed geoms, their physical bodies (:mod:`regrasp.workcell.shapes`: a
+block its box, an edge the rim of a bar, a corner a ball tip, a face a plate); a block edge that
+renders a push also gets a capsule of radius :data:`FEATURE_RADIUS` just behind the push's
+contact frame (MuJoCo's box-edge contact with a face lets a sticking line push slip:
+block-high-friction slips 1.6 mm down a bare box edge and holds on the capsule); the object and the pads of ``regrasp.mujoco`` (the planar
 model's pads and lamina for a planar scene, the 3-D model's pads and object otherwise), the pads
 on a driven 6-DoF gripper body (``regrasp.mujoco.model.add_driven_body``) squeezed with the
 motion's grip force. The object starts in the hand at the motion's first world pose; the
@@ -25,12 +24,11 @@ from .. import pose as P
 from ..errors import ArgumentError
 from ..extras import need
 from ..workcell.description import Workcell
+from ..workcell.shapes import EDGE_RADIUS
 from .world_motion import WorldMotion
 
-#: Radius [m] of the capsule of an edge feature and of the sphere of a corner feature.
-FEATURE_RADIUS = 0.003
-#: Thickness [m] of a face feature's plate and of the table's box.
-PLATE_DEPTH = 0.01
+#: Radius [m] of the capsule behind a pushed block edge (an edge feature's bar's).
+FEATURE_RADIUS = EDGE_RADIUS
 #: Time [s] the gripper holds still at the start before the motion (the pads settle).
 SETTLE = 0.2
 
@@ -58,29 +56,15 @@ class FreeGripperResult:
 
 
 def add_workcell_geoms(spec, workcell: Workcell):
-    """The table and every feature of ``workcell`` as fixed geoms of ``spec``'s world body (see
-    the module's doc), colliding with the object only."""
+    """The table and every feature of ``workcell`` as fixed geoms of ``spec``'s world body, their
+    physical bodies (:func:`regrasp.workcell.shapes.shapes`), colliding with the object (and a
+    robot's collision geoms)."""
     from ..mujoco.model import FEATURE_BITS, add_geom
+    from ..workcell.shapes import shapes
 
-    w, t = spec.worldbody, workcell.table
-    kw = dict(bits=FEATURE_BITS, condim=3)
-    add_geom(w, "box", [t.size[0] / 2, t.size[1] / 2, PLATE_DEPTH / 2], friction=[t.friction], name="table",
-             pos=[t.center[0], t.center[1], t.height - PLATE_DEPTH / 2], **kw)
-    for f in workcell.features:
-        back = P.quat_rotate(f.pose[3:], [0.0, 0, 1])
-        if f.kind == "block":
-            add_geom(w, "box", np.asarray(f.size) / 2, friction=[f.friction], name=f.name, pos=f.pose[:3],
-                     quat=f.pose[3:], **kw)
-        elif f.kind == "face":
-            add_geom(w, "box", [f.size[0] / 2, f.size[1] / 2, PLATE_DEPTH / 2], friction=[f.friction], name=f.name,
-                     pos=f.pose[:3] - back * PLATE_DEPTH / 2, quat=f.pose[3:], **kw)
-        elif f.kind == "edge":
-            x = P.quat_rotate(f.pose[3:], [f.length / 2, 0.0, 0])
-            c = f.pose[:3] - back * FEATURE_RADIUS
-            add_geom(w, "capsule", [FEATURE_RADIUS], friction=[f.friction], name=f.name, fromto=np.r_[c - x, c + x], **kw)
-        else:
-            add_geom(w, "sphere", [FEATURE_RADIUS], friction=[f.friction], name=f.name,
-                     pos=f.pose[:3] - back * FEATURE_RADIUS, **kw)
+    for s in shapes(workcell):
+        add_geom(spec.worldbody, s.kind, s.size, bits=FEATURE_BITS, condim=3, friction=[s.friction], name=s.name,
+                 pos=s.pose[:3], quat=s.pose[3:])
 
 
 def build(scene, motion: WorldMotion, workcell: Workcell | None = None):

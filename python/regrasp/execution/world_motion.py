@@ -10,17 +10,27 @@ twist ξ (3-D plans' ``pusher_twist``, expressed in the object frame at the step
 otherwise the object's own twist, a sticking pusher): ``P(s) = O exp(s ξ) O⁻¹ P_{k-1}``, s in
 [0, 1]. A sticking pusher keeps the object still in the world while the gripper moves around it.
 
-Around each push: a transfer down to a pre-contact pose ``timing.clearance`` away from the
-feature along its push direction, the approach, the push, the retreat by the clearance, and a
-transfer up to the safe height (every feature's top + clearance + the object's reach from the
-gripper origin), over (the switch-over's turn is made there) and down to the next push. Under a
-feature that pushes downward (a ledge), the transfers go down and up beside it, moved
-horizontally across the feature by twice the object's reach and the clearance.
+Around each push (one builder each: :func:`_transfer`, :func:`_approach`, :func:`_push`,
+:func:`_retreat`): a transfer up to the safe height, over (the switch-over's turn is made there)
+and down to a pre-contact pose ``timing.clearance`` away from the feature along its push
+direction, the approach, the push and the retreat by the clearance. The safe height is the
+top of every feature's body (:meth:`Workcell.top`) + the clearance + the larger of the object's
+reach from the gripper origin and how far the gripper's body (a capsule ``envelope`` long along
+its +z, :data:`GRIPPER_ENVELOPE`, :data:`GRIPPER_RADIUS`) hangs below its origin at the
+orientations the transfer turns between, so that neither object nor gripper comes within the
+clearance of the workcell there. Under a feature that pushes downward (a
+ledge), the transfers go down and up beside it, moved horizontally across the feature by twice
+the object's reach and the clearance.
 
-A push whose object goes below the table top (during its approach, push or retreat) is refused,
-naming the push, as is one whose object goes deeper than :data:`PENETRATION_LIMIT` into its feature (its points
-along its edges, :func:`edge_points`, behind the contact plane, within a face's rectangle) is
-refused, naming the push."""
+Refused (ArgumentError), naming the push: an object going deeper than
+:data:`PENETRATION_LIMIT` into its feature's contact plane during the push (its points along its
+edges, :func:`edge_points`, behind the plane, within a face's rectangle). Refused, naming the push
+or the transfer, the body hit and the depth: the object (a solid,
+:mod:`regrasp.execution.collision`) in the table or a feature's body
+(:func:`regrasp.workcell.shapes`) at any sample — deeper than :data:`TOUCH`, or, in a push's
+approach, push and retreat, deeper than :data:`PENETRATION_LIMIT` into that push's own feature.
+A push whose motion is refused so is rendered by the next contact that serves it
+(:func:`~regrasp.execution.assignment.candidates`); the first refusal is raised when none is left."""
 
 from __future__ import annotations
 
@@ -30,14 +40,24 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import pose as P
-from ..errors import ArgumentError
+from ..errors import ArgumentError, ExecutionError
 from ..workcell.default import default_workcell
 from ..workcell.description import Workcell
-from .assignment import MAX_TILT, Assignment, assign
+from ..workcell.shapes import shapes
+from . import collision
+from .assignment import MAX_TILT, Assignment, candidates
 
 #: The deepest [m] the object may go into a feature during a push (the plan is rendered exactly
 #: only if it does not go through it).
 PENETRATION_LIMIT = 0.5e-3
+#: How deep [m] the object may touch a body other than the push's own feature (numerical noise).
+TOUCH = 1e-6
+#: The gripper's body kept clear in transfers: a capsule from the gripper's origin (the TCP)
+#: along its +z (to the palm and the flange), ``GRIPPER_ENVELOPE`` [m] long, of radius
+#: ``GRIPPER_RADIUS`` [m] (the Robotiq 2F-85: its fingers and body reach 0.16 m from the TCP
+#: along +z and 0.05 m sideways). Pointing down, only its radius hangs below the origin.
+GRIPPER_ENVELOPE = 0.16
+GRIPPER_RADIUS = 0.05
 #: A feature pushes downward when its push direction is within this angle [rad] of the world's −z.
 DOWNWARD = np.pi / 3
 #: A free move (transfer, approach, retreat) follows the minimum-jerk profile s(τ) = 10τ³ − 15τ⁴ + 6τ⁵
@@ -84,11 +104,12 @@ class WorldMotion:
     (one of :data:`LABELS` per sample); ``push`` (n,) the push index of approach, push and retreat samples (−1 in transfers);
     ``grip_force`` (n,) [N] per finger. ``assignments``: the feature of each push; ``knots``:
     ``(path index, sample index)`` of each plan knot of each push (a knot shared by two pushes
-    appears once for each); ``safe_height`` [m] of transfers; ``workcell``; ``timing``;
+    appears once for each); ``safe_height`` [m]: the highest safe height of its transfers; ``workcell``; ``timing``;
     ``penetration`` [m] per push: how far the object's points (:func:`edge_points`) go behind
     the feature's contact plane (within a face's rectangle) during the push (0 for a sticking push of a convex object; a
     plan whose object turns against its pusher, e.g. a pivot on a patch, can go through a face
-    larger than the patch); ``scene``: the scene's name."""
+    larger than the patch); ``scene``: the scene's name; ``envelope`` [m]: the length of the gripper's
+    body along its +z kept clear in transfers at the safe height."""
     times: np.ndarray
     gripper: np.ndarray
     object: np.ndarray
@@ -103,6 +124,7 @@ class WorldMotion:
     timing: Timing = field(default_factory=Timing)
     penetration: list = field(default_factory=list)
     scene: str = ""
+    envelope: float = GRIPPER_ENVELOPE
 
     @property
     def duration(self) -> float:
@@ -219,16 +241,164 @@ def grip_force(scene) -> float:
     return float(scene.grip_force if scene.dimension == 2 else scene._core.grip_force)
 
 
+class _Samples:
+    """The samples of a world motion as it is built: times [s], gripper and in-hand poses, labels
+    and push indices; moves along straight lines (:meth:`move`) or by single samples
+    (:meth:`emit`)."""
+
+    def __init__(self, timing: Timing):
+        self.timing = timing
+        self.t, self.G, self.O, self.label, self.push = [0.0], [], [], [], []
+
+    def mark(self) -> int:
+        """The number of samples so far (for :meth:`rollback`)."""
+        return len(self.G)
+
+    def rollback(self, n: int):
+        """Drop the samples after the first ``n``."""
+        self.t, self.G, self.O = self.t[:n] if n else [0.0], self.G[:n], self.O[:n]
+        self.label, self.push = self.label[:n], self.push[:n]
+
+    def first(self, G, Oh):
+        self.G.append(np.asarray(G, float)), self.O.append(np.asarray(Oh, float))
+        self.label.append("start"), self.push.append(-1)
+
+    def emit(self, G, Oh, label, k, dt):
+        self.t.append(self.t[-1] + dt)
+        self.G.append(np.asarray(G, float)), self.O.append(np.asarray(Oh, float))
+        self.label.append(label), self.push.append(k)
+
+    def steps(self, a, b, v, w) -> tuple[int, float]:
+        """The number of samples and the time [s] to go from pose ``a`` to ``b`` at ``v`` [m/s], ``w`` [rad/s]."""
+        T = max(np.linalg.norm(b[:3] - a[:3]) / v, P.quat_angle(a[3:], b[3:]) / w, self.timing.sample_period)
+        return max(1, math.ceil(T / self.timing.sample_period - 1e-9)), T
+
+    def move(self, to, Oh, label, k, fast: bool):
+        """A straight move of the gripper to ``to`` holding the object at ``Oh``, at the
+        transfer speeds (``fast``) or the push speeds at its peak, minimum-jerk (:func:`eased`)."""
+        a, tm = self.G[-1], self.timing
+        if np.linalg.norm(to[:3] - a[:3]) < 1e-12 and P.quat_angle(a[3:], to[3:]) < 1e-12:
+            return
+        v, w = (tm.move_speed, tm.move_turn) if fast else (tm.push_speed, tm.push_turn)
+        n, T = self.steps(a, to, v / EASE_PEAK, w / EASE_PEAK)
+        Gs = P.interpolate(a, to, eased(np.arange(1, n + 1) / n))
+        Gs[-1] = to
+        t0 = self.t[-1]
+        self.t += list(t0 + T * np.arange(1, n + 1) / n)
+        self.G += list(Gs)
+        self.O += [np.asarray(Oh, float)] * n
+        self.label += [label] * n
+        self.push += [k] * n
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """What the segment builders share: the plan's object poses ``O`` (n, 7) and pusher twists,
+    the workcell's top + the clearance ``safe`` [m], the object's ``reach`` [m], the timing and
+    the gripper's ``envelope`` [m]."""
+    O: np.ndarray
+    twists: list
+    safe: float
+    reach: float
+    timing: Timing
+    envelope: float = GRIPPER_ENVELOPE
+
+    def lifted(self, G, *others):
+        """``G`` raised to the safe height of its orientation and ``others``' (:meth:`height`)."""
+        return np.r_[G[:2], max(G[2], *(self.height(g) for g in (G, *others))), G[3:]]
+
+    def height(self, G) -> float:
+        """The safe height [m] of a gripper at ``G``'s orientation: the workcell's top + the clearance +
+        the larger of the object's reach and how far the gripper's body hangs below its origin."""
+        z = P.quat_rotate(G[3:], [0.0, 0.0, 1.0])[2]
+        return self.safe + max(self.reach, GRIPPER_RADIUS + max(0.0, -self.envelope * z))
+
+    def beside(self, G, a: Assignment):
+        """``G`` moved horizontally across a downward-pushing feature (None for other features)."""
+        z = P.quat_rotate(a.frame[3:], [0.0, 0, 1])
+        if z[2] > -np.cos(DOWNWARD):
+            return None
+        d = P.quat_rotate(a.frame[3:], [0.0, 1, 0])
+        d = np.r_[d[:2], 0.0]
+        d = d / np.linalg.norm(d) if np.linalg.norm(d) > 1e-9 else np.r_[1.0, 0, 0]
+        return np.r_[G[:3] + (2 * self.reach + self.timing.clearance) * d, G[3:]]
+
+    def contact(self, a: Assignment):
+        """The gripper's pose in contact at push ``a``'s start and its pre-contact pose."""
+        G0 = P.compose(a.frame, P.inverse(P.compose(self.O[a.first], a.contact.frame)))
+        away = self.timing.clearance * P.quat_rotate(a.frame[3:], [0.0, 0, 1])
+        return G0, np.r_[G0[:3] + away, G0[3:]]
+
+
+def _transfer(S: _Samples, L: _Layout, a: Assignment, pre):
+    """Up to the safe height, over, and down to push ``a``'s pre-contact pose ``pre`` (beside a
+    downward-pushing feature: over to beside it, down, and across)."""
+    Oh = L.O[a.first]
+    side = L.beside(pre, a)
+    here = S.G[-1]
+    S.move(L.lifted(here, pre), Oh, "transfer", -1, True)
+    for to in ([L.lifted(pre, here)] if side is None else [L.lifted(side, here), side]) + [pre]:
+        S.move(to, Oh, "transfer", -1, True)
+
+
+def _approach(S: _Samples, L: _Layout, a: Assignment, G0):
+    """From the pre-contact pose into contact ``G0`` at the push speeds."""
+    S.move(G0, L.O[a.first], "approach", a.index, False)
+
+
+def _push(S: _Samples, L: _Layout, a: Assignment, knots: list):
+    """Push ``a``'s steps: the gripper moving so that the feature renders the pusher's motion
+    (see the module's doc); appends each knot's ``(path index, sample index)`` to ``knots``."""
+    O, Pk = L.O, P.compose(L.O[a.first], a.contact.frame)
+    knots.append((a.first, len(S.G) - 1))
+    for k in range(a.first + 1, a.last + 1):
+        xo = np.array(P.twist_between(O[k - 1], O[k]))
+        xp = xo if L.twists[k] is None else np.asarray(L.twists[k], float)
+        Gk_end = P.compose(a.frame, P.inverse(_moved(O[k - 1], xp, 1.0, Pk)))
+        n, T = S.steps(S.G[-1], Gk_end, L.timing.push_speed, L.timing.push_turn)
+        for i in range(1, n + 1):
+            s = i / n
+            Ps = _moved(O[k - 1], xp, s, Pk)
+            Os = O[k] if i == n else P.integrate(O[k - 1], xo, s)
+            S.emit(P.compose(a.frame, P.inverse(Ps)), Os, "push", a.index, T / n)
+        Pk = _moved(O[k - 1], xp, 1.0, Pk)
+        knots.append((k, len(S.G) - 1))
+
+
+def _dwell(S: _Samples, L: _Layout, a: Assignment):
+    """Holds the push's end for ``timing.dwell`` (a real arm lags its reference under the push's
+    load: it settles there before retreating)."""
+    n = math.ceil(L.timing.dwell / L.timing.sample_period - 1e-9)
+    for _ in range(n):
+        S.emit(S.G[-1], L.O[a.last], "push", a.index, L.timing.dwell / n)
+
+
+def _retreat(S: _Samples, L: _Layout, a: Assignment):
+    """Back by the clearance along the feature's push direction, then (beside a
+    downward-pushing feature) across it."""
+    G = S.G[-1]
+    away = L.timing.clearance * P.quat_rotate(a.frame[3:], [0.0, 0, 1])
+    S.move(np.r_[G[:3] + away, G[3:]], L.O[a.last], "retreat", a.index, False)
+    side = L.beside(S.G[-1], a)
+    if side is not None:
+        S.move(side, L.O[a.last], "transfer", -1, True)
+
+
 def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing = Timing(), start=None,
-                 max_tilt: float = MAX_TILT) -> WorldMotion:
+                 max_tilt: float = MAX_TILT, envelope: float = GRIPPER_ENVELOPE, exclude=()) -> WorldMotion:
     """The gripper's world motion executing ``plan`` (a :class:`~regrasp.Plan` of ``scene``) in
     ``workcell`` (default: :func:`~regrasp.workcell.default_workcell` of the scene), timed by
     ``timing``; ``start``: the gripper's world pose (m, unit quaternion) to begin from (default:
     above the first push's pre-contact pose, at the safe height); ``max_tilt`` [rad]: the most a
     push may turn the plan's gravity from the world's (default
-    :data:`~regrasp.execution.assignment.MAX_TILT`; see :func:`~regrasp.execution.assign`).
-    ArgumentError naming the push when no feature serves it or the object would go deeper than
-    :data:`PENETRATION_LIMIT` into its feature."""
+    :data:`~regrasp.execution.assignment.MAX_TILT`; see :func:`~regrasp.execution.assign`);
+    ``envelope`` [m]: the length of the gripper's body along its +z (default
+    :data:`GRIPPER_ENVELOPE`), kept clear of the workcell in transfers at the safe height;
+    ``exclude``: ``(push index, contact name)`` pairs not to use (e.g. where the arm cannot
+    follow the push, :func:`~regrasp.execution.arm.arm_motion`).
+    ExecutionError naming the push when no feature serves it or the object would go deeper than
+    :data:`PENETRATION_LIMIT` into its feature, and naming the push or transfer and the body
+    when the object would hit the table or a feature (see the module's doc)."""
     from ..scene.planar import Scene
     from ..scene.spatial import Scene3D
 
@@ -238,123 +408,147 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
         raise ArgumentError("invalid `scene`: a surface scene has no gripper to move (a [grasp] scene is needed)", "scene")
     if not isinstance(timing, Timing):
         raise ArgumentError(f"invalid `timing`: a Timing (got {type(timing).__name__})", "timing")
+    if isinstance(envelope, bool) or not isinstance(envelope, (int, float)) or not (math.isfinite(envelope) and 0 <= envelope <= 10):
+        raise ArgumentError(f"invalid `envelope`: a length in [0, 10] m (got {envelope!r:.40})", "envelope")
     workcell = default_workcell(scene) if workcell is None else workcell
     if not isinstance(workcell, Workcell):
         raise ArgumentError(f"invalid `workcell`: a Workcell (got {type(workcell).__name__})", "workcell")
     poses, O, pushers, twists = _plan_arrays(scene, plan)
     if len(poses) < 2:
         raise ArgumentError("invalid `plan`: it has no pushes (one path entry)", "plan.path")
-    pts = object_points(scene)
-    reach = max(float(np.max(np.linalg.norm(P.transform(o, pts), axis=1))) for o in O)
-    safe = workcell.top() + timing.clearance + reach
-    assignments = assign(scene, poses, pushers, workcell, max_tilt)
-    force = grip_force(scene)
-
-    S: dict = {"t": [0.0], "G": [], "O": [], "label": [], "push": []}
-
-    def emit(G, Oh, label, k, dt):
-        S["t"].append(S["t"][-1] + dt)
-        S["G"].append(np.asarray(G, float)), S["O"].append(np.asarray(Oh, float))
-        S["label"].append(label), S["push"].append(k)
-
-    def steps(a, b, v, w) -> tuple[int, float]:
-        T = max(np.linalg.norm(b[:3] - a[:3]) / v, P.quat_angle(a[3:], b[3:]) / w, timing.sample_period)
-        return max(1, math.ceil(T / timing.sample_period - 1e-9)), T
-
-    def move(to, Oh, label, k, v, w):
-        a = S["G"][-1]
-        if np.linalg.norm(to[:3] - a[:3]) < 1e-12 and P.quat_angle(a[3:], to[3:]) < 1e-12:
-            return
-        n, T = steps(a, to, v / EASE_PEAK, w / EASE_PEAK)
-        Gs = P.interpolate(a, to, eased(np.arange(1, n + 1) / n))
-        Gs[-1] = to
-        t0 = S["t"][-1]
-        S["t"] += list(t0 + T * np.arange(1, n + 1) / n)
-        S["G"] += list(Gs)
-        S["O"] += [np.asarray(Oh, float)] * n
-        S["label"] += [label] * n
-        S["push"] += [k] * n
-
-    def lifted(G):
-        return np.r_[G[:2], max(G[2], safe), G[3:]]
-
-    def beside(G, a):
-        """``G`` moved horizontally across a downward-pushing feature (None for other features)."""
-        z = P.quat_rotate(a.frame[3:], [0.0, 0, 1])
-        if z[2] > -np.cos(DOWNWARD):
-            return None
-        d = P.quat_rotate(a.frame[3:], [0.0, 1, 0])
-        d = np.r_[d[:2], 0.0]
-        d = d / np.linalg.norm(d) if np.linalg.norm(d) > 1e-9 else np.r_[1.0, 0, 0]
-        return np.r_[G[:3] + (2 * reach + timing.clearance) * d, G[3:]]
-
-    knots = []
-    for a in assignments:
-        Pk = P.compose(O[a.first], a.contact.frame)
-        G0 = P.compose(a.frame, P.inverse(Pk))
-        away = timing.clearance * P.quat_rotate(a.frame[3:], [0.0, 0, 1])
-        pre = np.r_[G0[:3] + away, G0[3:]]
-        if not S["G"]:
-            s0 = lifted(pre) if start is None else _check_start(start)
-            S["G"].append(s0), S["O"].append(O[a.first]), S["label"].append("start"), S["push"].append(-1)
-        side = beside(pre, a)
-        move(lifted(S["G"][-1]), O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
-        for to in ([lifted(pre)] if side is None else [lifted(side), side]) + [pre]:
-            move(to, O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
-        move(G0, O[a.first], "approach", a.index, timing.push_speed, timing.push_turn)
-        knots.append((a.first, len(S["G"]) - 1))
-        for k in range(a.first + 1, a.last + 1):
-            xo = np.array(P.twist_between(O[k - 1], O[k]))
-            xp = xo if twists[k] is None else np.asarray(twists[k], float)
-            Gk_end = P.compose(a.frame, P.inverse(_moved(O[k - 1], xp, 1.0, Pk)))
-            n, T = steps(S["G"][-1], Gk_end, timing.push_speed, timing.push_turn)
-            for i in range(1, n + 1):
-                s = i / n
-                Ps = _moved(O[k - 1], xp, s, Pk)
-                Os = O[k] if i == n else P.integrate(O[k - 1], xo, s)
-                emit(P.compose(a.frame, P.inverse(Ps)), Os, "push", a.index, T / n)
-            Pk = _moved(O[k - 1], xp, 1.0, Pk)
-            knots.append((k, len(S["G"]) - 1))
-        Gend = S["G"][-1]
-        for _ in range(math.ceil(timing.dwell / timing.sample_period - 1e-9)):  # hold: the arm settles on the push's end
-            emit(Gend, O[a.last], "push", a.index, timing.dwell / math.ceil(timing.dwell / timing.sample_period - 1e-9))
-        move(np.r_[Gend[:3] + away, Gend[3:]], O[a.last], "retreat", a.index, timing.push_speed, timing.push_turn)
-        side = beside(S["G"][-1], a)
-        if side is not None:
-            move(side, O[a.last], "transfer", -1, timing.move_speed, timing.move_turn)
-    move(lifted(S["G"][-1]), O[-1], "transfer", -1, timing.move_speed, timing.move_turn)
-
-    G, Oh = np.array(S["G"]), np.array(S["O"])
+    reach = float(np.linalg.norm(P.transform_rows(O, object_points(scene)), axis=2).max())
+    safe = workcell.top() + timing.clearance
+    contacts = workcell.contacts()
+    options = candidates(scene, poses, pushers, workcell, max_tilt, contacts)
+    L = _Layout(O, twists, safe, reach, timing, float(envelope))
+    S = _Samples(timing)
+    check = _Check(scene, workcell, contacts)
+    knots, assignments, depth = [], [], []
+    for choices in options:
+        first_error = None
+        for a in choices:          # the best contact first; another when its motion collides
+            if (a.index, a.feature) in exclude:
+                continue
+            n0, k0 = S.mark(), len(knots)
+            G0, pre = L.contact(a)
+            if not S.G:
+                S.first(L.lifted(pre) if start is None else _check_start(start), O[a.first])
+            _transfer(S, L, a, pre)
+            _approach(S, L, a, G0)
+            _push(S, L, a, knots)
+            _dwell(S, L, a)
+            _retreat(S, L, a)
+            try:
+                d = check(S, n0, a, assignments)
+            except (ArgumentError, ExecutionError) as e:
+                first_error = first_error or e
+                S.rollback(n0)
+                del knots[k0:]
+                continue
+            assignments.append(a), depth.append(d)
+            break
+        else:
+            if first_error is None:
+                a = choices[0]
+                raise ExecutionError(f"{_what(a)}: every contact of workcell `{workcell.name}` that serves it is "
+                                     f"excluded ({', '.join(c.feature for c in choices)})",
+                                     f"plan.path[{a.first + 1}].pusher")
+            raise first_error
+    n0 = S.mark()
+    S.move(L.lifted(S.G[-1]), O[-1], "transfer", -1, True)
+    check(S, n0, None, assignments)
+    G, Oh = np.array(S.G), np.array(S.O)
     W = P.compose_rows(G, Oh)
-    labels, push = S["label"], np.array(S["push"], int)
-    pts = edge_points(scene)
-    depth = []
-    extents = {c.name: c.extent for c in workcell.contacts()}
-    for a in assignments:
-        js = [j for j in np.flatnonzero(push == a.index) if labels[j] == "push"]
-        rel = P.compose_rows(np.repeat(P.inverse(a.frame)[None], len(js), axis=0), W[js])
-        depth.append(max(0.0, -min(_behind(P.transform(r, pts), extents[a.feature]) for r in rel)))
-        near = np.flatnonzero(push == a.index)
-        low = min(float(P.transform(W[j], pts)[:, 2].min()) for j in near) - workcell.table.height
-        if low < -PENETRATION_LIMIT and a.feature != "table":
-            raise ArgumentError(
-                f"push {a.index} (pusher `{a.pusher}`, plan path[{a.first}] to path[{a.last}]): the object goes "
-                f"{-low * 1e3:.1f} mm below the table top of workcell `{workcell.name}` at feature `{a.feature}` "
-                f"(a feature higher above the table serves it)", f"plan.path[{a.first + 1}].pusher")
-        if depth[-1] > PENETRATION_LIMIT:
-            raise ArgumentError(
-                f"push {a.index} (pusher `{a.pusher}`, plan path[{a.first}] to path[{a.last}]): the object goes "
-                f"{depth[-1] * 1e3:.2f} mm into feature `{a.feature}` of workcell `{workcell.name}`, more than "
-                f"{PENETRATION_LIMIT * 1e3:g} mm (a smaller feature, e.g. a face just larger than the pusher, "
-                f"lets it pivot)", f"plan.path[{a.first + 1}].pusher")
-    return WorldMotion(np.array(S["t"][:len(G)]), G, W, Oh, labels, push, np.full(len(G), force), assignments,
-                       knots, float(safe), workcell, timing, depth, scene.name)
+    return WorldMotion(np.array(S.t[:len(G)]), G, W, Oh, S.label, np.array(S.push, int), np.full(len(G), grip_force(scene)),
+                       assignments, knots, max(L.height(g) for g in G), workcell, timing, depth, scene.name,
+                       float(envelope))
+
+
+class _Check:
+    """The checks of a push's samples (see the module's doc): :func:`_penetration` and
+    :func:`_collisions`, with the object's solid and the workcell's bodies made once."""
+
+    def __init__(self, scene, workcell, contacts):
+        self.scene, self.workcell = scene, workcell
+        self.solid, self.bodies = collision.solid(scene), shapes(workcell)
+        self.cores = collision.cores(self.bodies)
+        self.points = edge_points(scene)
+        self.extents = {c.name: c.extent for c in contacts}
+
+    def __call__(self, S: _Samples, n0: int, a, done: list) -> float:
+        """Checks samples ``n0:`` of ``S`` (push ``a``'s, or the last transfer's when ``a`` is
+        None; ``done``: the pushes before); returns push ``a``'s penetration [m]."""
+        if len(S.G) <= n0:
+            return 0.0
+        W = P.compose_rows(np.array(S.G[n0:]), np.array(S.O[n0:]))
+        labels, push = S.label[n0:], np.array(S.push[n0:], int)
+        d = 0.0 if a is None else _penetration(self, a, W[(push == a.index) & np.array([x == "push" for x in labels])])
+        _collisions(self, W, labels, push, a, done[-1] if a is None else None)
+        return d
+
+
+def _what(a: Assignment) -> str:
+    return f"push {a.index} (pusher `{a.pusher}`, plan path[{a.first}] to path[{a.last}])"
+
+
+def _penetration(c: _Check, a: Assignment, W) -> float:
+    """How far [m] the object, at world poses ``W`` (push ``a``'s push samples), goes behind the
+    push's contact plane (within a face's rectangle); ExecutionError when more than
+    :data:`PENETRATION_LIMIT`."""
+    rel = P.compose_rows(np.repeat(P.inverse(a.frame)[None], len(W), axis=0), W)
+    out = max(0.0, -_behind(P.transform_rows(rel, c.points).reshape(-1, 3), c.extents[a.feature]))
+    if out > PENETRATION_LIMIT:
+        raise ExecutionError(
+            f"{_what(a)}: the object goes {out * 1e3:.2f} mm into feature `{a.feature}` of workcell "
+            f"`{c.workcell.name}`, more than {PENETRATION_LIMIT * 1e3:g} mm (a smaller feature, e.g. a face just "
+            f"larger than the pusher, lets it pivot)", f"plan.path[{a.first + 1}].pusher")
+    return out
+
+
+def _body(contact: str, names: list) -> str:
+    """The body (``"table"`` or a feature's name) a contact of :meth:`Workcell.contacts` belongs to."""
+    return next((n for n in names if contact == n or contact.startswith(n + ".")), contact)
+
+
+def _collisions(c: _Check, W, labels, push, a, last):
+    """ExecutionError naming the push (``a``) or transfer and the body when the object, at world
+    poses ``W``, goes into the table or a feature: more than :data:`TOUCH` deep, or, in push
+    ``a``'s approach, push and retreat, more than :data:`PENETRATION_LIMIT` into its own feature
+    (``last``: the push before a final transfer)."""
+    names = [b.name for b in c.bodies]
+    D = collision.depths(c.solid, c.bodies, W, c.cores)
+    limit = np.full(D.shape, TOUCH)
+    if a is not None:
+        limit[push == a.index, names.index(_body(a.feature, names))] = PENETRATION_LIMIT
+    bad = np.argwhere(D > limit)
+    if not len(bad):
+        return
+    j, i = bad[0]
+    lo, hi = j, j + 1          # the segment: the run of samples around j with j's label and push
+    while lo > 0 and labels[lo - 1] == labels[j] and push[lo - 1] == push[j]:
+        lo -= 1
+    while hi < len(labels) and labels[hi] == labels[j] and push[hi] == push[j]:
+        hi += 1
+    deepest = float(D[lo:hi, i].max())
+    if a is None:
+        what, a = f"the transfer after the last push ({_what(last)})", last
+    elif push[j] >= 0:
+        what = f"{_what(a)}, in its {labels[j]}" if labels[j] != "push" else _what(a)
+    else:
+        what = f"the transfer {'to' if np.all(push[:j] != a.index) else 'from'} {_what(a)}"
+    if names[i] == "table":
+        hit = f"goes {deepest * 1e3:.2f} mm below the table top of workcell `{c.workcell.name}`"
+    else:
+        hit = f"hits feature `{names[i]}` of workcell `{c.workcell.name}`, {deepest * 1e3:.2f} mm deep"
+    if labels[j] == "start":
+        raise ArgumentError(f"invalid `start`: there the object {hit}", "start")
+    raise ExecutionError(f"{what}: the object {hit}", f"plan.path[{a.first + 1}].pusher")
 
 
 def _behind(pts, extent) -> float:
     """The lowest z [m] of ``pts`` (k, 3) in a contact frame (0 when none is lower), counting
     only those within a face's half-sizes ``extent`` (an edge's or corner's zeros: all)."""
-    if np.any(np.asarray(extent) > 0):
+    if len(pts) and np.any(np.asarray(extent) > 0):
         pts = pts[np.all(np.abs(pts[:, :2]) <= np.asarray(extent) + 1e-9, axis=1)]
     return float(pts[:, 2].min()) if len(pts) else 0.0
 

@@ -21,7 +21,8 @@ ANGLE_TOLERANCE = 0.01  # rad, the accept/reject bound on a solution's TCP orien
 CONVERGED_POSITION = 1e-5  # m, the differential IK iterates until the TCP is this close ...
 CONVERGED_ANGLE = 1e-5  # rad, ... and this well turned (or MAX_ITERATIONS)
 MIN_DISTANCE = 0.005  # m, the closest the arm and gripper may come to the table and obstacles
-LIMIT_DISTANCE = MIN_DISTANCE + 0.002  # m, mink's collision limit (a margin: it is linearised and can tunnel)
+LIMIT_MARGIN_DISTANCE = 0.002  # m, mink's collision limit is this much more (it is linearised and can tunnel)
+LIMIT_DISTANCE = MIN_DISTANCE + LIMIT_MARGIN_DISTANCE  # m, mink's collision limit at MIN_DISTANCE
 MAX_ITERATIONS = 300  # of the differential IK
 IK_DT = 0.05  # s, the differential IK's integration step
 MAX_SPEED = np.pi  # rad/s, a joint's speed in the differential IK (a step turns it at most MAX_SPEED · IK_DT)
@@ -72,9 +73,11 @@ class IKSolver:
     mink ``Configuration`` with a frame task on the TCP, the joint limits, a joint speed limit
     (``MAX_SPEED``) and a collision limit (``LIMIT_DISTANCE``) between the arm's and gripper's
     collision geoms and the table and the geoms ``avoid`` (ids or names); every other degree
-    of freedom (the fingers, a held object) frozen at the robot's state when it is made."""
+    of freedom (the fingers, a held object) frozen at the robot's state when it is made;
+    ``min_distance`` [m]: the clearance to keep (default ``MIN_DISTANCE``; less near a feature
+    the gripper pushes against)."""
 
-    def __init__(self, robot, avoid=()):
+    def __init__(self, robot, avoid=(), min_distance: float = MIN_DISTANCE):
         mink = need("mink", "robot")
         mujoco = need("mujoco", "robot")
         from .model import ARM_PREFIX
@@ -98,11 +101,11 @@ class IKSolver:
         self.constraints = [mink.DofFreezingTask(m, dof_indices=others)] if others else None
         self.limits = [mink.ConfigurationLimit(m),
                        mink.VelocityLimit(m, {ARM_PREFIX + j: MAX_SPEED for j in robot.arm_joints})]
-        self.avoid = tuple(avoid)
+        self.avoid, self.min_distance = tuple(avoid), float(min_distance)
         self.obstacles = obstacle_geoms(robot, avoid)
         if self.obstacles:
             self.limits.append(mink.CollisionAvoidanceLimit(m, [(list(robot.clearance_geoms), self.obstacles)],
-                                                            minimum_distance_from_collisions=LIMIT_DISTANCE,
+                                                            minimum_distance_from_collisions=self.min_distance + LIMIT_MARGIN_DISTANCE,
                                                             collision_detection_distance=0.05))
 
     def tcp_pose(self) -> np.ndarray:
@@ -141,13 +144,13 @@ class IKSolver:
         rng = robot.joint_limits()
         inside = np.all((q >= rng[:, 0] - 1e-9) & (q <= rng[:, 1] + 1e-9))
         gap = table_distance(robot, q, self.avoid) if self.obstacles else float("inf")
-        if reached[0] <= POSITION_TOLERANCE and reached[1] <= ANGLE_TOLERANCE and inside and gap >= MIN_DISTANCE:
+        if reached[0] <= POSITION_TOLERANCE and reached[1] <= ANGLE_TOLERANCE and inside and gap >= self.min_distance:
             return q
         at_limit = [robot.arm_joints[i] for i in range(len(q)) if min(q[i] - rng[i, 0], rng[i, 1] - q[i]) < LIMIT_MARGIN]
         beyond = robot.reach(target)
         if beyond > 0:
             reason, why = "unreachable", f"{beyond * 1e3:.0f} mm beyond the arm's reach"
-        elif gap < MIN_DISTANCE + 1e-3:
+        elif gap < self.min_distance + 1e-3:
             reason, why = "collision", f"the arm or gripper {gap * 1e3:.1f} mm from the table or an obstacle"
         elif at_limit:
             reason, why = "joint limit", f"joint {', '.join(at_limit)} at its limit"
@@ -167,21 +170,23 @@ def solve_ik(robot, target_pose, q_init=None, field: str = "pose", avoid=()) -> 
     return IKSolver(robot, avoid).solve(target_pose, robot.q if q_init is None else q_init, field)
 
 
-def ik_path(robot, poses, q_init=None, avoid=(), max_jump: float = MAX_JUMP) -> np.ndarray:
+def ik_path(robot, poses, q_init=None, avoid=(), max_jump: float = MAX_JUMP, min_distance=MIN_DISTANCE) -> np.ndarray:
     """Arm joint positions [rad], shape (n, 6), reaching each of the TCP world ``poses`` (n, 7)
     ``[x, y, z, qw, qx, qy, qz]`` (m) in turn with one :class:`IKSolver`, each solution seeding
     the next, clear of the table and ``avoid``. Raises :class:`IKError` naming ``poses[i]`` at
     the first pose that cannot be reached (its ``reason`` as :func:`solve_ik`'s) or whose
     solution moves a joint more than ``max_jump`` [rad] from the previous one's (``q_init``'s
-    for ``poses[0]``; reason ``"jump"``: a branch flip, or poses sampled too far apart)."""
+    for ``poses[0]``; reason ``"jump"``: a branch flip, or poses sampled too far apart).
+    ``min_distance`` [m]: the clearance, one for every pose or one per pose (a solver each)."""
     P = np.asarray(poses, float)
     if P.ndim != 2 or P.shape[1] != 7 or len(P) == 0:
         raise ArgumentError(f"invalid `poses`: shape (n >= 1, 7) (got {P.shape})", "poses")
-    solver = IKSolver(robot, avoid)
+    gaps = np.broadcast_to(np.asarray(min_distance, float), (len(P),))
+    solvers = {g: IKSolver(robot, avoid, g) for g in np.unique(gaps)}
     q = robot.q if q_init is None else np.asarray(q_init, float)
     out = []
     for i, p in enumerate(P):
-        nxt = solver.solve(p, q, field=f"poses[{i}]")
+        nxt = solvers[gaps[i]].solve(p, q, field=f"poses[{i}]")
         jump = np.abs(nxt - q)
         if jump.max() > max_jump:
             j = int(np.argmax(jump))

@@ -268,19 +268,11 @@ class Workcell:
         return out
 
     def top(self) -> float:
-        """The highest point [m] (world z) of the table and every feature."""
-        zs = [self.table.height]
-        for f in self.features:
-            if f.kind == "block":
-                zs += list(P.transform(f.pose, np.array(list(itertools.product(*[(-s / 2, s / 2) for s in f.size]))))[:, 2])
-            elif f.kind == "face":
-                sx, sy = f.size / 2
-                zs += list(P.transform(f.pose, np.array([[a, b, 0] for a in (-sx, sx) for b in (-sy, sy)]))[:, 2])
-            elif f.kind == "edge":
-                zs += list(P.transform(f.pose, np.array([[-f.length / 2, 0, 0], [f.length / 2, 0, 0]]))[:, 2])
-            else:
-                zs.append(float(f.pose[2]))
-        return float(max(zs))
+        """The highest point [m] (world z) of the table and every feature's body
+        (:func:`regrasp.workcell.shapes.shapes`: an edge's bar and a corner's ball included)."""
+        from .shapes import shapes
+
+        return max([self.table.height] + [s.top for s in shapes(self)])
 
     # -- the file (regrasp.workcell.file) ------------------------------------------------------
 
