@@ -219,6 +219,93 @@ def grip_force(scene) -> float:
     return float(scene.grip_force if scene.dimension == 2 else scene._core.grip_force)
 
 
+def meeting(frame, pusher, clearance: float) -> tuple[np.ndarray, np.ndarray]:
+    """(G0, pre): the gripper's world pose at which the feature's contact ``frame`` (world; m,
+    unit quaternion) meets the pusher's contact frame ``pusher`` (gripper frame), ``G0 = F ∘ P⁻¹``,
+    and the pre-contact pose ``clearance`` [m] back from it along the feature's push direction."""
+    G0 = P.compose(frame, P.inverse(pusher))
+    away = clearance * P.quat_rotate(np.asarray(frame, float)[3:], [0.0, 0, 1])
+    return G0, np.r_[G0[:3] + away, G0[3:]]
+
+
+class Segments:
+    """A gripper motion being built sample by sample (the free moves of :func:`world_motion`,
+    also the switch-overs of a closed loop): ``S`` holds per sample the times ``t`` [s] (one
+    more: the next sample's start), gripper world poses ``G`` and in-hand object poses ``O``
+    (m, unit quaternion), ``label`` and ``push`` index; ``safe`` [m] the transfers' height,
+    ``reach`` [m] the object's from the gripper origin."""
+
+    def __init__(self, timing: Timing, safe: float, reach: float, start=None, t0: float = 0.0):
+        self.timing, self.safe, self.reach = timing, float(safe), float(reach)
+        self.S: dict = {"t": [float(t0)], "G": [], "O": [], "label": [], "push": []}
+        if start is not None:
+            self.S["G"].append(np.asarray(start, float))
+
+    def emit(self, G, Oh, label, k, dt):
+        """Appends gripper pose ``G`` with in-hand pose ``Oh``, ``label``, push ``k``, ``dt`` [s] after the last."""
+        S = self.S
+        S["t"].append(S["t"][-1] + dt)
+        S["G"].append(np.asarray(G, float)), S["O"].append(np.asarray(Oh, float))
+        S["label"].append(label), S["push"].append(k)
+
+    def steps(self, a, b, v, w) -> tuple[int, float]:
+        """(samples, duration [s]) of a move from pose ``a`` to ``b`` at ``v`` [m/s], ``w`` [rad/s]."""
+        T = max(np.linalg.norm(b[:3] - a[:3]) / v, P.quat_angle(a[3:], b[3:]) / w, self.timing.sample_period)
+        return max(1, math.ceil(T / self.timing.sample_period - 1e-9)), T
+
+    def move(self, to, Oh, label, k, v, w):
+        """A minimum-jerk move from the last pose to ``to`` at peak speeds ``v`` [m/s], ``w`` [rad/s]."""
+        S = self.S
+        a = S["G"][-1]
+        if np.linalg.norm(to[:3] - a[:3]) < 1e-12 and P.quat_angle(a[3:], to[3:]) < 1e-12:
+            return
+        n, T = self.steps(a, to, v / EASE_PEAK, w / EASE_PEAK)
+        Gs = P.interpolate(a, to, eased(np.arange(1, n + 1) / n))
+        Gs[-1] = to
+        t0 = S["t"][-1]
+        S["t"] += list(t0 + T * np.arange(1, n + 1) / n)
+        S["G"] += list(Gs)
+        S["O"] += [np.asarray(Oh, float)] * n
+        S["label"] += [label] * n
+        S["push"] += [k] * n
+
+    def lifted(self, G):
+        """Gripper pose ``G`` raised to the safe height (when below it)."""
+        return np.r_[G[:2], max(G[2], self.safe), G[3:]]
+
+    def beside(self, G, a):
+        """``G`` moved horizontally across a downward-pushing feature (None for other features)."""
+        z = P.quat_rotate(a.frame[3:], [0.0, 0, 1])
+        if z[2] > -np.cos(DOWNWARD):
+            return None
+        d = P.quat_rotate(a.frame[3:], [0.0, 1, 0])
+        d = np.r_[d[:2], 0.0]
+        d = d / np.linalg.norm(d) if np.linalg.norm(d) > 1e-9 else np.r_[1.0, 0, 0]
+        return np.r_[G[:3] + (2 * self.reach + self.timing.clearance) * d, G[3:]]
+
+    def transfer(self, pre, a: Assignment, Oh):
+        """Up to the safe height, over (beside ``a``'s feature when it pushes downward) and down
+        to the pre-contact pose ``pre`` of push ``a``, holding in-hand pose ``Oh``."""
+        tm = self.timing
+        side = self.beside(pre, a)
+        self.move(self.lifted(self.S["G"][-1]), Oh, "transfer", -1, tm.move_speed, tm.move_turn)
+        for to in ([self.lifted(pre)] if side is None else [self.lifted(side), side]) + [pre]:
+            self.move(to, Oh, "transfer", -1, tm.move_speed, tm.move_turn)
+
+    def approach(self, G0, a: Assignment, Oh):
+        """From the pre-contact pose to ``G0``, where ``a``'s feature touches the object, at push speed."""
+        self.move(G0, Oh, "approach", a.index, self.timing.push_speed, self.timing.push_turn)
+
+    def retreat(self, a: Assignment, Oh):
+        """Back from ``a``'s feature by the clearance at push speed (and beside a downward one)."""
+        tm, G = self.timing, self.S["G"][-1]
+        away = tm.clearance * P.quat_rotate(a.frame[3:], [0.0, 0, 1])
+        self.move(np.r_[G[:3] + away, G[3:]], Oh, "retreat", a.index, tm.push_speed, tm.push_turn)
+        side = self.beside(self.S["G"][-1], a)
+        if side is not None:
+            self.move(side, Oh, "transfer", -1, tm.move_speed, tm.move_turn)
+
+
 def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing = Timing(), start=None,
                  max_tilt: float = MAX_TILT) -> WorldMotion:
     """The gripper's world motion executing ``plan`` (a :class:`~regrasp.Plan` of ``scene``) in
@@ -250,58 +337,18 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
     assignments = assign(scene, poses, pushers, workcell, max_tilt)
     force = grip_force(scene)
 
-    S: dict = {"t": [0.0], "G": [], "O": [], "label": [], "push": []}
-
-    def emit(G, Oh, label, k, dt):
-        S["t"].append(S["t"][-1] + dt)
-        S["G"].append(np.asarray(G, float)), S["O"].append(np.asarray(Oh, float))
-        S["label"].append(label), S["push"].append(k)
-
-    def steps(a, b, v, w) -> tuple[int, float]:
-        T = max(np.linalg.norm(b[:3] - a[:3]) / v, P.quat_angle(a[3:], b[3:]) / w, timing.sample_period)
-        return max(1, math.ceil(T / timing.sample_period - 1e-9)), T
-
-    def move(to, Oh, label, k, v, w):
-        a = S["G"][-1]
-        if np.linalg.norm(to[:3] - a[:3]) < 1e-12 and P.quat_angle(a[3:], to[3:]) < 1e-12:
-            return
-        n, T = steps(a, to, v / EASE_PEAK, w / EASE_PEAK)
-        Gs = P.interpolate(a, to, eased(np.arange(1, n + 1) / n))
-        Gs[-1] = to
-        t0 = S["t"][-1]
-        S["t"] += list(t0 + T * np.arange(1, n + 1) / n)
-        S["G"] += list(Gs)
-        S["O"] += [np.asarray(Oh, float)] * n
-        S["label"] += [label] * n
-        S["push"] += [k] * n
-
-    def lifted(G):
-        return np.r_[G[:2], max(G[2], safe), G[3:]]
-
-    def beside(G, a):
-        """``G`` moved horizontally across a downward-pushing feature (None for other features)."""
-        z = P.quat_rotate(a.frame[3:], [0.0, 0, 1])
-        if z[2] > -np.cos(DOWNWARD):
-            return None
-        d = P.quat_rotate(a.frame[3:], [0.0, 1, 0])
-        d = np.r_[d[:2], 0.0]
-        d = d / np.linalg.norm(d) if np.linalg.norm(d) > 1e-9 else np.r_[1.0, 0, 0]
-        return np.r_[G[:3] + (2 * reach + timing.clearance) * d, G[3:]]
+    seg = Segments(timing, safe, reach)
+    S, emit, steps, move, lifted = seg.S, seg.emit, seg.steps, seg.move, seg.lifted
 
     knots = []
     for a in assignments:
         Pk = P.compose(O[a.first], a.contact.frame)
-        G0 = P.compose(a.frame, P.inverse(Pk))
-        away = timing.clearance * P.quat_rotate(a.frame[3:], [0.0, 0, 1])
-        pre = np.r_[G0[:3] + away, G0[3:]]
+        G0, pre = meeting(a.frame, Pk, timing.clearance)
         if not S["G"]:
             s0 = lifted(pre) if start is None else _check_start(start)
             S["G"].append(s0), S["O"].append(O[a.first]), S["label"].append("start"), S["push"].append(-1)
-        side = beside(pre, a)
-        move(lifted(S["G"][-1]), O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
-        for to in ([lifted(pre)] if side is None else [lifted(side), side]) + [pre]:
-            move(to, O[a.first], "transfer", -1, timing.move_speed, timing.move_turn)
-        move(G0, O[a.first], "approach", a.index, timing.push_speed, timing.push_turn)
+        seg.transfer(pre, a, O[a.first])
+        seg.approach(G0, a, O[a.first])
         knots.append((a.first, len(S["G"]) - 1))
         for k in range(a.first + 1, a.last + 1):
             xo = np.array(P.twist_between(O[k - 1], O[k]))
@@ -318,10 +365,7 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
         Gend = S["G"][-1]
         for _ in range(math.ceil(timing.dwell / timing.sample_period - 1e-9)):  # hold: the arm settles on the push's end
             emit(Gend, O[a.last], "push", a.index, timing.dwell / math.ceil(timing.dwell / timing.sample_period - 1e-9))
-        move(np.r_[Gend[:3] + away, Gend[3:]], O[a.last], "retreat", a.index, timing.push_speed, timing.push_turn)
-        side = beside(S["G"][-1], a)
-        if side is not None:
-            move(side, O[a.last], "transfer", -1, timing.move_speed, timing.move_turn)
+        seg.retreat(a, O[a.last])
     move(lifted(S["G"][-1]), O[-1], "transfer", -1, timing.move_speed, timing.move_turn)
 
     G, Oh = np.array(S["G"]), np.array(S["O"])
