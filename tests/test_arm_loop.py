@@ -1,6 +1,6 @@
 """Closed loop in the world with the arm (regrasp.execution.arm_loop): the MPC (planar) or
 re-planning (3-D) from the object's pose measured in MuJoCo, the UR5e + 2F-85 pushing the object
-against the workcell's fixed features. Each arm run costs 7-30 s of CPU: the file runs 7."""
+against the workcell's fixed features. Each arm run costs 4-40 s of CPU: the file makes 6 (about 80 s)."""
 
 from __future__ import annotations
 
