@@ -114,6 +114,15 @@ def planar_to_spatial(q) -> list:
     return [x, 0.0, z, *map(float, planar_quat(th))]
 
 
+def spatial_to_planar(q) -> np.ndarray:
+    """The 3-D pose ``q`` ``[x, y, z, qw, qx, qy, qz]`` (m, unit quaternion) as a planar pose
+    ``[x, z, theta]`` (m, m, rad) in the x-z plane (the inverse of :func:`planar_to_spatial`;
+    y and any turn off the plane dropped)."""
+    q = np.asarray(q, float)
+    R = quat_matrix(q[3:])
+    return np.array([q[0], q[2], np.arctan2(R[2, 0], R[0, 0])])
+
+
 def planar_compose(a, b) -> np.ndarray:
     """Planar pose composition ``a ∘ b`` of poses ``[x, z, theta]`` (m, m, rad)."""
     c, s = np.cos(a[2]), np.sin(a[2])

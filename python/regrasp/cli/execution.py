@@ -78,10 +78,38 @@ def _arm(scene, plan, motion, a):
     return out, (r, recorder)
 
 
+def _closed_loop(scene, plan, a) -> int:
+    """`--closed-loop`: the arm in the loop (docs/robot.md, "Closed loop with the arm")."""
+    from ..execution.arm import Scales
+    from ..execution.arm_loop import control_arm
+    from ..workcell.file import load as load_workcell
+
+    for opt in ("trajectory", "video", "html"):
+        if getattr(a, opt):
+            raise ArgumentError(f"invalid `--{opt}`: not with --closed-loop (the motion is decided as it runs)",
+                                f"--{opt}")
+    if a.robot == FREE_GRIPPER:
+        raise ArgumentError("invalid `--robot`: --closed-loop runs the arm (not the free gripper)", "--robot")
+    f, g, m = scales(a)
+    r = control_arm(scene, plan, load_workcell(a.workcell) if a.workcell else None, Scales(f, g, m, f), a.robot)
+    out = dict(success=r.success, goal_error=r.goal_error, replans=r.replans, switch_overs=r.switch_overs,
+               duration_s=r.duration, failure=r.failure, closed_loop=True)
+    if a.json:
+        print(json.dumps({k: (rounded(v) if isinstance(v, np.ndarray) else v) for k, v in out.items()}, allow_nan=False))
+    else:
+        err = rounded(r.goal_error) if scene.dimension == 2 else error3d(r.goal_error)
+        print(f"{scene.name}: closed loop with the arm, {r.duration:.1f} s, {r.replans} re-plans, {r.switch_overs} "
+              f"switch-overs: {'success' if r.success else 'outside the tolerance'}, error to goal {err}"
+              + (f" ({r.failure})" if r.failure else ""))
+    return OK if r.success else CANNOT
+
+
 def cmd_execute(a) -> int:
     _check(a)
     scene = load(a.scene, a)
     plan = Plan.load(a.plan, scene)
+    if a.closed_loop:
+        return _closed_loop(scene, plan, a)
     motion = _motion(scene, plan, a)
     out, extra = (_free if a.robot == FREE_GRIPPER else _arm)(scene, plan, motion, a)
     written = []
@@ -125,5 +153,7 @@ def add_parsers(sub) -> None:
     e.add_argument("--video", metavar="GIF|MP4", help="a video of the arm doing it (MuJoCo's renderer)")
     e.add_argument("--html", metavar="HTML", help="a browser view of the workcell and the world motion")
     add_scale_options(e, "the arm's world: ")
+    e.add_argument("--closed-loop", action="store_true", help="closed loop with the arm: the MPC (planar) or "
+                   "re-planning (3-D) from the object's pose measured in MuJoCo")
     e.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(e)

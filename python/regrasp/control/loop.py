@@ -151,11 +151,13 @@ def _iterable(x, name: str) -> list:
 
 class ControlRun:
     """One run of :func:`control`: the plant (the simulated world), the MPC, the pokes still to
-    come and what was recorded. :meth:`tick` is one control period of ``dt`` [s]."""
+    come and what was recorded. :meth:`tick` is one control period of ``dt`` [s]. ``plant``:
+    makes the world from the object's start pose ``[x, z, theta]`` (m, m, rad) (default: the
+    ``engine``'s, e.g. :class:`~regrasp.execution.arm_loop.ArmPlant` for the arm)."""
 
     def __init__(self, scene: Scene, plan, engine: str, policy: str, pokes, start_error, perturb: Perturbation,
                  controller_scene: Scene | None, noise: float, seed: int, dt: float, speed: float, horizon: int,
-                 max_time: float | None, mpc: dict):
+                 max_time: float | None, mpc: dict, plant=None):
         path = _plan_dict(plan)["path"]
         poses = [list(map(float, k["pose"])) for k in path]
         task = scene.task
@@ -181,7 +183,7 @@ class ControlRun:
         if not scene.admissible(q0):
             raise ArgumentError("invalid `start_error`: the object's start pose puts the pad off the object",
                                 "start_error")
-        self.plant = _plant(engine, scene, q0, perturb)
+        self.plant = _plant(engine, scene, q0, perturb) if plant is None else plant(q0)
         self.rng = np.random.default_rng(seed)
         self.pending = list(self.pokes)
         self.ts, self.qs, self.refs, self.used, self.statuses, self.times = [], [], [], [], [], []

@@ -325,15 +325,59 @@ class _Layout:
 
     def contact(self, a: Assignment):
         """The gripper's pose in contact at push ``a``'s start and its pre-contact pose."""
-        G0 = P.compose(a.frame, P.inverse(P.compose(self.O[a.first], a.contact.frame)))
-        away = self.timing.clearance * P.quat_rotate(a.frame[3:], [0.0, 0, 1])
-        return G0, np.r_[G0[:3] + away, G0[3:]]
+        return meeting(a.frame, P.compose(self.O[a.first], a.contact.frame), self.timing.clearance)
 
 
-def _transfer(S: _Samples, L: _Layout, a: Assignment, pre):
+def meeting(frame, pusher, clearance: float) -> tuple[np.ndarray, np.ndarray]:
+    """(G0, pre): the gripper's world pose at which the feature's contact ``frame`` (world; m,
+    unit quaternion) meets the pusher's contact frame ``pusher`` (gripper frame), ``G0 = F ∘ P⁻¹``,
+    and the pre-contact pose ``clearance`` [m] back from it along the feature's push direction."""
+    G0 = P.compose(frame, P.inverse(pusher))
+    away = clearance * P.quat_rotate(np.asarray(frame, float)[3:], [0.0, 0, 1])
+    return G0, np.r_[G0[:3] + away, G0[3:]]
+
+
+class Segments:
+    """Free moves of the gripper from world pose ``start`` (m, unit quaternion) built by the
+    world motion's segment builders — the switch-overs of a closed loop: :meth:`retreat`,
+    :meth:`transfer`, :meth:`approach`, each holding the object at a given in-hand pose; ``safe``
+    [m]: the workcell's top + the clearance (``Workcell.top()``), ``reach`` [m] the object's from
+    the gripper origin, ``envelope`` [m] the gripper body's length. :attr:`times` [s] and
+    :attr:`poses` (m, unit quaternion): the samples so far, ``start`` at time 0 first."""
+
+    def __init__(self, timing: Timing, safe: float, reach: float, start, envelope: float = GRIPPER_ENVELOPE):
+        self.samples = _Samples(timing)
+        self.samples.first(start, np.r_[0.0, 0, 0, 1, 0, 0, 0])
+        self.layout = _Layout(np.zeros((0, 7)), [], float(safe), float(reach), timing, float(envelope))
+
+    @property
+    def times(self) -> list:
+        """The samples' times [s]."""
+        return self.samples.t[:len(self.samples.G)]
+
+    @property
+    def poses(self) -> list:
+        """The samples' gripper world poses (m, unit quaternion)."""
+        return self.samples.G
+
+    def retreat(self, a: Assignment, Oh):
+        """Back from push ``a``'s feature by the clearance (and across a downward one), holding ``Oh``."""
+        _retreat(self.samples, self.layout, a, Oh)
+
+    def transfer(self, pre, a: Assignment, Oh):
+        """Up to the safe height, over and down to push ``a``'s pre-contact pose ``pre``, holding ``Oh``."""
+        _transfer(self.samples, self.layout, a, pre, Oh)
+
+    def approach(self, G0, a: Assignment, Oh):
+        """Into contact ``G0`` with push ``a``'s feature at the push speeds, holding ``Oh``."""
+        _approach(self.samples, self.layout, a, G0, Oh)
+
+
+def _transfer(S: _Samples, L: _Layout, a: Assignment, pre, Oh=None):
     """Up to the safe height, over, and down to push ``a``'s pre-contact pose ``pre`` (beside a
-    downward-pushing feature: over to beside it, down, and across)."""
-    Oh = L.O[a.first]
+    downward-pushing feature: over to beside it, down, and across), holding ``Oh`` (default:
+    the plan's pose at the push's start)."""
+    Oh = L.O[a.first] if Oh is None else Oh
     side = L.beside(pre, a)
     here = S.G[-1]
     S.move(L.lifted(here, pre), Oh, "transfer", -1, True)
@@ -341,9 +385,9 @@ def _transfer(S: _Samples, L: _Layout, a: Assignment, pre):
         S.move(to, Oh, "transfer", -1, True)
 
 
-def _approach(S: _Samples, L: _Layout, a: Assignment, G0):
+def _approach(S: _Samples, L: _Layout, a: Assignment, G0, Oh=None):
     """From the pre-contact pose into contact ``G0`` at the push speeds."""
-    S.move(G0, L.O[a.first], "approach", a.index, False)
+    S.move(G0, L.O[a.first] if Oh is None else Oh, "approach", a.index, False)
 
 
 def _push(S: _Samples, L: _Layout, a: Assignment, knots: list):
@@ -373,15 +417,15 @@ def _dwell(S: _Samples, L: _Layout, a: Assignment):
         S.emit(S.G[-1], L.O[a.last], "push", a.index, L.timing.dwell / n)
 
 
-def _retreat(S: _Samples, L: _Layout, a: Assignment):
+def _retreat(S: _Samples, L: _Layout, a: Assignment, Oh=None):
     """Back by the clearance along the feature's push direction, then (beside a
     downward-pushing feature) across it."""
-    G = S.G[-1]
+    G, Oh = S.G[-1], L.O[a.last] if Oh is None else Oh
     away = L.timing.clearance * P.quat_rotate(a.frame[3:], [0.0, 0, 1])
-    S.move(np.r_[G[:3] + away, G[3:]], L.O[a.last], "retreat", a.index, False)
+    S.move(np.r_[G[:3] + away, G[3:]], Oh, "retreat", a.index, False)
     side = L.beside(S.G[-1], a)
     if side is not None:
-        S.move(side, L.O[a.last], "transfer", -1, True)
+        S.move(side, Oh, "transfer", -1, True)
 
 
 def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing = Timing(), start=None,

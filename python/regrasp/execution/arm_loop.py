@@ -1,0 +1,367 @@
+"""Closed loop in the world with the arm (issue 15, item 6): the object's in-hand pose measured in
+MuJoCo, the arm (:mod:`regrasp.execution.arm`: the UR5e + 2F-85 holding the object in the
+workcell) moving the gripper so that the workcell's fixed features push it.
+
+:class:`ArmPlant` is a plant of :class:`~regrasp.control.loop.ControlRun` (``pose``, ``push``,
+``idle``, ``poke``): ``push(pusher, twist, duration)`` renders the pusher's commanded body twist
+(in the object frame at the measured pose) with the feature assigned to that pusher
+(:func:`~regrasp.execution.assignment.assign`): the feature is fixed in the world, so the gripper
+moves by the inverse of the intended object motion, ``G(s) = G ∘ O ∘ O(s)⁻¹`` with ``O`` the
+object's in-hand pose at the push's start and ``O(s) = O exp(s ξ)``. A push with another pusher
+than the one in contact first switches over (:class:`~regrasp.execution.world_motion.Segments`:
+retreat by the clearance, transfer at the safe height, approach to the new feature's contact at
+the measured pose). The gripper's poses every ``timing.sample_period`` are solved by one reused
+:class:`~regrasp.robot.ik.IKSolver`, each seeded by the previous joints, and tracked
+(:func:`~regrasp.robot.tracking.track`) with the grip force loop running.
+
+:func:`control_arm`: planar scenes by the MPC (``_core.Mpc`` through ``ControlRun``, one command
+per control period); 3-D scenes by re-planning (:func:`regrasp.scene.spatial.run_plan3d`: after
+each step of the plan the pose is measured; off the plan by more than half the tolerance, or at
+the plan's end outside it, the T-RRT* plans again from it), each step pushed at the timing's
+push speed."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _core
+from .. import pose as P
+from ..errors import ArgumentError, ExecutionError, RegraspError
+from ..extras import need
+from .arm import CONTACT_CLEARANCE, Scales, build_robot, close_on
+from .assignment import assign, pusher_contact
+from .world_motion import Segments, Timing, meeting, world_motion
+
+
+@dataclass
+class ArmLoopResult:
+    """A closed-loop run with the arm: ``success`` (the object's final in-hand pose within the
+    scene's goal tolerance); ``goal_error`` planar ``[x, z, theta]`` (m, m, rad) or 3-D
+    ``[position, angle]`` (m, rad) to the task's goal; ``replans`` (the MPC's or the
+    T-RRT*'s); ``duration`` [s] simulated; ``switch_overs`` made; ``final`` the measured in-hand
+    pose (planar ``[x, z, theta]`` or ``[x, y, z, qw, qx, qy, qz]``); ``failure`` why not (""
+    on success); ``control`` the planar run's :class:`~regrasp.control.loop.ControlResult`
+    (None in 3-D)."""
+    success: bool
+    goal_error: np.ndarray
+    replans: int
+    duration: float
+    switch_overs: int
+    final: np.ndarray
+    failure: str = ""
+    control: object = field(default=None, repr=False)
+
+
+class ArmPlant:
+    """The arm holding the object in the workcell in MuJoCo, as a control plant (see the
+    module's doc). ``scene``, ``plan``: the plan being executed (its world motion gives the start
+    above the first push, the safe height and the pushers' features); ``start``: the object's
+    in-hand start pose (planar ``[x, z, theta]`` or 3-D; default the plan's); ``workcell``,
+    ``robot``, ``scales`` (:class:`~regrasp.execution.arm.Scales`), ``timing``
+    (:class:`~regrasp.execution.world_motion.Timing`) as for an open-loop execution."""
+
+    def __init__(self, scene, plan, start=None, workcell=None, robot: str | None = None,
+                 scales: Scales = Scales(), timing: Timing = Timing()):
+        mujoco = need("mujoco", "robot")
+        from ..robot.ik import IKError, IKSolver
+
+        self.scene, self.timing, self._mj = scene, timing, mujoco
+        self.motion = world_motion(scene, plan, workcell, timing)
+        self.safe = self.motion.workcell.top() + timing.clearance  # Segments' safe height base
+        wc = self.motion.workcell
+        self.features = {}
+        for a in self.motion.assignments:
+            self.features.setdefault(a.pusher, a)
+        r, body, geoms, tcp = build_robot(scene, self.motion, robot, scales)
+        self.robot, self.body, self.tcp, self.untcp = r, body, tcp, P.inverse(tcp)
+        m = r.model
+        avoid = [g for g in range(m.ngeom) if m.geom_bodyid[g] == 0 and (m.geom_contype[g] or m.geom_conaffinity[g])]
+        self.G = self.motion.gripper[0].copy()  # the gripper's commanded world pose
+        try:
+            q0 = IKSolver(r, avoid).solve(P.compose(self.G, tcp), r.kind.home, field="start")
+        except IKError as e:
+            raise ExecutionError(f"the arm cannot reach the start above the first push: {e}", "robot") from None
+        r.set_q(q0)
+        O = self.motion.in_hand[0] if start is None else self._spatial(start)
+        jq = m.jnt_qposadr[m.body_jntadr[body]]
+        self._jq, self._jv = jq, m.jnt_dofadr[m.body_jntadr[body]]
+        r.data.qpos[jq:jq + 7] = P.compose(self.G, O)
+        mujoco.mj_forward(m, r.data)
+        self.grip = close_on(r, body, geoms, float(self.motion.grip_force[0]) * scales.grip)
+        self.solver = IKSolver(r, avoid)
+        self.contact_solver = IKSolver(r, avoid, CONTACT_CLEARANCE)  # fingers near the feature in contact
+        self.q = r.q.copy()  # the arm's commanded joints
+        self.current: str | None = None
+        self.switch_overs = 0
+        self._world = wc
+
+    # -- measurement ----------------------------------------------------------------------------
+
+    def in_hand(self) -> np.ndarray:
+        """The object's measured pose in the gripper frame ``[x, y, z, qw, qx, qy, qz]`` (m)."""
+        from ..robot.grip import body_pose
+
+        G = P.compose(self.robot.tcp_pose(), self.untcp)
+        return P.compose(P.inverse(G), body_pose(self.robot.data, self.body))
+
+    def pose(self) -> np.ndarray:
+        """The object's measured in-hand pose: planar ``[x, z, theta]`` (m, m, rad) or 3-D
+        ``[x, y, z, qw, qx, qy, qz]`` (m, unit quaternion)."""
+        H = self.in_hand()
+        return P.spatial_to_planar(H) if self.scene.dimension == 2 else H
+
+    def _spatial(self, q) -> np.ndarray:
+        q = np.asarray(q, float)
+        return np.asarray(P.planar_to_spatial(q), float) if self.scene.dimension == 2 else q
+
+    # -- motion ---------------------------------------------------------------------------------
+
+    def feature(self, pusher: str, pose):
+        """The :class:`~regrasp.execution.assignment.Assignment` rendering ``pusher`` (the plan's,
+        else assigned at ``pose``); ExecutionError naming the pusher when no feature serves it."""
+        if pusher not in self.features:
+            poses = np.array([pose, pose], float)
+            try:
+                self.features[pusher] = assign(self.scene, poses, [None, pusher], self._world)[0]
+            except ExecutionError as e:
+                raise ExecutionError(f"pusher `{pusher}`: {str(e).split(': ', 1)[-1]}", "workcell") from None
+        return self.features[pusher]
+
+    def _follow(self, times, Gs, what: str, contact=True):
+        """Moves the gripper through world poses ``Gs`` at ``times`` [s] (from now): IK from the
+        commanded joints, then the arm tracks them; ExecutionError naming ``what`` when the arm
+        cannot. ``contact``: whether each pose is in contact with a feature (one for all, or one
+        per pose: the arm keeps :data:`~regrasp.execution.arm.CONTACT_CLEARANCE` then, else the
+        IK's ``MIN_DISTANCE``)."""
+        from ..robot.ik import IKError
+        from ..robot.tracking import track
+
+        qs, q = [self.robot.q], self.q
+        near = np.broadcast_to(np.asarray(contact, bool), (len(Gs),))
+        for i, G in enumerate(Gs):
+            try:
+                solver = self.contact_solver if near[i] else self.solver
+                q = solver.solve(P.compose(G, self.tcp), q, field=f"{what}[{i}]")
+            except IKError as e:
+                why = str(e).split(": ", 1)[-1]
+                raise ExecutionError(f"the arm cannot execute {what}: {why}", "robot") from None
+            qs.append(q)
+        t = np.r_[0.0, np.asarray(times, float)]
+        track(self.robot, t, np.array(qs), settle=0.0, grip=self.grip, ease=False)
+        self.q, self.G = q, np.asarray(Gs[-1], float)
+
+    def switch(self, pusher: str, O) -> None:
+        """Switch-over to ``pusher`` with the object at in-hand pose ``O`` (m, unit quaternion):
+        retreat from the feature in contact, transfer at the safe height, approach the new
+        pusher's feature until it meets the object."""
+        pose = P.spatial_to_planar(O) if self.scene.dimension == 2 else O
+        a = self.feature(pusher, pose)
+        Pk = P.compose(O, pusher_contact(self.scene, pusher, pose).frame)
+        G0, pre = meeting(a.frame, Pk, self.timing.clearance)
+        seg = Segments(self.timing, self.safe, _reach(self.scene, O), self.G, self.motion.envelope)
+        if self.current is not None:
+            seg.retreat(self.features[self.current], O)
+        seg.transfer(pre, a, O)
+        seg.approach(G0, a, O)
+        if len(seg.poses) > 1:
+            self._follow(seg.times[1:], seg.poses[1:], f"the switch-over to pusher `{pusher}` ({a.feature})",
+                         [lab in ("approach", "retreat") for lab in seg.samples.label[1:]])
+        self.current = pusher
+        self.switch_overs += 1
+
+    def push(self, pusher: str, twist, duration: float, belief=None):
+        """Pushes with ``pusher``'s feature at body ``twist`` (planar ``[vx, vz, omega]`` (m/s,
+        m/s, rad/s), 3-D ``[v, omega]``, in the object frame) for ``duration`` [s], from the
+        object's ``belief`` pose (default: measured; after a switch-over, measured again)."""
+        if self.current != pusher:
+            self.switch(pusher, self.in_hand() if belief is None else self._spatial(belief))
+            belief = None
+        q = self.pose() if belief is None else np.asarray(belief, float)
+        O = self._spatial(q)
+        tw = np.asarray(twist, float)
+        n = max(1, math.ceil(duration / self.timing.sample_period - 1e-9))
+        s = duration * np.arange(1, n + 1) / n
+        if self.scene.dimension == 2:
+            from ..sim.quasistatic import integrate_pose
+
+            Os = [self._spatial(integrate_pose(q, tw, t)) for t in s]
+        else:
+            Os = [P.integrate(O, tw, t) for t in s]
+        G = self.G
+        self._follow(s, [P.compose(G, O, P.inverse(o)) for o in Os], f"the push with pusher `{pusher}`")
+
+    def idle(self, duration: float):
+        """Holds the arm still for ``duration`` [s] (the grip loop running)."""
+        from ..robot.tracking import track
+
+        track(self.robot, [0.0, duration], np.array([self.robot.q, self.q]), settle=0.0, grip=self.grip, ease=False)
+
+    def poke(self, delta):
+        """Displaces the object in the grasp by planar ``delta`` ``[dx, dz, dtheta]`` (m, m, rad)
+        (the feature in contact retreats first)."""
+        if self.current is not None:
+            seg = Segments(self.timing, self.safe, _reach(self.scene, self.in_hand()), self.G, self.motion.envelope)
+            seg.retreat(self.features[self.current], self.in_hand())
+            self._follow(seg.times[1:], seg.poses[1:], "the retreat before a poke",
+                         [lab == "retreat" for lab in seg.samples.label[1:]])
+            self.current = None
+        d = self.robot.data
+        G = P.compose(self.robot.tcp_pose(), self.untcp)
+        d.qpos[self._jq:self._jq + 7] = P.compose(G, self._spatial(self.pose() + np.asarray(delta, float)))
+        d.qvel[self._jv:self._jv + 6] = 0.0
+        self._mj.mj_forward(self.robot.model, d)
+        self.idle(0.1)
+
+    @property
+    def time(self) -> float:
+        """The simulated time [s] since the model was built."""
+        return float(self.robot.data.time)
+
+
+def _reach(scene, O) -> float:
+    """The object's reach [m] from the gripper origin at in-hand pose ``O``."""
+    from .world_motion import object_points
+
+    return float(np.max(np.linalg.norm(P.transform(O, object_points(scene)), axis=1)))
+
+
+def goal_error(scene, plan, pose) -> tuple[np.ndarray, bool]:
+    """(error, within tolerance) of the in-hand ``pose`` (planar ``[x, z, theta]`` or 3-D) to the
+    scene's task goal (the plan's last pose without a task): planar ``[x, z, theta]`` (m, m, rad),
+    3-D ``[position, angle]`` (m, rad)."""
+    q = np.asarray(pose, float)
+    if scene.dimension == 2:
+        goal = np.asarray(scene.task.goal if scene.task is not None else plan.poses[-1], float)
+        tol = scene.task.tolerance if scene.task is not None else np.array([1e-3, 1e-3, 0.0175])
+        err = q - goal
+        err[2] = (err[2] + np.pi) % (2 * np.pi) - np.pi
+        return err, bool(np.all(np.abs(err) <= tol))
+    _, goal, tol = scene.task
+    dp = q[:3] - goal[:3]
+    ang = P.quat_angle(q[3:], goal[3:])
+    return np.array([float(np.linalg.norm(dp)), ang]), bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])
+
+
+def control_arm(scene, plan, workcell=None, scales: Scales = Scales(), robot: str | None = None,
+                timing: Timing = Timing(), seed: int = 0, max_replans: int = 10, max_time: float | None = None,
+                **mpc) -> ArmLoopResult:
+    """Executes ``plan`` (a :class:`~regrasp.Plan` of ``scene``) closed loop with the arm in
+    ``workcell`` (default: the scene's default workcell) in a world perturbed by ``scales``
+    (see the module's doc): planar by the MPC (``mpc``: its settings, e.g. ``dt`` [s], ``speed``
+    [m/s], ``horizon``; ``max_time`` [s] of control, default ControlRun's), 3-D by re-planning
+    (at most ``max_replans``, seeds ``seed + 1, ...``). Raises ExecutionError naming a pusher of
+    the plan that no feature serves, or a move the arm cannot make."""
+    from ..planning.plan import Plan
+
+    if not isinstance(plan, Plan):
+        raise ArgumentError(f"invalid `plan`: a regrasp Plan (got {type(plan).__name__})", "plan")
+    if not isinstance(scales, Scales):
+        raise ArgumentError(f"invalid `scales`: a Scales (got {type(scales).__name__})", "scales")
+    _check_features(scene, plan, workcell)
+    if scene.dimension == 2:
+        return _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, mpc)
+    return _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_replans)
+
+
+def _check_features(scene, plan, workcell) -> None:
+    """ExecutionError naming each pusher of ``plan`` that no feature of the workcell serves."""
+    from ..workcell.default import default_workcell
+
+    wc = default_workcell(scene) if workcell is None else workcell
+    try:
+        assign(scene, np.asarray(plan.poses, float), list(plan.pushers), wc)
+    except ExecutionError as e:
+        raise ExecutionError(str(e), "workcell") from None
+
+
+def controller_scene(scene, plan, workcell=None):
+    """The planar ``scene`` with only the pushers the workcell can render, for the MPC and its
+    re-planning: the plan's and those a feature serves
+    (:func:`~regrasp.execution.assignment.assign`) at every pose of the plan; ``scene`` itself when it needs none removed
+    or has no source text to rebuild from."""
+    import json
+    import tomllib
+
+    from ..scene.planar import Scene
+    from ..workcell.default import default_workcell
+
+    wc = default_workcell(scene) if workcell is None else workcell
+    poses = np.asarray(plan.poses, float)
+    keep = set(plan.pushers[1:])
+    for p in scene.pusher_names:
+        if p not in keep and all(_served(scene, p, q, wc) for q in poses):
+            keep.add(p)
+    src = getattr(scene, "source", None)
+    if keep >= set(scene.pusher_names) or not src or getattr(scene, "_ops", ()):
+        return scene
+    d = tomllib.loads(src[1]) if src[0] == "toml" else json.loads(src[1])
+    d["pushers"] = [p for p in d.get("pushers", []) if p.get("name") in keep]
+    return Scene.from_dict(d)
+
+
+def _served(scene, pusher: str, pose, workcell) -> bool:
+    """Whether a feature of ``workcell`` serves ``pusher`` with the object at in-hand ``pose``."""
+    try:
+        assign(scene, np.array([pose, pose], float), [None, pusher], workcell)
+    except ExecutionError:
+        return False
+    return True
+
+
+def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, mpc) -> ArmLoopResult:
+    from ..control.loop import ControlRun
+    from ..mujoco.planar import Perturbation
+
+    d = _core.mpc_defaults()
+    dt, speed, horizon = (mpc.pop(k, d[k]) for k in ("dt", "speed", "horizon"))
+    made = []
+
+    def plant(q0):
+        made.append(ArmPlant(scene, plan, q0, workcell, robot, scales, timing))
+        return made[0]
+
+    run = ControlRun(scene, plan, "arm", "mpc", (), np.zeros(3), Perturbation(), controller_scene(scene, plan, workcell),
+                     0.0, seed, dt, speed, horizon, max_time, mpc, plant=plant)
+    while run.t <= run.max_time + 1e-9 and run.tick():
+        run.t += dt
+    c = run.result()
+    arm = made[0]
+    err, ok = goal_error(scene, plan, c.final_pose)
+    return ArmLoopResult(ok and c.success, err, c.replans, arm.time, arm.switch_overs, c.final_pose,
+                         c.failure, c)
+
+
+def _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_replans) -> ArmLoopResult:
+    from ..scene.spatial import check_plan3d, run_plan3d
+
+    arm = ArmPlant(scene, plan, None, workcell, robot, scales, timing)
+    path = check_plan3d(scene, plan)
+
+    def step(a: dict, b: dict) -> np.ndarray:
+        u = b.get("pusher_twist")
+        u = np.asarray(P.twist_between(a["pose"], b["pose"]) if u is None else u, float)
+        if arm.current != b["pusher"]:
+            arm.switch(b["pusher"], arm.in_hand())
+        # the step's duration at the timing's push speeds (the plan's twist is per unit time)
+        T = max(np.linalg.norm(u[:3]) / timing.push_speed, np.linalg.norm(u[3:]) / timing.push_turn,
+                timing.sample_period)
+        A = np.asarray(a["pose"], float) if scene._core.is_plane(b["pusher"]) else None
+        arm.push(b["pusher"], u / T, T, A)
+        return arm.pose()
+
+    failure = ""
+    try:
+        q, _, replans = run_plan3d(scene, path, step, arm.pose(), True, max_replans, seed)
+    except ExecutionError:
+        raise
+    except RegraspError as e:
+        q, replans, failure = arm.pose(), 0, str(e)
+    arm.idle(0.3)
+    q = arm.pose()
+    err, ok = goal_error(scene, plan, q)
+    if not ok and not failure:
+        failure = "ended outside the tolerance"
+    return ArmLoopResult(ok, err, replans, arm.time, arm.switch_overs, q, failure)
