@@ -24,21 +24,29 @@ def main() -> int:
     ap.add_argument("--spread", type=float, default=0.1)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--closed-loop", action="store_true", help="the arm in the loop (MPC / re-planning)")
     ap.add_argument("--json", help="also write the outcomes here")
     a = ap.parse_args()
     names = a.names or regrasp.examples.names()
     with ProcessPoolExecutor(a.workers) as pool:
-        outs = list(pool.map(example, names, [a.runs] * len(names), [a.spread] * len(names), [a.seed] * len(names)))
-    print(f"| example | success (±{a.spread:.0%}, {a.runs} runs) | median goal error | max creep [mm] | wall [s] |")
+        n = len(names)
+        outs = list(pool.map(example, names, [a.runs] * n, [a.spread] * n, [a.seed] * n, [a.closed_loop] * n))
+    loop = "closed loop" if a.closed_loop else "open loop"
+    print(f"| example | {loop}: success (±{a.spread:.0%}, {a.runs} runs) | median goal error | max creep [mm] | wall [s] |")
     print("|---|---|---|---|---|")
     for o in outs:
         if o.refused:
             print(f"| {o.name} | refused: {o.refused} | | | {o.seconds:.0f} |")
             continue
+        if not o.errors:
+            print(f"| {o.name} | 0/{o.runs} ({o.failures[0] if o.failures else ''}) | | | {o.seconds:.0f} |")
+            continue
         e = np.median(np.abs(np.array(o.errors)), axis=0)
         err = (f"{e[0] * 1e3:.2f} mm, {e[1] * 1e3:.2f} mm, {np.degrees(e[2]):.2f}°" if len(e) == 3
                else f"{e[0] * 1e3:.2f} mm, {np.degrees(e[1]):.2f}°")
-        print(f"| {o.name} | {o.successes}/{o.runs} | {err} | {max(o.max_creep) * 1e3:.2f} | {o.seconds:.0f} |")
+        creep = np.nanmax(o.max_creep) * 1e3 if not np.all(np.isnan(o.max_creep)) else float("nan")
+        print(f"| {o.name} | {o.successes}/{o.runs} | {err} | {'-' if np.isnan(creep) else f'{creep:.2f}'} | "
+              f"{o.seconds:.0f} |")
     if a.json:
         with open(a.json, "w") as f:
             json.dump([o.__dict__ for o in outs], f, indent=1)

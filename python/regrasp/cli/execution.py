@@ -9,8 +9,8 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..planning.plan import Plan
-from . import (CANNOT, OK, add_command, add_scale_options, add_verbose, check_outputs, error3d, load, rounded,
-               scales)
+from . import (CANNOT, OK, add_command, add_scale_options, add_verbose, check_outputs, error3d, load, refuse_flags,
+               rounded, scales)
 
 #: `--robot` of the free-flying gripper (the baseline rig, no arm)
 FREE_GRIPPER = "free-gripper"
@@ -33,56 +33,52 @@ def _check(a) -> None:
                   [a.scene, a.plan, a.workcell])
 
 
-def _motion(scene, plan, a):
-    from ..execution import world_motion
+def _workcell(a):
     from ..workcell.file import load as load_workcell
 
-    workcell = load_workcell(a.workcell) if a.workcell else None
-    return world_motion(scene, plan, workcell)
+    return load_workcell(a.workcell) if a.workcell else None
 
 
-def _free(scene, plan, motion, a) -> dict:
-    from ..execution import execute_free_gripper
+def _free(scene, plan, a):
+    """The free-flying gripper: (result dict, motion, None)."""
+    from ..execution import execute_free_gripper, world_motion
 
-    if a.scale_friction or a.scale_grip or a.scale_mass:
-        raise ArgumentError("invalid `--scale-friction`: the free-gripper rig is not perturbed (use the arm)",
-                            "--scale-friction")
+    refuse_flags(a, ("scale_friction", "scale_grip", "scale_mass"), "with --robot free-gripper",
+                 "the free-gripper rig is not perturbed (use the arm)")
+    motion = world_motion(scene, plan, _workcell(a))
     r = execute_free_gripper(scene, plan, motion)
     return dict(success=r.success, goal_error=r.goal_error, max_creep=r.max_creep, max_creep_angle=r.max_creep_angle,
-                duration_s=r.duration, robot=FREE_GRIPPER), None
+                duration_s=r.duration, robot=FREE_GRIPPER), motion, None
 
 
-def _arm(scene, plan, motion, a):
-    from ..execution.arm import Scales, execute_arm
+def _arm(scene, plan, a):
+    """The arm: (result dict, motion, (result, recorder or None))."""
+    from ..execution.arm import Scales, arm_motion, execute_arm
 
-    recorder = None
+    f, g, m = scales(a)
+    am = arm_motion(scene, plan, _workcell(a), a.robot, Scales(f, g, m, f))
+    holder: dict = {}
     observe = None
     if a.video:
         from ..robot.video import Recorder
-
-        holder = {}
 
         def observe(robot):  # the recorder is made on the first call, once the model exists
             if "r" not in holder:
                 holder["r"] = Recorder(robot.model, robot.data)
             holder["r"].capture()
-    f, g, m = scales(a)
-    r = execute_arm(scene, plan, motion, a.robot if a.robot != FREE_GRIPPER else None, Scales(f, g, m, f),
-                    observe=observe)
-    if a.video:
-        recorder = holder.get("r")
+    r = execute_arm(scene, plan, am.motion, scales=Scales(f, g, m, f), observe=observe, trajectory=am.trajectory)
     out = dict(success=r.success, goal_error=r.goal_error, max_creep=r.max_creep, max_creep_angle=r.max_creep_angle,
                duration_s=r.duration, robot=r.trajectory.robot,
                tracking=dict(max_joint_error=r.tracking.max_error, rms_joint_error=r.tracking.rms_error,
-                             max_tcp_error=r.tracking.tcp_error))
-    return out, (r, recorder)
+                             max_tcp_error=r.tracking.tcp_error),
+               refused=[dict(push=k, feature=f_, why=why) for k, f_, why in am.refused])
+    return out, am.motion, (r, holder.get("r"))
 
 
 def _closed_loop(scene, plan, a) -> int:
     """`--closed-loop`: the arm in the loop (docs/robot.md, "Closed loop with the arm")."""
     from ..execution.arm import Scales
     from ..execution.arm_loop import control_arm
-    from ..workcell.file import load as load_workcell
 
     for opt in ("trajectory", "video", "html"):
         if getattr(a, opt):
@@ -91,7 +87,7 @@ def _closed_loop(scene, plan, a) -> int:
     if a.robot == FREE_GRIPPER:
         raise ArgumentError("invalid `--robot`: --closed-loop runs the arm (not the free gripper)", "--robot")
     f, g, m = scales(a)
-    r = control_arm(scene, plan, load_workcell(a.workcell) if a.workcell else None, Scales(f, g, m, f), a.robot)
+    r = control_arm(scene, plan, _workcell(a), Scales(f, g, m, f), a.robot)
     out = dict(success=r.success, goal_error=r.goal_error, replans=r.replans, switch_overs=r.switch_overs,
                duration_s=r.duration, failure=r.failure, closed_loop=True)
     if a.json:
@@ -110,8 +106,7 @@ def cmd_execute(a) -> int:
     plan = Plan.load(a.plan, scene)
     if a.closed_loop:
         return _closed_loop(scene, plan, a)
-    motion = _motion(scene, plan, a)
-    out, extra = (_free if a.robot == FREE_GRIPPER else _arm)(scene, plan, motion, a)
+    out, motion, extra = (_free if a.robot == FREE_GRIPPER else _arm)(scene, plan, a)
     written = []
     if a.trajectory:
         arm = extra[0].trajectory if extra else None

@@ -2,8 +2,10 @@
 once (its default planner settings, seed 0), turned into a world motion in its default workcell
 and into the arm's joint trajectory (IK once), then executed ``runs`` times in MuJoCo with the
 finger friction, the features' friction, the grip force and the object's mass each drawn
-uniformly within ±``spread`` of nominal (:class:`~regrasp.execution.arm.Scales`). The README's
-table is printed by ``scripts/arm-statistics.py``."""
+uniformly within ±``spread`` of nominal (:class:`~regrasp.execution.arm.Scales`). With
+``closed_loop``, each run has the arm in the loop instead (the MPC for planar scenes,
+re-planning in 3-D; :mod:`~regrasp.execution.arm_loop`). The README's table is printed by
+``scripts/arm-statistics.py``."""
 
 from __future__ import annotations
 
@@ -19,7 +21,8 @@ class Outcome:
     """One example's runs: ``name``; ``runs`` executed; ``successes``; per run the goal error
     (``errors``, planar ``[x, z, theta]`` or 3-D ``[position, angle]``), ``max_creep`` [m];
     ``refused``: why the example could not be executed (no plan, no feature, the arm), else
-    None; ``seconds`` of wall time."""
+    None; ``seconds`` of wall time; ``failures``: why runs stopped early (the arm refused to go
+    on in a perturbed world; each counts as a failed run)."""
     name: str
     runs: int = 0
     successes: int = 0
@@ -27,6 +30,7 @@ class Outcome:
     max_creep: list = field(default_factory=list)
     refused: str | None = None
     seconds: float = 0.0
+    failures: list = field(default_factory=list)
 
     @property
     def rate(self) -> float:
@@ -47,32 +51,45 @@ def draws(runs: int, spread: float, seed: int):
     return out[:runs]
 
 
-def example(name: str, runs: int, spread: float, seed: int = 0) -> Outcome:
-    """The :class:`Outcome` of bundled example ``name`` (see the module's doc)."""
+def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: bool = False) -> Outcome:
+    """The :class:`Outcome` of bundled example ``name`` (see the module's doc); ``closed_loop``:
+    each run with the arm in the loop (:func:`~regrasp.execution.arm_loop.control_arm`) instead
+    of the open-loop joint trajectory."""
     import time
 
     import regrasp
 
-    from . import world_motion
-    from .arm import build_robot, execute_arm, solve_arm
+    from .arm import arm_motion, execute_arm
+    from .arm_loop import control_arm
 
     t0 = time.perf_counter()
     out = Outcome(name)
     scene = regrasp.load_scene(regrasp.examples.path(name))
+    if scene.task is None:
+        out.refused = "no task (the object rests on a surface: nothing to regrasp)"
+        return out
     try:
         plan = regrasp.plan(scene, seed=0)
-        motion = world_motion(scene, plan)
-        robot, _, _, tcp = build_robot(scene, motion)
-        trajectory = solve_arm(robot, motion, tcp)
+        am = None if closed_loop else arm_motion(scene, plan)
     except RegraspError as e:
         out.refused = f"{type(e).__name__}: {e}"
         out.seconds = time.perf_counter() - t0
         return out
     for scales in draws(runs, spread, seed):
-        r = execute_arm(scene, plan, motion, scales=scales, trajectory=trajectory)
+        try:
+            if closed_loop:
+                r = control_arm(scene, plan, scales=scales)
+                creep = float("nan")
+            else:
+                r = execute_arm(scene, plan, am.motion, scales=scales, trajectory=am.trajectory)
+                creep = r.max_creep
+        except RegraspError as e:  # the arm could not go on in this world: a failed run
+            out.failures.append(f"{type(e).__name__}: {e}")
+            out.runs += 1
+            continue
         out.runs += 1
         out.successes += int(r.success)
         out.errors.append([float(x) for x in r.goal_error])
-        out.max_creep.append(r.max_creep)
+        out.max_creep.append(creep)
     out.seconds = time.perf_counter() - t0
     return out
