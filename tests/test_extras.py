@@ -214,5 +214,5 @@ def test_bench_json_without_reference_is_valid_json(blocker):
     skipped = res["plan3d_offset-3d"]
     assert skipped["baseline_median_s"] is None and skipped["ratio"] is None, skipped
     assert "regrasp[reference]" in skipped["baseline"]
-    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_", "mujoco_", "ik_")) for k in res), sorted(res)
+    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_", "mujoco_", "ik_", "arm_")) for k in res), sorted(res)
     assert res["world_motion_block-low-friction"]["median_s"] > 0  # needs no extra

@@ -67,6 +67,7 @@ def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, sc
         ("3-D planner", run_plan3d),
         ("world motion", run_world_motion),
         ("arm IK", lambda: _unless_missing("the arm's inverse kinematics", run_ik)),
+        ("arm steps", lambda: _unless_missing("MuJoCo's speed with the arm", run_arm_steps)),
     ]
     results = {}
     with progress.bar(len(benchmarks), "bench", unit="benchmark") as bar:
@@ -235,6 +236,51 @@ def run_ik(poses: int = 40, reps: int = 3) -> dict:
     t = _median_time(lambda: ik_path(robot, path, q0), reps)
     return {"ik_path_per_pose": {"median_s": t / poses, "baseline_median_s": None, "ratio": None,
                                  "baseline": f"none: {poses} poses 1.1 mm apart (mink, DAQP; accept 1 mm / 0.01 rad)"}}
+
+
+def run_arm_steps(steps: int = 1000, reps: int = 3, example: str = "block-3d") -> dict:
+    """MuJoCo's speed with the arm (:mod:`regrasp.execution.arm`): the UR5e + 2F-85 holding the
+    seed-0 plan's object of ``example`` at the world motion's start in its default workcell, the
+    grip loop updated at its period, ``steps`` steps; against the free-flying gripper's model of
+    the same motion (:mod:`regrasp.execution.free_gripper`) in the same run. Median time per step
+    [s] (steps per second: its inverse)."""
+    mujoco = need("mujoco", "robot")
+    need("mink", "robot")
+    from .execution import world_motion
+    from .execution.arm import GRIP_PERIOD, build_robot, close_on
+    from .execution.free_gripper import build as free_build
+    from .mujoco.model import Contact, Rig
+    from .planning.plan import plan
+    from .robot.ik import solve_ik
+    from .scene import load_scene
+    from .pose import compose, inverse
+
+    scene = load_scene(bundled.path(example))
+    motion = world_motion(scene, plan(scene, seed=0))
+    robot, body, geoms, tcp = build_robot(scene, motion)
+    robot.set_q(solve_ik(robot, compose(motion.gripper[0], tcp), robot.kind.home))
+    m, d = robot.model, robot.data
+    jq = m.jnt_qposadr[m.body_jntadr[body]]
+    d.qpos[jq:jq + 7] = compose(robot.tcp_pose(), inverse(tcp), motion.in_hand[0])
+    mujoco.mj_forward(m, d)
+    grip = close_on(robot, body, geoms, float(motion.grip_force[0]))
+    grip.period = GRIP_PERIOD
+
+    def arm():
+        for _ in range(steps):
+            grip.update()
+            mujoco.mj_step(m, d)
+
+    rig = Rig(free_build(scene, motion), Contact(), float(motion.grip_force[0]))
+
+    def free():
+        for _ in range(steps):
+            rig.step()
+
+    t, base = _median_time(arm, reps) / steps, _median_time(free, reps) / steps
+    return {"arm_step": {"median_s": t, "baseline_median_s": base, "ratio": t / base,
+                         "baseline": f"the free-flying gripper's model of the same motion ({example}); "
+                                     f"{1 / t:,.0f} steps/s with the arm"}}
 
 
 def _mpc_qp_scipy(scene: Scene, q, steps, targets, settings: dict):
