@@ -31,6 +31,8 @@ from ..errors import ArgumentError, ExecutionError
 from ..extras import need
 from .world_motion import WorldMotion
 
+#: The object's colour in the arm's model (red, green, blue, alpha): seen in videos.
+OBJECT_RGBA = (0.95, 0.55, 0.1, 1.0)
 #: Time [s] the fingers close on the object held in place (at least, at most, until both pads
 #: press within :data:`SETTLED` of the grip force).
 CLOSE_TIME = (0.3, 1.5)
@@ -138,6 +140,8 @@ def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Sc
 
             v, t = scene.mesh()
             add_object3d(spec, scene, motion.object[0], (np.asarray(v, float), np.asarray(t, int)), scales.mass)
+        for g in spec.body("object").geoms:
+            g.rgba = OBJECT_RGBA
 
     try:
         r = build(name, base_pose=wc.robot.base, table=None, pads=Pads.of_scene(scene),
