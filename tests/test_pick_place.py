@@ -1,8 +1,7 @@
 """Pick-regrasp-place (regrasp.execution.pick_place, `regrasp pick-place`): the chosen grasps are
 the cheapest of every pair planned by brute force, reachable (checked by the arm's forward
 kinematics), keep the fingers above the table, and the motion starts at the pick pose and ends
-at the place pose. The MuJoCo execution itself is measured by the campaign in docs/robot.md
-(20 s a run: too slow here)."""
+at the place pose. The MuJoCo execution: tests/test_pick_place_mujoco.py."""
 
 import functools
 import json
