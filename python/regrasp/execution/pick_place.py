@@ -269,9 +269,13 @@ def assemble(scene, workcell: Workcell, pick_pose, place_pose, c: Candidate, tim
     S = {"t": [0.0], "G": [lifted(c.pick.gripper)], "W": [np.asarray(pick_pose, float)], "f": [0.0]}
     phases = {}
 
-    def hold(W_fixed, in_hand, f):
-        """World object pose of a sample: fixed on the table, or held at ``in_hand``."""
-        return (lambda G: W_fixed) if W_fixed is not None else (lambda G: P.compose(G, in_hand))
+    def resting(W):
+        """The object's world pose per gripper pose: still on the table at ``W``."""
+        return lambda G: np.asarray(W, float)
+
+    def holding(in_hand):
+        """The object's world pose per gripper pose: held at ``in_hand``."""
+        return lambda G: P.compose(G, in_hand)
 
     def add(name, Gs, T, obj, f):
         first = len(S["G"])
@@ -288,10 +292,10 @@ def assemble(scene, workcell: Workcell, pick_pose, place_pose, c: Candidate, tim
 
     pick_in = P.planar_to_spatial(c.pick.in_hand)
     place_in = P.planar_to_spatial(c.place.in_hand)
-    on_pick, on_place = hold(pick_pose, None, 0), hold(place_pose, None, 0)
+    on_pick, on_place = resting(pick_pose), resting(place_pose)
     add("approach", *_move(S["G"][-1], c.pick.gripper, TABLE_SPEED, timing.move_turn, timing.sample_period), on_pick, 0.0)
     dwell("close", on_pick, force)
-    held = hold(None, pick_in, force)
+    held = holding(pick_in)
     add("lift", *_move(S["G"][-1], lifted(c.pick.gripper), TABLE_SPEED, timing.move_turn, timing.sample_period), held, force)
     first = len(S["G"])
     if c.motion is not None:
@@ -301,7 +305,7 @@ def assemble(scene, workcell: Workcell, pick_pose, place_pose, c: Candidate, tim
         S["W"] += list(m.object[1:])
         S["f"] += [force] * (len(m.times) - 1)
     phases["regrasp"] = (first, len(S["G"]) - 1)
-    held = hold(None, place_in, force)
+    held = holding(place_in)
     above = lifted(c.place.gripper)
     top = np.r_[above[:2], max(S["G"][-1][2], above[2]), above[3:]]
     Gs1, T1 = _move(S["G"][-1], top, timing.move_speed, timing.move_turn, timing.sample_period)
