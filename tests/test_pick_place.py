@@ -17,7 +17,7 @@ from regrasp.workcell import default_workcell
 from .conftest import pose_matrix as T, run_cli
 
 pytest.importorskip("mink")
-NAMES = ("block-xztheta", "t-shape")
+NAMES = ("block-xztheta", "block-low-friction")
 
 
 def scene_of(name):
@@ -112,8 +112,18 @@ def test_a_place_too_deep_is_refused_naming_place():
     assert e.value.field == "place"
 
 
+def test_a_pusher_the_gripper_blocks_is_left_out_and_named():
+    """t-shape's `top` pusher is rendered by the ledge pushing down on the T's bar, which sits
+    inside the 2F-85's linkage: the arm cannot follow it, the pairs are re-planned without it,
+    and without it no regrasp reaches the place: refused naming the pusher left out."""
+    s = scene_of("t-shape")
+    with pytest.raises(ExecutionError, match=r"without pushers top") as e:
+        pp.pick_place(s, seed=1)
+    assert e.value.field == "place"
+
+
 def test_cli_json(chosen, monkeypatch):
-    s, wc, r, _ = chosen["t-shape"]
+    s, wc, r, _ = chosen["block-low-friction"]
     calls = []
 
     @functools.wraps(pp.pick_place)  # the options' defaults are read from its signature
@@ -122,7 +132,7 @@ def test_cli_json(chosen, monkeypatch):
         return r
 
     monkeypatch.setattr(pp, "pick_place", planned)
-    status, out, _ = run_cli("pick-place", regrasp.examples.path("t-shape"), "--plan-only", "--json")
+    status, out, _ = run_cli("pick-place", regrasp.examples.path("block-low-friction"), "--plan-only", "--json")
     assert status == 0
     d = json.loads(out)
     assert {"success", "pick_grasp", "place_error", "switch_overs", "planning_time_s"} <= set(d)

@@ -114,7 +114,7 @@ def test_workcell_in_hand_holds_the_object_at_its_start_above_the_table():
     assert np.allclose(pose_matrix(O), pose_matrix(G) @ pose_matrix(start))  # held at the scene's start
     w = np.asarray(d["object"]["vertices"]) @ rotation_matrix(O[3:]).T + O[:3]
     assert w[:, 2].min() > wc.top()  # above every feature
-    assert [f["name"] for f in d["features"]] == ["fixture", "ledge", "plate"]
+    assert [f["name"] for f in d["features"]] == [f.name for f in wc.features] == ["fixture", "ledge", "rod", "plate"]
 
 
 @pytest.mark.parametrize("name", ["t-shape", "pivot-3d"])

@@ -161,7 +161,8 @@ class ArmPlant:
         a = self.feature(pusher, pose)
         Pk = P.compose(O, pusher_contact(self.scene, pusher, pose).frame)
         G0, pre = meeting(a.frame, Pk, self.timing.clearance)
-        seg = Segments(self.timing, self.safe, _reach(self.scene, O), self.G, self.motion.envelope)
+        seg = Segments(self.timing, self.safe, _reach(self.scene, O), self.G, self.motion.envelope,
+                       self.motion.workcell.robot.base[:3])
         if self.current is not None:
             seg.retreat(self.features[self.current], O)
         seg.transfer(pre, a, O)
@@ -203,7 +204,8 @@ class ArmPlant:
         """Displaces the object in the grasp by planar ``delta`` ``[dx, dz, dtheta]`` (m, m, rad)
         (the feature in contact retreats first)."""
         if self.current is not None:
-            seg = Segments(self.timing, self.safe, _reach(self.scene, self.in_hand()), self.G, self.motion.envelope)
+            seg = Segments(self.timing, self.safe, _reach(self.scene, self.in_hand()), self.G, self.motion.envelope,
+                           self.motion.workcell.robot.base[:3])
             seg.retreat(self.features[self.current], self.in_hand())
             self._follow(seg.times[1:], seg.poses[1:], "the retreat before a poke",
                          [lab == "retreat" for lab in seg.samples.label[1:]])
@@ -282,10 +284,6 @@ def controller_scene(scene, plan, workcell=None):
     re-planning: the plan's and those a feature serves
     (:func:`~regrasp.execution.assignment.assign`) at every pose of the plan; ``scene`` itself when it needs none removed
     or has no source text to rebuild from."""
-    import json
-    import tomllib
-
-    from ..scene.planar import Scene
     from ..workcell.default import default_workcell
 
     wc = default_workcell(scene) if workcell is None else workcell
@@ -294,6 +292,18 @@ def controller_scene(scene, plan, workcell=None):
     for p in scene.pusher_names:
         if p not in keep and all(_served(scene, p, q, wc) for q in poses):
             keep.add(p)
+    return with_pushers(scene, keep)
+
+
+def with_pushers(scene, keep):
+    """The planar ``scene`` with only the pushers named in ``keep`` (rebuilt from its source text);
+    ``scene`` itself when it has none to remove or no source text to rebuild from."""
+    import json
+    import tomllib
+
+    from ..scene.planar import Scene
+
+    keep = set(keep)
     src = getattr(scene, "source", None)
     if keep >= set(scene.pusher_names) or not src or getattr(scene, "_ops", ()):
         return scene

@@ -43,6 +43,7 @@ from ..extras import need
 from ..workcell.default import default_workcell
 from ..workcell.description import Workcell
 from .assignment import MAX_TILT
+from .arm_loop import with_pushers
 from .world_motion import EASE_PEAK, Timing, WorldMotion, eased, grip_force, world_motion
 
 #: (m, rad): the placement succeeds when the object's final world pose is this close to the
@@ -64,6 +65,8 @@ DEFAULT_PICK = (0.4, 0.0)
 DEFAULT_SHIFT = (0.15, -0.1)
 #: Planner settings for each candidate regrasp (fast: many are planned).
 PLAN_SETTINGS = {"time_limit": 0.2}
+#: Rounds of re-planning without the pushers the arm could not follow.
+MAX_ROUNDS = 3
 
 
 @dataclass(frozen=True, eq=False)
@@ -106,7 +109,9 @@ class PickPlace:
     ``close``, ``lift``, ``regrasp``, ``carry``, ``lower``, ``open``, ``retreat``; ``arm``
     (:class:`~regrasp.execution.arm.ArmTrajectory` of the motion); ``planning_time`` [s] of the
     whole choice (grasps, plans, reachability, world motions; not the robot model's build nor
-    the chosen motion's joint trajectory); ``candidates``: every pair considered, ranked."""
+    the chosen motion's joint trajectory); ``candidates``: every pair considered, ranked;
+    ``without``: the pushers left out of the plans because the arm could not follow them (the
+    gripper's own body against the feature: see docs/robot.md)."""
     scene: str
     pick_pose: np.ndarray
     place_pose: np.ndarray
@@ -119,6 +124,7 @@ class PickPlace:
     arm: object
     planning_time: float
     candidates: list = field(default_factory=list)
+    without: list = field(default_factory=list)
 
 
 def _check_planar(scene) -> None:
@@ -399,7 +405,6 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
         raise ExecutionError("no pick grasp keeps the fingers above the table with the palm up", "pick")
     if not places:
         raise ExecutionError("no place grasp keeps the fingers above the table with the palm up", "place")
-    cands = planned(scene, picks, places, seed)
     seen: dict = {}
 
     def ok(g: Grasp) -> bool:
@@ -408,33 +413,44 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
             seen[key] = reachable(r, avoid, tcp, g.gripper) is not None
         return seen[key]
 
-    for c in cands:  # reachability first: it rules a grasp out for every pair
-        if not c.why and not ok(c.pick):
-            c.why = "the pick grasp is out of the arm's reach"
-        elif not c.why and not ok(c.place):
-            c.why = "the place grasp is out of the arm's reach"
-    planning = time.perf_counter() - t0
-    tiers = sorted({c.switch_overs for c in cands if not c.why})
-    for s_ in tiers:  # the fewest switch-overs first; within them the shortest motion
+    planning, banned, cands = time.perf_counter() - t0, set(), []
+    for _ in range(MAX_ROUNDS):  # without the pushers the arm could not follow, re-planned
         t1 = time.perf_counter()
-        tier = sorted((render(scene, workcell, c) for c in cands if not c.why and c.switch_overs == s_),
-                      key=lambda c: (bool(c.why), c.duration))
+        cands = planned(with_pushers(scene, [p for p in scene.pusher_names if p not in banned]), picks, places, seed)
+        for c in cands:  # reachability first: it rules a grasp out for every pair
+            if not c.why and not ok(c.pick):
+                c.why = "the pick grasp is out of the arm's reach"
+            elif not c.why and not ok(c.place):
+                c.why = "the place grasp is out of the arm's reach"
         planning += time.perf_counter() - t1
-        for c in tier:
-            if c.why:
-                continue
-            motion, phases = assemble(scene, workcell, pick_pose, place_pose, c, timing)
-            try:
-                arm = solve_arm(r, motion, tcp)
-            except ExecutionError as e:
-                c.why = str(e)
-                continue
-            ranked = sorted(cands, key=lambda c: (bool(c.why), c.cost))
-            return PickPlace(scene.name, pick_pose, place_pose, c.pick, c.place, c.plan, c.switch_overs, motion,
-                             phases, arm, planning, ranked)
+        blocked: set = set()
+        for s_ in sorted({c.switch_overs for c in cands if not c.why}):  # the fewest switch-overs first
+            t1 = time.perf_counter()
+            tier = sorted((render(scene, workcell, c) for c in cands if not c.why and c.switch_overs == s_),
+                          key=lambda c: (bool(c.why), c.duration))
+            planning += time.perf_counter() - t1
+            for c in tier:  # within them the shortest motion
+                if c.why:
+                    continue
+                motion, phases = assemble(scene, workcell, pick_pose, place_pose, c, timing)
+                try:
+                    arm = solve_arm(r, motion, tcp)
+                except ExecutionError as e:
+                    c.why = str(e)
+                    k = getattr(e, "push", -1)
+                    if 0 <= k < len(motion.assignments):
+                        blocked.add(motion.assignments[k].pusher)
+                    continue
+                ranked = sorted(cands, key=lambda c: (bool(c.why), c.cost))
+                return PickPlace(scene.name, pick_pose, place_pose, c.pick, c.place, c.plan, c.switch_overs, motion,
+                                 phases, arm, planning, ranked, sorted(banned))
+        if not blocked - banned or len(banned | blocked) >= len(scene.pusher_names):
+            break
+        banned |= blocked
     why = next((c.why for c in cands if c.why), "no candidate")
     raise ExecutionError(f"no pick-regrasp-place reaches the place pose {np.round(place_pose, 4).tolist()}: "
-                         f"{len(cands)} grasp pairs tried (e.g. {why})", "place")
+                         f"{len(cands)} grasp pairs tried"
+                         + (f" without pushers {', '.join(sorted(banned))}" if banned else "") + f" (e.g. {why})", "place")
 
 
 def place_error(scene_pose, place_pose) -> tuple[float, float]:

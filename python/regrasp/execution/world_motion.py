@@ -19,8 +19,8 @@ reach from the gripper origin and how far the gripper's body (a capsule ``envelo
 its +z, :data:`GRIPPER_ENVELOPE`, :data:`GRIPPER_RADIUS`) hangs below its origin at the
 orientations the transfer turns between, so that neither object nor gripper comes within the
 clearance of the workcell there. Under a feature that pushes downward (a
-ledge), the transfers go down and up beside it, moved horizontally across the feature by twice
-the object's reach and the clearance.
+ledge), the transfers go down and up beside it, on the robot's side, moved horizontally across
+the feature by twice the object's reach and the clearance.
 
 Refused (ArgumentError), naming the push: an object going deeper than
 :data:`PENETRATION_LIMIT` into its feature's contact plane during the push (its points along its
@@ -54,10 +54,11 @@ PENETRATION_LIMIT = 0.5e-3
 TOUCH = 1e-6
 #: The gripper's body kept clear in transfers: a capsule from the gripper's origin (the TCP)
 #: along its +z (to the palm and the flange), ``GRIPPER_ENVELOPE`` [m] long, of radius
-#: ``GRIPPER_RADIUS`` [m] (the Robotiq 2F-85: its fingers and body reach 0.16 m from the TCP
-#: along +z and 0.05 m sideways). Pointing down, only its radius hangs below the origin.
+#: ``GRIPPER_RADIUS`` [m] (the Robotiq 2F-85, measured on its model: 0.155 m from the TCP along
+#: +z, its linkage ±76 mm along the grasp axis and ±38 mm across it). Pointing down, only its
+#: radius hangs below the origin.
 GRIPPER_ENVELOPE = 0.16
-GRIPPER_RADIUS = 0.05
+GRIPPER_RADIUS = 0.085
 #: A feature pushes downward when its push direction is within this angle [rad] of the world's −z.
 DOWNWARD = np.pi / 3
 #: A free move (transfer, approach, retreat) follows the minimum-jerk profile s(τ) = 10τ³ − 15τ⁴ + 6τ⁵
@@ -295,13 +296,15 @@ class _Samples:
 class _Layout:
     """What the segment builders share: the plan's object poses ``O`` (n, 7) and pusher twists,
     the workcell's top + the clearance ``safe`` [m], the object's ``reach`` [m], the timing and
-    the gripper's ``envelope`` [m]."""
+    the gripper's ``envelope`` [m], the ``robot``'s base position [m] (transfers beside a
+    downward-pushing feature go down on its side)."""
     O: np.ndarray
     twists: list
     safe: float
     reach: float
     timing: Timing
     envelope: float = GRIPPER_ENVELOPE
+    robot: np.ndarray | None = None
 
     def lifted(self, G, *others):
         """``G`` raised to the safe height of its orientation and ``others``' (:meth:`height`)."""
@@ -321,7 +324,9 @@ class _Layout:
         d = P.quat_rotate(a.frame[3:], [0.0, 1, 0])
         d = np.r_[d[:2], 0.0]
         d = d / np.linalg.norm(d) if np.linalg.norm(d) > 1e-9 else np.r_[1.0, 0, 0]
-        return np.r_[G[:3] + (2 * self.reach + self.timing.clearance) * d, G[3:]]
+        if self.robot is not None and d[:2] @ (self.robot[:2] - G[:2]) < 0:
+            d = -d  # on the robot's side: the arm does not reach over the feature
+        return np.r_[G[:3] + (2 * self.reach + self.timing.clearance + GRIPPER_RADIUS) * d, G[3:]]
 
     def contact(self, a: Assignment):
         """The gripper's pose in contact at push ``a``'s start and its pre-contact pose."""
@@ -342,13 +347,16 @@ class Segments:
     world motion's segment builders — the switch-overs of a closed loop: :meth:`retreat`,
     :meth:`transfer`, :meth:`approach`, each holding the object at a given in-hand pose; ``safe``
     [m]: the workcell's top + the clearance (``Workcell.top()``), ``reach`` [m] the object's from
-    the gripper origin, ``envelope`` [m] the gripper body's length. :attr:`times` [s] and
+    the gripper origin, ``envelope`` [m] the gripper body's length, ``robot`` the robot base's
+    position [m] (or None). :attr:`times` [s] and
     :attr:`poses` (m, unit quaternion): the samples so far, ``start`` at time 0 first."""
 
-    def __init__(self, timing: Timing, safe: float, reach: float, start, envelope: float = GRIPPER_ENVELOPE):
+    def __init__(self, timing: Timing, safe: float, reach: float, start, envelope: float = GRIPPER_ENVELOPE,
+                 robot=None):
         self.samples = _Samples(timing)
         self.samples.first(start, np.r_[0.0, 0, 0, 1, 0, 0, 0])
-        self.layout = _Layout(np.zeros((0, 7)), [], float(safe), float(reach), timing, float(envelope))
+        self.layout = _Layout(np.zeros((0, 7)), [], float(safe), float(reach), timing, float(envelope),
+                              None if robot is None else np.asarray(robot, float))
 
     @property
     def times(self) -> list:
@@ -464,7 +472,7 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
     safe = workcell.top() + timing.clearance
     contacts = workcell.contacts()
     options = candidates(scene, poses, pushers, workcell, max_tilt, contacts)
-    L = _Layout(O, twists, safe, reach, timing, float(envelope))
+    L = _Layout(O, twists, safe, reach, timing, float(envelope), np.asarray(workcell.robot.base[:3], float))
     S = _Samples(timing)
     check = _Check(scene, workcell, contacts)
     knots, assignments, depth = [], [], []

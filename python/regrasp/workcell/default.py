@@ -3,7 +3,8 @@ fixture block (raised on a post) beside the robot that offers every pusher of th
 least as long as each line pusher, block corners for point pushers, block faces for patches; the
 table top for planes and pushers from below), a ledge (a horizontal edge high above the table
 that pushes downward, so a pusher that pushes the object along the scene's gravity needs no
-tilt) and a plate (a small face, just large enough for the scene's largest patch pusher, so an
+tilt), a rod (a short vertical bar pushing towards the robot: side pushers need no tilt on it,
+and it passes between the fingers) and a plate (a small face, just large enough for the scene's largest patch pusher, so an
 object pivoting on a patch does not swing into a larger face)."""
 
 from __future__ import annotations
@@ -32,6 +33,14 @@ FRICTION = 0.5
 #: along world x and pushes along world −z, its length as the block's side.
 LEDGE_CENTER = (0.5, -0.25)
 LEDGE_HEIGHT = 0.3
+#: The rod: a short vertical bar whose edge pushes along world −x (towards the robot): its centre
+#: [m] (world x-y) and height above the table top [m]; ``ROD_MARGIN`` [×] the longest line
+#: pusher long. A side pusher with the scene's gravity along its line needs no tilt on it, and,
+#: thin (an edge's bar, ``workcell.shapes``) and short, it passes between the fingers below the
+#: palm where a block's edge, 1.5 times as long with the block behind it, hits the gripper.
+ROD_CENTER = (0.55, 0.0)
+ROD_HEIGHT = 0.2
+ROD_MARGIN = 1.05
 #: The plate: its centre [m] (world x-y), height of its centre above the table [m]; it faces
 #: world +x and is square, its side ``PLATE_MARGIN`` [×] the largest patch's diameter (at least
 #: ``PLATE_MIN`` [m]).
@@ -85,13 +94,17 @@ def default_workcell(scene) -> Workcell:
                     [side] * 3)
     ledge = Feature("ledge", "edge", [*LEDGE_CENTER, TABLE_HEIGHT + LEDGE_HEIGHT, 0.0, 1.0, 0.0, 0.0], friction,
                     length=side, index=1)
+    r = np.sqrt(0.5)
     features = [block, ledge]
+    if size > 0:  # its x along world z, its z (the push) along world −x: −90° about y
+        features.append(Feature("rod", "edge", [*ROD_CENTER, TABLE_HEIGHT + ROD_HEIGHT, r, 0.0, -r, 0.0], friction,
+                                length=ROD_MARGIN * size, index=len(features)))
     patch = patch_extent(scene)
-    if patch > 0:
-        r = np.sqrt(0.5)  # the face's +z along world +x: a quarter turn about y
+    if patch > 0:  # the face's +z along world +x: a quarter turn about y
         features.append(Feature("plate", "face", [*PLATE_CENTER, TABLE_HEIGHT + PLATE_HEIGHT, r, 0.0, r, 0.0], friction,
-                                [max(PLATE_MIN, PLATE_MARGIN * patch)] * 2, index=2))
+                                [max(PLATE_MIN, PLATE_MARGIN * patch)] * 2, index=len(features)))
     robot = Robot(ROBOT, [0.0, 0.0, TABLE_HEIGHT, 1.0, 0.0, 0.0, 0.0])
     return Workcell(f"default-{scene.name}", table, tuple(features), robot, ObjectStart("hand"),
                     f"generated for scene {scene.name}: a table, a fixture block, a ledge"
+                    + (", a rod" if size > 0 else "")
                     + (" and a plate" if patch > 0 else ""))
