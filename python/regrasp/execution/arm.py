@@ -117,10 +117,12 @@ def _pad_friction(scene) -> float:
     return scene._core.friction_scale / (2 * scene.grip_force) if scene.dimension == 2 else scene._core.grip_friction
 
 
-def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Scales = Scales()):
+def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Scales = Scales(), pads=None):
     """The robot (:func:`regrasp.robot.model.build`) in ``motion``'s workcell with the object on
     a free joint at the motion's first world pose, the pads of the scene's pad shape and finger
-    friction; returns (robot, the object's body id, its geom ids, the TCP in the gripper frame)."""
+    friction (``pads``: another :class:`~regrasp.robot.pads.Pads`, e.g. the old single-contact
+    model :func:`~regrasp.robot.pads.single_contact`); returns (robot, the object's body id, its
+    geom ids, the TCP in the gripper frame)."""
     from ..mujoco.model import add_object
     from ..robot.model import build, robot_name
     from ..robot.pads import Pads
@@ -144,7 +146,7 @@ def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Sc
             g.rgba = OBJECT_RGBA
 
     try:
-        r = build(name, base_pose=wc.robot.base, table=None, pads=Pads.of_scene(scene),
+        r = build(name, base_pose=wc.robot.base, table=None, pads=Pads.of_scene(scene) if pads is None else pads,
                   pad_friction=_pad_friction(scene) * scales.finger_friction, grasp_width=width, add=add)
     except ArgumentError as e:
         if e.field == "grasp_width":
@@ -272,13 +274,13 @@ def close_on(robot, body: int, geoms, grip_force: float):
 
 
 def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scales: Scales = Scales(),
-                observe=None, trajectory: ArmTrajectory | None = None) -> ArmResult:
+                observe=None, trajectory: ArmTrajectory | None = None, pads=None) -> ArmResult:
     """Executes ``motion`` (the :class:`WorldMotion` of ``plan`` for ``scene``) with the arm
     ``robot`` (default: the workcell's) in MuJoCo, in a world perturbed by ``scales``, and
     measures it (:class:`ArmResult`). ``observe(robot)``: called after every control period
     (e.g. a video recorder). ``trajectory``: the arm's joint trajectory when already solved
     (:func:`solve_arm`, e.g. for repeated runs in perturbed worlds). Raises ExecutionError when
-    the arm cannot follow the motion."""
+    the arm cannot follow the motion. ``pads``: as :func:`build_robot`'s."""
     mujoco = need("mujoco", "robot")
     from ..robot.grip import body_pose
     from ..robot.tracking import track
@@ -286,7 +288,7 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
 
     if not isinstance(motion, WorldMotion):
         raise ArgumentError(f"invalid `motion`: a WorldMotion (got {type(motion).__name__})", "motion")
-    r, body, geoms, tcp = build_robot(scene, motion, robot if trajectory is None else trajectory.robot, scales)
+    r, body, geoms, tcp = build_robot(scene, motion, robot if trajectory is None else trajectory.robot, scales, pads)
     traj = solve_arm(r, motion, tcp) if trajectory is None else trajectory
     m, d = r.model, r.data
     r.set_q(traj.q[0])

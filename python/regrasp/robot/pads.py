@@ -33,18 +33,24 @@ class Pads:
     centres ``radius`` inside its edges. With a ``shape`` — a scene's pad, ``("circle", r, r)``
     or ``("rectangle", width, height)`` [m] (``Scene.pad``): a rubber tip of that shape centred on
     the face — the grid spans the shape (clipped to the face) and keeps the spheres inside it.
-    ``solref`` (s, −): the spheres' MuJoCo contact stiffness (:data:`PAD_SOLREF`)."""
+    ``solref`` (s, −): the spheres' MuJoCo contact stiffness (:data:`PAD_SOLREF`). ``torsion``
+    [m] > 0: the old single-contact model instead — one sphere at the face's centre with
+    torsional friction ``torsion · μ`` (MuJoCo's elliptic cone there is the ellipsoidal limit
+    surface; :meth:`single_contact`), for comparison."""
 
     columns: int = 3
     rows: int = 7
     radius: float = 0.001
     shape: tuple | None = None
     solref: tuple = PAD_SOLREF
+    torsion: float = 0.0
 
     def points(self) -> np.ndarray:
         """The spheres' centres in the pad body's frame, shape (k, 3) [m] (k = columns · rows
         without a ``shape``)."""
         hx, hz = HALF_WIDTH, LENGTH / 2
+        if self.torsion > 0:
+            return np.array([[0.0, FACE_Y + self.radius, LENGTH / 2]])
         if self.shape is not None:
             kind, a, b = self.shape
             hx, hz = (min(a, HALF_WIDTH), min(a, LENGTH / 2)) if kind == "circle" else \
@@ -66,6 +72,14 @@ class Pads:
         return cls(5, 5, 0.001, (str(pad[0]), float(pad[1]), float(pad[2])), TIP_SOLREF)
 
 
+def single_contact(scene) -> "Pads":
+    """The old pad model of ``scene`` (:attr:`Pads.torsion`): one contact at the face's centre
+    with the torsional friction of the scene's limit surface (planar ``pad_limit_surface_k``;
+    3-D (2/3) × the pad's radius, a uniformly pressed disc's)."""
+    k = scene._core.pad_limit_surface_k if scene.dimension == 2 else 2.0 / 3.0 * scene._core.pad_radius
+    return Pads(1, 1, 0.001, None, TIP_SOLREF, float(k))
+
+
 def add_pads(spec, body, pads: Pads, friction: float) -> None:
     """Replaces the contact geoms of pad ``body`` (an ``MjsBody`` of ``spec``) by ``pads``'s grid
     of spheres with Coulomb friction ``friction`` and no torsional or rolling friction."""
@@ -75,5 +89,6 @@ def add_pads(spec, body, pads: Pads, friction: float) -> None:
             spec.delete(g)
     for i, p in enumerate(pads.points()):
         body.add_geom(name=f"{body.name}_contact{i}", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[pads.radius, 0, 0],
-                      pos=p, condim=3, friction=[friction, 0, 0], priority=2, solref=pads.solref, solimp=PAD_SOLIMP,
+                      pos=p, condim=4 if pads.torsion > 0 else 3, friction=[friction, pads.torsion * friction, 0],
+                      priority=2, solref=pads.solref, solimp=PAD_SOLIMP,
                       mass=0, rgba=[0.2, 0.2, 0.2, 1], group=3)
