@@ -47,9 +47,12 @@ def main() -> int:
         creep = np.nanmax(o.max_creep) * 1e3 if not np.all(np.isnan(o.max_creep)) else float("nan")
         print(f"| {o.name} | {o.successes}/{o.runs} | {err} | {'-' if np.isnan(creep) else f'{creep:.2f}'} | "
               f"{o.seconds:.0f} |")
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump([o.__dict__ for o in outs], f, indent=1)
+    if a.json:  # NaN (no creep measured in closed loop) as null; written atomically
+        from regrasp.files import write_text
+
+        clean = lambda v: None if isinstance(v, float) and v != v else v  # noqa: E731
+        rows = [{k: ([clean(x) for x in v] if k == "max_creep" else v) for k, v in o.__dict__.items()} for o in outs]
+        write_text(a.json, json.dumps(rows, indent=1, allow_nan=False))
     return 0
 
 

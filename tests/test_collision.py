@@ -315,3 +315,30 @@ def test_a_start_pose_in_a_feature_is_refused_naming_start():
     with pytest.raises(ArgumentError) as e:
         world_motion(scene, plan, start=[*block.pose[:3], 1, 0, 0, 0])
     assert e.value.field == "start" and "feature `fixture`" in str(e.value)
+
+
+@pytest.mark.parametrize("name", ["t-shape", "block-xztheta"])
+def test_a_lamina_is_bounded_across_its_plane(name):
+    """Every convex piece of a planar object holds its two faces at ±THICKNESS/2 (also when an
+    outline's first three points are in a line, as t-shape's bar): a point off the plane is
+    outside by its distance from the face."""
+    so = C.solid(regrasp.load_scene(regrasp.examples.path(name)))
+    for A, b in so.pieces:
+        y = A[np.abs(A[:, 1]) > 0.5]
+        assert len(y) == 2 and np.allclose(sorted(y[:, 1]), [-1, 1])
+    off = np.array([[0.0, 0.5, 0.0], [0.0, -0.2, 0.01]])
+    assert np.allclose(so.distance(off), np.abs(off[:, 1]) - 0.006)
+
+
+def test_a_sphere_depth_is_exact_at_any_orientation():
+    """ball-roll-3d's ball pushed 2 mm into the table is 2 mm deep whatever its orientation."""
+    scene = regrasp.load_scene(regrasp.examples.path("ball-roll-3d"))
+    so = C.solid(scene)
+    wc = default_workcell(scene)
+    table = shapes(wc)[0]
+    r = so.sphere
+    rng = np.random.default_rng(0)
+    q = rng.normal(size=(5, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    W = np.c_[np.tile([0.5, 0.0, wc.table.height + r - 0.002], (5, 1)), q]
+    assert np.allclose(C.depths(so, [table], W)[:, 0], 0.002, atol=1e-12)

@@ -9,8 +9,8 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..planning.plan import Plan
-from . import (CANNOT, OK, add_command, add_scale_options, add_verbose, check_outputs, error3d, load, refuse_flags,
-               rounded, scales)
+from . import (CANNOT, OK, add_command, add_scale_options, add_verbose, check_outputs, load, refuse_flags, rounded,
+               scales)
 
 #: `--robot` of the free-flying gripper (the baseline rig, no arm)
 FREE_GRIPPER = "free-gripper"
@@ -31,6 +31,14 @@ def _check(a) -> None:
         raise ArgumentError("invalid `--video`: the video shows the arm (not --robot free-gripper)", "--video")
     check_outputs(a, {"trajectory": (".json",), "video": (".gif", ".mp4"), "html": (".html", ".htm")},
                   [a.scene, a.plan, a.workcell])
+
+
+def goal_text(scene, err) -> str:
+    """A goal error for people: planar ``[x, z, theta]`` (m, m, rad), 3-D ``[position, angle]``
+    (m, rad)."""
+    if scene.dimension == 2:
+        return f"{rounded(err)} (m, m, rad)"
+    return f"{float(err[0]) * 1e3:.2f} mm, {float(err[1]):.4f} rad"
 
 
 def _workcell(a):
@@ -93,7 +101,7 @@ def _closed_loop(scene, plan, a) -> int:
     if a.json:
         print(json.dumps({k: (rounded(v) if isinstance(v, np.ndarray) else v) for k, v in out.items()}, allow_nan=False))
     else:
-        err = rounded(r.goal_error) if scene.dimension == 2 else error3d(r.goal_error)
+        err = goal_text(scene, r.goal_error)
         print(f"{scene.name}: closed loop with the arm, {r.duration:.1f} s, {r.replans} re-plans, {r.switch_overs} "
               f"switch-overs: {'success' if r.success else 'outside the tolerance'}, error to goal {err}"
               + (f" ({r.failure})" if r.failure else ""))
@@ -123,7 +131,7 @@ def cmd_execute(a) -> int:
         print(json.dumps({k: (rounded(v) if isinstance(v, np.ndarray) else v) for k, v in out.items()},
                          allow_nan=False))
     else:
-        err = rounded(out["goal_error"]) if scene.dimension == 2 else error3d(out["goal_error"])
+        err = goal_text(scene, out["goal_error"])
         print(f"{scene.name}: {out['robot']} in workcell {out['workcell']}, {len(motion.assignments)} pushes "
               f"({', '.join(f'{p.pusher} on {p.feature}' for p in motion.assignments)}), {out['duration_s']:.1f} s: "
               f"{'success' if out['success'] else 'outside the tolerance'}, error to goal {err}; "

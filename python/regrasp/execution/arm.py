@@ -186,10 +186,9 @@ def solve_arm(robot, motion: WorldMotion, tcp) -> ArmTrajectory:
     sample, clear of the table and the workcell's features (by :data:`CONTACT_CLEARANCE` in
     contact, else the IK's ``MIN_DISTANCE``); from the solution for the first pose
     found from the arm's home. Raises ExecutionError naming the push (see the module's doc)."""
-    from ..robot.ik import MIN_DISTANCE, IKError, ik_path, solve_ik
+    from ..robot.ik import MIN_DISTANCE, IKError, fixed_geoms, ik_path, solve_ik
 
-    m = robot.model
-    avoid = [g for g in range(m.ngeom) if m.geom_bodyid[g] == 0 and (m.geom_contype[g] or m.geom_conaffinity[g])]
+    avoid = fixed_geoms(robot)
     targets = P.compose_rows(motion.gripper, np.broadcast_to(tcp, motion.gripper.shape))
     try:
         q0 = solve_ik(robot, targets[0], robot.kind.home, field="poses[0]", avoid=avoid)
@@ -199,7 +198,8 @@ def solve_arm(robot, motion: WorldMotion, tcp) -> ArmTrajectory:
         i = int(e.field.split("[")[1].rstrip("]")) if "[" in (e.field or "") else 0
         why = str(e).split(": ", 1)[1] if ": " in str(e) else str(e)
         err = ExecutionError(f"the arm cannot execute {where(motion, i)}: {why}", "robot")
-        err.push = next((int(p) for p in motion.push[i:] if p >= 0), -1)  # the push it serves or leads to
+        # the push it serves or leads to (the final transfer: the last push's)
+        err.push = next((int(p) for p in motion.push[i:] if p >= 0), int(motion.push.max()))
         raise err from None
     return ArmTrajectory(robot.name, [robot.kind.arm_joints[j] for j in range(len(robot.kind.arm_joints))],
                          motion.times.copy(), q, np.asarray(tcp, float), robot.grasp_width)

@@ -66,7 +66,7 @@ class ArmPlant:
     def __init__(self, scene, plan, start=None, workcell=None, robot: str | None = None,
                  scales: Scales = Scales(), timing: Timing = Timing()):
         mujoco = need("mujoco", "robot")
-        from ..robot.ik import IKError, IKSolver
+        from ..robot.ik import IKError, IKSolver, fixed_geoms
 
         self.scene, self.timing, self._mj = scene, timing, mujoco
         self.motion = world_motion(scene, plan, workcell, timing)
@@ -78,7 +78,7 @@ class ArmPlant:
         r, body, geoms, tcp = build_robot(scene, self.motion, robot, scales)
         self.robot, self.body, self.tcp, self.untcp = r, body, tcp, P.inverse(tcp)
         m = r.model
-        avoid = [g for g in range(m.ngeom) if m.geom_bodyid[g] == 0 and (m.geom_contype[g] or m.geom_conaffinity[g])]
+        avoid = fixed_geoms(r)
         self.G = self.motion.gripper[0].copy()  # the gripper's commanded world pose
         try:
             q0 = IKSolver(r, avoid).solve(P.compose(self.G, tcp), r.kind.home, field="start")
@@ -88,7 +88,7 @@ class ArmPlant:
         O = self.motion.in_hand[0] if start is None else self._spatial(start)
         jq = m.jnt_qposadr[m.body_jntadr[body]]
         self._jq, self._jv = jq, m.jnt_dofadr[m.body_jntadr[body]]
-        r.data.qpos[jq:jq + 7] = P.compose(self.G, O)
+        r.data.qpos[jq:jq + 7] = P.compose(r.tcp_pose(), self.untcp, O)  # at the arm's actual TCP
         mujoco.mj_forward(m, r.data)
         self.grip = close_on(r, body, geoms, float(self.motion.grip_force[0]) * scales.grip)
         self.solver = IKSolver(r, avoid)
@@ -362,13 +362,11 @@ def _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_rep
         arm.push(b["pusher"], u / T, T, A)
         return arm.pose()
 
-    failure = ""
+    failure, replans = "", 0
     try:
         q, _, replans = run_plan3d(scene, path, step, arm.pose(), True, max_replans, seed)
-    except ExecutionError:
-        raise
-    except RegraspError as e:
-        q, replans, failure = arm.pose(), 0, str(e)
+    except RegraspError as e:  # the arm cannot go on, or no re-plan: the run ends, saying why
+        q, failure = arm.pose(), str(e)
     arm.idle(0.3)
     q = arm.pose()
     err, ok = goal_error(scene, plan, q)

@@ -98,8 +98,8 @@ def solid(scene) -> Solid:
             q = np.asarray(piece, float)
             v = np.vstack([np.c_[q[:, 0], np.full(len(q), y), q[:, 1]] for y in (-h, h)])
             m = len(q)
-            faces = [(i, (i + 1) % m, i + m) for i in range(m)] + [(0, 1, 2), (m, m + 1, m + 2)]
-            pieces.append(_planes(v, faces))
+            A, b = _planes(v, [(i, (i + 1) % m, i + m) for i in range(m)])  # the sides
+            pieces.append((np.vstack([A, [[0.0, -1.0, 0.0], [0.0, 1.0, 0.0]]]), np.r_[b, h, h]))  # and the faces ±h
         corners = [np.array([p[0], y, p[1]]) for p in out for y in (-h, h)]
         segs = [(corners[2 * i + j], corners[(2 * i + 2 + j) % len(corners)]) for i in range(len(out)) for j in (0, 1)]
         segs += [(corners[2 * i], corners[2 * i + 1]) for i in range(len(out))]
@@ -128,6 +128,8 @@ def depths(body: Solid, shapes: list[Shape], poses, core_runs: list | None = Non
     (n, 7) (m, unit quaternion): (n, len(shapes)), > 0 inside; otherwise not in it (≤ 0, or −inf
     where none of the points checked came near); ``core_runs``: :func:`cores` of the shapes."""
     W = np.asarray(poses, float)
+    if body.sphere > 0:  # exact: the centre's depth in the body plus the radius
+        return np.stack([s.depth(W[:, :3]) + body.sphere for s in shapes], axis=1).reshape(len(W), len(shapes))
     out = np.full((len(W), len(shapes)), -np.inf)
     runs, centres, radii = body.runs
     core_runs = cores(shapes) if core_runs is None else core_runs

@@ -344,14 +344,14 @@ def assemble(scene, workcell: Workcell, pick_pose, place_pose, c: Candidate, tim
 def _arm_robot(scene, workcell: Workcell, pick_pose, in_hand):
     """The robot in ``workcell`` (:func:`~regrasp.execution.arm.build_robot`) with the object,
     and the geoms the IK keeps clear of (the table and the features)."""
+    from ..robot.ik import fixed_geoms
     from .arm import build_robot
 
     # build_robot reads only the motion's workcell, first in-hand pose and first object pose
     stub = SimpleNamespace(workcell=workcell, in_hand=[np.asarray(P.planar_to_spatial(in_hand))],
                            object=[np.asarray(pick_pose, float)])
     r, body, geoms, tcp = build_robot(scene, stub)
-    m = r.model
-    avoid = [g for g in range(m.ngeom) if m.geom_bodyid[g] == 0 and (m.geom_contype[g] or m.geom_conaffinity[g])]
+    avoid = fixed_geoms(r)
     return r, body, geoms, tcp, avoid
 
 

@@ -20,9 +20,9 @@ its +z, :data:`GRIPPER_ENVELOPE`, :data:`GRIPPER_RADIUS`) hangs below its origin
 orientations the transfer turns between, so that neither object nor gripper comes within the
 clearance of the workcell there. Under a feature that pushes downward (a
 ledge), the transfers go down and up beside it, on the robot's side, moved horizontally across
-the feature by twice the object's reach and the clearance.
+the feature by twice the object's reach, the clearance and :data:`GRIPPER_RADIUS`.
 
-Refused (ArgumentError), naming the push: an object going deeper than
+Refused (ExecutionError), naming the push: an object going deeper than
 :data:`PENETRATION_LIMIT` into its feature's contact plane during the push (its points along its
 edges, :func:`edge_points`, behind the plane, within a face's rectangle). Refused, naming the push
 or the transfer, the body hit and the depth: the object (a solid,

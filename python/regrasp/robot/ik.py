@@ -53,6 +53,13 @@ def obstacle_geoms(robot, avoid=()) -> list:
     return out
 
 
+def fixed_geoms(robot) -> list:
+    """The colliding geoms fixed in the world (on the world body: a workcell's table and
+    features added through ``build(add=...)``), the obstacles of an execution's IK."""
+    m = robot.model
+    return [g for g in range(m.ngeom) if m.geom_bodyid[g] == 0 and (m.geom_contype[g] or m.geom_conaffinity[g])]
+
+
 def table_distance(robot, q, avoid=()) -> float:
     """The smallest distance [m] between the arm's and gripper's collision geoms and the table
     (and the geoms ``avoid``) at arm joint positions ``q`` [rad] (inf when there are none;
