@@ -9,9 +9,23 @@ within ±``--spread``, ``--workers`` processes.
 import argparse
 import json
 import sys
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
+
+
+def row(o) -> str:
+    """The README's table row of an :class:`~regrasp.execution.campaign.Outcome`."""
+    if o.refused:
+        return f"| {o.name} | refused: {o.refused} | | | {o.seconds:.0f} |"
+    if not o.errors:
+        return f"| {o.name} | 0/{o.runs} ({o.failures[0] if o.failures else ''}) | | | {o.seconds:.0f} |"
+    e = np.median(np.abs(np.array(o.errors)), axis=0)
+    err = (f"{e[0] * 1e3:.2f} mm, {e[1] * 1e3:.2f} mm, {np.degrees(e[2]):.2f}°" if len(e) == 3
+           else f"{e[0] * 1e3:.2f} mm, {np.degrees(e[1]):.2f}°")
+    creep = np.array(o.max_creep, float)
+    creep = "-" if np.all(np.isnan(creep)) else f"{np.nanmax(creep) * 1e3:.2f}"
+    return f"| {o.name} | {o.successes}/{o.runs} | {err} | {creep} | {o.seconds:.0f} |"
 
 
 def main() -> int:
@@ -28,25 +42,14 @@ def main() -> int:
     ap.add_argument("--json", help="also write the outcomes here")
     a = ap.parse_args()
     names = a.names or regrasp.examples.names()
-    with ProcessPoolExecutor(a.workers) as pool:
-        n = len(names)
-        outs = list(pool.map(example, names, [a.runs] * n, [a.spread] * n, [a.seed] * n, [a.closed_loop] * n))
     loop = "closed loop" if a.closed_loop else "open loop"
     print(f"| example | {loop}: success (±{a.spread:.0%}, {a.runs} runs) | median goal error | max creep [mm] | wall [s] |")
-    print("|---|---|---|---|---|")
-    for o in outs:
-        if o.refused:
-            print(f"| {o.name} | refused: {o.refused} | | | {o.seconds:.0f} |")
-            continue
-        if not o.errors:
-            print(f"| {o.name} | 0/{o.runs} ({o.failures[0] if o.failures else ''}) | | | {o.seconds:.0f} |")
-            continue
-        e = np.median(np.abs(np.array(o.errors)), axis=0)
-        err = (f"{e[0] * 1e3:.2f} mm, {e[1] * 1e3:.2f} mm, {np.degrees(e[2]):.2f}°" if len(e) == 3
-               else f"{e[0] * 1e3:.2f} mm, {np.degrees(e[1]):.2f}°")
-        creep = np.nanmax(o.max_creep) * 1e3 if not np.all(np.isnan(o.max_creep)) else float("nan")
-        print(f"| {o.name} | {o.successes}/{o.runs} | {err} | {'-' if np.isnan(creep) else f'{creep:.2f}'} | "
-              f"{o.seconds:.0f} |")
+    print("|---|---|---|---|---|", flush=True)
+    with ProcessPoolExecutor(a.workers) as pool:  # a row as each example completes
+        jobs = [pool.submit(example, name, a.runs, a.spread, a.seed, a.closed_loop) for name in names]
+        for job in as_completed(jobs):
+            print(row(job.result()), flush=True)
+    outs = [job.result() for job in jobs]
     if a.json:  # NaN (no creep measured in closed loop) as null; written atomically
         from regrasp.files import write_text
 
