@@ -8,18 +8,6 @@ const slider = document.getElementById("t"), info = document.getElementById("inf
 const speedBox = document.getElementById("speed"), playBtn = document.getElementById("play");
 let yaw = D.dimension === 2 ? 0.35 : 0.6, pitch = D.dimension === 2 ? 0.25 : 0.35, zoom = 1.0;
 let playing = false, drawn = 0, drawnAll = 0, W = cv.width, H = cv.height, layer = "all", jawGap = null;
-const add = (a, b) => [a[0]+b[0], a[1]+b[1], a[2]+b[2]], sub = (a, b) => [a[0]-b[0], a[1]-b[1], a[2]-b[2]];
-const mul = (a, s) => [a[0]*s, a[1]*s, a[2]*s], dot = (a, b) => a[0]*b[0] + a[1]*b[1] + a[2]*b[2];
-const cross = (a, b) => [a[1]*b[2]-a[2]*b[1], a[2]*b[0]-a[0]*b[2], a[0]*b[1]-a[1]*b[0]];
-function qmul(a, b) { return [a[0]*b[0]-a[1]*b[1]-a[2]*b[2]-a[3]*b[3], a[0]*b[1]+a[1]*b[0]+a[2]*b[3]-a[3]*b[2],
-  a[0]*b[2]-a[1]*b[3]+a[2]*b[0]+a[3]*b[1], a[0]*b[3]+a[1]*b[2]-a[2]*b[1]+a[3]*b[0]]; }
-function qrot(q, v) { const p = qmul(qmul(q, [0, v[0], v[1], v[2]]), [q[0], -q[1], -q[2], -q[3]]); return [p[1], p[2], p[3]]; }
-function slerp(a, b, t) {
-  let d = a[0]*b[0]+a[1]*b[1]+a[2]*b[2]+a[3]*b[3]; if (d < 0) { b = b.map(x => -x); d = -d; }
-  if (d > 0.9995) { const r = a.map((x, i) => x + t*(b[i]-x)); const n = Math.hypot(...r); return r.map(x => x/n); }
-  const th = Math.acos(d), s = Math.sin(th);
-  return a.map((x, i) => (Math.sin((1-t)*th)*x + Math.sin(t*th)*b[i]) / s);
-}
 function poseAt(u) {  // u in [0, 1] along the plan: the pose and the step it is in
   const n = D.poses.length - 1; if (n <= 0) return [D.poses[0], 0];
   const f = Math.min(u * n, n - 1e-9), k = Math.floor(f), t = f - k, a = D.poses[k], b = D.poses[k+1];

@@ -27,25 +27,31 @@ from ..planning.plan import as_plan
 from .view_data import planar_description, spatial_description
 
 SCRIPT = Path(__file__).with_name("viewer.js")
+#: The vector and quaternion helpers both scripts share (prepended to each page's script).
+MATH_SCRIPT = Path(__file__).with_name("view_math.js")
 #: The world view's script (a workcell, a world motion).
 WORLD_SCRIPT = Path(__file__).with_name("world_viewer.js")
 
-PAGE = r"""<!doctype html>
-<html><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
-<title>regrasp: __TITLE__</title>
-<style>
-html,body{height:100%;margin:0}
+#: The pages' shared style sheet (head: the page and its bar; tail: the canvas, legend, info).
+STYLE_HEAD = """html,body{height:100%;margin:0}
 body{font-family:system-ui,sans-serif;background:#fff;display:flex;flex-direction:column;overflow:hidden}
 #bar{padding:6px 8px;display:flex;gap:10px;align-items:center;flex-wrap:wrap;background:#f4f4f4;border-bottom:1px solid #ddd}
-#t{flex:1;min-width:120px}
-#info{font-size:13px;color:#333}
+"""
+STYLE_TAIL = """#info{font-size:13px;color:#333}
 #wrap{position:relative;flex:1;min-height:200px}
 #c{position:absolute;left:0;top:0;width:100%;height:100%;display:block;cursor:grab}
 #legend{position:absolute;right:8px;top:8px;font-size:12px;background:rgba(255,255,255,0.85);padding:4px 8px;
  border:1px solid #ddd;line-height:1.5;pointer-events:none}
 #legend i{display:inline-block;width:12px;height:10px;margin-right:5px;vertical-align:middle}
 #selftest{display:none}
-</style></head><body>
+"""
+
+PAGE = r"""<!doctype html>
+<html><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
+<title>regrasp: __TITLE__</title>
+<style>
+__STYLE_HEAD__#t{flex:1;min-width:120px}
+__STYLE_TAIL__</style></head><body>
 <div id="bar"><button id="play">play</button>
 <input id="t" type="range" min="0" max="1000" value="0" step="any" list="knots" title="along the plan"><datalist id="knots">__KNOTS__</datalist>
 <label>speed <select id="speed"><option>0.25</option><option>0.5</option><option selected>1</option><option>2</option><option>4</option></select></label>
@@ -97,8 +103,9 @@ def page(scene, plan=None) -> str:
     knots = "".join(f'<option value="{1000 * k / n:.3f}"></option>' for k in range(n + 1)) if n > 0 else ""
     ground = "ground" if d["ground"]["support"] is None else f"support ({html.escape(d['ground']['support'])})"
     text = json.dumps(d, allow_nan=False).replace("</", "<\\/")
-    return (PAGE.replace("__TITLE__", html.escape(scene.name)).replace("__KNOTS__", knots)
-            .replace("__GROUND__", ground).replace("__SCRIPT__", SCRIPT.read_text()).replace("__DATA__", text))
+    return (PAGE.replace("__STYLE_HEAD__", STYLE_HEAD).replace("__STYLE_TAIL__", STYLE_TAIL)
+            .replace("__TITLE__", html.escape(scene.name)).replace("__KNOTS__", knots)
+            .replace("__GROUND__", ground).replace("__SCRIPT__", MATH_SCRIPT.read_text() + SCRIPT.read_text()).replace("__DATA__", text))
 
 
 def write_html(scene, plan, path) -> Path:
@@ -139,20 +146,10 @@ WORLD_PAGE = r"""<!doctype html>
 <html><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
 <title>regrasp: __TITLE__</title>
 <style>
-html,body{height:100%;margin:0}
-body{font-family:system-ui,sans-serif;background:#fff;display:flex;flex-direction:column;overflow:hidden}
-#bar{padding:6px 8px;display:flex;gap:10px;align-items:center;flex-wrap:wrap;background:#f4f4f4;border-bottom:1px solid #ddd}
-#tbox{flex:1;min-width:120px;display:flex;flex-direction:column}
+__STYLE_HEAD__#tbox{flex:1;min-width:120px;display:flex;flex-direction:column}
 #t{width:100%;margin:0}
 #strip{height:5px;width:100%}
-#info{font-size:13px;color:#333}
-#wrap{position:relative;flex:1;min-height:200px}
-#c{position:absolute;left:0;top:0;width:100%;height:100%;display:block;cursor:grab}
-#legend{position:absolute;right:8px;top:8px;font-size:12px;background:rgba(255,255,255,0.85);padding:4px 8px;
- border:1px solid #ddd;line-height:1.5;pointer-events:none}
-#legend i{display:inline-block;width:12px;height:10px;margin-right:5px;vertical-align:middle}
-#selftest{display:none}
-</style></head><body>
+__STYLE_TAIL__</style></head><body>
 <div id="bar"><button id="play">play</button>
 <div id="tbox"><input id="t" type="range" min="0" max="__DURATION__" value="0" step="any" title="time [s]"><div id="strip"></div></div>
 <label>speed <select id="speed"><option>0.25</option><option>0.5</option><option selected>1</option><option>2</option><option>4</option></select></label>
@@ -178,8 +175,9 @@ def world_page(d: dict, title: str) -> str:
     (:mod:`regrasp.viz.world_data`) titled ``title``."""
     text = json.dumps(d, allow_nan=False).replace("</", "<\\/")
     duration = max(float(d["samples"]["times"][-1]), 0.0)
-    return (WORLD_PAGE.replace("__TITLE__", html.escape(title)).replace("__DURATION__", f"{duration!r}")
-            .replace("__SCRIPT__", WORLD_SCRIPT.read_text()).replace("__DATA__", text))
+    return (WORLD_PAGE.replace("__STYLE_HEAD__", STYLE_HEAD).replace("__STYLE_TAIL__", STYLE_TAIL)
+            .replace("__TITLE__", html.escape(title)).replace("__DURATION__", f"{duration!r}")
+            .replace("__SCRIPT__", MATH_SCRIPT.read_text() + WORLD_SCRIPT.read_text()).replace("__DATA__", text))
 
 
 def _check_workcell(workcell):
