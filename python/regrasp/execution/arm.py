@@ -181,17 +181,37 @@ def where(motion: WorldMotion, i: int) -> str:
     return f"the transfer before push {nxt[0]} ({t})" if nxt else f"the final transfer ({t})"
 
 
+def first_solution(robot, target, avoid):
+    """Arm joints [rad] reaching TCP pose ``target`` clear of ``avoid``: the differential IK from
+    the arm's home, else from home with the wrist's last joint or the base turned by ±π/2 or π
+    (a large turn of the TCP from home can stall it); the home's IKError when none reaches it."""
+    from ..robot.ik import IKError, IKSolver
+
+    solver, home = IKSolver(robot, avoid), np.asarray(robot.kind.home, float)
+    first = None
+    for j, turn in [(None, 0.0), (5, np.pi), (5, -np.pi), (5, np.pi / 2), (5, -np.pi / 2), (0, np.pi / 2),
+                    (0, -np.pi / 2)]:
+        q = home.copy()
+        if j is not None:
+            q[j] += turn
+        try:
+            return solver.solve(target, q, field="poses[0]")
+        except IKError as e:
+            first = first or e
+    raise first
+
+
 def solve_arm(robot, motion: WorldMotion, tcp) -> ArmTrajectory:
     """The arm's :class:`ArmTrajectory` putting the TCP at ``motion.gripper ∘ tcp`` at every
     sample, clear of the table and the workcell's features (by :data:`CONTACT_CLEARANCE` in
     contact, else the IK's ``MIN_DISTANCE``); from the solution for the first pose
     found from the arm's home. Raises ExecutionError naming the push (see the module's doc)."""
-    from ..robot.ik import MIN_DISTANCE, IKError, fixed_geoms, ik_path, solve_ik
+    from ..robot.ik import MIN_DISTANCE, IKError, fixed_geoms, ik_path
 
     avoid = fixed_geoms(robot)
     targets = P.compose_rows(motion.gripper, np.broadcast_to(tcp, motion.gripper.shape))
     try:
-        q0 = solve_ik(robot, targets[0], robot.kind.home, field="poses[0]", avoid=avoid)
+        q0 = first_solution(robot, targets[0], avoid)
         gaps = [CONTACT_CLEARANCE if lab in ("approach", "push", "retreat") else MIN_DISTANCE for lab in motion.labels]
         q = ik_path(robot, targets, q0, avoid=avoid, min_distance=gaps)
     except IKError as e:

@@ -38,7 +38,7 @@ LEDGE_HEIGHT = 0.3
 #: pusher long. A side pusher with the scene's gravity along its line needs no tilt on it, and,
 #: thin (an edge's bar, ``workcell.shapes``) and short, it passes between the fingers below the
 #: palm where a block's edge, 1.5 times as long with the block behind it, hits the gripper.
-ROD_CENTER = (0.55, 0.0)
+ROD_CENTER = (0.66, 0.05)
 ROD_HEIGHT = 0.2
 ROD_MARGIN = 1.05
 #: The plate: its centre [m] (world x-y), height of its centre above the table [m]; it faces
