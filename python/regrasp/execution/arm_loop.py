@@ -31,7 +31,7 @@ from .. import _core
 from .. import pose as P
 from ..errors import ArgumentError, ExecutionError, RegraspError
 from ..extras import need
-from .arm import CONTACT_CLEARANCE, Scales, build_robot, close_on
+from .arm import CONTACT_CLEARANCE, Scales, arm_motion, build_robot, close_on, first_solution
 from .assignment import assign, pusher_contact
 from .world_motion import Segments, Timing, meeting, world_motion
 
@@ -69,7 +69,9 @@ class ArmPlant:
         from ..robot.ik import IKError, IKSolver, fixed_geoms
 
         self.scene, self.timing, self._mj = scene, timing, mujoco
-        self.motion = world_motion(scene, plan, workcell, timing)
+        # the plan's world motion whose features the arm can follow (arm_motion: the next feature
+        # of a push the arm cannot follow with the first), for the features and the start
+        self.motion = arm_motion(scene, plan, workcell, robot, scales, timing).motion
         self.safe = self.motion.workcell.top() + timing.clearance  # Segments' safe height base
         wc = self.motion.workcell
         self.features = {}
@@ -81,7 +83,7 @@ class ArmPlant:
         avoid = fixed_geoms(r)
         self.G = self.motion.gripper[0].copy()  # the gripper's commanded world pose
         try:
-            q0 = IKSolver(r, avoid).solve(P.compose(self.G, tcp), r.kind.home, field="start")
+            q0 = first_solution(r, P.compose(self.G, tcp), avoid)
         except IKError as e:
             raise ExecutionError(f"the arm cannot reach the start above the first push: {e}", "robot") from None
         r.set_q(q0)
