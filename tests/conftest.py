@@ -8,6 +8,11 @@ from hypothesis import settings
 from hypothesis import strategies as st
 
 import regrasp
+from regrasp.extras import default_gl
+
+# MuJoCo picks its OpenGL backend once, at its first import: choose it before any test module
+# imports mujoco itself (else the rendering tests find GLFW without a display and skip)
+default_gl()
 
 # Property tests draw the same examples on every run (reproducible CI); a failure a random
 # exploration finds (HYPOTHESIS_PROFILE=explore) becomes a regression test.
