@@ -308,13 +308,15 @@ class _Layout:
 
     def lifted(self, G, *others):
         """``G`` raised to the safe height of its orientation and ``others``' (:meth:`height`)."""
-        return np.r_[G[:2], max(G[2], *(self.height(g) for g in (G, *others))), G[3:]]
+        return np.r_[G[:2], max(G[2], *(float(self.height(g)) for g in (G, *others))), G[3:]]
 
-    def height(self, G) -> float:
-        """The safe height [m] of a gripper at ``G``'s orientation: the workcell's top + the clearance +
-        the larger of the object's reach and how far the gripper's body hangs below its origin."""
-        z = P.quat_rotate(G[3:], [0.0, 0.0, 1.0])[2]
-        return self.safe + max(self.reach, GRIPPER_RADIUS + max(0.0, -self.envelope * z))
+    def height(self, G):
+        """The safe height [m] of a gripper at pose ``G``'s orientation (or of each row of an
+        (n, 7) array): the workcell's top + the clearance + the larger of the object's reach and
+        how far the gripper's body hangs below its origin (its +z's world z is 1 − 2(qx² + qy²))."""
+        q = np.asarray(G, float)[..., 3:]
+        z = 1.0 - 2.0 * (q[..., 1] ** 2 + q[..., 2] ** 2)
+        return self.safe + np.maximum(self.reach, GRIPPER_RADIUS + np.maximum(0.0, -self.envelope * z))
 
     def beside(self, G, a: Assignment):
         """``G`` moved horizontally across a downward-pushing feature (None for other features)."""
@@ -512,7 +514,7 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
     G, Oh = np.array(S.G), np.array(S.O)
     W = P.compose_rows(G, Oh)
     return WorldMotion(np.array(S.t[:len(G)]), G, W, Oh, S.label, np.array(S.push, int), np.full(len(G), grip_force(scene)),
-                       assignments, knots, max(L.height(g) for g in G), workcell, timing, depth, scene.name,
+                       assignments, knots, float(np.max(L.height(G))), workcell, timing, depth, scene.name,
                        float(envelope))
 
 
