@@ -115,3 +115,13 @@ def test_the_controller_keeps_only_pushers_the_workcell_renders():
     assert set(plan.pushers[1:]) <= set(c.pusher_names) < set(scene.pusher_names)
     scene2, plan2 = example("block-fixtureless")
     assert controller_scene(scene2, plan2) is scene2
+
+
+@pytest.mark.parametrize("bad", [dict(dt=0.0), dict(dt=-0.1), dict(speed=float("nan")), dict(max_time=-1.0)])
+def test_bad_control_settings_are_refused_before_any_work(bad):
+    """A control period of 0 would never end the loop: refused naming the setting, the arm never built."""
+    scene = regrasp.load_scene(regrasp.examples.path("block-xztheta"))
+    plan = regrasp.plan(scene, seed=0)
+    with pytest.raises(regrasp.ArgumentError) as e:
+        control_arm(scene, plan, **bad)
+    assert e.value.field == next(iter(bad))

@@ -324,11 +324,12 @@ def _served(scene, pusher: str, pose, workcell) -> bool:
 
 
 def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, mpc) -> ArmLoopResult:
-    from ..control.loop import ControlRun
+    from ..control.loop import ControlRun, _check_arguments
     from ..mujoco.planar import Perturbation
 
     d = _core.mpc_defaults()
     dt, speed, horizon = (mpc.pop(k, d[k]) for k in ("dt", "speed", "horizon"))
+    _check_arguments("quasistatic", "mpc", dt, speed, horizon, max_time, np.zeros(3), 0.0, seed, ())  # before any work
     made = []
 
     def plant(q0):
