@@ -140,3 +140,29 @@ def test_execute_cli_refusals(tmp_path):
     assert code == 2 and "--trajectory" in err
     code, _, err = run_cli("execute", scene, "--plan", tmp_path / "p.json", "--trajectory", scene)
     assert code == 2
+
+
+def test_the_workcell_and_the_object_touch_with_the_stiff_contact_settings():
+    """The table, the features and the object take the model's contact settings (a stiff
+    aluminium-on-steel contact), not MuJoCo's soft default (0.02 s): with that, a 24 N push
+    pressed the block 1 mm into the table and every planar push ended 1 mm short."""
+    import mujoco
+
+    from regrasp.mujoco.model import Contact
+
+    scene, plan, motion, robot, tcp, arm = case("block-fixtureless")
+    m, d = robot.model, robot.data
+    mine = [g for g in range(m.ngeom) if m.geom_bodyid[g] == 0 or m.body(m.geom_bodyid[g]).name == "object"]
+    assert len(mine) >= 3
+    assert np.allclose(m.geom_solref[mine], Contact().solref) and np.allclose(m.geom_solimp[mine, :3], Contact().solimp)
+    # independent: the block pressed onto the table top with 24 N stays within 0.05 mm of it
+    body = m.body("object").id
+    jq, jv = m.jnt_qposadr[m.body_jntadr[body]], m.jnt_dofadr[m.body_jntadr[body]]
+    top = m.geom_pos[m.geom("table").id][2] + m.geom_size[m.geom("table").id][2]
+    d.qpos[jq:jq + 7] = [0.9, -0.3, top + 0.04, 1, 0, 0, 0]  # clear of the arm and the features, its bottom face on the table
+    d.qvel[jv:jv + 6] = 0
+    d.xfrc_applied[body, 2] = -24.0
+    for _ in range(400):
+        mujoco.mj_step(m, d)
+    assert top - (d.xpos[body][2] - 0.04) < 5e-5
+    d.xfrc_applied[body] = 0

@@ -144,6 +144,13 @@ def new_spec(name: str, gravity, contact: Contact = Contact()):
     o.cone = {"elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC, "pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL}[contact.cone]
     o.impratio = contact.impratio
     o.noslip_iterations = contact.noslip_iterations
+    set_geom_defaults(spec, contact)
+    return spec
+
+
+def set_geom_defaults(spec, contact: Contact) -> None:
+    """Sets the default ``solref``/``solimp`` of the geoms ``spec`` creates (not those of specs
+    attached to it, which keep their own defaults) to ``contact``'s."""
     g = spec.default.geom
     for attr in ("solref", "solimp"):
         given = getattr(contact, attr)
@@ -151,7 +158,6 @@ def new_spec(name: str, gravity, contact: Contact = Contact()):
         value = np.array(getattr(g, attr), float)
         value[:len(given)] = given  # what is not given keeps MuJoCo's default (as MJCF reads it)
         setattr(g, attr, value)
-    return spec
 
 
 def add_geom(body, kind: str, size, bits=(0, 0), friction=None, **kw):

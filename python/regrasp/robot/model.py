@@ -31,7 +31,7 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..extras import need
-from ..mujoco.model import Contact
+from ..mujoco.model import Contact, set_geom_defaults
 from .pads import PAD_FRICTION, Pads, add_pads
 
 TCP = "tcp"  # the name of the TCP site (regrasp's gripper frame)
@@ -262,6 +262,7 @@ def robot_spec(kind: RobotKind, name: str, base_pose, table, pads: Pads, pad_fri
     mujoco = need("mujoco", "robot")
     spec = mujoco.MjSpec()
     set_options(spec, contact)
+    set_geom_defaults(spec, contact)  # the workcell's and the object's geoms, added later (``add``)
     w = spec.worldbody
     if table is not None:
         top, size = np.asarray(table.top, float), np.asarray(table.size, float)
