@@ -166,3 +166,19 @@ def test_the_workcell_and_the_object_touch_with_the_stiff_contact_settings():
         mujoco.mj_step(m, d)
     assert top - (d.xpos[body][2] - 0.04) < 5e-5
     d.xfrc_applied[body] = 0
+
+
+def test_the_robot_is_built_with_its_fingers_on_the_object():
+    """The IK freezes the fingers as built: they must sit where they hold the object (the 2F-85's
+    linkage moves in and down as it closes, so an open hand's clearance to a feature is wrong)."""
+    scene, plan, motion, robot, tcp, arm = case("block-3d")
+    width, _ = grasp_of(scene, motion.in_hand[0])
+    m, d = robot.model, robot.data
+    R = T(robot.tcp_pose())
+    # independent: the pad spheres' innermost surfaces, in the TCP frame (y across the pads)
+    ys = [np.linalg.inv(R) @ np.r_[d.geom_xpos[g], 1.0] for side in robot.pad_geoms for g in side]
+    rad = m.geom_size[robot.pad_geoms[0][0], 0]
+    left = [p[1] for p in ys[:len(robot.pad_geoms[0])]]
+    right = [p[1] for p in ys[len(robot.pad_geoms[0]):]]
+    gap = abs(np.mean(left) - np.mean(right)) - 2 * rad
+    assert gap == pytest.approx(width, abs=5e-4)

@@ -110,7 +110,7 @@ def pad_state(grasp_width: float, robot_name: str = "", pads=None, pad_friction:
     from .pads import PAD_FRICTION, Pads
 
     return _pad_state(float(grasp_width), robot_name or DEFAULT_ROBOT, pads or Pads(),
-                      float(PAD_FRICTION if pad_friction is None else pad_friction), contact or Contact())
+                      float(PAD_FRICTION if pad_friction is None else pad_friction), contact or Contact())[:3]
 
 
 def robot_pad_state(robot) -> tuple:
@@ -152,7 +152,23 @@ def _pad_state(grasp_width: float, robot_name: str, pads, pad_friction: float, c
     pad = m.body(kind.pad_bodies[1]).id
     centre = transform(body_pose(d, pad), [0.0, 0.0, LENGTH / 2])
     local = transform(inverse(body_pose(d, base)), centre)
-    return float(gain), float(f1 - gain * u1), float(local[2])
+    joints = tuple((m.joint(j).name, float(d.qpos[m.jnt_qposadr[j]])) for j in range(m.njnt))
+    return float(gain), float(f1 - gain * u1), float(local[2]), joints
+
+
+def close_fingers(robot) -> None:
+    """Puts ``robot``'s finger linkage where it closes on an object as wide as its grasp width
+    (measured by :func:`pad_state`), at rest: the state its IK freezes the fingers in (the
+    linkage moves in and down as it closes: from open, its spring links come 10 mm nearer
+    to a feature beside the pads)."""
+    mujoco = need("mujoco", "robot")
+    from .model import GRIPPER_PREFIX
+
+    m, d = robot.model, robot.data
+    for name, q in _pad_state(robot.grasp_width, robot.name, robot.pads, robot.pad_friction, robot.contact)[3]:
+        j = m.joint(GRIPPER_PREFIX + name).id
+        d.qpos[m.jnt_qposadr[j]], d.qvel[m.jnt_dofadr[j]] = q, 0.0
+    mujoco.mj_forward(m, d)
 
 
 def body_pose(data, body: int) -> np.ndarray:
