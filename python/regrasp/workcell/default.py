@@ -42,9 +42,10 @@ ROD_CENTER = (0.66, 0.05)
 ROD_HEIGHT = 0.2
 ROD_MARGIN = 1.05
 #: The plate: its centre [m] (world x-y), height of its centre above the table [m]; it faces
-#: world +x and is square, its side ``PLATE_MARGIN`` [×] the largest patch's diameter (at least
-#: ``PLATE_MIN`` [m]).
-PLATE_CENTER = (0.75, 0.25)
+#: world −x (towards the robot, like the rod: facing away, the gripper had to reach past it,
+#: beyond the UR5e's reach) and is square, its side ``PLATE_MARGIN`` [×] the largest patch's
+#: diameter (at least ``PLATE_MIN`` [m]).
+PLATE_CENTER = (0.7, -0.1)
 PLATE_HEIGHT = 0.15
 PLATE_MARGIN = 1.02
 PLATE_MIN = 0.005
@@ -100,8 +101,8 @@ def default_workcell(scene) -> Workcell:
         features.append(Feature("rod", "edge", [*ROD_CENTER, TABLE_HEIGHT + ROD_HEIGHT, r, 0.0, -r, 0.0], friction,
                                 length=ROD_MARGIN * size, index=len(features)))
     patch = patch_extent(scene)
-    if patch > 0:  # the face's +z along world +x: a quarter turn about y
-        features.append(Feature("plate", "face", [*PLATE_CENTER, TABLE_HEIGHT + PLATE_HEIGHT, r, 0.0, r, 0.0], friction,
+    if patch > 0:  # the face's +z along world −x: −90° about y
+        features.append(Feature("plate", "face", [*PLATE_CENTER, TABLE_HEIGHT + PLATE_HEIGHT, r, 0.0, -r, 0.0], friction,
                                 [max(PLATE_MIN, PLATE_MARGIN * patch)] * 2, index=len(features)))
     robot = Robot(ROBOT, [0.0, 0.0, TABLE_HEIGHT, 1.0, 0.0, 0.0, 0.0])
     return Workcell(f"default-{scene.name}", table, tuple(features), robot, ObjectStart("hand"),
