@@ -296,13 +296,15 @@ def close_on(robot, body: int, geoms, grip_force: float):
 
 
 def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scales: Scales = Scales(),
-                observe=None, trajectory: ArmTrajectory | None = None, pads=None) -> ArmResult:
+                observe=None, trajectory: ArmTrajectory | None = None, pads=None, start=None) -> ArmResult:
     """Executes ``motion`` (the :class:`WorldMotion` of ``plan`` for ``scene``) with the arm
     ``robot`` (default: the workcell's) in MuJoCo, in a world perturbed by ``scales``, and
     measures it (:class:`ArmResult`). ``observe(robot)``: called after every control period
     (e.g. a video recorder). ``trajectory``: the arm's joint trajectory when already solved
     (:func:`solve_arm`, e.g. for repeated runs in perturbed worlds). Raises ExecutionError when
-    the arm cannot follow the motion. ``pads``: as :func:`build_robot`'s."""
+    the arm cannot follow the motion. ``pads``: as :func:`build_robot`'s. ``start``: where the
+    object really starts in the hand (planar ``[x, z, theta]`` or ``[x, y, z, qw, qx, qy, qz]``;
+    default the motion's first in-hand pose), the motion left as planned."""
     mujoco = need("mujoco", "robot")
     from ..robot.grip import body_pose
     from ..robot.tracking import track
@@ -310,12 +312,13 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
 
     if not isinstance(motion, WorldMotion):
         raise ArgumentError(f"invalid `motion`: a WorldMotion (got {type(motion).__name__})", "motion")
+    start = np.asarray(_start(scene, motion, start), float)
     r, body, geoms, tcp = build_robot(scene, motion, robot if trajectory is None else trajectory.robot, scales, pads)
     traj = solve_arm(r, motion, tcp) if trajectory is None else trajectory
     m, d = r.model, r.data
     r.set_q(traj.q[0])
     jq = m.jnt_qposadr[m.body_jntadr[body]]
-    d.qpos[jq:jq + 7] = P.compose(P.compose(r.tcp_pose(), P.inverse(tcp)), motion.in_hand[0])
+    d.qpos[jq:jq + 7] = P.compose(P.compose(r.tcp_pose(), P.inverse(tcp)), start)
     mujoco.mj_forward(m, d)
     grip = close_on(r, body, geoms, float(motion.grip_force[0]) * scales.grip)
     untcp = P.inverse(tcp)
@@ -341,6 +344,18 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
     err, ok = _tolerance_error(scene, plan, H[-1])
     return ArmResult(ok, err, creep, turn, float(d.time), tracking, traj, motion.times.copy(), H,
                      motion.in_hand.copy(), np.array(qs))
+
+
+def _start(scene, motion: WorldMotion, start) -> np.ndarray:
+    """The object's in-hand start pose (m, unit quaternion): ``start`` (planar or 3-D) or the motion's."""
+    if start is None:
+        return motion.in_hand[0]
+    n = 3 if scene.dimension == 2 else 7
+    s = np.asarray(start, float) if np.ndim(start) == 1 and len(start) == n else None
+    if s is None or not np.all(np.isfinite(s)) or (n == 7 and np.linalg.norm(s[3:]) < 1e-9):
+        what = "[x, z, theta] (m, m, rad)" if n == 3 else "[x, y, z, qw, qx, qy, qz] (m)"
+        raise ArgumentError(f"invalid `start`: the object's in-hand start pose {what} (got {start!r})", "start")
+    return P.planar_to_spatial(s) if n == 3 else np.r_[s[:3], s[3:] / np.linalg.norm(s[3:])]
 
 
 def _creep(motion: WorldMotion, H) -> tuple[float, float]:

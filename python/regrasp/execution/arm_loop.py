@@ -251,13 +251,15 @@ def goal_error(scene, plan, pose) -> tuple[np.ndarray, bool]:
 
 def control_arm(scene, plan, workcell=None, scales: Scales = Scales(), robot: str | None = None,
                 timing: Timing = Timing(), seed: int = 0, max_replans: int = 10, max_time: float | None = None,
-                **mpc) -> ArmLoopResult:
+                start_error=(0.0, 0.0, 0.0), **mpc) -> ArmLoopResult:
     """Executes ``plan`` (a :class:`~regrasp.Plan` of ``scene``) closed loop with the arm in
     ``workcell`` (default: the scene's default workcell) in a world perturbed by ``scales``
     (see the module's doc): planar by the MPC (``mpc``: its settings, e.g. ``dt`` [s], ``speed``
     [m/s], ``horizon``; ``max_time`` [s] of control, default ControlRun's), 3-D by re-planning
     (at most ``max_replans``, seeds ``seed + 1, ...``). Raises ExecutionError naming a pusher of
-    the plan that no feature serves, or a move the arm cannot make."""
+    the plan that no feature serves, or a move the arm cannot make. ``start_error`` (planar
+    ``[x, z, theta]`` (m, m, rad)): the object starts this far from the plan's start in the
+    grasp, unknown to the controller until it measures it (thesis Fig 5-9; planar only)."""
     from ..planning.plan import Plan
 
     if not isinstance(plan, Plan):
@@ -266,7 +268,12 @@ def control_arm(scene, plan, workcell=None, scales: Scales = Scales(), robot: st
         raise ArgumentError(f"invalid `scales`: a Scales (got {type(scales).__name__})", "scales")
     _check_features(scene, plan, workcell)
     if scene.dimension == 2:
-        return _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, mpc)
+        return _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, start_error, mpc)
+    from ..control.loop import _vec
+
+    if np.any(_vec(start_error, 3, "start_error") != 0):
+        raise ArgumentError("invalid `start_error`: planar scenes only (3-D re-planning starts from the plan's start)",
+                            "start_error")
     return _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_replans)
 
 
@@ -323,20 +330,20 @@ def _served(scene, pusher: str, pose, workcell) -> bool:
     return True
 
 
-def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, mpc) -> ArmLoopResult:
+def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, start_error, mpc) -> ArmLoopResult:
     from ..control.loop import ControlRun, _check_arguments
     from ..mujoco.planar import Perturbation
 
     d = _core.mpc_defaults()
     dt, speed, horizon = (mpc.pop(k, d[k]) for k in ("dt", "speed", "horizon"))
-    _check_arguments("quasistatic", "mpc", dt, speed, horizon, max_time, np.zeros(3), 0.0, seed, ())  # before any work
+    se = _check_arguments("quasistatic", "mpc", dt, speed, horizon, max_time, start_error, 0.0, seed, ())  # before any work
     made = []
 
     def plant(q0):
         made.append(ArmPlant(scene, plan, q0, workcell, robot, scales, timing))
         return made[0]
 
-    run = ControlRun(scene, plan, "arm", "mpc", (), np.zeros(3), Perturbation(), controller_scene(scene, plan, workcell),
+    run = ControlRun(scene, plan, "arm", "mpc", (), se, Perturbation(), controller_scene(scene, plan, workcell),
                      0.0, seed, dt, speed, horizon, max_time, mpc, plant=plant)
     while run.t <= run.max_time + 1e-9 and run.tick():
         run.t += dt
