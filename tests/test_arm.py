@@ -140,6 +140,15 @@ def test_execute_cli_refusals(tmp_path):
     assert code == 2 and "--trajectory" in err
     code, _, err = run_cli("execute", scene, "--plan", tmp_path / "p.json", "--trajectory", scene)
     assert code == 2
+    for name in ("block-3d", "block-xztheta"):
+        regrasp.plan(regrasp.load_scene(regrasp.examples.path(name)), seed=0).save(tmp_path / f"{name}.json")
+    bad = [("block-3d", ["--start-error", "0.001,0,0"]),  # planar only
+           ("block-xztheta", ["--start-error", "0.001,0"]),
+           ("block-xztheta", ["--start-error", "0.001,nan,0", "--closed-loop"]),
+           ("block-xztheta", ["--start-error", "0.001,0,0", "--robot", "free-gripper"])]
+    for name, extra in bad:
+        code, out, err = run_cli("execute", regrasp.examples.path(name), "--plan", tmp_path / f"{name}.json", *extra)
+        assert code == 2 and "--start-error" in err and "Traceback" not in err, (extra, err)
 
 
 def test_the_workcell_and_the_object_touch_with_the_stiff_contact_settings():

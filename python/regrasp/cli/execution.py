@@ -9,8 +9,8 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..planning.plan import Plan
-from . import (CANNOT, OK, add_command, add_scale_options, add_verbose, check_outputs, load, refuse_flags, rounded,
-               scales)
+from . import (CANNOT, OK, add_command, add_scale_options, add_verbose, check_outputs, floats, load, refuse_flags,
+               rounded, scales)
 
 #: `--robot` of the free-flying gripper (the baseline rig, no arm)
 FREE_GRIPPER = "free-gripper"
@@ -47,11 +47,20 @@ def _workcell(a):
     return load_workcell(a.workcell) if a.workcell else None
 
 
+def _start_error(scene, a):
+    """``--start-error`` as a planar ``[dx, dz, dtheta]`` (m, m, rad), None when not given."""
+    if a.start_error is None:
+        return None
+    if scene.dimension != 2:
+        raise ArgumentError("invalid `--start-error`: planar scenes only", "--start-error")
+    return floats(a.start_error, 3, "--start-error")
+
+
 def _free(scene, plan, a):
     """The free-flying gripper: (result dict, motion, None)."""
     from ..execution import execute_free_gripper, world_motion
 
-    refuse_flags(a, ("scale_friction", "scale_grip", "scale_mass"), "with --robot free-gripper",
+    refuse_flags(a, ("scale_friction", "scale_grip", "scale_mass", "start_error"), "with --robot free-gripper",
                  "the free-gripper rig is not perturbed (use the arm)")
     motion = world_motion(scene, plan, _workcell(a))
     r = execute_free_gripper(scene, plan, motion)
@@ -74,7 +83,10 @@ def _arm(scene, plan, a):
             if "r" not in holder:
                 holder["r"] = Recorder(robot.model, robot.data)
             holder["r"].capture()
-    r = execute_arm(scene, plan, am.motion, scales=Scales(f, g, m, f), observe=observe, trajectory=am.trajectory)
+    se = _start_error(scene, a)
+    start = None if se is None else np.asarray(plan.poses[0], float) + se
+    r = execute_arm(scene, plan, am.motion, scales=Scales(f, g, m, f), observe=observe, trajectory=am.trajectory,
+                    start=start)
     out = dict(success=r.success, goal_error=r.goal_error, max_creep=r.max_creep, max_creep_angle=r.max_creep_angle,
                duration_s=r.duration, robot=r.trajectory.robot,
                tracking=dict(max_joint_error=r.tracking.max_error, rms_joint_error=r.tracking.rms_error,
@@ -95,7 +107,9 @@ def _closed_loop(scene, plan, a) -> int:
     if a.robot == FREE_GRIPPER:
         raise ArgumentError("invalid `--robot`: --closed-loop runs the arm (not the free gripper)", "--robot")
     f, g, m = scales(a)
-    r = control_arm(scene, plan, _workcell(a), Scales(f, g, m, f), a.robot)
+    se = _start_error(scene, a)
+    r = control_arm(scene, plan, _workcell(a), Scales(f, g, m, f), a.robot,
+                    start_error=np.zeros(3) if se is None else se)
     out = dict(success=r.success, goal_error=r.goal_error, replans=r.replans, switch_overs=r.switch_overs,
                duration_s=r.duration, failure=r.failure, closed_loop=True)
     if a.json:
@@ -158,5 +172,7 @@ def add_parsers(sub) -> None:
     add_scale_options(e, "the arm's world: ")
     e.add_argument("--closed-loop", action="store_true", help="closed loop with the arm: the MPC (planar) or "
                    "re-planning (3-D) from the object's pose measured in MuJoCo")
+    e.add_argument("--start-error", metavar="dx,dz,dtheta", help="planar: the object starts this far from the "
+                   "plan's start in the grasp (m, m, rad)")
     e.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(e)
