@@ -191,3 +191,24 @@ def test_the_robot_is_built_with_its_fingers_on_the_object():
     right = [p[1] for p in ys[len(robot.pad_geoms[0]):]]
     gap = abs(np.mean(left) - np.mean(right)) - 2 * rad
     assert gap == pytest.approx(width, abs=5e-4)
+
+
+def test_a_finger_too_near_the_table_is_refused_with_the_exact_clearance():
+    """prism-3d's `ground` push holds the prism's apex on the table 13 mm below the pads' centre:
+    the closed 2F-85's fingers come within 1 mm (CONTACT_CLEARANCE) of the table and of the
+    fixture's top. The IK reaches the pose (mink's collision limit, 2 mm more cautious, alone
+    stopped it 1 mm short and 2.8 mm clear) and the exact clearance refuses it, naming the
+    finger, the table and the distance."""
+    import re
+
+    from regrasp.execution.arm import CONTACT_CLEARANCE, arm_motion
+
+    scene = regrasp.load_scene(regrasp.examples.path("prism-3d"))
+    with pytest.raises(ExecutionError) as e:
+        arm_motion(scene, regrasp.plan(scene, seed=0))
+    text = str(e.value)
+    for feature in ("table", "fixture"):
+        m = re.search(r"collision: the arm or gripper ([0-9.]+) mm from the table or an obstacle \(gripper/\w+ and "
+                      + feature + r"; it keeps 1 mm\); closest ([0-9.]+) mm", text)
+        assert m, text
+        assert float(m.group(1)) < CONTACT_CLEARANCE * 1e3 and float(m.group(2)) <= 0.1

@@ -24,6 +24,7 @@ MIN_DISTANCE = 0.005  # m, the closest the arm and gripper may come to the table
 LIMIT_MARGIN_DISTANCE = 0.002  # m, mink's collision limit is this much more (it is linearised and can tunnel)
 LIMIT_DISTANCE = MIN_DISTANCE + LIMIT_MARGIN_DISTANCE  # m, mink's collision limit at MIN_DISTANCE
 MAX_ITERATIONS = 300  # of the differential IK
+POLISH_ITERATIONS = 50  # without the collision limit, when it held the TCP back from the target
 IK_DT = 0.05  # s, the differential IK's integration step
 MAX_SPEED = np.pi  # rad/s, a joint's speed in the differential IK (a step turns it at most MAX_SPEED · IK_DT)
 LIMIT_MARGIN = 1e-3  # rad, a joint this close to its range's end is at its limit
@@ -64,15 +65,25 @@ def table_distance(robot, q, avoid=()) -> float:
     """The smallest distance [m] between the arm's and gripper's collision geoms and the table
     (and the geoms ``avoid``) at arm joint positions ``q`` [rad] (inf when there are none;
     negative: penetration)."""
+    return closest(robot, q, avoid)[0]
+
+
+def closest(robot, q, avoid=()) -> tuple:
+    """(distance [m], the robot's body, the obstacle's geom name) of the closest pair between the
+    arm's and gripper's collision geoms and the table and ``avoid`` at arm joints ``q`` [rad]
+    (inf, "", "" when there are no obstacles; a distance beyond 0.1 m reads 0.1 m)."""
     mujoco = need("mujoco", "robot")
     obstacles = obstacle_geoms(robot, avoid)
     if not obstacles:
-        return float("inf")
-    d = mujoco.MjData(robot.model)
+        return float("inf"), "", ""
+    m = robot.model
+    d = mujoco.MjData(m)
     d.qpos[:] = robot.data.qpos
     d.qpos[robot.arm_qpos] = q
-    mujoco.mj_kinematics(robot.model, d)
-    return min(mujoco.mj_geomDistance(robot.model, d, g, o, 0.1, None) for g in robot.clearance_geoms for o in obstacles)
+    mujoco.mj_kinematics(m, d)
+    gap, g, o = min((mujoco.mj_geomDistance(m, d, g, o, 0.1, None), g, o) for g in robot.clearance_geoms
+                    for o in obstacles)
+    return float(gap), m.body(m.geom_bodyid[g]).name, m.geom(o).name or f"geom {o}"
 
 
 class IKSolver:
@@ -120,6 +131,21 @@ class IKSolver:
         T = self.config.get_transform_frame_to_world(self.site, "site").wxyz_xyz
         return np.concatenate([T[4:], T[:4]])
 
+    def _iterate(self, target, limits, iterations: int) -> None:
+        """Differential IK steps towards ``target`` under ``limits`` until converged
+        (``CONVERGED_POSITION``/``CONVERGED_ANGLE``), stalled (no feasible step) or ``iterations``."""
+        mink = self.mink
+        for _ in range(iterations):
+            reached = pose_error(self.tcp_pose(), target)
+            if reached[0] <= CONVERGED_POSITION and reached[1] <= CONVERGED_ANGLE:
+                return
+            try:
+                v = mink.solve_ik(self.config, [self.task], IK_DT, "daqp", damping=1e-3, limits=limits,
+                                  constraints=self.constraints)
+            except mink.NoSolutionFound:  # the limits admit no step from here: classified by solve
+                return
+            self.config.integrate_inplace(v, IK_DT)
+
     def solve(self, target_pose, q_init, field: str = "pose") -> np.ndarray:
         """Arm joint positions [rad] putting the TCP at world ``target_pose``
         ``[x, y, z, qw, qx, qy, qz]`` (m), from ``q_init`` [rad]: iterates to ``CONVERGED_POSITION``
@@ -136,29 +162,25 @@ class IKSolver:
         full[robot.arm_qpos] = q0
         self.config.update(full)
         self.task.set_target(mink.SE3(np.concatenate([target[3:], target[:3]])))
-        for _ in range(MAX_ITERATIONS):
-            reached = pose_error(self.tcp_pose(), target)
-            if reached[0] <= CONVERGED_POSITION and reached[1] <= CONVERGED_ANGLE:
-                break
-            try:
-                v = mink.solve_ik(self.config, [self.task], IK_DT, "daqp", damping=1e-3, limits=self.limits,
-                                  constraints=self.constraints)
-            except mink.NoSolutionFound:  # the limits admit no step from here: classified below
-                break
-            self.config.integrate_inplace(v, IK_DT)
+        self._iterate(target, self.limits, MAX_ITERATIONS)
+        if self.obstacles and pose_error(self.tcp_pose(), target)[0] > POSITION_TOLERANCE:
+            # held back by the collision limit's margin (LIMIT_MARGIN_DISTANCE) within a few mm of the
+            # target: the last steps without it; the exact clearance check below still decides
+            self._iterate(target, self.limits[:2], POLISH_ITERATIONS)
         q = self.config.q[robot.arm_qpos].copy()
         reached = pose_error(self.tcp_pose(), target)
         rng = robot.joint_limits()
         inside = np.all((q >= rng[:, 0] - 1e-9) & (q <= rng[:, 1] + 1e-9))
-        gap = table_distance(robot, q, self.avoid) if self.obstacles else float("inf")
+        gap, part, obstacle = closest(robot, q, self.avoid)
         if reached[0] <= POSITION_TOLERANCE and reached[1] <= ANGLE_TOLERANCE and inside and gap >= self.min_distance:
             return q
         at_limit = [robot.arm_joints[i] for i in range(len(q)) if min(q[i] - rng[i, 0], rng[i, 1] - q[i]) < LIMIT_MARGIN]
         beyond = robot.reach(target)
         if beyond > 0:
             reason, why = "unreachable", f"{beyond * 1e3:.0f} mm beyond the arm's reach"
-        elif gap < self.min_distance + 1e-3:
-            reason, why = "collision", f"the arm or gripper {gap * 1e3:.1f} mm from the table or an obstacle"
+        elif gap < self.min_distance + LIMIT_MARGIN_DISTANCE + 1e-3:  # the collision limit held it back
+            reason, why = "collision", (f"the arm or gripper {gap * 1e3:.1f} mm from the table or an obstacle "
+                                        f"({part} and {obstacle}; it keeps {self.min_distance * 1e3:.0f} mm)")
         elif at_limit:
             reason, why = "joint limit", f"joint {', '.join(at_limit)} at its limit"
         else:
