@@ -25,6 +25,7 @@ LIMIT_MARGIN_DISTANCE = 0.002  # m, mink's collision limit is this much more (it
 LIMIT_DISTANCE = MIN_DISTANCE + LIMIT_MARGIN_DISTANCE  # m, mink's collision limit at MIN_DISTANCE
 MAX_ITERATIONS = 300  # of the differential IK
 POLISH_ITERATIONS = 50  # without the collision limit, when it held the TCP back from the target
+POLISH_REACH = 0.005  # m, ... by at most this much (the margin's worth; a larger miss is not the margin's)
 IK_DT = 0.05  # s, the differential IK's integration step
 MAX_SPEED = np.pi  # rad/s, a joint's speed in the differential IK (a step turns it at most MAX_SPEED · IK_DT)
 LIMIT_MARGIN = 1e-3  # rad, a joint this close to its range's end is at its limit
@@ -163,7 +164,7 @@ class IKSolver:
         self.config.update(full)
         self.task.set_target(mink.SE3(np.concatenate([target[3:], target[:3]])))
         self._iterate(target, self.limits, MAX_ITERATIONS)
-        if self.obstacles and pose_error(self.tcp_pose(), target)[0] > POSITION_TOLERANCE:
+        if self.obstacles and POSITION_TOLERANCE < pose_error(self.tcp_pose(), target)[0] <= POLISH_REACH:
             # held back by the collision limit's margin (LIMIT_MARGIN_DISTANCE) within a few mm of the
             # target: the last steps without it; the exact clearance check below still decides
             self._iterate(target, self.limits[:2], POLISH_ITERATIONS)
