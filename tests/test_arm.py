@@ -143,6 +143,7 @@ def test_execute_cli_refusals(tmp_path):
     for name in ("block-3d", "block-xztheta"):
         regrasp.plan(regrasp.load_scene(regrasp.examples.path(name)), seed=0).save(tmp_path / f"{name}.json")
     bad = [("block-3d", ["--start-error", "0.001,0,0"]),  # planar only
+           ("block-3d", ["--start-error", "0.001,0,0", "--closed-loop"]),
            ("block-xztheta", ["--start-error", "0.001,0"]),
            ("block-xztheta", ["--start-error", "0.001,nan,0", "--closed-loop"]),
            ("block-xztheta", ["--start-error", "0.001,0,0", "--robot", "free-gripper"])]
@@ -160,7 +161,8 @@ def test_the_workcell_and_the_object_touch_with_the_stiff_contact_settings():
     from regrasp.mujoco.model import Contact
 
     scene, plan, motion, robot, tcp, arm = case("block-fixtureless")
-    m, d = robot.model, robot.data
+    m, d = robot.model, mujoco.MjData(robot.model)
+    d.qpos[:] = robot.data.qpos
     mine = [g for g in range(m.ngeom) if m.geom_bodyid[g] == 0 or m.body(m.geom_bodyid[g]).name == "object"]
     assert len(mine) >= 3
     assert np.allclose(m.geom_solref[mine], Contact().solref) and np.allclose(m.geom_solimp[mine, :3], Contact().solimp)
@@ -173,8 +175,7 @@ def test_the_workcell_and_the_object_touch_with_the_stiff_contact_settings():
     d.xfrc_applied[body, 2] = -24.0
     for _ in range(400):
         mujoco.mj_step(m, d)
-    assert top - (d.xpos[body][2] - 0.04) < 5e-5
-    d.xfrc_applied[body] = 0
+    assert 0.0 <= top - (d.xpos[body][2] - 0.04) < 5e-5
 
 
 def test_the_robot_is_built_with_its_fingers_on_the_object():
@@ -208,7 +209,19 @@ def test_a_finger_too_near_the_table_is_refused_with_the_exact_clearance():
         arm_motion(scene, regrasp.plan(scene, seed=0))
     text = str(e.value)
     for feature in ("table", "fixture"):
-        m = re.search(r"collision: the arm or gripper ([0-9.]+) mm from the table or an obstacle \(gripper/\w+ and "
+        m = re.search(r"collision: the arm or gripper ([0-9.]+) mm from the table or an obstacle \(gripper/(left|right)_\w+ and "
                       + feature + r"; it keeps 1 mm\); closest ([0-9.]+) mm", text)
         assert m, text
-        assert float(m.group(1)) < CONTACT_CLEARANCE * 1e3 and float(m.group(2)) <= 0.1
+        assert float(m.group(1)) < CONTACT_CLEARANCE * 1e3 and float(m.group(3)) <= 0.1
+
+
+def test_the_plate_faces_the_robot_within_its_reach():
+    """pivot-3d's patch pivot goes to the default workcell's plate, which faces the robot: the arm
+    can follow it (facing away, the plate was beyond the UR5e's reach)."""
+    from regrasp.execution.arm import arm_motion
+
+    scene = regrasp.load_scene(regrasp.examples.path("pivot-3d"))
+    am = arm_motion(scene, regrasp.plan(scene, seed=0))
+    assert am.motion.assignments[0].feature == "plate" and not am.refused
+    normal = regrasp.pose.quat_rotate(am.motion.workcell.feature("plate").pose[3:], [0.0, 0, 1])
+    assert normal[0] == pytest.approx(-1.0)  # pushes along world −x, towards the robot at the origin

@@ -47,6 +47,7 @@ def test_planar_mpc_with_the_arm_reaches_the_goal_from_a_wrong_start():
     r = control_arm(scene, plan, start_error=error)
     assert r.success and within(scene, r.final), (r.goal_error, r.failure)
     c = r.control
+    assert np.all(np.abs(c.poses[0] - (plan.poses[0] + error)) <= [1e-3, 1e-3, np.radians(0.2)])  # it started there
     # the measured trace ends at the reported pose; the MPC used only pushers the workcell serves
     assert np.allclose(c.poses[-1], r.final)
     assert {p for p in c.pushers if p} <= {"bottom", "left"}
@@ -62,8 +63,9 @@ def test_planar_mpc_with_the_arm_reaches_the_goal_from_a_wrong_start():
     assert abs(P.spatial_to_planar(o.in_hand[first])[0] - P.spatial_to_planar(o.planned[first])[0]) > 0.0015
     with pytest.raises(regrasp.ArgumentError, match="start_error"):
         control_arm(*example("block-3d"), start_error=error)
-    with pytest.raises(regrasp.ArgumentError, match="`start`"):
-        execute_arm(scene, plan, motion, start=[0.0, np.nan, 0.0])
+    for bad in ([0.0, np.nan, 0.0], ["a", 0, 0], [0.0, 0.0], [1.0, 0.0, 0.0]):  # the last: the pad off the object
+        with pytest.raises(regrasp.ArgumentError, match="`start`"):
+            execute_arm(scene, plan, motion, start=bad)
 
 
 def test_cli_closed_loop_fixtureless(tmp_path):
@@ -92,7 +94,6 @@ def test_3d_replanning_with_the_arm_succeeds_in_a_perturbed_world():
     scene, plan = example("block-3d")
     r = control_arm(scene, plan, scales=STIFF)
     assert r.success and within(scene, r.final), (r.goal_error, r.failure)
-    assert r.switch_overs >= 1 and r.replans <= 10
     o = execute_arm(scene, plan, world_motion(scene, plan), scales=STIFF)
     assert within(scene, o.in_hand[-1])
 
@@ -103,7 +104,9 @@ def test_the_plant_pushes_the_object_as_commanded():
     scene, plan = example("block-fixtureless")
     arm = ArmPlant(scene, plan)
     q0 = arm.pose()
-    assert np.all(np.abs(q0 - plan.poses[0]) <= [1e-3, 1e-3, np.radians(0.1)])  # after the fingers close
+    # measured after the fingers close (from the grasp width, where they are built, they press
+    # the object: 0.07° measured)
+    assert np.all(np.abs(q0 - plan.poses[0]) <= [1e-3, 1e-3, np.radians(0.1)])
     a, b = np.asarray(plan.poses[0]), np.asarray(plan.poses[1])
     from regrasp.sim.quasistatic import body_twist
 

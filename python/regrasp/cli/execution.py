@@ -125,6 +125,7 @@ def _closed_loop(scene, plan, a) -> int:
 def cmd_execute(a) -> int:
     _check(a)
     scene = load(a.scene, a)
+    _start_error(scene, a)  # before any work
     plan = Plan.load(a.plan, scene)
     if a.closed_loop:
         return _closed_loop(scene, plan, a)

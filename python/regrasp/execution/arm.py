@@ -347,15 +347,24 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
 
 
 def _start(scene, motion: WorldMotion, start) -> np.ndarray:
-    """The object's in-hand start pose (m, unit quaternion): ``start`` (planar or 3-D) or the motion's."""
+    """The object's in-hand start pose (m, unit quaternion): ``start`` (planar ``[x, z, theta]``,
+    admissible: the pad on the object; or 3-D) or the motion's; else an ArgumentError naming ``start``."""
     if start is None:
         return motion.in_hand[0]
-    n = 3 if scene.dimension == 2 else 7
-    s = np.asarray(start, float) if np.ndim(start) == 1 and len(start) == n else None
-    if s is None or not np.all(np.isfinite(s)) or (n == 7 and np.linalg.norm(s[3:]) < 1e-9):
-        what = "[x, z, theta] (m, m, rad)" if n == 3 else "[x, y, z, qw, qx, qy, qz] (m)"
-        raise ArgumentError(f"invalid `start`: the object's in-hand start pose {what} (got {start!r})", "start")
-    return P.planar_to_spatial(s) if n == 3 else np.r_[s[:3], s[3:] / np.linalg.norm(s[3:])]
+    if scene.dimension != 2:
+        from ..robot.model import check_pose
+
+        return check_pose(start, "start")
+    try:
+        s = np.asarray(start, float)
+    except (TypeError, ValueError):
+        s = np.zeros(0)
+    if s.shape != (3,) or not np.all(np.isfinite(s)):
+        raise ArgumentError(f"invalid `start`: the object's in-hand start pose [x, z, theta] (m, m, rad) "
+                            f"(got {start!r})", "start")
+    if not scene.admissible(s):
+        raise ArgumentError("invalid `start`: the object's start pose puts the pad off the object", "start")
+    return np.asarray(P.planar_to_spatial(s), float)
 
 
 def _creep(motion: WorldMotion, H) -> tuple[float, float]:

@@ -266,14 +266,14 @@ def control_arm(scene, plan, workcell=None, scales: Scales = Scales(), robot: st
         raise ArgumentError(f"invalid `plan`: a regrasp Plan (got {type(plan).__name__})", "plan")
     if not isinstance(scales, Scales):
         raise ArgumentError(f"invalid `scales`: a Scales (got {type(scales).__name__})", "scales")
+    from ..scene.planar import _vec
+
+    if scene.dimension != 2 and np.any(_vec(start_error, 3, "start_error") != 0):
+        raise ArgumentError("invalid `start_error`: planar scenes only (3-D re-planning starts from the plan's start)",
+                            "start_error")
     _check_features(scene, plan, workcell)
     if scene.dimension == 2:
         return _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, start_error, mpc)
-    from ..control.loop import _vec
-
-    if np.any(_vec(start_error, 3, "start_error") != 0):
-        raise ArgumentError("invalid `start_error`: planar scenes only (3-D re-planning starts from the plan's start)",
-                            "start_error")
     return _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_replans)
 
 

@@ -167,6 +167,8 @@ def close_fingers(robot) -> None:
     m, d = robot.model, robot.data
     for name, q in _pad_state(robot.grasp_width, robot.name, robot.pads, robot.pad_friction, robot.contact)[3]:
         j = m.joint(GRIPPER_PREFIX + name).id
+        if m.jnt_limited[j]:  # a linkage joint settles a hair outside its range
+            q = min(max(q, m.jnt_range[j, 0]), m.jnt_range[j, 1])
         d.qpos[m.jnt_qposadr[j]], d.qvel[m.jnt_dofadr[j]] = q, 0.0
     mujoco.mj_forward(m, d)
 

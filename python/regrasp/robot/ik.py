@@ -120,6 +120,7 @@ class IKSolver:
         self.constraints = [mink.DofFreezingTask(m, dof_indices=others)] if others else None
         self.limits = [mink.ConfigurationLimit(m),
                        mink.VelocityLimit(m, {ARM_PREFIX + j: MAX_SPEED for j in robot.arm_joints})]
+        self.free_limits = list(self.limits)  # without the collision limit (the polish)
         self.avoid, self.min_distance = tuple(avoid), float(min_distance)
         self.obstacles = obstacle_geoms(robot, avoid)
         if self.obstacles:
@@ -167,7 +168,7 @@ class IKSolver:
         if self.obstacles and POSITION_TOLERANCE < pose_error(self.tcp_pose(), target)[0] <= POLISH_REACH:
             # held back by the collision limit's margin (LIMIT_MARGIN_DISTANCE) within a few mm of the
             # target: the last steps without it; the exact clearance check below still decides
-            self._iterate(target, self.limits[:2], POLISH_ITERATIONS)
+            self._iterate(target, self.free_limits, POLISH_ITERATIONS)
         q = self.config.q[robot.arm_qpos].copy()
         reached = pose_error(self.tcp_pose(), target)
         rng = robot.joint_limits()
