@@ -119,7 +119,8 @@ def _pad_friction(scene) -> float:
 
 def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Scales = Scales(), pads=None):
     """The robot (:func:`regrasp.robot.model.build`) in ``motion``'s workcell with the object on
-    a free joint at the motion's first world pose, the fingers closed at its width (:func:`~regrasp.robot.grip.close_fingers`), the pads of the scene's pad shape and finger
+    a free joint at the motion's first world pose, the fingers closed at its width
+    (:func:`~regrasp.robot.grip.close_fingers`), the pads of the scene's pad shape and finger
     friction (``pads``: another :class:`~regrasp.robot.pads.Pads`, e.g. the old single-contact
     model :func:`~regrasp.robot.pads.single_contact`); returns (robot, the object's body id, its
     geom ids, the TCP in the gripper frame)."""
@@ -154,7 +155,7 @@ def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Sc
             raise ExecutionError(f"the object is {width * 1e3:.1f} mm wide across the grasp: the 2F-85 opens "
                                  f"85 mm", "grasp_width") from None
         raise
-    close_fingers(r)  # as they hold the object: the IK keeps the linkage clear of the features so
+    close_fingers(r)  # as they will hold the object, so that the IK checks the closed linkage's clearance
     m = r.model
     body = m.body("object").id
     geoms = [g for g in range(m.ngeom) if m.geom_bodyid[g] == body]
