@@ -225,3 +225,37 @@ def test_the_plate_faces_the_robot_within_its_reach():
     assert am.motion.assignments[0].feature == "plate" and not am.refused
     normal = regrasp.pose.quat_rotate(am.motion.workcell.feature("plate").pose[3:], [0.0, 0, 1])
     assert normal[0] == pytest.approx(-1.0)  # pushes along world −x, towards the robot at the origin
+
+
+def test_a_top_push_slides_under_the_ledge_lengthwise_between_the_fingers(tmp_path):
+    """block-low-friction's `top`, 40 mm above the pads' centre, pushed down by the ledge: the
+    ledge's bar enters between the fingers along its length, 3 mm above the block and under the
+    2F-85's housing (across it, the fingers meet the bar; 20 mm above the block, the housing
+    does), and the arm executes the push."""
+    from regrasp.execution.arm import arm_motion
+    from regrasp.execution.world_motion import SLIDE_GAP
+
+    text = open(regrasp.examples.path("block-low-friction")).read()
+    keep = [p for p in text.split("[[pushers]]")[1:] if 'name = "top"' in p]
+    head = text.split("[[pushers]]")[0].replace('name = "block-low-friction"', 'name = "block-top"')
+    task = "[task]" + text.split("[task]")[1].replace("goal = [0.012, 0.008, 0.0]", "goal = [0.0, -0.008, 0.0]")
+    (tmp_path / "top.toml").write_text(head + "[[pushers]]" + keep[0].split("[task]")[0] + task)
+    scene = regrasp.load_scene(tmp_path / "top.toml")
+    plan = regrasp.plan(scene, seed=0)
+    am = arm_motion(scene, plan)
+    m = am.motion
+    assert [(a.pusher, a.feature) for a in m.assignments] == [("top", "ledge")] and not am.refused
+    # the approach slides along the ledge (world x), across the grasp axis (world y), SLIDE_GAP below it
+    ledge = m.workcell.feature("ledge")
+    slide = [j for j in range(len(m.labels)) if m.labels[j] == "approach" and m.push[j] == 0]
+    G = m.gripper[slide]
+    grasp_axis = np.array([T(g)[:3, 1] for g in G])
+    moves = np.diff(G[:, :3], axis=0)
+    along = moves[np.linalg.norm(moves, axis=1) > 1e-9]
+    assert np.abs(along[:, 1]).max() < 1e-9 and np.abs(along[:, 0]).max() > 0
+    assert np.abs(grasp_axis[:, 0]).max() < 1e-9
+    corners = np.c_[np.asarray(scene.outline)[:, 0], np.zeros(4), np.asarray(scene.outline)[:, 1], np.ones(4)]
+    top = (T(m.object[slide[0]]) @ corners.T)[2].max()
+    assert ledge.pose[2] - top == pytest.approx(SLIDE_GAP, abs=1e-6)
+    r = execute_arm(scene, plan, m, trajectory=am.trajectory)
+    assert r.success, r.goal_error

@@ -13,7 +13,7 @@ import regrasp
 from regrasp import ArgumentError, ExecutionError, Plan
 from regrasp.execution import Timing, world_motion
 from regrasp.execution.assignment import MAX_TILT
-from regrasp.execution.world_motion import LABELS, PENETRATION_LIMIT, edge_points, object_points
+from regrasp.execution.world_motion import LABELS, PENETRATION_LIMIT, SLIDE_GAP, edge_points, object_points
 from regrasp.workcell import Table, Workcell, default_workcell
 from regrasp.workcell.description import Feature, Robot
 
@@ -165,16 +165,34 @@ def test_approach_retreat_and_transfers_clear_the_features(name):
             assert len(js) >= 1
             Pk = P0[a.first] if part == "approach" else P0[a.last]
             # the pusher's contact point, seen from the feature's frame: on its normal line,
-            # between contact and the clearance
+            # between contact and the pre-contact distance (the clearance, or SLIDE_GAP under a
+            # feature it slides under lengthwise: there, before the approach and after the
+            # retreat, it moves along the edge only, SLIDE_GAP off it, and starts or ends past its end)
             local = np.array([(np.linalg.inv(F) @ T(m.gripper[j]) @ Pk)[:3, 3] for j in js])
+            off = np.abs(local[:, 0]) > 1e-9
+            slide = off.any()
+            gap = SLIDE_GAP if slide else tm.clearance
+            if slide:
+                assert (name, a.feature) == ("t-shape", "ledge")
+                ends = local[off]
+                assert np.allclose(ends[:, 1:], [0.0, SLIDE_GAP], atol=1e-9)
+                assert np.abs(local[0 if part == "approach" else -1, 0]) > m.workcell.feature("ledge").length / 2
+                k = np.flatnonzero(off)
+                assert np.all(np.diff(k) == 1)
+                if part == "approach":   # the slide ends at the pre-contact pose; the approach follows
+                    assert k[0] == 0 and local[k[-1] + 1, 2] == pytest.approx(SLIDE_GAP, abs=1e-9)
+                    js, local = js[k[-1] + 2:], local[k[-1] + 2:]
+                else:
+                    assert k[-1] == len(off) - 1 and k[0] > 0
+                    js, local = js[:k[0]], local[:k[0]]
             assert np.allclose(local[:, :2], 0, atol=1e-9)
-            assert np.all(local[:, 2] >= -1e-9) and np.all(local[:, 2] <= tm.clearance + 1e-9)
-            # it ends in contact (approach) or the clearance away (retreat), and starts from the
-            # clearance away (the pre-contact pose before the approach) or in contact (the push's end)
+            assert np.all(local[:, 2] >= -1e-9) and np.all(local[:, 2] <= gap + 1e-9)
+            # it ends in contact (approach) or the gap away (retreat), and starts from the gap
+            # away (the pre-contact pose before the approach) or in contact (the push's end)
             before = (np.linalg.inv(F) @ T(m.gripper[js[0] - 1]) @ Pk)[:3, 3]
             assert np.allclose(before[:2], 0, atol=1e-9)
-            assert local[-1, 2] == pytest.approx(0.0 if part == "approach" else tm.clearance, abs=1e-9)
-            assert before[2] == pytest.approx(tm.clearance if part == "approach" else 0.0, abs=1e-9)
+            assert local[-1, 2] == pytest.approx(0.0 if part == "approach" else gap, abs=1e-9)
+            assert before[2] == pytest.approx(gap if part == "approach" else 0.0, abs=1e-9)
             assert np.all(np.diff(local[:, 2]) * (1 if part == "retreat" else -1) > 0)   # monotone
     # transfers at the safe height: every point of the object above every feature by the clearance
     top = m.workcell.top()
@@ -340,15 +358,13 @@ def test_max_tilt_refuses_pushes_that_would_turn_gravity():
     assert [(a.pusher, a.feature) for a in world_motion(scene, plan).assignments][0] == ("top", "ledge")
     assert all(a.tilt <= MAX_TILT for a in world_motion(scene, plan).assignments)
     # without it, the raised block's underside edges push down, 45° less the edge cone off vertical
-    # (the block raised 0.1 m more: on its way under the default block the object, hanging 2 cm
-    # lower at the pre-contact pose, would graze the table top)
+    # (the object slides under them lengthwise, SLIDE_GAP below; the block raised 0.1 m more or not)
     f = cell.feature("fixture")
     higher = Feature(f.name, f.kind, f.pose + np.r_[0, 0, 0.1, 0, 0, 0, 0], f.friction, f.size)
+    for block in (f, higher):
+        under = world_motion(scene, plan, Workcell("no-ledge", cell.table, (block,), cell.robot)).assignments[0]
+        assert under.pusher == "top" and under.tilt == pytest.approx(np.radians(5.0), abs=1e-6)
     no_ledge = Workcell("no-ledge", cell.table, (higher,), cell.robot)
-    with pytest.raises(ExecutionError, match="below the table top"):
-        world_motion(scene, plan, Workcell("no-ledge", cell.table, (f,), cell.robot))
-    under = world_motion(scene, plan, no_ledge).assignments[0]
-    assert under.pusher == "top" and under.tilt == pytest.approx(np.radians(5.0), abs=1e-6)
     with pytest.raises(ExecutionError) as e:
         world_motion(scene, plan, no_ledge, max_tilt=np.radians(4.0))
     assert "`top`" in str(e.value) and "max_tilt 4.0°" in str(e.value)

@@ -33,7 +33,7 @@ from ..errors import ArgumentError, ExecutionError, RegraspError
 from ..extras import need
 from .arm import CONTACT_CLEARANCE, Scales, arm_motion, build_robot, close_on, first_solution
 from .assignment import assign, pusher_contact
-from .world_motion import Segments, Timing, meeting, world_motion
+from .world_motion import Segments, Timing, world_motion
 
 
 @dataclass
@@ -162,9 +162,9 @@ class ArmPlant:
         pose = P.spatial_to_planar(O) if self.scene.dimension == 2 else O
         a = self.feature(pusher, pose)
         Pk = P.compose(O, pusher_contact(self.scene, pusher, pose).frame)
-        G0, pre = meeting(a.frame, Pk, self.timing.clearance)
         seg = Segments(self.timing, self.safe, _reach(self.scene, O), self.G, self.motion.envelope,
-                       self.motion.workcell.robot.base[:3])
+                       self.motion.workcell.robot.base[:3], self.motion.workcell.contacts())
+        G0, pre = seg.meeting(a, Pk)
         if self.current is not None:
             seg.retreat(self.features[self.current], O)
         seg.transfer(pre, a, O)
@@ -207,7 +207,7 @@ class ArmPlant:
         (the feature in contact retreats first)."""
         if self.current is not None:
             seg = Segments(self.timing, self.safe, _reach(self.scene, self.in_hand()), self.G, self.motion.envelope,
-                           self.motion.workcell.robot.base[:3])
+                           self.motion.workcell.robot.base[:3], self.motion.workcell.contacts())
             seg.retreat(self.features[self.current], self.in_hand())
             self._follow(seg.times[1:], seg.poses[1:], "the retreat before a poke",
                          [lab == "retreat" for lab in seg.samples.label[1:]])

@@ -19,8 +19,10 @@ reach from the gripper origin and how far the gripper's body (a capsule ``envelo
 its +z, :data:`GRIPPER_ENVELOPE`, :data:`GRIPPER_RADIUS`) hangs below its origin at the
 orientations the transfer turns between, so that neither object nor gripper comes within the
 clearance of the workcell there. Under a feature that pushes downward (a
-ledge), the transfers go down and up beside it, on the robot's side, moved horizontally across
-the feature by twice the object's reach, the clearance and :data:`GRIPPER_RADIUS`.
+ledge), the transfers go down and up beside it, on the robot's side, moved horizontally off
+the feature until the object and the gripper's body (:data:`GRIPPER_RADIUS`) are the clearance
+past its end: across it, or along it when that crosses the grasp axis less (an edge between the
+fingers, pushing the top of an object held below it, passes between them only lengthwise).
 
 Refused (ExecutionError), naming the push: an object going deeper than
 :data:`PENETRATION_LIMIT` into its feature's contact plane during the push (its points along its
@@ -43,7 +45,7 @@ from .. import pose as P
 from ..errors import ArgumentError, ExecutionError
 from ..workcell.default import default_workcell
 from ..workcell.description import Workcell
-from ..workcell.shapes import shapes
+from ..workcell.shapes import EDGE_RADIUS, shapes
 from . import collision
 from .assignment import MAX_TILT, Assignment, candidates
 
@@ -61,6 +63,16 @@ GRIPPER_ENVELOPE = 0.16
 GRIPPER_RADIUS = 0.085
 #: A feature pushes downward when its push direction is within this angle [rad] of the world's −z.
 DOWNWARD = np.pi / 3
+#: Under a downward-pushing feature the transfers come and go across it (its contact frame's y)
+#: unless along it (its x) crosses the grasp axis less by this much (|cos| of the angles): an
+#: edge between the fingers, over an object held below its top, passes between them only
+#: lengthwise.
+ALONG_MARGIN = 0.1
+#: The gap [m] between the object and a feature it slides under lengthwise (the pre-contact
+#: pose's distance there, instead of ``Timing.clearance``): the edge passes between the fingers
+#: below the gripper's housing, so the slide and the retreat along it are part of the approach
+#: and the retreat (kept the contact clearance from the arm).
+SLIDE_GAP = 0.003
 #: A free move (transfer, approach, retreat) follows the minimum-jerk profile s(τ) = 10τ³ − 15τ⁴ + 6τ⁵
 #: (zero speed and acceleration at both ends: no jolt on the held object); its peak speed is this
 #: many times its mean, so its duration is stretched by it to keep the peak at the Timing's speed.
@@ -297,7 +309,8 @@ class _Layout:
     """What the segment builders share: the plan's object poses ``O`` (n, 7) and pusher twists,
     the workcell's top + the clearance ``safe`` [m], the object's ``reach`` [m], the timing and
     the gripper's ``envelope`` [m], the ``robot``'s base position [m] (transfers beside a
-    downward-pushing feature go down on its side)."""
+    downward-pushing feature go down on its side), the ``spans`` [m] of the workcell's contacts
+    along their frames' x and y (:func:`spans`)."""
     O: np.ndarray
     twists: list
     safe: float
@@ -305,6 +318,7 @@ class _Layout:
     timing: Timing
     envelope: float = GRIPPER_ENVELOPE
     robot: np.ndarray | None = None
+    spans: dict = field(default_factory=dict)
 
     def lifted(self, G, *others):
         """``G`` raised to the safe height of its orientation and ``others``' (:meth:`height`)."""
@@ -318,21 +332,62 @@ class _Layout:
         z = 1.0 - 2.0 * (q[..., 1] ** 2 + q[..., 2] ** 2)
         return self.safe + np.maximum(self.reach, GRIPPER_RADIUS + np.maximum(0.0, -self.envelope * z))
 
-    def beside(self, G, a: Assignment):
-        """``G`` moved horizontally across a downward-pushing feature (None for other features)."""
+    def along(self, G, a: Assignment):
+        """The horizontal unit direction in which the gripper at pose ``G`` leaves push ``a``'s
+        feature when it pushes downward (None for other features) and whether it is lengthwise:
+        across the feature (its frame's y), or along it (its x) when that crosses the grasp axis
+        less (:data:`ALONG_MARGIN`); towards the robot."""
         z = P.quat_rotate(a.frame[3:], [0.0, 0, 1])
         if z[2] > -np.cos(DOWNWARD):
             return None
-        d = P.quat_rotate(a.frame[3:], [0.0, 1, 0])
-        d = np.r_[d[:2], 0.0]
-        d = d / np.linalg.norm(d) if np.linalg.norm(d) > 1e-9 else np.r_[1.0, 0, 0]
+        grasp = P.quat_rotate(G[3:], [0.0, 1, 0])
+        best = (np.inf, np.r_[1.0, 0, 0], False)
+        for lengthwise, axis in ((False, [0.0, 1, 0]), (True, [1.0, 0, 0])):
+            d = P.quat_rotate(a.frame[3:], axis)
+            d = np.r_[d[:2], 0.0]
+            if np.linalg.norm(d) > 1e-9 and abs(d @ grasp) / np.linalg.norm(d) < best[0] - ALONG_MARGIN:
+                best = (abs(d @ grasp) / np.linalg.norm(d), d / np.linalg.norm(d), lengthwise)
+        _, d, lengthwise = best
         if self.robot is not None and d[:2] @ (self.robot[:2] - G[:2]) < 0:
             d = -d  # on the robot's side: the arm does not reach over the feature
-        return np.r_[G[:3] + (2 * self.reach + self.timing.clearance + GRIPPER_RADIUS) * d, G[3:]]
+        return d, lengthwise
+
+    def beside(self, G, a: Assignment):
+        """``G`` moved horizontally off a downward-pushing feature (:meth:`along`) until the
+        object and the gripper's body are the clearance past the feature's end (None for other
+        features)."""
+        way = self.along(G, a)
+        if way is None:
+            return None
+        d, lengthwise = way
+        end = float((a.frame[:3] - G[:3]) @ d) + self.spans.get(a.feature, (0.0, 0.0))[0 if lengthwise else 1]
+        return np.r_[G[:3] + (max(end, self.reach) + self.reach + self.timing.clearance + GRIPPER_RADIUS) * d, G[3:]]
+
+    def gap(self, G, a: Assignment) -> float:
+        """The pre-contact distance [m] of push ``a`` with the gripper at ``G``'s orientation:
+        :data:`SLIDE_GAP` under a feature it slides under lengthwise, else the clearance."""
+        way = self.along(G, a)
+        return SLIDE_GAP if way is not None and way[1] else self.timing.clearance
+
+    def meet(self, a: Assignment, pusher):
+        """The gripper's pose in contact with push ``a``'s feature and its pre-contact pose
+        (:func:`meeting`, :meth:`gap` away), for the pusher's contact frame ``pusher``
+        (gripper frame)."""
+        G0, _ = meeting(a.frame, pusher, 0.0)
+        return meeting(a.frame, pusher, self.gap(G0, a))
 
     def contact(self, a: Assignment):
         """The gripper's pose in contact at push ``a``'s start and its pre-contact pose."""
-        return meeting(a.frame, P.compose(self.O[a.first], a.contact.frame), self.timing.clearance)
+        return self.meet(a, P.compose(self.O[a.first], a.contact.frame))
+
+
+def spans(contacts) -> dict:
+    """How far [m] each contact's body (:meth:`Workcell.contacts`; an edge's bar, a corner's tip
+    of radius :data:`~regrasp.workcell.shapes.EDGE_RADIUS`) reaches from its frame's origin along
+    the frame's x and y: name → (x, y)."""
+    return {c.name: (c.length / 2 + EDGE_RADIUS, EDGE_RADIUS) if c.kind == "edge" else
+            (float(c.extent[0]), float(c.extent[1])) if c.kind == "face" else (EDGE_RADIUS, EDGE_RADIUS)
+            for c in contacts}
 
 
 def meeting(frame, pusher, clearance: float) -> tuple[np.ndarray, np.ndarray]:
@@ -350,15 +405,16 @@ class Segments:
     :meth:`transfer`, :meth:`approach`, each holding the object at a given in-hand pose; ``safe``
     [m]: the workcell's top + the clearance (``Workcell.top()``), ``reach`` [m] the object's from
     the gripper origin, ``envelope`` [m] the gripper body's length, ``robot`` the robot base's
-    position [m] (or None). :attr:`times` [s] and
+    position [m] (or None), ``contacts`` the workcell's (:meth:`Workcell.contacts`, for the
+    transfers beside a downward-pushing feature). :attr:`times` [s] and
     :attr:`poses` (m, unit quaternion): the samples so far, ``start`` at time 0 first."""
 
     def __init__(self, timing: Timing, safe: float, reach: float, start, envelope: float = GRIPPER_ENVELOPE,
-                 robot=None):
+                 robot=None, contacts=()):
         self.samples = _Samples(timing)
         self.samples.first(start, np.r_[0.0, 0, 0, 1, 0, 0, 0])
         self.layout = _Layout(np.zeros((0, 7)), [], float(safe), float(reach), timing, float(envelope),
-                              None if robot is None else np.asarray(robot, float))
+                              None if robot is None else np.asarray(robot, float), spans(contacts))
 
     @property
     def times(self) -> list:
@@ -378,6 +434,11 @@ class Segments:
         """Up to the safe height, over and down to push ``a``'s pre-contact pose ``pre``, holding ``Oh``."""
         _transfer(self.samples, self.layout, a, pre, Oh)
 
+    def meeting(self, a: Assignment, pusher):
+        """The gripper's pose in contact with push ``a``'s feature and its pre-contact pose, for
+        the pusher's contact frame ``pusher`` (gripper frame; :meth:`_Layout.meet`)."""
+        return self.layout.meet(a, pusher)
+
     def approach(self, G0, a: Assignment, Oh):
         """Into contact ``G0`` with push ``a``'s feature at the push speeds, holding ``Oh``."""
         _approach(self.samples, self.layout, a, G0, Oh)
@@ -385,14 +446,17 @@ class Segments:
 
 def _transfer(S: _Samples, L: _Layout, a: Assignment, pre, Oh=None):
     """Up to the safe height, over, and down to push ``a``'s pre-contact pose ``pre`` (beside a
-    downward-pushing feature: over to beside it, down, and across), holding ``Oh`` (default:
-    the plan's pose at the push's start)."""
+    downward-pushing feature: over to beside it, down, and across, or, sliding under it
+    lengthwise, along it as part of the approach), holding ``Oh`` (default: the plan's pose at
+    the push's start)."""
     Oh = L.O[a.first] if Oh is None else Oh
     side = L.beside(pre, a)
     here = S.G[-1]
     S.move(L.lifted(here, pre), Oh, "transfer", -1, True)
-    for to in ([L.lifted(pre, here)] if side is None else [L.lifted(side, here), side]) + [pre]:
+    for to in [L.lifted(pre, here)] if side is None else [L.lifted(side, here), side]:
         S.move(to, Oh, "transfer", -1, True)
+    lengthwise = side is not None and L.along(pre, a)[1]
+    S.move(pre, Oh, "approach" if lengthwise else "transfer", a.index if lengthwise else -1, True)
 
 
 def _approach(S: _Samples, L: _Layout, a: Assignment, G0, Oh=None):
@@ -428,14 +492,16 @@ def _dwell(S: _Samples, L: _Layout, a: Assignment):
 
 
 def _retreat(S: _Samples, L: _Layout, a: Assignment, Oh=None):
-    """Back by the clearance along the feature's push direction, then (beside a
-    downward-pushing feature) across it."""
+    """Back by the pre-contact distance (:meth:`_Layout.gap`) along the feature's push
+    direction, then (beside a downward-pushing feature) off it: across it, or along it as part of
+    the retreat."""
     G, Oh = S.G[-1], L.O[a.last] if Oh is None else Oh
-    away = L.timing.clearance * P.quat_rotate(a.frame[3:], [0.0, 0, 1])
+    away = L.gap(G, a) * P.quat_rotate(a.frame[3:], [0.0, 0, 1])
     S.move(np.r_[G[:3] + away, G[3:]], Oh, "retreat", a.index, False)
     side = L.beside(S.G[-1], a)
     if side is not None:
-        S.move(side, Oh, "transfer", -1, True)
+        lengthwise = L.along(S.G[-1], a)[1]
+        S.move(side, Oh, "retreat" if lengthwise else "transfer", a.index if lengthwise else -1, True)
 
 
 def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing = Timing(), start=None,
@@ -474,7 +540,8 @@ def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing =
     safe = workcell.top() + timing.clearance
     contacts = workcell.contacts()
     options = candidates(scene, poses, pushers, workcell, max_tilt, contacts)
-    L = _Layout(O, twists, safe, reach, timing, float(envelope), np.asarray(workcell.robot.base[:3], float))
+    L = _Layout(O, twists, safe, reach, timing, float(envelope), np.asarray(workcell.robot.base[:3], float),
+                spans(contacts))
     S = _Samples(timing)
     check = _Check(scene, workcell, contacts)
     knots, assignments, depth = [], [], []
