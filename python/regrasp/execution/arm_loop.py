@@ -175,10 +175,14 @@ class ArmPlant:
         self.current = pusher
         self.switch_overs += 1
 
-    def push(self, pusher: str, twist, duration: float, belief=None):
+    def push(self, pusher: str, twist, duration: float, belief=None, absolute: bool = False):
         """Pushes with ``pusher``'s feature at body ``twist`` (planar ``[vx, vz, omega]`` (m/s,
         m/s, rad/s), 3-D ``[v, omega]``, in the object frame) for ``duration`` [s], from the
-        object's ``belief`` pose (default: measured; after a switch-over, measured again)."""
+        object's ``belief`` pose (default: measured; after a switch-over, measured again).
+        The gripper moves from its commanded pose by the inverse of the object's motion, or,
+        ``absolute``, from where the feature meets the pusher with the object at the belief
+        (``G = F ∘ (O ∘ C)⁻¹``, as the open loop renders a plan step): the step then ends where
+        the feature holds the object at the step's end whatever the arm's lag left before."""
         if self.current != pusher:
             self.switch(pusher, self.in_hand() if belief is None else self._spatial(belief))
             belief = None
@@ -194,6 +198,8 @@ class ArmPlant:
         else:
             Os = [P.integrate(O, tw, t) for t in s]
         G = self.G
+        if absolute:
+            G = P.compose(self.features[pusher].frame, P.inverse(P.compose(O, pusher_contact(self.scene, pusher, q).frame)))
         self._follow(s, [P.compose(G, O, P.inverse(o)) for o in Os], f"the push with pusher `{pusher}`")
 
     def idle(self, duration: float):
@@ -368,8 +374,7 @@ def _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_rep
         # the step's duration at the timing's push speeds (the plan's twist is per unit time)
         T = max(np.linalg.norm(u[:3]) / timing.push_speed, np.linalg.norm(u[3:]) / timing.push_turn,
                 timing.sample_period)
-        A = np.asarray(a["pose"], float) if scene._core.is_plane(b["pusher"]) else None
-        arm.push(b["pusher"], u / T, T, A)
+        arm.push(b["pusher"], u / T, T, np.asarray(a["pose"], float), absolute=True)
         return arm.pose()
 
     failure, replans = "", 0
