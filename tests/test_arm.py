@@ -146,7 +146,9 @@ def test_execute_cli_refusals(tmp_path):
            ("block-3d", ["--start-error", "0.001,0,0", "--closed-loop"]),
            ("block-xztheta", ["--start-error", "0.001,0"]),
            ("block-xztheta", ["--start-error", "0.001,nan,0", "--closed-loop"]),
-           ("block-xztheta", ["--start-error", "0.001,0,0", "--robot", "free-gripper"])]
+           ("block-xztheta", ["--start-error", "0.001,0,0", "--robot", "free-gripper"]),
+           ("block-xztheta", ["--start-error", "0.5,0,0"]),  # the pad off the object
+           ("block-xztheta", ["--start-error", "0,0.5,0", "--closed-loop"])]
     for name, extra in bad:
         code, out, err = run_cli("execute", regrasp.examples.path(name), "--plan", tmp_path / f"{name}.json", *extra)
         assert code == 2 and "--start-error" in err and "Traceback" not in err, (extra, err)

@@ -47,13 +47,18 @@ def _workcell(a):
     return load_workcell(a.workcell) if a.workcell else None
 
 
-def _start_error(scene, a):
-    """``--start-error`` as a planar ``[dx, dz, dtheta]`` (m, m, rad), None when not given."""
+def _start_error(scene, a, plan=None):
+    """``--start-error`` as a planar ``[dx, dz, dtheta]`` (m, m, rad), None when not given;
+    with ``plan``, it must keep the pad on the object at the plan's start."""
     if a.start_error is None:
         return None
     if scene.dimension != 2:
         raise ArgumentError("invalid `--start-error`: planar scenes only", "--start-error")
-    return floats(a.start_error, 3, "--start-error")
+    se = floats(a.start_error, 3, "--start-error")
+    if plan is not None and not scene.admissible(np.asarray(plan.poses[0], float) + se):
+        raise ArgumentError("invalid `--start-error`: from the plan's start it puts the pad off the object",
+                            "--start-error")
+    return se
 
 
 def _free(scene, plan, a):
@@ -127,6 +132,7 @@ def cmd_execute(a) -> int:
     scene = load(a.scene, a)
     _start_error(scene, a)  # before any work
     plan = Plan.load(a.plan, scene)
+    _start_error(scene, a, plan)
     if a.closed_loop:
         return _closed_loop(scene, plan, a)
     out, motion, extra = (_free if a.robot == FREE_GRIPPER else _arm)(scene, plan, a)
