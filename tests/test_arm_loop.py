@@ -110,6 +110,19 @@ def test_3d_replanning_renders_each_step_against_the_feature():
     assert r.goal_error[0] < 0.9e-3
 
 
+def test_only_sticking_steps_are_rendered_against_the_feature():
+    """block-3d's `ground` patch moves with the object (absolute rendering); ball-roll-3d's floor
+    is a plane whose contact rolls over the ball (rendered from the commanded pose: from the
+    planned start, the gripper would jump back along the table at every step)."""
+    from regrasp.execution.arm_loop import sticking
+    from regrasp.scene.spatial import check_plan3d
+
+    for name, want in (("block-3d", True), ("ball-roll-3d", False)):
+        scene, plan = example(name)
+        path = check_plan3d(scene, plan)
+        assert [sticking(scene, a, b) for a, b in zip(path, path[1:])] == [want] * (len(path) - 1), name
+
+
 def test_the_plant_pushes_the_object_as_commanded():
     """One push of the plan's first pusher, its twist the plan's first step's: the measured
     in-hand pose moves toward the plan's next pose (independently: the planned displacement)."""

@@ -18,7 +18,8 @@ the measured pose). The gripper's poses every ``timing.sample_period`` are solve
 per control period); 3-D scenes by re-planning (:func:`regrasp.scene.spatial.run_plan3d`: after
 each step of the plan the pose is measured; off the plan by more than half the tolerance, or at
 the plan's end outside it, the T-RRT* plans again from it), each step pushed at the timing's
-push speed."""
+push speed; a sticking step against its feature from the step's planned start
+(``push(..., absolute=True)``), so that the arm's lag and the start's offset do not add up."""
 
 from __future__ import annotations
 
@@ -360,6 +361,16 @@ def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time
                          c.failure, c)
 
 
+def sticking(scene, a: dict, b: dict) -> bool:
+    """Whether the 3-D plan step from path entry ``a`` to ``b`` sticks: its pusher (not a plane,
+    whose contact rolls over the object) moves with the object (its pusher twist, when given,
+    the object's own twist)."""
+    if scene._core.is_plane(b["pusher"]):
+        return False
+    u = b.get("pusher_twist")
+    return u is None or bool(np.allclose(u, P.twist_between(a["pose"], b["pose"]), rtol=1e-6, atol=1e-9))
+
+
 def _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_replans) -> ArmLoopResult:
     from ..scene.spatial import check_plan3d, run_plan3d
 
@@ -374,7 +385,11 @@ def _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_rep
         # the step's duration at the timing's push speeds (the plan's twist is per unit time)
         T = max(np.linalg.norm(u[:3]) / timing.push_speed, np.linalg.norm(u[3:]) / timing.push_turn,
                 timing.sample_period)
-        arm.push(b["pusher"], u / T, T, np.asarray(a["pose"], float), absolute=True)
+        # a sticking step rendered against the feature from the step's planned start, as the
+        # open loop does; else from the commanded pose (a plane's from the planned pose)
+        plane, sticks = bool(scene._core.is_plane(b["pusher"])), sticking(scene, a, b)
+        A = np.asarray(a["pose"], float) if plane or sticks else None
+        arm.push(b["pusher"], u / T, T, A, absolute=sticks)
         return arm.pose()
 
     failure, replans = "", 0

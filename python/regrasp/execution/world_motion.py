@@ -13,16 +13,19 @@ otherwise the object's own twist, a sticking pusher): ``P(s) = O exp(s ξ) O⁻�
 Around each push (one builder each: :func:`_transfer`, :func:`_approach`, :func:`_push`,
 :func:`_retreat`): a transfer up to the safe height, over (the switch-over's turn is made there)
 and down to a pre-contact pose ``timing.clearance`` away from the feature along its push
-direction, the approach, the push and the retreat by the clearance. The safe height is the
+direction (:data:`SLIDE_GAP` under an edge it slides under lengthwise), the approach, the push
+and the retreat by that distance. The safe height is the
 top of every feature's body (:meth:`Workcell.top`) + the clearance + the larger of the object's
 reach from the gripper origin and how far the gripper's body (a capsule ``envelope`` long along
 its +z, :data:`GRIPPER_ENVELOPE`, :data:`GRIPPER_RADIUS`) hangs below its origin at the
 orientations the transfer turns between, so that neither object nor gripper comes within the
 clearance of the workcell there. Under a feature that pushes downward (a
-ledge), the transfers go down and up beside it, on the robot's side, moved horizontally off
-the feature until the object and the gripper's body (:data:`GRIPPER_RADIUS`) are the clearance
-past its end: across it, or along it when that crosses the grasp axis less (an edge between the
-fingers, pushing the top of an object held below it, passes between them only lengthwise).
+ledge), the transfers go down and up beside it, on the robot's side, moved off the feature
+until the object and the gripper's body (:data:`GRIPPER_RADIUS`) are the clearance past its
+end: along an edge square to the grasp axis (:data:`ALONG_MAX`; an edge between the fingers,
+pushing the top of an object held below it, passes between them only lengthwise: the slide,
+:data:`SLIDE_GAP` below the edge, is part of the approach and of the retreat, at the transfer
+speeds), else horizontally across the feature.
 
 Refused (ExecutionError), naming the push: an object going deeper than
 :data:`PENETRATION_LIMIT` into its feature's contact plane during the push (its points along its
@@ -63,11 +66,11 @@ GRIPPER_ENVELOPE = 0.16
 GRIPPER_RADIUS = 0.085
 #: A feature pushes downward when its push direction is within this angle [rad] of the world's −z.
 DOWNWARD = np.pi / 3
-#: Under a downward-pushing feature the transfers come and go across it (its contact frame's y)
-#: unless along it (its x) crosses the grasp axis less by this much (|cos| of the angles): an
-#: edge between the fingers, over an object held below its top, passes between them only
-#: lengthwise.
-ALONG_MARGIN = 0.1
+#: Under a downward-pushing edge the transfers come and go along it (its contact frame's x)
+#: when that is this close to square to the grasp axis (|cos| of the angle), else across it
+#: (its y): an edge between the fingers, over an object held below its top, passes between them
+#: only lengthwise.
+ALONG_MAX = 0.1
 #: The gap [m] between the object and a feature it slides under lengthwise (the pre-contact
 #: pose's distance there, instead of ``Timing.clearance``): the edge passes between the fingers
 #: below the gripper's housing, so the slide and the retreat along it are part of the approach
@@ -91,7 +94,8 @@ def eased(tau):
 class Timing:
     """Speeds and spacing of a world motion, stated once: the gripper's speed while pushing,
     approaching and retreating (``push_speed`` [m/s], ``push_turn`` [rad/s]) and in free transfers
-    (``move_speed`` [m/s], ``move_turn`` [rad/s]); the ``clearance`` [m] of pre-contact poses; the
+    and sliding lengthwise under an edge (``move_speed`` [m/s], ``move_turn`` [rad/s]); the
+    ``clearance`` [m] of pre-contact poses; the
     longest time between samples ``sample_period`` [s]; the ``dwell`` [s] held at each push's end
     (a real arm lags its reference under the push's load: it settles there before retreating)."""
     push_speed: float = 0.01
@@ -333,34 +337,35 @@ class _Layout:
         return self.safe + np.maximum(self.reach, GRIPPER_RADIUS + np.maximum(0.0, -self.envelope * z))
 
     def along(self, G, a: Assignment):
-        """The horizontal unit direction in which the gripper at pose ``G`` leaves push ``a``'s
-        feature when it pushes downward (None for other features) and whether it is lengthwise:
-        across the feature (its frame's y), or along it (its x) when that crosses the grasp axis
-        less (:data:`ALONG_MARGIN`); towards the robot."""
-        z = P.quat_rotate(a.frame[3:], [0.0, 0, 1])
-        if z[2] > -np.cos(DOWNWARD):
+        """How the gripper at pose ``G`` leaves push ``a``'s feature when it pushes downward
+        (None for other features): ``(d, lengthwise)``, ``d`` a unit direction towards the robot.
+        Along an edge (its frame's x, sloped as the edge) when that is within
+        :data:`ALONG_MAX` of square to the grasp axis (an edge between the fingers passes
+        between them only lengthwise), else horizontally across the feature (its frame's y)."""
+        R = P.quat_matrix(a.frame[3:])
+        if R[2, 2] > -np.cos(DOWNWARD):
             return None
         grasp = P.quat_rotate(G[3:], [0.0, 1, 0])
-        best = (np.inf, np.r_[1.0, 0, 0], False)
-        for lengthwise, axis in ((False, [0.0, 1, 0]), (True, [1.0, 0, 0])):
-            d = P.quat_rotate(a.frame[3:], axis)
-            d = np.r_[d[:2], 0.0]
-            if np.linalg.norm(d) > 1e-9 and abs(d @ grasp) / np.linalg.norm(d) < best[0] - ALONG_MARGIN:
-                best = (abs(d @ grasp) / np.linalg.norm(d), d / np.linalg.norm(d), lengthwise)
-        _, d, lengthwise = best
+        body = self.spans.get(a.feature)
+        if body is not None and body[0] == "edge" and abs(R[:, 0] @ grasp) <= ALONG_MAX:
+            d, lengthwise = R[:, 0].copy(), True
+        else:
+            d = np.r_[R[:2, 1], 0.0]
+            d = d / np.linalg.norm(d) if np.linalg.norm(d) > 1e-9 else np.r_[1.0, 0, 0]
+            lengthwise = False
         if self.robot is not None and d[:2] @ (self.robot[:2] - G[:2]) < 0:
             d = -d  # on the robot's side: the arm does not reach over the feature
         return d, lengthwise
 
     def beside(self, G, a: Assignment):
-        """``G`` moved horizontally off a downward-pushing feature (:meth:`along`) until the
-        object and the gripper's body are the clearance past the feature's end (None for other
-        features)."""
+        """``G`` moved off a downward-pushing feature (:meth:`along`) until the object and the
+        gripper's body are the clearance past the feature's end (None for other features)."""
         way = self.along(G, a)
         if way is None:
             return None
-        d, lengthwise = way
-        end = float((a.frame[:3] - G[:3]) @ d) + self.spans.get(a.feature, (0.0, 0.0))[0 if lengthwise else 1]
+        d = way[0]
+        _, axes, half = self.spans.get(a.feature, ("", np.eye(3)[:2], np.zeros(2)))
+        end = float((a.frame[:3] - G[:3]) @ d) + float(half @ np.abs(axes @ d))
         return np.r_[G[:3] + (max(end, self.reach) + self.reach + self.timing.clearance + GRIPPER_RADIUS) * d, G[3:]]
 
     def gap(self, G, a: Assignment) -> float:
@@ -382,12 +387,16 @@ class _Layout:
 
 
 def spans(contacts) -> dict:
-    """How far [m] each contact's body (:meth:`Workcell.contacts`; an edge's bar, a corner's tip
-    of radius :data:`~regrasp.workcell.shapes.EDGE_RADIUS`) reaches from its frame's origin along
-    the frame's x and y: name → (x, y)."""
-    return {c.name: (c.length / 2 + EDGE_RADIUS, EDGE_RADIUS) if c.kind == "edge" else
-            (float(c.extent[0]), float(c.extent[1])) if c.kind == "face" else (EDGE_RADIUS, EDGE_RADIUS)
-            for c in contacts}
+    """Each contact's body (:meth:`Workcell.contacts`; an edge's bar, a corner's tip of radius
+    :data:`~regrasp.workcell.shapes.EDGE_RADIUS`): name → (kind, its frame's x and y axes in
+    the world (2, 3), how far [m] it reaches from the frame's origin along each (2,))."""
+    out = {}
+    for c in contacts:
+        R = P.quat_matrix(c.frame[3:])
+        half = ((c.length / 2 + EDGE_RADIUS, EDGE_RADIUS) if c.kind == "edge" else
+                (float(c.extent[0]), float(c.extent[1])) if c.kind == "face" else (EDGE_RADIUS, EDGE_RADIUS))
+        out[c.name] = (c.kind, R[:, :2].T.copy(), np.asarray(half, float))
+    return out
 
 
 def meeting(frame, pusher, clearance: float) -> tuple[np.ndarray, np.ndarray]:
@@ -427,7 +436,7 @@ class Segments:
         return self.samples.G
 
     def retreat(self, a: Assignment, Oh):
-        """Back from push ``a``'s feature by the clearance (and across a downward one), holding ``Oh``."""
+        """Back from push ``a``'s feature by the pre-contact distance (and off a downward one), holding ``Oh``."""
         _retreat(self.samples, self.layout, a, Oh)
 
     def transfer(self, pre, a: Assignment, Oh):
