@@ -313,8 +313,8 @@ class _Layout:
     """What the segment builders share: the plan's object poses ``O`` (n, 7) and pusher twists,
     the workcell's top + the clearance ``safe`` [m], the object's ``reach`` [m], the timing and
     the gripper's ``envelope`` [m], the ``robot``'s base position [m] (transfers beside a
-    downward-pushing feature go down on its side), the ``spans`` [m] of the workcell's contacts
-    along their frames' x and y (:func:`spans`)."""
+    downward-pushing feature go down on its side), the ``spans`` of the workcell's contacts
+    (their kinds, axes and reach [m], :func:`spans`)."""
     O: np.ndarray
     twists: list
     safe: float
