@@ -14,7 +14,8 @@ from ..extras import need
 
 START_TOLERANCE = 0.005  # rad, the largest joint error between the arm now and a trajectory's start
 SAMPLE = 0.01  # s, the eased reference's sample spacing
-INTEGRAL_TIME = 0.04  # s, the joint loop's integral time (a stiff servo, as an industrial arm's: no static error under load)
+STIFFNESS = 4.0  # the joint loop's proportional gain added to the actuators' (a stiff servo, as an industrial arm's): kp·(1 + STIFFNESS)
+INTEGRAL_TIME = 0.08  # s, the joint loop's integral time (no static error under load; with STIFFNESS and the actuators' kp/kv = 5 /s, damping ratio 0.7)
 INTEGRAL_BOUND = 0.05  # rad, the integral term's bound (anti-windup)
 CONTROL_PERIOD = 0.002  # s, the joint servo's period (500 Hz, a UR's controller); the grip loop runs faster
 
@@ -29,6 +30,31 @@ class Tracking:
     rms_error: float
     final_error: float
     tcp_error: float
+
+
+class Servo:
+    """The arm's joint servo, run every :data:`CONTROL_PERIOD`: the position actuators' PD
+    (Menagerie's gains ``kp``, ``kv``) with the target shifted by ``kv/kp · q̇_ref`` (velocity
+    feed-forward) and by a bounded integral of the joint error (:data:`INTEGRAL_TIME`,
+    :data:`INTEGRAL_BOUND`): no static error under a load (a push, the fingers closing)."""
+
+    def __init__(self, robot):
+        m = robot.model
+        self.robot = robot
+        self.kp = m.actuator_gainprm[robot.arm_actuators, 0]
+        self.kv = -m.actuator_biasprm[robot.arm_actuators, 2]
+        self.integral = np.zeros(len(robot.arm_qpos))
+        self.steps = max(1, int(round(CONTROL_PERIOD / m.opt.timestep)))  # simulation steps per period
+        self.period = self.steps * m.opt.timestep  # s
+
+    def command(self, q_ref, v_ref=None) -> None:
+        """Sets the actuators' targets for the next period towards ``q_ref`` [rad] moving at
+        ``v_ref`` [rad/s] (default: at rest)."""
+        r, d = self.robot, self.robot.data
+        e = q_ref - d.qpos[r.arm_qpos]
+        self.integral += (1.0 + STIFFNESS) * self.period / INTEGRAL_TIME * e
+        np.clip(self.integral, -INTEGRAL_BOUND, INTEGRAL_BOUND, out=self.integral)
+        d.ctrl[r.arm_actuators] = q_ref + STIFFNESS * e + self.integral + (0.0 if v_ref is None else self.kv / self.kp * v_ref)
 
 
 def reference(times, qs, t: float) -> tuple:
@@ -83,21 +109,15 @@ def track(robot, times, qs, settle: float = 0.5, grip=None, ease: bool = True, o
                             f"{robot.arm_joints[j]} (more than {START_TOLERANCE} rad; move there first: "
                             f"track from robot.q)", "qs[0]")
     ref_t, ref_q = smooth(times, qs, SAMPLE) if ease else (times, qs)
-    kp = m.actuator_gainprm[robot.arm_actuators, 0]
-    kv = -m.actuator_biasprm[robot.arm_actuators, 2]
+    servo = Servo(robot)
     errs, tcp_err = [], 0.0
-    integral = np.zeros(len(robot.arm_qpos))
     data_ref = mujoco.MjData(m)
-    steps = max(1, int(round(CONTROL_PERIOD / m.opt.timestep)))
-    period = steps * m.opt.timestep
     start = d.time  # the trajectory's times[0] is now
     clock = lambda: times[0] + d.time - start  # noqa: E731
     while clock() < times[-1] + settle:
         q_ref, v_ref = reference(ref_t, ref_q, clock())
-        integral += period / INTEGRAL_TIME * (q_ref - d.qpos[robot.arm_qpos])
-        np.clip(integral, -INTEGRAL_BOUND, INTEGRAL_BOUND, out=integral)
-        d.ctrl[robot.arm_actuators] = q_ref + kv / kp * v_ref + integral
-        for _ in range(steps):
+        servo.command(q_ref, v_ref)
+        for _ in range(servo.steps):
             if grip is not None:
                 grip.update()
             mujoco.mj_step(m, d)
