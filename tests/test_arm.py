@@ -220,13 +220,70 @@ def test_a_finger_too_near_the_table_is_refused_with_the_exact_clearance():
 def test_the_plate_faces_the_robot_within_its_reach():
     """pivot-3d's patch pivot goes to the default workcell's plate, which faces the robot: the arm
     can follow it (facing away, the plate was beyond the UR5e's reach)."""
-    from regrasp.execution.arm import arm_motion
+    from regrasp.execution.arm import CONTACT_CLEARANCE, first_solution
+    from regrasp.robot.ik import fixed_geoms, ik_path
 
     scene = regrasp.load_scene(regrasp.examples.path("pivot-3d"))
-    am = arm_motion(scene, regrasp.plan(scene, seed=0))
-    assert am.motion.assignments[0].feature == "plate" and not am.refused
-    normal = regrasp.pose.quat_rotate(am.motion.workcell.feature("plate").pose[3:], [0.0, 0, 1])
+    motion = world_motion(scene, regrasp.plan(scene, seed=0))
+    assert motion.assignments[0].feature == "plate"
+    normal = regrasp.pose.quat_rotate(motion.workcell.feature("plate").pose[3:], [0.0, 0, 1])
     assert normal[0] == pytest.approx(-1.0)  # pushes along world −x, towards the robot at the origin
+    robot, _, _, tcp = build_robot(scene, motion)
+    push = np.flatnonzero(motion.push == 0)
+    targets = regrasp.pose.compose_rows(motion.gripper[push], np.broadcast_to(tcp, (len(push), 7)))
+    avoid = fixed_geoms(robot)
+    q = ik_path(robot, targets, first_solution(robot, targets[0], avoid), avoid=avoid, min_distance=CONTACT_CLEARANCE)
+    assert np.all(np.isfinite(q)) and len(q) == len(push)
+
+
+def _object_hand_contacts(robot, motion, tcp, i):
+    """MuJoCo's own contacts (mj_forward's collision detection) between the object at in-hand
+    pose ``i`` of ``motion`` and the gripper's bodies other than the pads: [(body name, dist)]."""
+    import mujoco
+
+    m = robot.model
+    d = mujoco.MjData(m)
+    d.qpos[:] = robot.data.qpos
+    body = m.body("object").id
+    jq = m.jnt_qposadr[m.body_jntadr[body]]
+    frame = regrasp.pose.compose(robot.tcp_pose(), regrasp.pose.inverse(tcp))
+    d.qpos[jq:jq + 7] = regrasp.pose.compose(frame, motion.in_hand[i])
+    mujoco.mj_forward(m, d)
+    pads = {int(m.geom_bodyid[g]) for side in robot.pad_geoms for g in side}
+    out = []
+    for c in d.contact[:d.ncon]:
+        b1, b2 = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
+        if body in (b1, b2):
+            other = b2 if b1 == body else b1
+            if other not in pads and m.body(other).name.startswith("gripper/"):
+                out.append((m.body(other).name, float(c.dist)))
+    return out
+
+
+def test_a_plan_that_puts_the_object_into_the_gripper_is_refused():
+    """pivot-3d's lift raises the block 10 mm in the hand turned 0.4 rad: its corner goes 2.4 mm
+    into the 2F-85's housing, which the planner (it sees only the pads) cannot know; executed,
+    the housing pressed the block with ≈ 170 N and the run failed. Refused before the arm
+    moves, naming the push and the part; MuJoCo's own collision detection finds the contact at
+    the reported pose, and none on block-3d, whose object stays clear of the hand."""
+    from regrasp.execution.arm import arm_motion, hand_clearance
+
+    scene = regrasp.load_scene(regrasp.examples.path("pivot-3d"))
+    plan = regrasp.plan(scene, seed=0)
+    with pytest.raises(ExecutionError, match=r"cannot be done in this hand: at push 1 \(push, pusher ground.* goes "
+                       r"([0-9.]+) mm into the gripper's `base`") as e:
+        arm_motion(scene, plan)
+    motion = world_motion(scene, plan)
+    assert e.value.field == f"plan.path[{motion.assignments[1].first + 1}].pusher"
+    robot, _, _, tcp = build_robot(scene, motion)
+    dist, i, part = hand_clearance(robot, motion, tcp)
+    assert part == "gripper/base" and -4e-3 < dist < -1e-3 and motion.push[i] == 1
+    hits = _object_hand_contacts(robot, motion, tcp, i)
+    assert hits and min(h[1] for h in hits) == pytest.approx(dist, abs=5e-4)
+    assert not _object_hand_contacts(robot, motion, tcp, 0)  # at the start the block is clear
+    scene, plan, motion, robot, tcp, arm = case("block-3d")
+    dist, i, _ = hand_clearance(robot, motion, tcp)
+    assert dist > 1e-3 and not _object_hand_contacts(robot, motion, tcp, i)
 
 
 def test_a_top_push_slides_under_the_ledge_lengthwise_between_the_fingers(tmp_path):

@@ -45,6 +45,9 @@ GRIP_PERIOD = 0.001
 #: (approach, push, retreat: the fingers hold the object against a feature); elsewhere the IK's
 #: ``MIN_DISTANCE``.
 CONTACT_CLEARANCE = 0.001
+#: Depth [m] beyond which the object, at a planned in-hand pose, is inside the gripper's own body
+#: (its housing, the fingers' linkage; the pads excepted): the plan cannot be done in this hand.
+HAND_TOUCH = 1e-6
 #: How many choices of contacts :func:`arm_motion` tries before giving up.
 MAX_TRIES = 6
 #: Time [s] the arm holds still after the motion before the object's pose is measured.
@@ -204,13 +207,64 @@ def first_solution(robot, target, avoid):
     raise first
 
 
+def hand_clearance(robot, motion: WorldMotion, tcp) -> tuple[float, int, str]:
+    """(m, sample, body): the smallest signed distance (MuJoCo's ``mj_geomDistance``, negative
+    inside) from the object at each in-hand pose of ``motion`` to the gripper's body (every
+    colliding geom of the gripper but the pads'), the fingers as :func:`build_robot` closed
+    them, the sample where it is smallest and the gripper body it is to. The planner sees only
+    the pads: a regrasp that raises the object far enough towards the palm runs it into the
+    housing (pivot-3d's lift), which no feature and no arm motion can avoid."""
+    mujoco = need("mujoco", "robot")
+    from ..robot.model import GRIPPER_PREFIX
+
+    m = robot.model
+    d = mujoco.MjData(m)
+    d.qpos[:] = robot.data.qpos
+    body = m.body("object").id
+    jq = m.jnt_qposadr[m.body_jntadr[body]]
+    pads = {int(m.geom_bodyid[g]) for side in robot.pad_geoms for g in side}
+    obj = [g for g in range(m.ngeom) if m.geom_bodyid[g] == body]
+    hand = [g for g in robot.robot_geoms if m.geom_bodyid[g] not in pads
+            and mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g])).startswith(GRIPPER_PREFIX)]
+    frame = P.compose(robot.tcp_pose(), P.inverse(tcp))
+    best, at, part, last = np.inf, 0, "", None
+    for i, h in enumerate(motion.in_hand):
+        if last is not None and np.max(np.abs(h - last)) < 1e-7:
+            continue  # the object still in the hand where it was last checked
+        last = h
+        d.qpos[jq:jq + 7] = P.compose(frame, h)
+        mujoco.mj_kinematics(m, d)
+        for g in hand:
+            for o in obj:
+                dist = mujoco.mj_geomDistance(m, d, o, g, min(best, 0.01), None)
+                if dist < best:
+                    best, at, part = dist, i, mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g]))
+    return float(best), at, part
+
+
+def check_hand(robot, motion: WorldMotion, tcp) -> None:
+    """Raises ExecutionError (field ``plan.path[i].pusher`` of the push) when the object, at a
+    planned in-hand pose, goes more than :data:`HAND_TOUCH` into the gripper's body
+    (:func:`hand_clearance`)."""
+    dist, i, part = hand_clearance(robot, motion, tcp)
+    if dist >= -HAND_TOUCH:
+        return
+    k = int(motion.push[i])
+    first = motion.assignments[k].first if k >= 0 else 0
+    raise ExecutionError(f"the plan cannot be done in this hand: at {where(motion, i)} the object goes "
+                         f"{-dist * 1e3:.2f} mm into the gripper's `{part.split('/')[-1]}` (the planner sees only "
+                         f"the pads)", f"plan.path[{first + 1}].pusher")
+
+
 def solve_arm(robot, motion: WorldMotion, tcp) -> ArmTrajectory:
     """The arm's :class:`ArmTrajectory` putting the TCP at ``motion.gripper ∘ tcp`` at every
     sample, clear of the table and the workcell's features (by :data:`CONTACT_CLEARANCE` in
     contact, else the IK's ``MIN_DISTANCE``); from the solution for the first pose
-    found from the arm's home. Raises ExecutionError naming the push (see the module's doc)."""
+    found from the arm's home. Raises ExecutionError naming the push (see the module's doc), or
+    when the plan puts the object into the gripper's body (:func:`check_hand`)."""
     from ..robot.ik import MIN_DISTANCE, IKError, fixed_geoms, ik_path
 
+    check_hand(robot, motion, tcp)
     avoid = fixed_geoms(robot)
     targets = P.compose_rows(motion.gripper, np.broadcast_to(tcp, motion.gripper.shape))
     try:
