@@ -21,8 +21,6 @@ from .conftest import rotation_matrix as rot
 mujoco = pytest.importorskip("mujoco")
 
 PLANS: dict = {}
-# block-tilted-gripper's gravity is 30° off its pushers' normals: rendered only with any tilt allowed
-TILT = {"block-tilted-gripper": np.pi}
 
 
 def plan_of(name):
@@ -92,7 +90,7 @@ def test_every_example_moves_clear_of_the_workcell_by_mujocos_distances(name):
     finds the object, at every sample, at most PENETRATION_LIMIT into the feature of a push during
     its approach, push and retreat and out of every other body (and out of all in transfers)."""
     scene, plan = plan_of(name)
-    m = world_motion(scene, plan, **({"max_tilt": TILT[name]} if name in TILT else {}))
+    m = world_motion(scene, plan)
     D = mujoco_depths(scene, m.workcell, m.object)
     names = [s.name for s in shapes(m.workcell)]
     allowed = np.full(D.shape, 2e-5)                                  # MuJoCo's tolerance

@@ -255,3 +255,43 @@ def test_default_workcell_needs_a_scene():
     with pytest.raises(ArgumentError) as e:
         default_workcell("t-shape")
     assert e.value.field == "scene"
+
+
+def test_a_rolled_gripper_gets_inclines_that_serve_its_line_pushers_level():
+    """block-tilted-gripper's gravity is 30° off the gripper's −z: its line pushers' segments are
+    neither level nor plumb, so no block edge, ledge or rod serves them within MAX_TILT; the
+    default workcell adds a bar per pusher, laid along the segment as the scene's gravity holds
+    it. Independent check: scipy's rotation taking the scene's gravity to the world's −z turns
+    the pusher's segment and normal onto the bar (up to a turn about the vertical), and every
+    other bundled example gets none."""
+    from scipy.spatial.transform import Rotation
+
+    from regrasp.execution.assignment import MAX_TILT
+
+    scene = regrasp.load_scene(regrasp.examples.path("block-tilted-gripper"))
+    w = default_workcell(scene)
+    inclines = [f for f in w.features if f.name.startswith("incline-")]
+    assert sorted(f.name for f in inclines) == ["incline-bottom", "incline-left", "incline-right"]
+    (gx, gz), _ = scene.gravity
+    R, _ = Rotation.align_vectors([[0.0, 0.0, -1.0]], [[gx, 0.0, gz]])
+    start = scene.task.start
+    for f in inclines:
+        name = f.name.removeprefix("incline-")
+        pts, n = np.asarray(scene.pusher(name).points), np.asarray(scene.pusher(name).normal)
+        seg = np.r_[pts[1, 0] - pts[0, 0], 0.0, pts[1, 1] - pts[0, 1]]
+        seg, push = R.apply(seg / np.linalg.norm(seg)), R.apply([n[0], 0.0, n[1]])
+        B = rot(f.pose[3:])
+        # the same vertical components (a turn about the vertical keeps them) and angle between
+        assert abs(B[2, 0]) == pytest.approx(abs(seg[2]), abs=1e-9) and B[2, 2] == pytest.approx(push[2], abs=1e-9)
+        assert f.length >= np.linalg.norm(pts[1] - pts[0]) - 1e-12
+        if np.hypot(push[0], push[1]) > 1e-6:
+            assert B[0, 2] < 0 and B[1, 2] == pytest.approx(0.0, abs=1e-9)  # pushes towards the robot
+        (a,) = assign(scene, [start, start], [None, name], w)
+        assert a.feature == f.name and a.tilt <= 1e-6
+    plan = regrasp.plan(scene, seed=0)
+    motion = regrasp.execution.world_motion(scene, plan)  # within the default MAX_TILT now
+    assert all(a.tilt <= MAX_TILT and a.feature.startswith("incline-") for a in motion.assignments)
+    for name in regrasp.examples.names():
+        if name != "block-tilted-gripper":
+            cell = default_workcell(regrasp.load_scene(regrasp.examples.path(name)))
+            assert not any(f.name.startswith("incline-") for f in cell.features), name

@@ -49,6 +49,15 @@ PLATE_CENTER = (0.7, -0.1)
 PLATE_HEIGHT = 0.15
 PLATE_MARGIN = 1.02
 PLATE_MIN = 0.005
+#: Inclines: for a line pusher that no other feature serves within the assignment's ``MAX_TILT``
+#: (its segment neither level nor plumb under the scene's gravity: a gripper rolled about its
+#: grasp axis), a bar like the rod, laid along the pusher's segment as the scene's gravity holds
+#: it, pushing along the pusher's normal (turned so that it pushes towards the robot): the first
+#: centred at ``INCLINE_CENTER`` [m] (world x-y) ``INCLINE_HEIGHT`` [m] above the table, each next
+#: ``INCLINE_STEP`` [m] further along world y.
+INCLINE_CENTER = (0.45, -0.05)
+INCLINE_HEIGHT = 0.2
+INCLINE_STEP = -0.12
 
 
 def pusher_extent(scene) -> tuple[float, float]:
@@ -105,7 +114,65 @@ def default_workcell(scene) -> Workcell:
         features.append(Feature("plate", "face", [*PLATE_CENTER, TABLE_HEIGHT + PLATE_HEIGHT, r, 0.0, -r, 0.0], friction,
                                 [max(PLATE_MIN, PLATE_MARGIN * patch)] * 2, index=len(features)))
     robot = Robot(ROBOT, [0.0, 0.0, TABLE_HEIGHT, 1.0, 0.0, 0.0, 0.0])
-    return Workcell(f"default-{scene.name}", table, tuple(features), robot, ObjectStart("hand"),
+    name, start = f"default-{scene.name}", ObjectStart("hand")
+    inclines = _inclines(scene, Workcell(name, table, tuple(features), robot, start), friction)
+    return Workcell(name, table, tuple(features) + inclines, robot, start,
                     f"generated for scene {scene.name}: a table, a fixture block, a ledge"
                     + (", a rod" if size > 0 else "")
-                    + (" and a plate" if patch > 0 else ""))
+                    + (", a plate" if patch > 0 else "")
+                    + (f", {len(inclines)} incline(s)" if inclines else ""))
+
+
+def _start_pose(scene) -> np.ndarray:
+    """The object's pose in the grasp at the task's start (identity without a task)."""
+    t = scene.task
+    if t is not None:  # a planar Task, a 3-D (start, goal, tolerance)
+        return np.asarray(t.start if hasattr(t, "start") else t[0], float)
+    return np.zeros(3) if scene.dimension == 2 else np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+
+
+def _inclines(scene, cell: Workcell, friction: float) -> tuple:
+    """The inclines (see :data:`INCLINE_CENTER`) for the line pushers of ``scene`` that no
+    contact of ``cell`` serves within ``MAX_TILT`` at the task's start."""
+    from .. import pose as P
+    from ..errors import ExecutionError
+    from ..execution.assignment import candidates, gravity_in_gripper, pusher_contact
+
+    start, g = _start_pose(scene), gravity_in_gripper(scene)
+    R = _upright(g)
+    O = P.planar_to_spatial(start) if scene.dimension == 2 else start
+    out = []
+    for name in scene.pusher_names:
+        pc = pusher_contact(scene, name, start)
+        if pc.kind != "line":
+            continue
+        try:
+            candidates(scene, [start, start], [None, name], cell)
+            continue
+        except ExecutionError:
+            pass
+        F = P.quat_matrix(P.compose(O, pc.frame)[3:])  # the contact frame in the gripper frame
+        e, d = R @ F[:, 0], R @ F[:, 2]                # along the segment, the push: world
+        yaw = np.pi - np.arctan2(d[1], d[0]) if np.hypot(d[0], d[1]) > 1e-6 else -np.arctan2(e[1], e[0])
+        c, s_ = np.cos(yaw), np.sin(yaw)
+        Z = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])  # towards the robot (world −x)
+        e, d = Z @ e, Z @ d
+        k = len(out)
+        origin = [INCLINE_CENTER[0], INCLINE_CENTER[1] + k * INCLINE_STEP, TABLE_HEIGHT + INCLINE_HEIGHT]
+        pose = P.from_frame(np.column_stack([e, np.cross(d, e), d]), origin)
+        length = ROD_MARGIN * float(np.ptp(pc.footprint[:, 0]))
+        out.append(Feature(f"incline-{name}", "edge", pose, friction, length=length,
+                           index=len(cell.features) + k))
+    return tuple(out)
+
+
+def _upright(g) -> np.ndarray:
+    """A rotation (3 x 3) taking the unit direction ``g`` to the world's −z (the least turn)."""
+    down = np.array([0.0, 0.0, -1.0])
+    axis = np.cross(g, down)
+    s, c = np.linalg.norm(axis), float(g @ down)
+    if s < 1e-12:
+        return np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
+    k = axis / s
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + s * K + (1 - c) * K @ K
