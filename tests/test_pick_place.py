@@ -112,14 +112,44 @@ def test_a_place_too_deep_is_refused_naming_place():
     assert e.value.field == "place"
 
 
-def test_a_pusher_the_gripper_blocks_is_left_out_and_named():
-    """t-shape's `top` pusher is rendered by the ledge pushing down on the T's bar, which sits
-    inside the 2F-85's linkage: the arm cannot follow it, the pairs are re-planned without it,
-    and without it no regrasp reaches the place: refused naming the pusher left out."""
+def test_an_object_the_hand_cannot_hold_is_refused_naming_the_part():
+    """t-shape's T, held in any of its pick grasps, reaches into the 2F-85's base (its top is
+    60 mm above the pads' centre, the housing lower): every grasp pair is refused before the arm
+    moves, the message naming the part."""
     s = scene_of("t-shape")
-    with pytest.raises(ExecutionError, match=r"without pushers top") as e:
+    with pytest.raises(ExecutionError, match=r"grasp pairs tried .*goes [0-9.]+ mm into the gripper's `base`") as e:
         pp.pick_place(s, seed=1)
     assert e.value.field == "place"
+
+
+def test_a_pusher_the_arm_cannot_follow_is_left_out_and_named(monkeypatch):
+    """When the arm cannot follow a push (``solve_arm`` raises naming it: its reach, a joint
+    limit, the fingers against the feature), the grasp pairs are planned again without that
+    pusher. The real ``solve_arm``, wrapped to refuse every push of the pusher that the first
+    choice uses (as an arm blocked there would), on block-xztheta: the choice found instead uses
+    none of it and names it left out, or the refusal names it."""
+    from regrasp.execution import arm
+
+    s = scene_of("block-xztheta")
+    first = pp.pick_place(s, seed=1)
+    blocked = first.motion.assignments[0].pusher
+    real = arm.solve_arm
+
+    def solve(robot, motion, tcp):
+        for a in motion.assignments:
+            if a.pusher == blocked:
+                e = ExecutionError(f"the arm cannot execute push {a.index}: blocked in this test", "robot")
+                e.push = a.index
+                raise e
+        return real(robot, motion, tcp)
+
+    monkeypatch.setattr(arm, "solve_arm", solve)
+    try:
+        r = pp.pick_place(s, seed=1)
+    except ExecutionError as e:
+        assert f"without pushers {blocked}" in str(e) and e.field == "place"
+    else:
+        assert blocked in r.without and blocked not in {a.pusher for a in r.motion.assignments}
 
 
 def test_cli_json(chosen, monkeypatch):
