@@ -260,6 +260,50 @@ def _object_hand_contacts(robot, motion, tcp, i):
     return out
 
 
+def test_the_arm_holds_still_while_the_fingers_close():
+    """close_on holds the arm's joints with the servo while the fingers close on offset-3d's
+    block: the TCP moves 0.003 mm (with the actuators merely commanded to the measured joints,
+    the arm sagged 0.54 mm and the block started 0.5 mm up in the hand)."""
+    import mujoco
+
+    from regrasp.execution.arm import arm_motion, close_on
+
+    scene = regrasp.load_scene(regrasp.examples.path("offset-3d"))
+    am = arm_motion(scene, regrasp.plan(scene, seed=0))
+    motion, arm = am.motion, am.trajectory
+    r, body, geoms, tcp = build_robot(scene, motion)
+    r.set_q(arm.q[0])
+    jq = r.model.jnt_qposadr[r.model.body_jntadr[body]]
+    r.data.qpos[jq:jq + 7] = regrasp.pose.compose(regrasp.pose.compose(r.tcp_pose(), regrasp.pose.inverse(tcp)),
+                                                  motion.in_hand[0])
+    mujoco.mj_forward(r.model, r.data)
+    before = r.tcp_pose()
+    close_on(r, body, geoms, float(motion.grip_force[0]))
+    assert np.linalg.norm(r.tcp_pose()[:3] - before[:3]) < 5e-5
+
+
+def _brute_clearance(robot, motion, tcp):
+    """hand_clearance's minimum the slow way: every sample, every pair of the object's and
+    the gripper's colliding geoms (pads' bodies left out by name), a fixed 50 mm search."""
+    import mujoco
+
+    m = robot.model
+    d = mujoco.MjData(m)
+    d.qpos[:] = robot.data.qpos
+    body = m.body("object").id
+    jq = m.jnt_qposadr[m.body_jntadr[body]]
+    hand = [g for g in range(m.ngeom) if m.body(m.geom_bodyid[g]).name.startswith("gripper/")
+            and not m.body(m.geom_bodyid[g]).name.endswith("_pad") and (m.geom_contype[g] or m.geom_conaffinity[g])]
+    obj = [g for g in range(m.ngeom) if m.geom_bodyid[g] == body]
+    frame = regrasp.pose.compose(robot.tcp_pose(), regrasp.pose.inverse(tcp))
+    best = np.inf
+    for h in motion.in_hand:
+        d.qpos[jq:jq + 7] = regrasp.pose.compose(frame, h)
+        mujoco.mj_kinematics(m, d)
+        best = min([best] + [mujoco.mj_geomDistance(m, d, o, g, 0.05, None) for o in obj for g in hand])
+    return best
+
+
 def test_a_plan_that_puts_the_object_into_the_gripper_is_refused():
     """pivot-3d's lift raises the block 10 mm in the hand turned 0.4 rad: its corner goes 2.4 mm
     into the 2F-85's housing, which the planner (it sees only the pads) cannot know; executed,
@@ -281,9 +325,16 @@ def test_a_plan_that_puts_the_object_into_the_gripper_is_refused():
     hits = _object_hand_contacts(robot, motion, tcp, i)
     assert hits and min(h[1] for h in hits) == pytest.approx(dist, abs=5e-4)
     assert not _object_hand_contacts(robot, motion, tcp, 0)  # at the start the block is clear
+    assert dist == pytest.approx(_brute_clearance(robot, motion, tcp), abs=1e-9)
     scene, plan, motion, robot, tcp, arm = case("block-3d")
     dist, i, _ = hand_clearance(robot, motion, tcp)
     assert dist > 1e-3 and not _object_hand_contacts(robot, motion, tcp, i)
+    assert dist == pytest.approx(_brute_clearance(robot, motion, tcp), abs=1e-9)
+    # held between pushes (t-shape's T at its start, inside the base): the plan's pose is named
+    scene = regrasp.load_scene(regrasp.examples.path("t-shape"))
+    with pytest.raises(ExecutionError, match=r"at the transfer before push 0 .* goes [0-9.]+ mm into the gripper's `base`") as e:
+        arm_motion(scene, regrasp.plan(scene, seed=0))
+    assert e.value.field == "plan.path[0].pose"
 
 
 def test_a_top_push_slides_under_the_ledge_lengthwise_between_the_fingers(tmp_path):

@@ -207,13 +207,19 @@ def first_solution(robot, target, avoid):
     raise first
 
 
+#: How far [m] :func:`hand_clearance` looks: beyond it the object is clear of the hand (inf).
+HAND_REACH = 0.01
+
+
 def hand_clearance(robot, motion: WorldMotion, tcp) -> tuple[float, int, str]:
     """(m, sample, body): the smallest signed distance (MuJoCo's ``mj_geomDistance``, negative
     inside) from the object at each in-hand pose of ``motion`` to the gripper's body (every
     colliding geom of the gripper but the pads'), the fingers as :func:`build_robot` closed
-    them, the sample where it is smallest and the gripper body it is to. The planner sees only
-    the pads: a regrasp that raises the object far enough towards the palm runs it into the
-    housing (pivot-3d's lift), which no feature and no arm motion can avoid."""
+    them, the sample where it is smallest and the gripper body it is to; (inf, 0, "") when the
+    object stays farther than :data:`HAND_REACH`. The planner sees only the pads: a regrasp that
+    raises the object far enough towards the palm runs it into the housing (pivot-3d's lift),
+    which no feature and no arm motion can avoid. (The arm's wrist, behind the gripper's base,
+    is not checked: an object would meet the base first.)"""
     mujoco = need("mujoco", "robot")
     from ..robot.model import GRIPPER_PREFIX
 
@@ -236,24 +242,29 @@ def hand_clearance(robot, motion: WorldMotion, tcp) -> tuple[float, int, str]:
         mujoco.mj_kinematics(m, d)
         for g in hand:
             for o in obj:
-                dist = mujoco.mj_geomDistance(m, d, o, g, min(best, 0.01), None)
-                if dist < best:
+                dist = mujoco.mj_geomDistance(m, d, o, g, HAND_REACH, None)
+                if dist < min(best, HAND_REACH):
                     best, at, part = dist, i, mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g]))
     return float(best), at, part
 
 
 def check_hand(robot, motion: WorldMotion, tcp) -> None:
-    """Raises ExecutionError (field ``plan.path[i].pusher`` of the push) when the object, at a
-    planned in-hand pose, goes more than :data:`HAND_TOUCH` into the gripper's body
-    (:func:`hand_clearance`)."""
+    """Raises ExecutionError when the object, at a planned in-hand pose, goes more than
+    :data:`HAND_TOUCH` into the gripper's body (:func:`hand_clearance`); its field names the
+    plan's pusher of the push (``plan.path[i].pusher``), or, outside a push, the plan's pose
+    the object is held at (``plan.path[i].pose``: ``path[0]``, the start, before the first push)."""
     dist, i, part = hand_clearance(robot, motion, tcp)
     if dist >= -HAND_TOUCH:
         return
     k = int(motion.push[i])
-    first = motion.assignments[k].first if k >= 0 else 0
+    if k >= 0:
+        field_ = f"plan.path[{motion.assignments[k].first + 1}].pusher"
+    else:  # held between pushes: at the end of the last push before it
+        done = [int(p) for p in motion.push[:i] if p >= 0]
+        field_ = f"plan.path[{motion.assignments[done[-1]].last if done else 0}].pose"
     raise ExecutionError(f"the plan cannot be done in this hand: at {where(motion, i)} the object goes "
                          f"{-dist * 1e3:.2f} mm into the gripper's `{part.split('/')[-1]}` (the planner sees only "
-                         f"the pads)", f"plan.path[{first + 1}].pusher")
+                         f"the pads)", field_)
 
 
 def solve_arm(robot, motion: WorldMotion, tcp) -> ArmTrajectory:
@@ -374,6 +385,8 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
         raise ArgumentError(f"invalid `motion`: a WorldMotion (got {type(motion).__name__})", "motion")
     start = np.asarray(_start(scene, motion, start), float)
     r, body, geoms, tcp = build_robot(scene, motion, robot if trajectory is None else trajectory.robot, scales, pads)
+    if trajectory is not None:
+        check_hand(r, motion, tcp)  # solve_arm checks it otherwise
     traj = solve_arm(r, motion, tcp) if trajectory is None else trajectory
     m, d = r.model, r.data
     r.set_q(traj.q[0])
