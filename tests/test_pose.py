@@ -10,7 +10,8 @@ from hypothesis import strategies as st
 
 from regrasp import _core
 from regrasp.pose import (planar_compose, planar_inverse, planar_quat, planar_rotate, planar_to_spatial, quat_angle,
-                          quat_from_matrix, quat_matrix, quat_rotate, slerp, tangents, twist_between, twist_in)
+                          quat_from_matrix, quat_matrix, quat_rotate, slerp, tangents, turn_onto, twist_between,
+                          twist_in)
 
 unit = st.lists(st.floats(-1, 1), min_size=3, max_size=3).filter(lambda v: np.linalg.norm(v) > 1e-3) \
     .map(lambda v: np.asarray(v) / np.linalg.norm(v))

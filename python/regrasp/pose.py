@@ -224,6 +224,17 @@ def compose_rows(a, b) -> np.ndarray:
     return np.concatenate([a[:, :3] + rotated, q / np.linalg.norm(q, axis=1, keepdims=True)], axis=1)
 
 
+def turn_onto(u, v) -> np.ndarray:
+    """The unit quaternion ``[w, x, y, z]`` of the least turn taking the direction ``u`` onto
+    ``v`` (neither zero): about ``u × v`` by their angle; a half turn about a direction normal
+    to ``u`` when they are opposite."""
+    u, v = np.asarray(u, float) / np.linalg.norm(u), np.asarray(v, float) / np.linalg.norm(v)
+    q = np.r_[1.0 + u @ v, np.cross(u, v)]
+    if q[0] < 1e-12:  # opposite
+        q = np.r_[0.0, tangents(u)[0]]
+    return q / np.linalg.norm(q)
+
+
 def z_turn(phi: float) -> np.ndarray:
     """The pose (no translation) of a turn by ``phi`` [rad] about +z."""
     return np.array([0.0, 0.0, 0.0, np.cos(phi / 2), 0.0, 0.0, np.sin(phi / 2)])

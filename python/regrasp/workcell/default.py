@@ -139,7 +139,7 @@ def _inclines(scene, cell: Workcell, friction: float) -> tuple:
     from ..execution.assignment import candidates, gravity_in_gripper, pusher_contact
 
     start, g = _start_pose(scene), gravity_in_gripper(scene)
-    R = _upright(g)
+    R = P.quat_matrix(P.turn_onto(g, [0.0, 0.0, -1.0]))  # the gripper frame with the scene's gravity down
     O = P.planar_to_spatial(start) if scene.dimension == 2 else start
     out = []
     for name in scene.pusher_names:
@@ -154,8 +154,7 @@ def _inclines(scene, cell: Workcell, friction: float) -> tuple:
         F = P.quat_matrix(P.compose(O, pc.frame)[3:])  # the contact frame in the gripper frame
         e, d = R @ F[:, 0], R @ F[:, 2]                # along the segment, the push: world
         yaw = np.pi - np.arctan2(d[1], d[0]) if np.hypot(d[0], d[1]) > 1e-6 else -np.arctan2(e[1], e[0])
-        c, s_ = np.cos(yaw), np.sin(yaw)
-        Z = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])  # towards the robot (world −x)
+        Z = P.quat_matrix(P.z_turn(yaw)[3:])  # pushing towards the robot (world −x)
         e, d = Z @ e, Z @ d
         k = len(out)
         origin = [INCLINE_CENTER[0], INCLINE_CENTER[1] + k * INCLINE_STEP, TABLE_HEIGHT + INCLINE_HEIGHT]
@@ -165,14 +164,3 @@ def _inclines(scene, cell: Workcell, friction: float) -> tuple:
                            index=len(cell.features) + k))
     return tuple(out)
 
-
-def _upright(g) -> np.ndarray:
-    """A rotation (3 x 3) taking the unit direction ``g`` to the world's −z (the least turn)."""
-    down = np.array([0.0, 0.0, -1.0])
-    axis = np.cross(g, down)
-    s, c = np.linalg.norm(axis), float(g @ down)
-    if s < 1e-12:
-        return np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
-    k = axis / s
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + s * K + (1 - c) * K @ K
