@@ -80,6 +80,17 @@ def test_quat_angle_is_the_turn_between(base, axis, th):
 
 
 @settings(max_examples=200, deadline=None)
+@given(unit, unit, st.floats(0.1, 10))
+def test_turn_onto_is_the_least_turn_taking_one_direction_onto_the_other(u, v, scale):
+    q = turn_onto(scale * u, v)
+    assert np.linalg.norm(q) == pytest.approx(1) and np.allclose(quat_rotate(q, u), v, atol=1e-9)
+    # the least turn: by the angle between them (2 acos |w| of the quaternion)
+    angle = np.arccos(np.clip(u @ v, -1, 1))
+    assert 2 * np.arccos(min(1.0, abs(q[0]))) == pytest.approx(angle, abs=1e-6)
+    assert np.allclose(quat_rotate(turn_onto(u, -u), u), -u, atol=1e-12)  # opposite: a half turn
+
+
+@settings(max_examples=200, deadline=None)
 @given(unit)
 def test_tangents_complete_a_right_handed_orthonormal_frame(n):
     t1, t2 = tangents(5 * n)

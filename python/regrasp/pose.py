@@ -229,10 +229,11 @@ def turn_onto(u, v) -> np.ndarray:
     ``v`` (neither zero): about ``u × v`` by their angle; a half turn about a direction normal
     to ``u`` when they are opposite."""
     u, v = np.asarray(u, float) / np.linalg.norm(u), np.asarray(v, float) / np.linalg.norm(v)
-    q = np.r_[1.0 + u @ v, np.cross(u, v)]
-    if q[0] < 1e-12:  # opposite
-        q = np.r_[0.0, tangents(u)[0]]
-    return q / np.linalg.norm(q)
+    c = np.cross(u, v)
+    s = float(np.linalg.norm(c))
+    angle = np.arctan2(s, float(u @ v))  # accurate near 0 and near a half turn
+    axis = c / s if s > 0 else tangents(u)[0]
+    return np.r_[np.cos(angle / 2), np.sin(angle / 2) * axis]
 
 
 def z_turn(phi: float) -> np.ndarray:
