@@ -374,7 +374,7 @@ def add_quiet(p, default=False) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from . import cones, control, dynamics, examples, execution, pick_place, planning, tools
+    from . import cones, control, dexterity, dynamics, examples, execution, pick_place, planning, tools
 
     ap = Parser(prog="regrasp", description="In-hand regrasps by prehensile pushing: motion cones, planning, "
                 "simulation and control (`regrasp COMMAND --help` for each command).",
@@ -384,7 +384,7 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("-v", "--verbose", action="store_true", help="print the scenes' notes on stderr")
     add_quiet(ap)
     sub = ap.add_subparsers(dest="cmd", metavar="COMMAND", parser_class=Parser)
-    for group in (planning, cones, dynamics, control, execution, pick_place, tools, examples):
+    for group in (planning, cones, dynamics, control, execution, pick_place, dexterity, tools, examples):
         group.add_parsers(sub)
     ap.description += f"\nCOMMAND: one of {{{','.join(sub.choices)}}}."
     for p in sub.choices.values():

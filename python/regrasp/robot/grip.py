@@ -156,6 +156,43 @@ def _pad_state(grasp_width: float, robot_name: str, pads, pad_friction: float, c
     return float(gain), float(f1 - gain * u1), float(local[2]), joints
 
 
+LOW_FORCES = (0.0, 0.02, 0.05, 0.1, 0.2, 0.4, 0.7, 1.0)  # N, the actuator forces of low_force_curve (up to CALIBRATION_FORCES[0])
+
+
+def low_force_curve(robot) -> tuple:
+    """(u [N], f [N]): the pads' mean normal force ``f`` at grip actuator forces ``u``
+    (:data:`LOW_FORCES`) on a fixed box as wide as ``robot``'s grasp, gravity off — the low end of
+    the linkage's map, where the affine :func:`pad_state` (measured at 1 and 5 N) is off by up to
+    0.5 N (its spring is not linear: at a 30 mm grasp the affine map reads 0.58 N at u = 0.115 N,
+    the gripper presses 0.95 N there). Measured once per grasp width, gripper, pads and settings."""
+    return _low_force_curve(robot.grasp_width, robot.name, robot.pads, robot.pad_friction, robot.contact)
+
+
+@lru_cache(maxsize=32)
+def _low_force_curve(grasp_width: float, robot_name: str, pads, pad_friction: float, contact) -> tuple:
+    mujoco = need("mujoco", "robot")
+    from .model import ROBOTS, gripper_spec, set_options
+
+    kind = ROBOTS[robot_name]
+    g = gripper_spec(kind, pads, pad_friction)
+    set_options(g, contact)
+    g.option.gravity = [0, 0, 0]
+    g.worldbody.add_geom(name="calibration_box", type=mujoco.mjtGeom.mjGEOM_BOX, size=[grasp_width / 2, 0.03, 0.035],
+                         pos=[0, 0, 0.16])
+    m = g.compile()
+    d = mujoco.MjData(m)
+    pad_geoms = tuple(tuple(i for i in range(m.ngeom) if m.geom_bodyid[i] == m.body(b).id and m.geom_contype[i])
+                      for b in kind.pad_bodies)
+    box = [m.geom("calibration_box").id]
+    forces = []
+    for u in reversed((*LOW_FORCES, CALIBRATION_FORCES[0])):  # from closed down: the pads stay on the box
+        d.ctrl[m.actuator("grip").id] = u
+        for _ in range(int(CALIBRATION_TIME / 2 / m.opt.timestep)):
+            mujoco.mj_step(m, d)
+        forces.append(float(contact_normal_forces(m, d, pad_geoms, box).mean()))
+    return np.array((*LOW_FORCES, CALIBRATION_FORCES[0])), np.array(forces[::-1])
+
+
 def close_fingers(robot) -> None:
     """Puts ``robot``'s finger linkage where it closes on an object as wide as its grasp width
     (measured by :func:`pad_state`), at rest: the state its IK freezes the fingers in (the

@@ -1,0 +1,1 @@
+"""Extrinsic dexterity: grasps of an object, regrasp actions, the grasp graph."""

@@ -1,0 +1,506 @@
+"""Regrasp actions (thesis §1.1.1, ICRA 2014 "Extrinsic dexterity"): open-loop, parameterised
+motions of the arm and grip-force schedules that change the grasp on an object with resources
+outside the hand — gravity, the inertia of the arm's motion, contacts with the table. Each
+action (:class:`Action`) says which grasps it applies to (:meth:`Action.applies`), and
+turns a grasp into a :class:`Setup`: the hand's start pose, its timed path, the grip schedule
+and the model's prediction of the in-hand pose at the end (:mod:`.slip` for the gravity and
+inertial actions, the kinematics of sticking contact for the table's), whose nearest grasp of
+the taxonomy is the grasp it is meant to reach. Geometry in the hand frame (x, z: the plane of
+the pads, y the grasp axis); every action here keeps the grasp axis horizontal along the
+world's y, so that the hand frame's x-z plane is the world's x-z plane turned by the hand's
+angle α (the hand's x from the world's x towards its z; α = 0: the fingers point down).
+Parameters are SI; their defaults are physically grounded (the holding force m g / 2 μ, the
+taxonomy's offset and turn steps) and stated in :data:`DEFAULTS`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import numpy as np
+
+from .. import pose as P
+from ..errors import ArgumentError
+from .slip import Body, Slip, simulate
+from .taxonomy import grasp_distance
+from .world import WORK_POINT, HandPath, ramps
+
+G = 9.81  # m/s², the default gravity's norm (a scene's own is used: ObjectModel.g)
+RAMP = 0.05  # s, a grip change is ramped over this long (the linkage follows; a step springs the pads off)
+DEFAULTS = {
+    "overdrive": 1.4,   # gravity-pivot: the gravity moment at the start over the pads' torsion capacity at the lowered grip
+    "max_tilt": 2.618,  # rad, gravity-pivot: the centre of mass at most this far from hanging at the start (150°)
+    "pivot_time": 0.8,  # s, gravity-pivot: how long the grip stays low
+    "slide_ratio": 0.8,  # gravity-slide: 2 μ N / m g while sliding (the object accelerates at (1 − ratio) g)
+    "lag": 0.5236,      # rad, grip-pivot: the angle from the vertical at which the object lags the turning hand (30°)
+    "turn_time": 1.2,   # s, grip-pivot and table-pivot: how long the hand turns
+    "acceleration": 30.0,  # m/s², inertial-slide: the hand's downward jab (more than g: the object rises in the hand)
+    "braking": 15.0,    # m/s², inertial-slide: the hand's stop after the jab, the grip firm again
+    "jab_hold": 1.3,    # inertial-slide: 2 μ N / m g during the jab (holds the weight, lets the jab slide it)
+    "press_hold": 1.5,  # push-down and table-pivot: 2 μ N / m g while the table pushes
+    "approach": 0.02,   # m, push-down and table-pivot: the object's lowest point above the table at the start
+    "speed": 0.03,      # m/s, push-down: the hand's descent
+}
+
+
+@dataclass(frozen=True)
+class ObjectModel:
+    """What the actions need of an object: its ``scene`` (a :class:`regrasp.Scene3D`), the
+    grasp ``taxonomy`` (:class:`~regrasp.dexterity.taxonomy.Taxonomy`), ``mass`` [kg],
+    ``inertia`` (3, 3) [kg·m²] about the centre of mass (object frame), ``com`` (3,) [m], the
+    pads' friction ``mu``, the scene's grip force ``grip`` [N] per pad and gravity ``g`` [m/s²]."""
+
+    scene: object
+    taxonomy: object
+    mass: float
+    inertia: np.ndarray
+    com: np.ndarray
+    mu: float
+    grip: float
+    g: float
+
+    @classmethod
+    def of(cls, scene, taxonomy) -> "ObjectModel":
+        """The model of ``scene``'s object (a :class:`regrasp.Scene3D`) with its ``taxonomy``."""
+        return cls(scene, taxonomy, float(scene.mass), np.asarray(scene.inertia, float), np.asarray(scene._core.com, float),
+                   float(scene._core.grip_friction), float(scene._core.grip_force),
+                   float(np.linalg.norm(scene._core.gravity)))
+
+    @property
+    def weight(self) -> float:
+        """m g [N]."""
+        return self.mass * self.g
+
+    def holding(self, ratio: float) -> float:
+        """The per-pad force [N] at which the pads' force capacity 2 μ N is ``ratio`` times the weight."""
+        return ratio * self.weight / (2 * self.mu)
+
+
+@dataclass(frozen=True)
+class Setup:
+    """An action on a grasp, ready to run: the hand's world ``start`` pose, its ``path`` (from
+    ``start``), the ``grip`` schedule (:mod:`.world`), ``settle`` [s] after the path, the
+    ``predicted`` in-hand pose at the end (None: the object is predicted to drop), the
+    ``intended`` grasp's name, and the model's ``detail`` (for the record)."""
+
+    start: np.ndarray
+    path: HandPath
+    grip: Callable[[float], Optional[float]]
+    settle: float
+    predicted: Optional[np.ndarray]
+    intended: Optional[str]
+    detail: dict = field(default_factory=dict)
+
+
+# --- the geometry of a grasp in the hand ---------------------------------------------------------
+
+
+def hand_pose(alpha: float, point=WORK_POINT) -> np.ndarray:
+    """The TCP's world pose at ``point`` [m] with the grasp axis along the world's y and the
+    hand's x at angle ``alpha`` [rad] from the world's x towards its z (0: fingers down)."""
+    x = np.array([np.cos(alpha), 0.0, np.sin(alpha)])
+    y = np.array([0.0, 1.0, 0.0])
+    return np.concatenate([np.asarray(point, float), P.quat_from_matrix(np.column_stack([x, y, np.cross(x, y)]))])
+
+
+def contact_centre(obj: ObjectModel, grasp) -> np.ndarray:
+    """The pads' contact centre (x, z) [m] in the hand frame: the centroid of the pad's patch
+    (the object's face against the left pad, clipped to the pad's face)."""
+    return np.asarray(obj.taxonomy.patch_centre(grasp), float)
+
+
+def com_in_hand(obj: ObjectModel, grasp) -> np.ndarray:
+    """The centre of mass (x, z) [m] in the hand frame from the contact centre."""
+    c = P.transform(grasp.pose, obj.com)
+    return np.array([c[0], c[2]]) - contact_centre(obj, grasp)
+
+
+def plane_inertia(obj: ObjectModel, grasp) -> float:
+    """The moment of inertia [kg·m²] about the grasp axis through the centre of mass."""
+    R = P.quat_matrix(grasp.pose[3:])
+    return float((R @ obj.inertia @ R.T)[1, 1])
+
+
+def body(obj: ObjectModel, grasp) -> Body:
+    """The slip model's :class:`~.slip.Body` of ``obj`` at ``grasp``."""
+    return Body(obj.mass, plane_inertia(obj, grasp), tuple(com_in_hand(obj, grasp)), float(grasp.torsion_k), obj.mu)
+
+
+def moved(obj: ObjectModel, grasp, slip: Slip) -> np.ndarray:
+    """The in-hand pose after ``slip`` of ``grasp``: turned by ``slip.turn`` (x towards z: −turn
+    about y) about the grasp axis through the contact centre, then shifted by ``slip.shift``."""
+    cx, cz = contact_centre(obj, grasp)
+    turn = np.array([np.cos(-slip.turn / 2), 0.0, np.sin(-slip.turn / 2), 0.0])
+    to_centre = np.array([-cx, 0.0, -cz, 1.0, 0.0, 0.0, 0.0])
+    back = np.array([cx + slip.shift[0], 0.0, cz + slip.shift[1], 1.0, 0.0, 0.0, 0.0])
+    return P.compose(back, P.compose(np.array([0.0, 0.0, 0.0, *turn]), P.compose(to_centre, grasp.pose)))
+
+
+def lowest(grasp, vertices) -> np.ndarray:
+    """The object's vertex (hand frame, (3,)) farthest towards the fingertips (least z)."""
+    v = P.transform(grasp.pose, vertices)
+    return v[int(np.argmin(v[:, 2]))]
+
+
+def _angle(v) -> float:
+    return float(np.arctan2(v[1], v[0]))
+
+
+def _still(alpha: float, point=WORK_POINT):
+    return lambda t: (np.array([point[0], point[2]]), alpha)
+
+
+def _intended(obj: ObjectModel, pose) -> Optional[str]:
+    return None if pose is None else obj.taxonomy.nearest(pose)[0]
+
+
+def _siblings(obj: ObjectModel, grasp) -> list:
+    """The grasps on the same faces as ``grasp``."""
+    return [g for g in obj.taxonomy.grasps if g.faces == grasp.faces and g.name != grasp.name]
+
+
+def _offset_step(obj: ObjectModel, grasp, sign: int) -> Optional[float]:
+    """The distance [m] to the nearest grasp on the same faces at the same turn with an offset
+    further in ``sign`` (+1 towards the palm), or None."""
+    steps = [sign * (g.offset - grasp.offset) for g in _siblings(obj, grasp)
+             if abs(np.angle(np.exp(1j * (g.angle - grasp.angle)))) < 1e-6 and sign * (g.offset - grasp.offset) > 1e-6]
+    return min(steps) if steps else None
+
+
+TURNS = np.radians(np.arange(-180, 180, 1.0))  # the turns that turn_target tries
+
+
+_TURNS: dict = {}
+
+
+def turn_target(obj: ObjectModel, grasp) -> Optional[tuple]:
+    """(turn [rad] about the grasp axis through the contact centre, x towards z; the grasp it
+    reaches; its distance [m]): the least turn (of more than 0.2 rad, to the degree) that brings
+    ``grasp`` (the pads staying where they are on the object's faces) nearest to another grasp
+    on the same faces — the object's symmetry included (a triangle's next orientation is 60°
+    away) — within the classification tolerance; None if no turn does."""
+    from .trial import tolerance
+
+    key = (id(obj.taxonomy), grasp.name)
+    if key in _TURNS:
+        return _TURNS[key]
+    best, tol = None, tolerance(obj.taxonomy)
+    siblings = {g.name for g in _siblings(obj, grasp)}
+    for turn in TURNS:
+        if abs(turn) < 0.2:
+            continue
+        name, dist = obj.taxonomy.nearest(moved(obj, grasp, Slip(np.zeros(2), float(turn), np.zeros(2))))
+        if name in siblings and dist <= tol and (best is None or (round(dist, 4), abs(turn)) < (round(best[2], 4), abs(best[0]))):
+            best = (float(turn), name, float(dist))
+    _TURNS[key] = best
+    return best
+
+
+# --- the actions -----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Action:
+    """A regrasp action: ``name``, the ``resource`` it uses (``gravity``, ``inertia``,
+    ``contact``), a one-line ``summary``; :meth:`applies` and :meth:`setup` per action."""
+
+    name: str
+    resource: str
+    summary: str
+
+    def applies(self, obj: ObjectModel, grasp) -> Optional[str]:
+        """None when the action applies to ``grasp``, else why not."""
+        raise NotImplementedError
+
+    def setup(self, obj: ObjectModel, grasp, params: dict | None = None) -> Setup:
+        """The :class:`Setup` of the action on ``grasp`` (``params``: overrides of :data:`DEFAULTS`)."""
+        raise NotImplementedError
+
+    def to_dict(self) -> dict:
+        """The action's name, resource and summary (for the graph file)."""
+        return {"name": self.name, "resource": self.resource, "summary": self.summary}
+
+
+def _params(params: dict | None) -> dict:
+    p = dict(DEFAULTS)
+    for k, v in (params or {}).items():
+        if k not in DEFAULTS:
+            raise ArgumentError(f"invalid `params.{k}`: unknown parameter (known: {', '.join(DEFAULTS)})", f"params.{k}")
+        if not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
+            raise ArgumentError(f"invalid `params.{k}`: a number > 0 (got {v!r})", f"params.{k}")
+        p[k] = float(v)
+    return p
+
+
+class GravityPivot(Action):
+    """The hand turns (grip firm) so that the centre of mass would hang under the grasp axis once
+    the object has turned to the nearest other orientation of its faces (:func:`turn_target`),
+    then lowers the grip until the gravity moment m g d sin φ at the start is ``overdrive``
+    times the pads' torsion capacity (the limit surface: (m g / 2μN)² + (m g d sin φ / 2kμN)²
+    = 1 at the capacity): the object swings about the grasp axis towards hanging; the grip comes
+    back after ``pivot_time``."""
+
+    def __init__(self):
+        super().__init__("gravity-pivot", "gravity", "swing about the grasp axis under gravity with a lowered grip")
+
+    def applies(self, obj, grasp):
+        t = turn_target(obj, grasp)
+        if t is None:
+            return "no other orientation on these faces"
+        d = float(np.hypot(*com_in_hand(obj, grasp)))
+        moment = d * abs(np.sin(self._tilt(t[0], DEFAULTS)))
+        return None if moment > 0.5 * grasp.torsion_k else \
+            f"the gravity moment arm at the start is {moment * 1e3:.1f} mm (a pivot needs > k / 2 = " \
+            f"{0.5e3 * grasp.torsion_k:.1f} mm)"
+
+    @staticmethod
+    def _tilt(turn: float, p: dict) -> float:
+        """The centre of mass's angle from hanging at the start [rad] (signed as ``turn``)."""
+        return float(np.sign(turn) * min(abs(turn), p["max_tilt"]))
+
+    def grip(self, obj, grasp, tilt: float, overdrive: float) -> float:
+        """The per-pad force [N] at which the start moment is ``overdrive`` times the torsion capacity."""
+        d = float(np.hypot(*com_in_hand(obj, grasp)))
+        ratio = np.sqrt(1.0 + (d * abs(np.sin(tilt)) / (overdrive * grasp.torsion_k)) ** 2)
+        return obj.holding(float(ratio))
+
+    def setup(self, obj, grasp, params=None):
+        p = _params(params)
+        turn = turn_target(obj, grasp)[0]
+        tilt = self._tilt(turn, p)
+        c = com_in_hand(obj, grasp)
+        # the hand starts with the centre of mass `tilt` from hanging and, while the grip is low, turns
+        # so that it hangs once the object has turned by `turn` (a turn beyond max_tilt: the hand adds the rest)
+        end = float(np.angle(np.exp(1j * (-np.pi / 2 - _angle(c) - turn))))
+        start_angle = end + (turn - tilt)
+        low, T = self.grip(obj, grasp, tilt, p["overdrive"]), p["pivot_time"]
+        grip = ramps((0.0, obj.grip), (RAMP, low), (RAMP + T, low), (2 * RAMP + T, obj.grip))
+
+        def angle(t: float) -> float:
+            s = min(max((t - RAMP) / (T / 2), 0.0), 1.0)
+            return start_angle + (end - start_angle) * s * s * (3 - 2 * s)
+
+        hand = lambda t: (np.array([WORK_POINT[0], WORK_POINT[2]]), angle(t))  # noqa: E731
+        slip = simulate(body(obj, grasp), 2 * RAMP + T, hand, grip, (0.0, -obj.g))
+        pose = moved(obj, grasp, slip)
+        times = np.linspace(0.0, 2 * RAMP + T, int(np.ceil((2 * RAMP + T) / 0.01)) + 1)
+        poses = np.array([hand_pose(angle(t)) for t in times])
+        return Setup(poses[0], HandPath(times, poses), grip, 0.3, pose, _intended(obj, pose),
+                     {"alpha": start_angle, "tilt": tilt, "turn": slip.turn, "target_turn": turn, "grip": low})
+
+
+class GravitySlide(Action):
+    """Fingers down, the grip lowered until the pads carry ``slide_ratio`` of the weight: the
+    object slides towards the fingertips at (1 − ratio) g for the time that makes it slide one
+    offset step of the taxonomy (½ a t²), then the grip comes back."""
+
+    def __init__(self):
+        super().__init__("gravity-slide", "gravity", "slide along the fingers under gravity with a lowered grip")
+
+    def applies(self, obj, grasp):
+        return None if _offset_step(obj, grasp, -1) is not None else "no grasp further towards the fingertips"
+
+    def setup(self, obj, grasp, params=None):
+        p = _params(params)
+        step = _offset_step(obj, grasp, -1)
+        a = (1 - min(p["slide_ratio"], 0.99)) * obj.g
+        T = float(np.sqrt(2 * step / a))
+        low = obj.holding(p["slide_ratio"])
+        grip = ramps((0.0, obj.grip), (RAMP, low), (RAMP + T, low), (2 * RAMP + T, obj.grip))
+        slip = simulate(body(obj, grasp), 2 * RAMP + T, _still(0.0), grip, (0.0, -obj.g))
+        pose = moved(obj, grasp, slip)
+        start = hand_pose(0.0)
+        return Setup(start, HandPath(np.array([0.0, 2 * RAMP + T]), np.array([start, start])), grip, 0.3, pose,
+                     _intended(obj, pose), {"slide_time": T, "grip": low, "slide": float(-slip.shift[1])})
+
+
+class GripPivot(Action):
+    """A controlled pivot to a target angle by grip modulation: the object hanging (centre of
+    mass under the grasp axis), the grip is set so that the object lags the turning hand at
+    ``lag`` from the vertical ((m g / 2μN)² + (m g d sin φ / 2kμN)² = 1, the limit surface), and
+    the hand turns about the grasp axis by the target in-hand turn plus the lag over
+    ``turn_time``; the grip comes back. The target: the turn to the nearest other orientation
+    of the grasp's faces."""
+
+    def __init__(self):
+        super().__init__("grip-pivot", "gravity", "pivot to a target angle: turn the hand with the grip set for a lag")
+
+    def applies(self, obj, grasp):
+        if turn_target(obj, grasp) is None:
+            return "no other orientation on these faces"
+        d = float(np.hypot(*com_in_hand(obj, grasp)))
+        return None if d * np.sin(DEFAULTS["lag"]) > 0.5 * grasp.torsion_k else \
+            f"the centre of mass is {d * 1e3:.1f} mm from the grasp axis (a lag of {np.degrees(DEFAULTS['lag']):.0f}° " \
+            f"needs > {0.5e3 * grasp.torsion_k / np.sin(DEFAULTS['lag']):.1f} mm)"
+
+    def grip_for_lag(self, obj, grasp, lag: float) -> float:
+        """The per-pad force [N] at which a hanging object stays at ``lag`` [rad] from the vertical."""
+        d = float(np.hypot(*com_in_hand(obj, grasp)))
+        cap = obj.weight * np.sqrt(1.0 + (d * np.sin(lag) / grasp.torsion_k) ** 2)
+        return float(cap / (2 * obj.mu))
+
+    def setup(self, obj, grasp, params=None):
+        p = _params(params)
+        c = com_in_hand(obj, grasp)
+        alpha0 = float(np.angle(np.exp(1j * (-np.pi / 2 - _angle(c)))))  # hanging
+        target = turn_target(obj, grasp)[0]
+        # the object turns by −(hand turn − lag) relative to the hand (it lags): turn the hand the other way
+        sweep = -np.sign(target) * (abs(target) + p["lag"])
+        low, T = self.grip_for_lag(obj, grasp, p["lag"]), p["turn_time"]
+        grip = ramps((0.0, obj.grip), (RAMP, low), (RAMP + T, low), (2 * RAMP + T, obj.grip))
+
+        def angle(t: float) -> float:
+            s = min(max((t - RAMP) / T, 0.0), 1.0)
+            return alpha0 + sweep * s * s * (3 - 2 * s)
+
+        slip = simulate(body(obj, grasp), 2 * RAMP + T, lambda t: (np.array([WORK_POINT[0], WORK_POINT[2]]), angle(t)),
+                        grip, (0.0, -obj.g))
+        pose = moved(obj, grasp, slip)
+        times = np.linspace(0.0, 2 * RAMP + T, int(np.ceil((2 * RAMP + T) / 0.01)) + 1)
+        poses = np.array([hand_pose(angle(t)) for t in times])
+        return Setup(poses[0], HandPath(times, poses), grip, 0.3, pose, _intended(obj, pose),
+                     {"alpha": alpha0, "sweep": float(sweep), "grip": low, "turn": slip.turn, "target": target})
+
+
+class InertialSlide(Action):
+    """Fingers down, the grip lowered to ``jab_hold`` times the holding force, the hand jabs
+    downwards at ``acceleration`` (> g): in the hand the object feels m (a − g) towards the
+    palm, more than the pads' 2 μ N, and slides deeper; then the grip comes back and the hand
+    stops at ``braking``. The jab's length from the slip model, for one offset step."""
+
+    def __init__(self):
+        super().__init__("inertial-slide", "inertia", "slide deeper into the hand by a downward jab of the arm")
+
+    def applies(self, obj, grasp):
+        return None if _offset_step(obj, grasp, +1) is not None else "no grasp further towards the palm"
+
+    @staticmethod
+    def _run(obj, p, jab: float):
+        a, b = p["acceleration"], p["braking"]
+        v = a * jab
+        stop = v / b
+        T = RAMP + jab + stop
+        top = np.array([WORK_POINT[0], WORK_POINT[2] + 0.05])
+
+        def down(t: float) -> float:  # the hand's descent [m] at time t
+            t = t - RAMP
+            if t <= 0:
+                return 0.0
+            if t <= jab:
+                return 0.5 * a * t * t
+            u = min(t - jab, stop)
+            return 0.5 * a * jab * jab + v * u - 0.5 * b * u * u
+
+        low = obj.holding(p["jab_hold"])
+        grip = ramps((0.0, obj.grip), (RAMP, low), (RAMP + jab, low), (2 * RAMP + jab, obj.grip))
+        return T, (lambda t: (top - np.array([0.0, down(t)]), 0.0)), grip
+
+    def setup(self, obj, grasp, params=None):
+        p = _params(params)
+        step = _offset_step(obj, grasp, +1)
+        jab, slip = 0.0, None
+        for jab in np.linspace(0.005, 0.1, 39):  # the shortest jab that slides the object one step
+            T, hand, grip = self._run(obj, p, float(jab))
+            slip = simulate(body(obj, grasp), T + RAMP, hand, grip, (0.0, -obj.g))
+            if slip.shift[1] >= step:
+                break
+        T, hand, grip = self._run(obj, p, float(jab))
+        times = np.arange(0.0, T + 1e-9, 0.005)
+        poses = np.array([hand_pose(0.0, (hand(t)[0][0], WORK_POINT[1], hand(t)[0][1])) for t in times])
+        pose = moved(obj, grasp, slip)
+        return Setup(poses[0], HandPath(times, poses), grip, 0.3, pose, _intended(obj, pose),
+                     {"jab": float(jab), "grip": obj.holding(p["jab_hold"]), "slide": float(slip.shift[1])})
+
+
+class PushDown(Action):
+    """Fingers down, the object below the fingertips: the hand descends at ``speed`` with the
+    grip at ``press_hold`` times the holding force until the table has pushed the object one
+    offset step deeper into the hand (the object sticks on the table, the pads slide: a
+    prehensile push against the table), then the grip comes back and the hand lifts."""
+
+    def __init__(self):
+        super().__init__("push-down", "contact", "press the object on the table to slide it deeper into the hand")
+
+    def applies(self, obj, grasp):
+        if _offset_step(obj, grasp, +1) is None:
+            return "no grasp further towards the palm"
+        reach = -lowest(grasp, obj.taxonomy.vertices)[2]
+        step = _offset_step(obj, grasp, +1)
+        from ..robot.pads import LENGTH
+
+        return None if reach - LENGTH / 2 > step + 0.005 else \
+            f"the object reaches {(reach - LENGTH / 2) * 1e3:.1f} mm below the pads (a {step * 1e3:.1f} mm push needs more)"
+
+    def setup(self, obj, grasp, params=None):
+        p = _params(params)
+        step = _offset_step(obj, grasp, +1)
+        reach = -lowest(grasp, obj.taxonomy.vertices)[2]
+        top = reach + p["approach"]  # the TCP's height above the table at the start
+        low = obj.holding(p["press_hold"])
+        start = hand_pose(0.0, (WORK_POINT[0], WORK_POINT[1], top))
+        bottom = hand_pose(0.0, (WORK_POINT[0], WORK_POINT[1], reach - step))
+        down = HandPath.line(start, bottom, (p["approach"] + step) / p["speed"] * 1.5)
+        up = HandPath.line(bottom, start, 1.0)
+        t1 = down.times[-1]
+        grip = ramps((0.0, obj.grip), (RAMP, low), (t1, low), (t1 + RAMP, obj.grip))
+        pose = P.compose(np.array([0.0, 0.0, step, 1.0, 0.0, 0.0, 0.0]), grasp.pose)
+        return Setup(start, down.then(up), grip, 0.3, pose,
+                     _intended(obj, pose), {"push": step, "grip": low})
+
+
+class TablePivot(Action):
+    """Fingers down, the object's lowest vertex on the table: the hand moves on an arc about that
+    vertex, keeping its orientation, so that the object (held on the table by friction) turns in
+    the hand about the grasp axis by the turn to the nearest other orientation of its faces
+    (a pivot on an edge against the table: Hou, Jia & Mason's pivot-on-support); the grip at
+    ``press_hold`` times the holding force meanwhile."""
+
+    def __init__(self):
+        super().__init__("table-pivot", "contact", "pivot about an edge on the table by moving the hand on an arc")
+
+    def applies(self, obj, grasp):
+        from ..robot.pads import LENGTH
+
+        if turn_target(obj, grasp) is None:
+            return "no other orientation on these faces"
+        reach = -lowest(grasp, obj.taxonomy.vertices)[2]
+        return None if reach - LENGTH / 2 > 0.012 else \
+            f"the object reaches {(reach - LENGTH / 2) * 1e3:.1f} mm below the pads (a table pivot needs 12 mm)"
+
+    def setup(self, obj, grasp, params=None):
+        p = _params(params)
+        target = turn_target(obj, grasp)[0]
+        v = lowest(grasp, obj.taxonomy.vertices)
+        c = contact_centre(obj, grasp)
+        r0 = np.array([c[0] - v[0], c[1] - v[2]])  # the contact centre from the vertex, in the plane (x, z)
+        pivot = np.array([WORK_POINT[0], 0.0])  # the vertex on the table (world x, z)
+        T = p["turn_time"]
+        low = obj.holding(p["press_hold"])
+        # the object turns by `target` (x towards z) in the world about the vertex; the hand only translates
+        press = 0.0005  # m, the vertex pressed this far into the table (soft contact)
+
+        def tcp(t: float, above: float = 0.0) -> np.ndarray:
+            s = min(max(t / T, 0.0), 1.0)
+            a = target * s * s * (3 - 2 * s)
+            ca, sa = np.cos(a), np.sin(a)
+            centre = pivot + np.array([ca * r0[0] - sa * r0[1], sa * r0[0] + ca * r0[1]])
+            return hand_pose(0.0, (centre[0] - c[0], WORK_POINT[1], centre[1] - c[1] - press + above))
+
+        times = np.linspace(0.0, T, int(np.ceil(T / 0.01)) + 1)
+        lift = HandPath.line(tcp(0.0, p["approach"]), tcp(0.0), 0.6)
+        arc = HandPath(times, np.array([tcp(t) for t in times]))
+        path = lift.then(arc).then(HandPath.line(tcp(T), tcp(T, p["approach"]), 0.6))
+        t0, t1 = lift.times[-1], lift.times[-1] + T
+        grip = ramps((0.0, obj.grip), (t0 - RAMP, obj.grip), (t0, low), (t1, low), (t1 + RAMP, obj.grip))
+        pose = moved(obj, grasp, Slip(np.zeros(2), float(target), np.zeros(2)))
+        return Setup(path.poses[0], path, grip, 0.3, pose, _intended(obj, pose), {"turn": float(target), "grip": low})
+
+
+ACTIONS = {a.name: a for a in (GravityPivot(), GravitySlide(), GripPivot(), InertialSlide(), PushDown(), TablePivot())}
+
+
+def action(name: str) -> Action:
+    """The action ``name`` (:data:`ACTIONS`), or an ArgumentError naming ``action``."""
+    if name not in ACTIONS:
+        raise ArgumentError(f"invalid `action`: unknown action {name!r} (known: {', '.join(ACTIONS)})", "action")
+    return ACTIONS[name]

@@ -1,0 +1,283 @@
+"""The grasp graph of an object, measured in simulation (thesis Fig 1-2; ICRA 2014): its nodes
+are the grasps of the object's taxonomy (:mod:`.taxonomy`), its edges the regrasp actions
+(:mod:`.actions`): for each grasp that holds and each action that applies to it, ``trials``
+runs of the arm in MuJoCo (:mod:`.trial`) in worlds drawn within ``spread`` (the pads'
+friction, the grip force and the object's mass each ±spread; the object's start pose in the
+hand ±``shift`` [m] and ±``turn`` [rad] about the grasp axis); each run's outcome classified to
+the nearest grasp (or dropped / other). An edge carries the grasp the action is meant to reach
+(the model's prediction), the measured success rate (the share of runs that reached it) and the
+distribution of outcomes. Runs go in parallel over processes or a Ray cluster. The graph file
+(JSON, :class:`GraspGraph`: read and written here only) is documented in docs/grasp-graph.md."""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import signal
+import time
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ArgumentError
+from ..extras import need
+from ..files import write_text
+from .. import progress as bars
+
+FORMAT, VERSION = "regrasp-grasp-graph", 1
+TRIALS = 20  # runs per edge (the issue's minimum: ≥ 20 per edge)
+SPREAD = 0.2  # ±20 % on the pads' friction, the grip force and the object's mass
+SHIFT = 0.001  # m, ± on the object's start position in the hand (x and z)
+TURN = 0.035  # rad, ± on its start turn about the grasp axis (2°)
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How the graph is measured: ``trials`` per edge, ``seed``, the world's ``spread``,
+    ``shift`` [m], ``turn`` [rad] (see the module's doc), ``actions`` (names; None: all)."""
+
+    trials: int = TRIALS
+    seed: int = 0
+    spread: float = SPREAD
+    shift: float = SHIFT
+    turn: float = TURN
+    actions: tuple | None = None
+
+    def to_dict(self) -> dict:
+        """The settings as the graph file records them."""
+        return {"trials": self.trials, "seed": self.seed, "spread": self.spread, "shift": self.shift, "turn": self.turn,
+                "actions": None if self.actions is None else list(self.actions)}
+
+
+@dataclass
+class Edge:
+    """Runs of ``action`` from grasp ``source``: ``target`` the grasp it is meant to reach,
+    ``trials`` run, ``outcomes`` {outcome: count}, ``predicted`` the model's in-hand pose,
+    ``detail`` the action's parameters as set up, ``seconds`` of wall time."""
+
+    source: str
+    action: str
+    target: str | None
+    trials: int
+    outcomes: dict
+    detail: dict = field(default_factory=dict)
+    seconds: float = 0.0
+
+    @property
+    def success_rate(self) -> float:
+        """The share of the runs that reached ``target`` (0 without runs)."""
+        return self.outcomes.get(self.target, 0) / self.trials if self.trials else 0.0
+
+    def to_dict(self) -> dict:
+        """The edge as the graph file writes it (docs/grasp-graph.md)."""
+        return {"from": self.source, "to": self.target, "action": self.action, "success_rate": self.success_rate,
+                "trials": self.trials, "outcomes": dict(self.outcomes), "detail": self.detail, "seconds": self.seconds}
+
+    @classmethod
+    def from_dict(cls, d: dict, i: int) -> "Edge":
+        """The edge of a graph file's ``edges[i]`` ``d``; an ArgumentError naming the field."""
+        f = f"edges[{i}]"
+        try:
+            e = cls(str(d["from"]), str(d["action"]), None if d["to"] is None else str(d["to"]), int(d["trials"]),
+                    {str(k): int(v) for k, v in dict(d["outcomes"]).items()}, dict(d.get("detail", {})),
+                    float(d.get("seconds", 0.0)))
+        except (KeyError, TypeError, ValueError) as ex:
+            raise ArgumentError(f"invalid `{f}`: {ex!s} (an edge has from, to, action, trials, outcomes)", f) from None
+        if e.trials < 0 or sum(e.outcomes.values()) != e.trials:
+            raise ArgumentError(f"invalid `{f}.outcomes`: the counts must add up to `trials` ({e.trials})",
+                                f"{f}.outcomes")
+        return e
+
+
+@dataclass
+class GraspGraph:
+    """A measured grasp graph: the ``object`` (its name and file), the ``taxonomy``'s grasps
+    (nodes), the ``edges``, the ``actions`` measured and the ``settings``."""
+
+    object: dict
+    nodes: list
+    edges: list
+    actions: list
+    settings: dict
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict:
+        """The graph file's JSON (docs/grasp-graph.md)."""
+        return {"format": FORMAT, "version": VERSION, "object": self.object, "nodes": self.nodes,
+                "edges": [e.to_dict() for e in self.edges], "actions": self.actions, "settings": self.settings,
+                "seconds": self.seconds}
+
+    def save(self, path) -> Path:
+        """Writes the graph as JSON to ``path`` (atomically)."""
+        return write_text(Path(path), json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n")
+
+    @classmethod
+    def load(cls, path) -> "GraspGraph":
+        """The graph file ``path``; an ArgumentError naming the field of a bad file."""
+        try:
+            d = json.loads(Path(path).read_text())
+        except OSError as e:
+            raise ArgumentError(f"cannot read the grasp graph {str(path)!r}: {e.strerror}", "graph") from None
+        except json.JSONDecodeError as e:
+            raise ArgumentError(f"invalid grasp graph {str(path)!r}: not JSON ({e})", "graph") from None
+        return cls.from_dict(d)
+
+    @classmethod
+    def from_dict(cls, d) -> "GraspGraph":
+        """The graph of a graph file's JSON ``d``; an ArgumentError naming the field of a bad one."""
+        if not isinstance(d, dict) or d.get("format") != FORMAT:
+            raise ArgumentError(f"invalid `format`: a grasp graph file has \"format\": \"{FORMAT}\"", "format")
+        if d.get("version") != VERSION:
+            raise ArgumentError(f"invalid `version`: {d.get('version')!r} (this regrasp reads version {VERSION})", "version")
+        for key in ("object", "nodes", "edges", "actions", "settings"):
+            if key not in d:
+                raise ArgumentError(f"invalid `{key}`: is required", key)
+        if not isinstance(d["nodes"], list) or not all(isinstance(n, dict) and "name" in n for n in d["nodes"]):
+            raise ArgumentError("invalid `nodes`: a list of grasps, each with a `name`", "nodes")
+        names = {n["name"] for n in d["nodes"]}
+        edges = [Edge.from_dict(e, i) for i, e in enumerate(d["edges"])]
+        for i, e in enumerate(edges):
+            for key, v in (("from", e.source), ("to", e.target)):
+                if v is not None and v not in names:
+                    raise ArgumentError(f"invalid `edges[{i}].{key}`: {v!r} is not a node", f"edges[{i}].{key}")
+        return cls(dict(d["object"]), list(d["nodes"]), edges, list(d["actions"]), dict(d["settings"]),
+                   float(d.get("seconds", 0.0)))
+
+    @property
+    def node_names(self) -> list:
+        """The grasps' names, in the taxonomy's order."""
+        return [n["name"] for n in self.nodes]
+
+    def summary(self) -> dict:
+        """The ``--json`` form: nodes, edges (from, to, action, success_rate, trials, outcomes), actions."""
+        return {"nodes": self.nodes, "edges": [{k: v for k, v in e.to_dict().items() if k not in ("detail", "seconds")}
+                                               for e in self.edges], "actions": self.actions,
+                "trials": sum(e.trials for e in self.edges), "seconds": self.seconds}
+
+
+# --- measuring -----------------------------------------------------------------------------------
+
+
+def _ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+_CACHE: dict = {}
+
+
+def _object(path: str):
+    """(scene, taxonomy, ObjectModel) of an object file, once per process."""
+    if path not in _CACHE:
+        from .actions import ObjectModel
+        from .objects import load_object
+        from .taxonomy import taxonomy_of
+
+        scene = load_object(path)
+        tax = taxonomy_of(scene)
+        _CACHE[path] = (scene, tax, ObjectModel.of(scene, tax))
+    return _CACHE[path]
+
+
+def perturbations(settings: Settings, key: str) -> list:
+    """The ``settings.trials`` worlds of the edge ``key`` (the first nominal), drawn from a seed
+    made of ``settings.seed`` and ``key`` (an edge's worlds do not depend on the others)."""
+    from .world import Perturbation
+
+    rng = np.random.default_rng([settings.seed, zlib.crc32(key.encode())])
+    out = [Perturbation()]
+    while len(out) < settings.trials:
+        out.append(Perturbation.draw(rng, settings.spread, settings.shift, settings.turn))
+    return out[:settings.trials]
+
+
+def run_edge(job: tuple) -> Edge:
+    """Runs the trials of one edge: ``job`` = (object path, grasp name, action name, settings, robot)."""
+    from .actions import action
+    from .trial import Runner
+
+    path, grasp_name, action_name, settings, robot = job
+    scene, tax, obj = _object(path)
+    grasp = tax.grasp(grasp_name)
+    t0 = time.perf_counter()
+    setup = action(action_name).setup(obj, grasp)
+    runner = Runner(scene, tax, grasp, setup, robot)
+    outcomes: dict = {}
+    try:
+        for p in perturbations(settings, f"{grasp_name}/{action_name}"):
+            r = runner.run(p)
+            outcomes[r.outcome] = outcomes.get(r.outcome, 0) + 1
+    except ArgumentError as e:  # the arm cannot follow the action here (IK): no edge
+        return Edge(grasp_name, action_name, setup.intended, 0, {}, {"refused": str(e)}, time.perf_counter() - t0)
+    detail = {k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in setup.detail.items()}
+    return Edge(grasp_name, action_name, setup.intended, settings.trials, outcomes, detail, time.perf_counter() - t0)
+
+
+def edges_to_measure(obj, settings: Settings) -> list:
+    """(grasp name, action name) of every holding grasp and action that applies to it."""
+    from .actions import ACTIONS
+
+    names = list(ACTIONS) if settings.actions is None else list(settings.actions)
+    for n in names:
+        if n not in ACTIONS:
+            raise ArgumentError(f"invalid `actions`: unknown action {n!r} (known: {', '.join(ACTIONS)})", "actions")
+    out = []
+    for g in obj.taxonomy.grasps:
+        if not g.holds:
+            continue
+        for n in names:
+            if ACTIONS[n].applies(obj, g) is None:
+                out.append((g.name, n))
+    return out
+
+
+def _each(jobs: list, workers: int, ray_address, take) -> None:
+    if ray_address is not None:
+        ray = need("ray", "ray")
+        from ..sim.validation import _check_reachable
+
+        if not ray.is_initialized():
+            _check_reachable(ray_address)
+            ray.init(address=None if ray_address == "local" else ray_address, include_dashboard=False,
+                     log_to_driver=False, num_cpus=workers if ray_address == "local" else None)
+        remote = ray.remote(run_edge)
+        pending = [remote.remote(j) for j in jobs]
+        while pending:
+            done, pending = ray.wait(pending, num_returns=1)
+            take(ray.get(done[0]))
+    elif workers <= 1:
+        for j in jobs:
+            take(run_edge(j))
+    else:
+        with multiprocessing.get_context("spawn").Pool(workers, initializer=_ignore_sigint) as pool:
+            for e in pool.imap_unordered(run_edge, jobs):
+                take(e)
+
+
+def build_graph(path, settings: Settings = Settings(), workers: int = 1, ray_address: str | None = None,
+                robot: str | None = None, progress: bool = False) -> GraspGraph:
+    """Measures the grasp graph of the object file ``path`` (see the module's doc)."""
+    from .actions import ACTIONS
+
+    if not (isinstance(settings.trials, int) and settings.trials >= 1):
+        raise ArgumentError(f"invalid `trials`: an integer >= 1 (got {settings.trials!r})", "trials")
+    if not (isinstance(workers, int) and workers >= 1):
+        raise ArgumentError(f"invalid `workers`: an integer >= 1 (got {workers!r})", "workers")
+    path = str(Path(path).resolve())
+    scene, tax, obj = _object(path)
+    todo = edges_to_measure(obj, settings)
+    jobs = [(path, g, a, settings, robot) for g, a in todo]
+    edges: list = []
+    t0 = time.perf_counter()
+    with bars.bar(len(jobs) * settings.trials, f"grasp graph ({scene.name})", unit="trial", show=progress) as bar:
+        def take(e: Edge) -> None:
+            edges.append(e)
+            bar.update(settings.trials)
+
+        _each(jobs, workers, ray_address, take)
+    order = {j[1:3]: i for i, j in enumerate(jobs)}
+    edges.sort(key=lambda e: order[(e.source, e.action)])
+    used = sorted({e.action for e in edges})
+    return GraspGraph({"name": scene.name, "file": path}, [g.to_dict() for g in tax.grasps], edges,
+                      [ACTIONS[a].to_dict() for a in used], settings.to_dict(), time.perf_counter() - t0)

@@ -1,0 +1,72 @@
+"""An object for the grasp graph: a 3-D scene file (docs/scene-file.md) of which the
+``[object]``, ``[grasp]`` and ``[gravity]`` tables are read; its ``[[pushers]]`` and ``[task]``
+are optional (a task is required by :meth:`regrasp.Scene3D.load`: without one, the object is
+loaded with a still one at the origin, which nothing here uses). The bundled objects
+(:data:`OBJECTS`): the thesis' triangular prism, a cylinder and a box."""
+
+from __future__ import annotations
+
+import tomllib
+from importlib.resources import files
+from pathlib import Path
+
+from ..errors import SceneError
+
+OBJECTS = ("prism", "cylinder", "box")  # examples/objects/NAME.toml
+STILL_TASK = "\n[task]\nstart = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]\ngoal = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]\n" \
+             "tolerance = [0.001, 0.001, 0.001, 0.0175]\n"
+
+
+PLACEHOLDER = "_unused"  # the name of the pusher added to an object file without one (the loader needs one)
+
+
+def _placeholder(data: dict, base: Path) -> str:
+    """A ``[[pushers]]`` table at a point of the object's surface (a box's face centre, a
+    sphere's pole, a mesh's first vertex): :meth:`regrasp.Scene3D.load` needs one pusher; the
+    grasp graph uses none."""
+    obj = data.get("object", {})
+    try:
+        if obj.get("shape") == "box":
+            point = [float(obj["size"][0]) / 2, 0.0, 0.0]
+        elif obj.get("shape") == "sphere":
+            point = [float(obj["radius"]), 0.0, 0.0]
+        else:
+            line = next(x for x in (base / obj["mesh"]).read_text().splitlines() if x.startswith("v "))
+            point = [float(c) for c in line.split()[1:4]]
+    except (KeyError, TypeError, ValueError, IndexError, OSError, StopIteration):
+        return ""  # the loader names what is wrong with the object table
+    normal = [-c for c in point]  # into the object (its frame's origin inside it)
+    return f"\n[[pushers]]\nname = \"{PLACEHOLDER}\"\nfriction = 0.0\npoints = [{point}]\nnormal = {normal}\n"
+
+
+def object_path(name: str) -> Path:
+    """The path of bundled object ``name`` (:data:`OBJECTS`)."""
+    return Path(str(files("regrasp") / "examples" / "objects" / f"{name}.toml"))
+
+
+def load_object(path):
+    """The :class:`regrasp.Scene3D` of the object file ``path`` (or a bundled object's name),
+    its task optional; a SceneError naming the field for a bad file (``dimension`` when it is
+    not a 3-D scene)."""
+    from ..scene.spatial import Scene3D
+
+    if isinstance(path, str) and path in OBJECTS:
+        path = object_path(path)
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as e:
+        raise SceneError(f"cannot read the object file {str(path)!r}: {e.strerror}", "(file)") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(f"scene field `(toml)`: {e}", "(toml)") from None
+    if data.get("dimension") != 3:
+        raise SceneError("scene field `dimension`: the grasp graph needs a 3-D scene (`dimension = 3`)", "dimension")
+    if not data.get("pushers"):
+        text += _placeholder(data, path.parent)
+    if "task" not in data:
+        text += STILL_TASK
+    scene = Scene3D.from_toml(text, path.parent)
+    scene.path = path
+    return scene

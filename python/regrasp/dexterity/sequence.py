@@ -1,0 +1,142 @@
+"""Planning on the grasp graph (networkx): the most reliable sequence of regrasp actions between
+two grasps — the path of maximum product of measured transition probabilities (Dijkstra on
+−log p) — or the one of fewest expected attempts (Σ 1/p: each action retried until it succeeds,
+a failure assumed to leave the grasp as it was). Every observed outcome of an (action, grasp)
+is a transition, not only the intended one: an action that lands somewhere useful by a
+different route counts. :func:`execute` runs a sequence end to end in MuJoCo, the arm moving
+from one action's end to the next one's start with the grip firm."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ArgumentError
+from ..extras import need
+from .graph import GraspGraph
+from .trial import DROPPED, OTHER
+
+OBJECTIVES = ("reliable", "expected")
+TRANSFER_SPEED = 0.25  # m/s, the hand's move between two actions (and 1 rad/s turning)
+
+
+@dataclass(frozen=True)
+class Step:
+    """One action of a sequence: from grasp ``source`` by ``action`` to ``target`` with measured
+    probability ``p`` (``trials`` runs)."""
+
+    source: str
+    action: str
+    target: str
+    p: float
+    trials: int
+
+    def to_dict(self) -> dict:
+        """The step as JSON."""
+        return {"from": self.source, "action": self.action, "to": self.target, "p": self.p, "trials": self.trials}
+
+
+@dataclass(frozen=True)
+class Sequence:
+    """A planned sequence: its ``steps``, the predicted ``probability`` that it all succeeds (the
+    product of the steps' p) and the ``expected_actions`` (Σ 1/p)."""
+
+    steps: tuple
+    probability: float
+    expected_actions: float
+
+    def to_dict(self) -> dict:
+        """The sequence as JSON (``regrasp regrasp-sequence --json``)."""
+        return {"steps": [s.to_dict() for s in self.steps], "probability": self.probability,
+                "expected_actions": self.expected_actions}
+
+
+def transitions(graph: GraspGraph):
+    """The networkx DiGraph of the best transition between each pair of grasps: edge attributes
+    ``action``, ``p`` (measured share of runs), ``trials``."""
+    nx = need("networkx", "robot")
+    G = nx.DiGraph()
+    G.add_nodes_from(graph.node_names)
+    for e in graph.edges:
+        for outcome, count in e.outcomes.items():
+            if outcome in (DROPPED, OTHER) or outcome == e.source or count == 0 or e.trials == 0:
+                continue
+            p = count / e.trials
+            if not G.has_edge(e.source, outcome) or G[e.source][outcome]["p"] < p:
+                G.add_edge(e.source, outcome, action=e.action, p=p, trials=e.trials)
+    return G
+
+
+def plan(graph: GraspGraph, start: str, goal: str, objective: str = "reliable") -> Sequence:
+    """The best sequence from grasp ``start`` to ``goal`` (``objective``: ``reliable`` or
+    ``expected``, :data:`OBJECTIVES`); an ArgumentError naming ``from``/``to`` for an unknown
+    grasp, ``objective`` for an unknown objective, and one naming ``to`` when no sequence of
+    measured transitions reaches it."""
+    nx = need("networkx", "robot")
+    for field_, name in (("from", start), ("to", goal)):
+        if name not in graph.node_names:
+            raise ArgumentError(f"invalid `{field_}`: {name!r} is not a grasp of the graph "
+                                f"(grasps: {', '.join(graph.node_names)})", field_)
+    if objective not in OBJECTIVES:
+        raise ArgumentError(f"invalid `objective`: {objective!r} (known: {', '.join(OBJECTIVES)})", "objective")
+    G = transitions(graph)
+    weight = (lambda u, v, d: -math.log(d["p"])) if objective == "reliable" else (lambda u, v, d: 1.0 / d["p"])
+    try:
+        nodes = nx.dijkstra_path(G, start, goal, weight=weight)
+    except nx.NetworkXNoPath:
+        raise ArgumentError(f"invalid `to`: no sequence of measured regrasps reaches {goal!r} from {start!r}",
+                            "to") from None
+    steps = tuple(Step(u, G[u][v]["action"], v, float(G[u][v]["p"]), int(G[u][v]["trials"]))
+                  for u, v in zip(nodes, nodes[1:]))
+    return Sequence(steps, float(np.prod([s.p for s in steps])) if steps else 1.0, float(sum(1 / s.p for s in steps)))
+
+
+@dataclass(frozen=True)
+class SequenceRun:
+    """One execution: the grasp reached after each step (``outcomes``), ``success`` (every step
+    reached its target)."""
+
+    outcomes: tuple
+    success: bool
+
+    def to_dict(self) -> dict:
+        """The run as JSON."""
+        return {"outcomes": list(self.outcomes), "success": self.success}
+
+
+def execute(path, sequence: Sequence, perturbation=None, robot: str | None = None, observe=None) -> SequenceRun:
+    """Runs ``sequence`` on the object file ``path`` in MuJoCo, open loop: the world built at the
+    first grasp and the first action's start; before each later action the hand moves to its
+    start (:data:`TRANSFER_SPEED`, grip firm); each action set up for the grasp the plan expects
+    there. Stops at the first step that misses its target."""
+    from .actions import action
+    from .graph import _object
+    from .trial import classify
+    from .world import HandPath, HandWorld, Perturbation, constant, solve_path
+
+    scene, tax, obj = _object(str(path))
+    if not sequence.steps:
+        return SequenceRun((), True)
+    p = perturbation or Perturbation()
+    first = action(sequence.steps[0].action).setup(obj, tax.grasp(sequence.steps[0].source))
+    world = HandWorld(scene, tax.grasp(sequence.steps[0].source).pose, first.start, p, robot)
+    outcomes = []
+    for i, step in enumerate(sequence.steps):
+        setup = first if i == 0 else action(step.action).setup(obj, tax.grasp(step.source))
+        if i > 0:
+            here = world.robot.tcp_pose()
+            dist = float(np.linalg.norm(here[:3] - setup.start[:3]))
+            from ..pose import quat_angle
+
+            T = max(0.5, dist / TRANSFER_SPEED, quat_angle(here[3:], setup.start[3:]) / 1.0)
+            move = HandPath.line(here, setup.start, T)
+            world.follow(move, solve_path(world.robot, move, world.robot.q), constant(obj.grip), 0.2, observe)
+        q = solve_path(world.robot, setup.path, world.robot.q)
+        world.follow(setup.path, q, setup.grip, setup.settle, observe)
+        outcome = classify(world, tax)[0]
+        outcomes.append(outcome)
+        if outcome != step.target:
+            return SequenceRun(tuple(outcomes), False)
+    return SequenceRun(tuple(outcomes), True)
