@@ -31,6 +31,7 @@ TRIALS = 20  # runs per edge (the issue's minimum: ≥ 20 per edge)
 SPREAD = 0.2  # ±20 % on the pads' friction, the grip force and the object's mass
 SHIFT = 0.001  # m, ± on the object's start position in the hand (x and z)
 TURN = 0.035  # rad, ± on its start turn about the grasp axis (2°)
+FIT = 0.0005  # m, a grasp fits the hand when the object stays this far from the gripper's links besides the pads
 
 
 @dataclass(frozen=True)
@@ -214,21 +215,34 @@ def run_edge(job: tuple) -> Edge:
     return Edge(grasp_name, action_name, setup.intended, settings.trials, outcomes, detail, time.perf_counter() - t0)
 
 
-def edges_to_measure(obj, settings: Settings) -> list:
-    """(grasp name, action name) of every holding grasp and action that applies to it."""
+def fitting(scene, taxonomy, robot: str | None = None) -> dict:
+    """{grasp name: clearance [m]} of the grasps whose object stays :data:`FIT` clear of the
+    gripper's links (:func:`~.world.hand_clearances`)."""
+    from .world import hand_clearances
+
+    return {k: v[0] for k, v in hand_clearances(scene, taxonomy.grasps, robot).items()}
+
+
+def edges_to_measure(obj, settings: Settings, clear: dict | None = None) -> list:
+    """(grasp name, action name) of every grasp that holds (and fits the hand: ``clear``
+    {name: clearance [m]}, :func:`fitting`) and every action that applies to it and is meant to
+    reach a grasp that fits too."""
     from .actions import ACTIONS
 
     names = list(ACTIONS) if settings.actions is None else list(settings.actions)
     for n in names:
         if n not in ACTIONS:
             raise ArgumentError(f"invalid `actions`: unknown action {n!r} (known: {', '.join(ACTIONS)})", "actions")
+    fits = (lambda name: True) if clear is None else (lambda name: clear[name] >= FIT)  # noqa: E731
     out = []
     for g in obj.taxonomy.grasps:
-        if not g.holds:
+        if not (g.holds and fits(g.name)):
             continue
         for n in names:
             if ACTIONS[n].applies(obj, g) is None:
-                out.append((g.name, n))
+                target = ACTIONS[n].setup(obj, g).intended
+                if target is not None and target != g.name and fits(target):
+                    out.append((g.name, n))
     return out
 
 
@@ -266,7 +280,8 @@ def build_graph(path, settings: Settings = Settings(), workers: int = 1, ray_add
         raise ArgumentError(f"invalid `workers`: an integer >= 1 (got {workers!r})", "workers")
     path = str(Path(path).resolve())
     scene, tax, obj = _object(path)
-    todo = edges_to_measure(obj, settings)
+    clear = fitting(scene, tax, robot)
+    todo = edges_to_measure(obj, settings, clear)
     jobs = [(path, g, a, settings, robot) for g, a in todo]
     edges: list = []
     t0 = time.perf_counter()
@@ -279,5 +294,6 @@ def build_graph(path, settings: Settings = Settings(), workers: int = 1, ray_add
     order = {j[1:3]: i for i, j in enumerate(jobs)}
     edges.sort(key=lambda e: order[(e.source, e.action)])
     used = sorted({e.action for e in edges})
-    return GraspGraph({"name": scene.name, "file": path}, [g.to_dict() for g in tax.grasps], edges,
+    nodes = [{**g.to_dict(), "clearance": clear[g.name], "fits": clear[g.name] >= FIT} for g in tax.grasps]
+    return GraspGraph({"name": scene.name, "file": path}, nodes, edges,
                       [ACTIONS[a].to_dict() for a in used], settings.to_dict(), time.perf_counter() - t0)

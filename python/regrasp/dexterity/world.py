@@ -305,3 +305,32 @@ def solve_path(robot, path: HandPath, q0) -> np.ndarray:
     from ..robot.ik import ik_path
 
     return ik_path(robot, path.poses, q0)
+
+
+def hand_clearances(scene, grasps, robot: str | None = None) -> dict:
+    """{grasp name: (m, gripper body)}: how far the object at each grasp (``grasps``, of
+    ``scene``'s taxonomy) stays from the gripper's body besides the pads (negative: inside it;
+    :func:`regrasp.execution.arm.clearance`), the fingers closed at its width. A grasp whose
+    object would go into the 2F-85's links above the pads (a wide object held deep) cannot be
+    taken: the grasp graph leaves it out. One robot model per grasp width."""
+    from ..execution.arm import clearance, grasp_of
+    from ..mujoco.spatial import add_object3d
+    from ..robot.grip import close_fingers
+    from ..robot.model import DEFAULT_ROBOT, build
+    from ..robot.pads import Pads
+
+    v, t = scene.mesh()
+    mesh = (np.asarray(v, float), np.asarray(t, int))
+    models: dict = {}
+    out = {}
+    for g in grasps:
+        width = round(grasp_of(scene, g.pose)[0], 9)
+        if width not in models:
+            r = build(robot or DEFAULT_ROBOT, pads=Pads.of_scene(scene), pad_friction=float(scene._core.grip_friction),
+                      grasp_width=width, add=lambda spec: add_object3d(spec, scene, np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]), mesh, 1.0))
+            close_fingers(r)
+            models[width] = r
+        r = models[width]
+        dist, _, part = clearance(r, r.tcp_pose(), [g.pose])
+        out[g.name] = (dist, part)
+    return out

@@ -220,6 +220,15 @@ def hand_clearance(robot, motion: WorldMotion, tcp) -> tuple[float, int, str]:
     raises the object far enough towards the palm runs it into the housing (pivot-3d's lift),
     which no feature and no arm motion can avoid. (The arm's wrist, behind the gripper's base,
     is not checked: an object would meet the base first.)"""
+    return clearance(robot, P.compose(robot.tcp_pose(), P.inverse(tcp)), motion.in_hand)
+
+
+def clearance(robot, frame, in_hand) -> tuple[float, int, str]:
+    """(m, index, body): the smallest signed distance (``mj_geomDistance``, negative inside) from
+    the object (body ``object``) at each of the poses ``in_hand`` (n, 7) in the world frame
+    ``frame`` (7,) to the gripper's body (its colliding geoms but the pads'), the fingers as they
+    are in ``robot``'s data; the pose where it is smallest and the gripper body; (inf, 0, "")
+    when farther than :data:`HAND_REACH` (:func:`hand_clearance`)."""
     mujoco = need("mujoco", "robot")
     from ..robot.model import GRIPPER_PREFIX
 
@@ -232,9 +241,8 @@ def hand_clearance(robot, motion: WorldMotion, tcp) -> tuple[float, int, str]:
     obj = [g for g in range(m.ngeom) if m.geom_bodyid[g] == body]
     hand = [g for g in robot.robot_geoms if m.geom_bodyid[g] not in pads
             and mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g])).startswith(GRIPPER_PREFIX)]
-    frame = P.compose(robot.tcp_pose(), P.inverse(tcp))
     best, at, part, last = np.inf, 0, "", None
-    for i, h in enumerate(motion.in_hand):
+    for i, h in enumerate(np.asarray(in_hand, float)):
         if last is not None and np.max(np.abs(h - last)) < 1e-7:
             continue  # the object still in the hand where it was last checked
         last = h
