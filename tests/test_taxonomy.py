@@ -292,7 +292,8 @@ def test_grasp_from_a_bad_dict_names_the_field(key, value):
 def test_taxonomy_of_a_scene():
     scene = regrasp.Scene3D.load(EXAMPLES / "block-3d.toml")  # a 50 x 12 x 80 mm box, 0.13 kg, 20 N, μ 0.6
     a = taxonomy_of(scene)
-    b = taxonomy(box_vertices([0.05, 0.012, 0.08]), 0.13, np.zeros(3), 20.0, 0.6)
+    b = taxonomy(box_vertices([0.05, 0.012, 0.08]), 0.13, np.zeros(3), 20.0, 0.6,
+                 pad=T.pad_disc(float(scene._core.pad_radius)))  # the scene's pad, a disc
     assert [g.to_dict() for g in a.grasps] == [g.to_dict() for g in b.grasps] and len(a.grasps) == 18
     assert len(taxonomy_of(scene, offsets=(0.0,)).grasps) == 6
 
@@ -330,3 +331,18 @@ def test_bad_lookups_name_the_field():
     with pytest.raises(ArgumentError) as e:
         tax(BOX, width_range=(0.0, 0.01)).nearest(t.grasps[0].pose)
     assert e.value.field == "taxonomy"
+
+
+def test_a_disc_pad_has_the_torsion_radius_of_a_uniform_disc():
+    # k = 2/3 r for a uniformly pressed disc; the 64-gon is within 0.2 % of it
+    r = 0.006
+    t = taxonomy(box_vertices([0.05, 0.03, 0.08]), MASS, np.zeros(3), FORCE, MU, pad=T.pad_disc(r))
+    centred = [g for g in t.grasps if abs(g.offset) < 1e-12]
+    assert centred and all(g.torsion_k == pytest.approx(2 / 3 * r, rel=2e-3) for g in centred)
+    assert all(g.patch_area == pytest.approx(np.pi * r * r, rel=2e-3) for g in centred)
+
+
+def test_a_bad_pad_is_refused():
+    with pytest.raises(ArgumentError) as e:
+        taxonomy(CUBE, MASS, np.zeros(3), FORCE, MU, pad=[[0, 0], [1, 0]])
+    assert e.value.field == "pad"

@@ -34,7 +34,7 @@ A flat pad touches only the object's convex hull, so the grasps are those of the
 from __future__ import annotations
 
 import numbers
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -114,6 +114,7 @@ class Taxonomy:
     vertices: np.ndarray
     faces: tuple
     grasps: tuple
+    pad: np.ndarray = field(default_factory=lambda: PAD.copy())
 
     def grasp(self, name: str) -> Grasp:
         """The grasp ``name``, or an ArgumentError naming ``grasp``."""
@@ -150,23 +151,26 @@ class Taxonomy:
         if len(region) < 3:
             raise ArgumentError(f"invalid `grasp`: {grasp.name}'s faces {grasp.faces} do not face each other "
                                 "at its pose", "grasp")
-        patch = _patch(region, eps)
+        patch = _patch(region, eps, self.pad)
         return _centroid(patch if len(patch) else region)
 
 
 def taxonomy(vertices, mass: float, com, grip_force: float, friction: float, gravity: float = 9.81,
-             width_range=WIDTH_RANGE, offsets=OFFSETS) -> Taxonomy:
+             width_range=WIDTH_RANGE, offsets=OFFSETS, pad=None) -> Taxonomy:
     """The grasp taxonomy (see the module's doc) of the object with ``vertices`` (n ≥ 4, 3) [m],
     ``mass`` [kg], centre of mass ``com`` (3,) [m] (object frame), held at ``grip_force`` [N]
     per pad with the pads' ``friction`` μ under ``gravity`` [m/s²]; pad widths within
-    ``width_range`` (m, m), the region's centroid at z = f h for f in ``offsets`` (in (−½, ½)).
-    An ArgumentError naming the argument at fault."""
+    ``width_range`` (m, m), the region's centroid at z = f h for f in ``offsets`` (in (−½, ½));
+    ``pad``: the pad's face (k, 2) (x, z) [m] in the TCP frame, convex, counter-clockwise (default
+    the 2F-85's whole face, :data:`PAD`; :func:`pad_disc` for a rubber tip). An ArgumentError
+    naming the argument at fault."""
     V = _check_vertices(vertices)
     weight = _number(mass, "mass") * _number(gravity, "gravity", 0.0, True)
     grip, mu = _number(grip_force, "grip_force"), _number(friction, "friction")
     com = _check_com(com)
     lo, hi = _check_width_range(width_range)
     fractions = _check_offsets(offsets)
+    pad = PAD.copy() if pad is None else _check_pad(pad)
     faces, V = _hull(V)
     eps = TOLERANCE * _size(V)
     kept: list = []
@@ -179,12 +183,14 @@ def taxonomy(vertices, mass: float, com, grip_force: float, friction: float, gra
                 near = [k["placed"] for k in kept if np.all(np.abs(k["box"] - box) < eps)]
                 if not near or np.min(_hausdorff(np.array(near), placed)) >= eps:
                     kept.append(dict(c, placed=placed, box=box, pair=pair))
-    return Taxonomy(V, faces, tuple(_grasp(f"g{i}", c, com, weight, mu, grip, eps) for i, c in enumerate(kept)))
+    return Taxonomy(V, faces, tuple(_grasp(f"g{i}", c, com, weight, mu, grip, eps, pad) for i, c in enumerate(kept)), pad)
 
 
 def taxonomy_of(scene, **kw) -> Taxonomy:
     """The taxonomy of a :class:`regrasp.Scene3D`'s object (its mesh, mass, centre of mass, grip
-    force, pad friction and gravity's norm); ``kw``: :func:`taxonomy`'s ``width_range``, ``offsets``."""
+    force, pad friction, gravity's norm and pad: a disc of its ``pad_radius``, :func:`pad_disc`);
+    ``kw``: :func:`taxonomy`'s ``width_range``, ``offsets``, ``pad``."""
+    kw.setdefault("pad", pad_disc(float(scene._core.pad_radius)))
     return taxonomy(np.asarray(scene.mesh()[0], float), float(scene.mass), np.asarray(scene._core.com, float),
                     float(scene._core.grip_force), float(scene._core.grip_friction),
                     float(np.linalg.norm(scene._core.gravity)), **kw)
@@ -278,19 +284,19 @@ def _candidates(faces, V, pair: tuple, fractions: tuple, eps: float):
                        "pose": np.r_[t, turn[3:]], "region": r + t[[0, 2]]}
 
 
-def _grasp(name: str, c: dict, com, weight: float, mu: float, grip: float, eps: float) -> Grasp:
+def _grasp(name: str, c: dict, com, weight: float, mu: float, grip: float, eps: float, pad=PAD) -> Grasp:
     """The :class:`Grasp` of candidate ``c``, its hold checked."""
-    holds, margin, k, area = _hold(c["region"], P.transform(c["pose"], com), weight, mu, grip, eps)
+    holds, margin, k, area = _hold(c["region"], P.transform(c["pose"], com), weight, mu, grip, eps, pad)
     label = f"faces {c['pair'][0]}|{c['pair'][1]}, edge {c['edge']} to {c['side']}, offset {c['offset'] * 1e3:+.1f} mm"
     return Grasp(name, label, tuple(c["pair"]), c["angle"], float(c["offset"]), float(c["width"]), c["pose"],
                  holds, margin, k, area)
 
 
-def _hold(region, com, weight: float, mu: float, grip: float, eps: float) -> tuple:
+def _hold(region, com, weight: float, mu: float, grip: float, eps: float, pad=PAD) -> tuple:
     """(holds, margin, k [m], patch area [m²]) of the contact ``region`` (k, 2) (TCP x, z) with
     the centre of mass at ``com`` (3,) (TCP frame), ``weight`` m g [N]: margin = 1 − (m g / 2μN)
     √(1 + (d/k)²) (see the module's doc); −1 when the patch is negligible."""
-    patch = _patch(region, eps)
+    patch = _patch(region, eps, pad)
     if not len(patch):
         return False, -1.0, 0.0, 0.0
     area, c = _area(patch), _centroid(patch)
@@ -309,11 +315,27 @@ def _region(faces, pair, pose, eps: float) -> np.ndarray:
     return _clean(_clip(a, b), eps)
 
 
-def _patch(region, eps: float) -> np.ndarray:
-    """The pad's patch (k, 2) [m] of ``region``: its part on the pad's face; empty (0, 2) when
-    that is smaller than :data:`NEGLIGIBLE` of the face."""
-    patch = _clean(_clip(region, PAD), eps)
-    return patch if len(patch) and _area(patch) > NEGLIGIBLE * _area(PAD) else np.zeros((0, 2))
+def _patch(region, eps: float, pad=PAD) -> np.ndarray:
+    """The pad's patch (k, 2) [m] of ``region``: its part on the pad's face ``pad``; empty (0, 2)
+    when that is smaller than :data:`NEGLIGIBLE` of the face."""
+    patch = _clean(_clip(region, pad), eps)
+    return patch if len(patch) and _area(patch) > NEGLIGIBLE * _area(pad) else np.zeros((0, 2))
+
+
+def pad_disc(radius: float, sides: int = 64) -> np.ndarray:
+    """A rubber tip's face: the disc of ``radius`` [m] at the pad's centre (a ``sides``-gon, the
+    2F-85's face clipped to it), (k, 2) (x, z) [m], counter-clockwise — the pad of a 3-D scene
+    (``grasp.pad_radius``), as the simulated pads (:meth:`regrasp.robot.pads.Pads.of_scene`)."""
+    a = 2 * np.pi * np.arange(sides) / sides
+    return _clip(radius * np.column_stack([np.cos(a), np.sin(a)]), PAD)
+
+
+def _check_pad(pad) -> np.ndarray:
+    p = _array(pad, "pad", "a convex polygon (k >= 3, 2) [m], counter-clockwise")
+    if p.ndim != 2 or p.shape[1] != 2 or len(p) < 3 or not np.all(np.isfinite(p)) or signed_area(p) <= 0:
+        raise ArgumentError(f"invalid `pad`: a convex polygon (k >= 3, 2) [m], counter-clockwise (got shape "
+                            f"{p.shape})", "pad")
+    return p
 
 
 def _flat(p) -> np.ndarray:
