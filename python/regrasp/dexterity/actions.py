@@ -40,7 +40,14 @@ DEFAULTS = {
     "press_hold": 1.5,  # push-down and table-pivot: 2 μ N / m g while the table pushes
     "approach": 0.02,   # m, push-down and table-pivot: the object's lowest point above the table at the start
     "speed": 0.03,      # m/s, push-down: the hand's descent
+    "drop": 0.002,      # m, place-repick: the object's face above the table when the fingers open
+    "clear": 0.06,      # m, place-repick: the hand's retreat and approach along its fingers
+    "close_time": 1.0,  # s, place-repick: the fingers close on the object on the table this long before the lift
 }
+MAX_PLACE_TILT = np.radians(90.0) + 1e-9  # rad, place-repick: the hand placing at most this far from fingers-down (level)
+MAX_PICK_TILT = np.radians(45.0)  # rad, place-repick: the hand picking at most this far from fingers-down
+FINGER_ROOM = 0.008  # m, place-repick: the pads' lowest corner at least this far above the table (the IK keeps 5 mm)
+TARGETS = 4  # place-repick: at most this many new grasps per grasp (other faces first)
 
 
 @dataclass(frozen=True)
@@ -224,6 +231,9 @@ class Action:
 def _params(params: dict | None) -> dict:
     p = dict(DEFAULTS)
     for k, v in (params or {}).items():
+        if k == "target":
+            p[k] = v
+            continue
         if k not in DEFAULTS:
             raise ArgumentError(f"invalid `params.{k}`: unknown parameter (known: {', '.join(DEFAULTS)})", f"params.{k}")
         if not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
@@ -359,14 +369,14 @@ class GripPivot(Action):
         times = np.linspace(0.0, 2 * RAMP + T, int(np.ceil((2 * RAMP + T) / 0.01)) + 1)
         poses = np.array([hand_pose(angle(t)) for t in times])
         return Setup(poses[0], HandPath(times, poses), grip, 0.3, pose, _intended(obj, pose),
-                     {"alpha": alpha0, "sweep": float(sweep), "grip": low, "turn": slip.turn, "target": target})
+                     {"alpha": alpha0, "sweep": float(sweep), "grip": low, "turn": slip.turn, "target_turn": target})
 
 
 class InertialSlide(Action):
     """Fingers down, the grip lowered to ``jab_hold`` times the holding force, the hand jabs
     downwards at ``acceleration`` (> g): in the hand the object feels m (a − g) towards the
-    palm, more than the pads' 2 μ N, and slides deeper; then the grip comes back and the hand
-    stops at ``braking``. The jab's length from the slip model, for one offset step."""
+    palm, more than the pads' 2 μ N, and slides deeper; the hand coasts while the grip comes
+    back, then stops at ``braking``. The jab's length from the slip model, for one offset step."""
 
     def __init__(self):
         super().__init__("inertial-slide", "inertia", "slide deeper into the hand by a downward jab of the arm")
@@ -376,10 +386,12 @@ class InertialSlide(Action):
 
     @staticmethod
     def _run(obj, p, jab: float):
+        """(duration [s], hand(t), grip(t)) of a jab of ``jab`` [s]: the grip lowered (RAMP), the
+        jab, a coast at the jab's speed while the grip comes back (RAMP), the braking."""
         a, b = p["acceleration"], p["braking"]
         v = a * jab
         stop = v / b
-        T = RAMP + jab + stop
+        T = RAMP + jab + RAMP + stop
         top = np.array([WORK_POINT[0], WORK_POINT[2] + 0.05])
 
         def down(t: float) -> float:  # the hand's descent [m] at time t
@@ -388,8 +400,9 @@ class InertialSlide(Action):
                 return 0.0
             if t <= jab:
                 return 0.5 * a * t * t
-            u = min(t - jab, stop)
-            return 0.5 * a * jab * jab + v * u - 0.5 * b * u * u
+            coast = min(t - jab, RAMP)
+            u = min(max(t - jab - RAMP, 0.0), stop)
+            return 0.5 * a * jab * jab + v * (coast + u) - 0.5 * b * u * u
 
         low = obj.holding(p["jab_hold"])
         grip = ramps((0.0, obj.grip), (RAMP, low), (RAMP + jab, low), (2 * RAMP + jab, obj.grip))
@@ -496,7 +509,121 @@ class TablePivot(Action):
         return Setup(path.poses[0], path, grip, 0.3, pose, _intended(obj, pose), {"turn": float(target), "grip": low})
 
 
-ACTIONS = {a.name: a for a in (GravityPivot(), GravitySlide(), GripPivot(), InertialSlide(), PushDown(), TablePivot())}
+class PlaceRepick(Action):
+    """Place the object on the table and pick it again with another grasp: the hand turns about
+    the grasp axis (at most until its fingers are level) so that a face of the object's hull on which it
+    rests stably (its centre of mass over the face) looks straight down, lowers it to ``drop``
+    above the table, opens, retreats ``clear`` along its fingers, comes down over the object
+    at the new grasp's pose (the object where it was let go) and closes on it for
+    ``close_time``, then lifts. The new grasp (``params["target"]``): one of :meth:`targets`."""
+
+    def __init__(self):
+        super().__init__("place-repick", "contact", "place on the table and pick again with another grasp")
+
+    def placing(self, obj, grasp) -> Optional[tuple]:
+        """(hand angle α [rad], the TCP's height above the table [m] with the face on it) of the
+        stable face nearest to straight down, or None."""
+        from ..robot.pads import HALF_WIDTH, LENGTH
+
+        V = P.transform(grasp.pose, obj.taxonomy.vertices)
+        com = P.transform(grasp.pose, obj.com)
+        best = None
+        for f in obj.taxonomy.faces:
+            n = P.quat_rotate(grasp.pose[3:], f.normal)
+            if abs(n[1]) > 1e-6:
+                continue  # not parallel to the grasp axis: the hand's turn cannot put it level
+            alpha = float(np.angle(np.exp(1j * (-np.pi / 2 - np.arctan2(n[2], n[0])))))
+            if abs(alpha) > MAX_PLACE_TILT:
+                continue
+            poly = P.transform(grasp.pose, f.polygon)
+            h = float(np.max(V @ n))  # the face's plane: p · n = h
+            if not _over(com, poly, n):
+                continue  # it would topple
+            R = P.quat_matrix(hand_pose(alpha)[3:])
+            corners = np.array([[x, 0.0, z] for x in (-HALF_WIDTH, HALF_WIDTH) for z in (-LENGTH / 2, LENGTH / 2)])
+            if h + float(np.min((corners @ R.T)[:, 2])) < FINGER_ROOM:
+                continue  # the fingers would reach the table first
+            if best is None or abs(alpha) < abs(best[0]):
+                best = (alpha, h)
+        return best
+
+    def targets(self, obj, grasp, usable=None) -> list:
+        """The new grasps (names) reachable from above once the object rests where
+        :meth:`placing` puts it (the fingers within 45° of down, the pads above the table), other
+        faces first, at most :data:`TARGETS`; ``usable``: the names allowed (default all)."""
+        from ..robot.pads import HALF_WIDTH, LENGTH
+
+        place = self.placing(obj, grasp)
+        if place is None:
+            return []
+        alpha, h = place
+        resting = P.compose(hand_pose(alpha, (0.0, 0.0, h)), grasp.pose)  # the object on the table (z = 0)
+        out = []
+        for g in obj.taxonomy.grasps:
+            if g.name == grasp.name or (usable is not None and g.name not in usable):
+                continue
+            tcp = P.compose(resting, P.inverse(g.pose))
+            R = P.quat_matrix(tcp[3:])
+            if R[2, 2] < np.cos(MAX_PICK_TILT):
+                continue
+            corners = np.array([[x, y, z] for x in (-HALF_WIDTH, HALF_WIDTH) for y in (-g.width / 2, g.width / 2)
+                                for z in (-LENGTH / 2, LENGTH / 2)])
+            if tcp[2] + float(np.min((corners @ R.T)[:, 2])) < FINGER_ROOM:
+                continue
+            out.append((g.faces == grasp.faces, -R[2, 2], g.name))
+        return [name for *_, name in sorted(out)[:TARGETS]]
+
+    def applies(self, obj, grasp):
+        if self.placing(obj, grasp) is None:
+            return "no face to rest on with the fingers at most level and clear of the table"
+        return None if self.targets(obj, grasp) else "no other grasp to pick it with from above"
+
+    def setup(self, obj, grasp, params=None):
+        p = _params(params)
+        target = p.get("target") or (self.targets(obj, grasp) or [None])[0]
+        if target is None:
+            raise ArgumentError(f"invalid `grasp`: place-repick does not apply to {grasp.name}", "grasp")
+        new = obj.taxonomy.grasp(str(target))
+        alpha, h = self.placing(obj, grasp)
+        x, y = WORK_POINT[0], WORK_POINT[1]
+        above = hand_pose(alpha, (x, y, h + p["drop"] + p["clear"]))
+        place = hand_pose(alpha, (x, y, h + p["drop"]))
+        resting = P.compose(hand_pose(alpha, (x, y, h)), grasp.pose)  # let go, it falls `drop`
+        pick = P.compose(resting, P.inverse(new.pose))
+        over = P.compose(pick, np.array([0.0, 0.0, p["clear"], 1.0, 0.0, 0.0, 0.0]))  # back along its fingers
+        down = HandPath.line(above, place, 1.0)
+        t_open = down.times[-1]
+        path = down.then(HandPath.line(place, place, 0.4)).then(HandPath.line(place, above, 0.8))
+        path = path.then(HandPath.line(above, over, 1.2)).then(HandPath.line(over, pick, 1.0))
+        t_close = path.times[-1]
+        path = path.then(HandPath.line(pick, pick, p["close_time"]))
+        t_lift = path.times[-1]
+        path = path.then(HandPath.line(pick, over, 1.0))
+        grip = _place_grip(obj.grip, t_open, t_close, t_lift)
+        return Setup(above, path, grip, 0.3, new.pose, new.name, {"target": new.name, "alpha": alpha})
+
+
+def _place_grip(force: float, t_open: float, t_close: float, t_lift: float):
+    def grip(t: float):
+        if t_open <= t < t_close:
+            return None  # open
+        if t >= t_close:
+            return force * min(1.0, 0.3 + 0.7 * (t - t_close) / max(t_lift - t_close, 1e-9))
+        return force
+    return grip
+
+
+def _over(point, polygon, normal) -> bool:
+    """Whether ``point`` projects inside the convex ``polygon`` (k, 3) along ``normal``."""
+    c = polygon.mean(axis=0)
+    for a, b in zip(polygon, np.roll(polygon, -1, axis=0)):
+        if np.dot(np.cross(b - a, point - a), normal) * np.dot(np.cross(b - a, c - a), normal) < 0:
+            return False
+    return True
+
+
+ACTIONS = {a.name: a for a in (GravityPivot(), GravitySlide(), GripPivot(), InertialSlide(), PushDown(), TablePivot(),
+                                PlaceRepick())}
 
 
 def action(name: str) -> Action:

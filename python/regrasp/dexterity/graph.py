@@ -194,23 +194,25 @@ def perturbations(settings: Settings, key: str) -> list:
 
 
 def run_edge(job: tuple) -> Edge:
-    """Runs the trials of one edge: ``job`` = (object path, grasp name, action name, settings, robot)."""
+    """Runs the trials of one edge: ``job`` = (object path, grasp name, action name, the
+    action's params (a dict: place-repick's ``target``), settings, robot)."""
     from .actions import action
     from .trial import Runner
 
-    path, grasp_name, action_name, settings, robot = job
+    path, grasp_name, action_name, params, settings, robot = job
     scene, tax, obj = _object(path)
     grasp = tax.grasp(grasp_name)
     t0 = time.perf_counter()
-    setup = action(action_name).setup(obj, grasp)
+    setup = action(action_name).setup(obj, grasp, params)
     runner = Runner(scene, tax, grasp, setup, robot)
     outcomes: dict = {}
+    key = "/".join([grasp_name, action_name, *(str(v) for v in params.values())])
     try:
-        for p in perturbations(settings, f"{grasp_name}/{action_name}"):
+        for p in perturbations(settings, key):
             r = runner.run(p)
             outcomes[r.outcome] = outcomes.get(r.outcome, 0) + 1
     except ArgumentError as e:  # the arm cannot follow the action here (IK): no edge
-        return Edge(grasp_name, action_name, setup.intended, 0, {}, {"refused": str(e)}, time.perf_counter() - t0)
+        return Edge(grasp_name, action_name, setup.intended, 0, {}, {"refused": str(e), **params}, time.perf_counter() - t0)
     detail = {k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in setup.detail.items()}
     return Edge(grasp_name, action_name, setup.intended, settings.trials, outcomes, detail, time.perf_counter() - t0)
 
@@ -224,25 +226,30 @@ def fitting(scene, taxonomy, robot: str | None = None) -> dict:
 
 
 def edges_to_measure(obj, settings: Settings, clear: dict | None = None) -> list:
-    """(grasp name, action name) of every grasp that holds (and fits the hand: ``clear``
+    """(grasp name, action name, params) of every grasp that holds (and fits the hand: ``clear``
     {name: clearance [m]}, :func:`fitting`) and every action that applies to it and is meant to
-    reach a grasp that fits too."""
+    reach another grasp that holds and fits."""
     from .actions import ACTIONS
 
     names = list(ACTIONS) if settings.actions is None else list(settings.actions)
     for n in names:
         if n not in ACTIONS:
             raise ArgumentError(f"invalid `actions`: unknown action {n!r} (known: {', '.join(ACTIONS)})", "actions")
-    fits = (lambda name: True) if clear is None else (lambda name: clear[name] >= FIT)  # noqa: E731
+    tax = obj.taxonomy
+    usable = {g.name for g in tax.grasps if g.holds and (clear is None or clear[g.name] >= FIT)}
     out = []
-    for g in obj.taxonomy.grasps:
-        if not (g.holds and fits(g.name)):
+    for g in tax.grasps:
+        if g.name not in usable:
             continue
         for n in names:
-            if ACTIONS[n].applies(obj, g) is None:
-                target = ACTIONS[n].setup(obj, g).intended
-                if target is not None and target != g.name and fits(target):
-                    out.append((g.name, n))
+            if ACTIONS[n].applies(obj, g) is not None:
+                continue
+            if n == "place-repick":  # an edge per new grasp
+                out.extend((g.name, n, {"target": t}) for t in ACTIONS[n].targets(obj, g, usable))
+                continue
+            target = ACTIONS[n].setup(obj, g).intended
+            if target in usable and target != g.name:
+                out.append((g.name, n, {}))
     return out
 
 
@@ -282,7 +289,7 @@ def build_graph(path, settings: Settings = Settings(), workers: int = 1, ray_add
     scene, tax, obj = _object(path)
     clear = fitting(scene, tax, robot)
     todo = edges_to_measure(obj, settings, clear)
-    jobs = [(path, g, a, settings, robot) for g, a in todo]
+    jobs = [(path, g, a, params, settings, robot) for g, a, params in todo]
     edges: list = []
     t0 = time.perf_counter()
     with bars.bar(len(jobs) * settings.trials, f"grasp graph ({scene.name})", unit="trial", show=progress) as bar:
@@ -291,8 +298,8 @@ def build_graph(path, settings: Settings = Settings(), workers: int = 1, ray_add
             bar.update(settings.trials)
 
         _each(jobs, workers, ray_address, take)
-    order = {j[1:3]: i for i, j in enumerate(jobs)}
-    edges.sort(key=lambda e: order[(e.source, e.action)])
+    order = {(j[1], j[2], j[3].get("target")): i for i, j in enumerate(jobs)}
+    edges.sort(key=lambda e: order[(e.source, e.action, e.detail.get("target"))])
     used = sorted({e.action for e in edges})
     nodes = [{**g.to_dict(), "clearance": clear[g.name], "fits": clear[g.name] >= FIT} for g in tax.grasps]
     return GraspGraph({"name": scene.name, "file": path}, nodes, edges,

@@ -60,16 +60,16 @@ def _perp(w: float, r) -> np.ndarray:
 
 def pad_wrench(body: Body, cap: float, slip, spin: float, need, need_tau: float) -> tuple:
     """The pads' (force (2,), couple) on the object [N, N·m] about the contact centre: the
-    ``need``/``need_tau`` that keeps it with the hand when inside the limit surface of capacity
-    ``cap`` = 2 μ N [N], else the friction opposing the relative ``slip`` velocity [m/s] and
-    ``spin`` [rad/s] along the limit surface's normal (or the need scaled onto the surface while
-    the relative twist is still zero)."""
+    ``need``/``need_tau`` that brings it to the hand's motion within the step when that lies
+    inside the limit surface of capacity ``cap`` = 2 μ N [N] (it sticks), else the friction
+    opposing the relative ``slip`` velocity [m/s] and ``spin`` [rad/s] along the limit surface's
+    normal (or the need scaled onto the surface while the relative twist is still zero)."""
     if cap <= 0:
         return np.zeros(2), 0.0
     k = body.k
     load = np.hypot(*need) ** 2 / cap ** 2 + (need_tau / (k * cap)) ** 2
     s = float(np.sqrt(slip @ slip + (k * spin) ** 2))
-    if load <= 1.0 and s < STICK:
+    if load <= 1.0:
         return need, need_tau
     if s >= STICK:
         return -cap * slip / s, -cap * k * k * spin / s
@@ -78,11 +78,13 @@ def pad_wrench(body: Body, cap: float, slip, spin: float, need, need_tau: float)
 
 
 def simulate(body: Body, duration: float, hand: Callable[[float], tuple], grip: Callable[[float], float],
-             gravity=(0.0, -9.81)) -> Slip:
+             gravity=(0.0, -9.81), observe: Callable[[float, np.ndarray], None] | None = None) -> Slip:
     """Integrates the slip for ``duration`` [s] from rest in the hand. ``hand(t)`` → (position
     (2,) [m] of the contact centre, angle [rad] of the hand's x axis) in a fixed vertical plane
     (its x, z; angles from x towards z), ``grip(t)`` → the per-pad normal force [N]; ``gravity``
-    (2,) [m/s²] in that plane. Returns the :class:`Slip` relative to the hand."""
+    (2,) [m/s²] in that plane; ``observe(t, x)``: called every step with the time [s] and the
+    centre of mass's position (2,) [m] in the plane. Returns the :class:`Slip` relative to the hand.
+    The hand's motion should start smoothly: a jump in its speed asks the pads for an impulse."""
     m, I = body.mass, body.inertia
     g = np.asarray(gravity, float)
     p0, a0 = hand(0.0)
@@ -104,6 +106,8 @@ def simulate(body: Body, duration: float, hand: Callable[[float], tuple], grip: 
         v = v + DT * (g + f / m)
         w = w + DT * (tau + _cross(rc, f)) / I
         x, th = x + DT * v, th + DT * w
+        if observe is not None:
+            observe(t, x)
     ph, ah = hand(duration)
     com = _rot(-ah) @ (x - np.asarray(ph, float))
     turn = (th - ah) - (a0 - a0)
