@@ -156,3 +156,155 @@ def test_planning_refuses_unknown_grasps_and_objectives():
     with pytest.raises(ArgumentError) as e:
         plan(g, "g0", "g1", "fastest")
     assert e.value.field == "objective"
+
+
+# --- the bundled objects ------------------------------------------------------------------------------
+
+
+def test_the_bundled_objects_load_without_task_or_pushers():
+    from regrasp.dexterity.objects import OBJECTS, load_object
+    from regrasp.dexterity.taxonomy import taxonomy_of
+
+    counts = {}
+    for name in OBJECTS:
+        scene = load_object(name)
+        counts[name] = len(taxonomy_of(scene).grasps)
+    # prism: 2 orientations x 3 offsets; cylinder: ends 1 x 3, across 2 x 3; box: 3 face pairs x 2 x 3
+    assert counts == {"prism": 6, "cylinder": 9, "box": 18}
+
+
+def test_a_bad_object_file_names_its_field(tmp_path):
+    from regrasp.dexterity.objects import load_object
+    from regrasp.errors import SceneError
+
+    p = tmp_path / "o.toml"
+    p.write_text('name = "x"\n[object]\nshape = "box"\nsize = [0.04, 0.03, 0.07]\nmass = 0.2\n'
+                 '[grasp]\nforce = 5.0\nfriction = 0.5\npad_radius = 0.008\n')
+    with pytest.raises(SceneError) as e:
+        load_object(p)
+    assert e.value.field == "dimension"
+    p.write_text(p.read_text().replace('name = "x"', 'dimension = 3\nname = "x"').replace("mass = 0.2", "mass = -1"))
+    with pytest.raises(SceneError) as e:
+        load_object(p)
+    assert e.value.field == "object.mass"
+
+
+# --- in MuJoCo, with the arm ----------------------------------------------------------------------------
+
+mujoco = pytest.importorskip("mujoco")
+pytest.importorskip("mink")
+
+
+@pytest.fixture(scope="module")
+def box():
+    from regrasp.dexterity.actions import ObjectModel
+    from regrasp.dexterity.objects import load_object
+    from regrasp.dexterity.taxonomy import taxonomy_of
+
+    scene = load_object("box")
+    tax = taxonomy_of(scene)
+    return scene, tax, ObjectModel.of(scene, tax)
+
+
+def test_a_grasp_whose_object_goes_into_the_fingers_links_does_not_fit(box):
+    from regrasp.dexterity.graph import FIT, fitting
+
+    scene, tax, obj = box
+    clear = fitting(scene, tax)
+    # g1: the 70 mm side along the fingers, 40 mm across the pads: the 2F-85's spring links close in
+    # above the pads and hold the box instead of them (MuJoCo: its only contacts are with the links)
+    assert clear["g1"] < 0 and clear["g6"] > FIT
+
+
+def test_the_pivot_breaks_away_at_the_limit_surface_angle_in_mujoco(box):
+    # the hanging box (g0: its centre of mass 23 mm below the pads' patch) at the grip where the
+    # limit surface lets it lag 30° behind the hand: the hand turns 90°; the largest lag is 30°
+    from regrasp import pose as P
+    from regrasp.dexterity.actions import RAMP, GripPivot, _angle, com_in_hand, contact_centre, hand_pose
+    from regrasp.dexterity.world import HandPath, HandWorld, ramps, solve_path
+
+    scene, tax, obj = box
+    g = tax.grasp("g0")
+    lag = math.radians(30.0)
+    N = GripPivot().grip_for_lag(obj, g, lag)
+    c, centre = com_in_hand(obj, g), contact_centre(obj, g)
+    a0, T = float(np.angle(np.exp(1j * (-np.pi / 2 - _angle(c))))), 1.5
+    times = np.linspace(0.0, T + 2 * RAMP, int((T + 2 * RAMP) / 0.01) + 1)
+    path = HandPath(times, np.array([hand_pose(a0 + 0.5 * math.pi * smooth((t - RAMP) / T)) for t in times]))
+    world = HandWorld(scene, g.pose, path.poses[0])
+    lags = []
+
+    def observe(w):
+        v = P.transform(w.object_pose(), obj.com) - P.transform(w.hand_frame(), [centre[0], 0.0, centre[1]])
+        lags.append(math.degrees(math.atan2(v[0], -v[2])))
+
+    world.follow(path, solve_path(world.robot, path, world.robot.q), ramps((0, obj.grip), (RAMP, N)), 0.0, observe)
+    assert max(lags) == pytest.approx(30.0, abs=4.0)
+
+
+@pytest.mark.parametrize("name, grasp, action, params", [
+    ("box", "g4", "gravity-slide", {}),
+    ("box", "g3", "inertial-slide", {}),
+    ("box", "g6", "place-repick", {"target": "g12"}),
+    ("prism", "g1", "table-pivot", {}),
+])
+def test_an_action_reaches_its_intended_grasp_in_the_nominal_world(name, grasp, action, params):
+    from regrasp.dexterity.actions import ACTIONS, ObjectModel
+    from regrasp.dexterity.objects import load_object
+    from regrasp.dexterity.taxonomy import taxonomy_of
+    from regrasp.dexterity.trial import Runner
+
+    scene = load_object(name)
+    tax = taxonomy_of(scene)
+    obj = ObjectModel.of(scene, tax)
+    g = tax.grasp(grasp)
+    assert ACTIONS[action].applies(obj, g) is None
+    setup = ACTIONS[action].setup(obj, g, params)
+    assert setup.intended not in (None, grasp)
+    r = Runner(scene, tax, g, setup).run()
+    assert r.outcome == setup.intended, (r.outcome, r.distance)
+
+
+def run_cli(*args):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "regrasp", *args], capture_output=True, text=True, timeout=600)
+
+
+def test_the_cli_measures_a_graph_and_plans_on_it(tmp_path):
+    out = tmp_path / "g.json"
+    r = run_cli("grasp-graph", "box", "--trials", "1", "--actions", "gravity-slide", "--workers", "1", "--out",
+                str(out), "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert {"nodes", "edges", "actions"} <= set(d) and d["edges"]
+    assert all({"from", "to", "action", "success_rate", "trials"} <= set(e) for e in d["edges"])
+    assert [a["name"] for a in d["actions"]] == ["gravity-slide"]
+    e = next(e for e in d["edges"] if e["success_rate"] > 0)
+    r = run_cli("regrasp-sequence", str(out), "--from", e["from"], "--to", e["to"], "--json")
+    assert r.returncode == 0, r.stderr
+    s = json.loads(r.stdout)["sequence"]
+    assert s["steps"][0]["from"] == e["from"] and s["steps"][-1]["to"] == e["to"] and 0 < s["probability"] <= 1
+
+
+@pytest.mark.parametrize("args, field", [
+    (["grasp-graph", "box", "--trials", "0"], "--trials"),
+    (["grasp-graph", "box", "--actions", "juggle"], "actions"),
+    (["grasp-graph", "no-such-object.toml"], "`object`"),
+    (["grasp-graph", "box", "--out", "g.txt"], "--out"),
+])
+def test_bad_grasp_graph_input_is_refused_naming_the_field(args, field):
+    r = run_cli(*args)
+    assert r.returncode == 2 and field in r.stderr and "Traceback" not in r.stderr, r.stderr
+
+
+def test_bad_regrasp_sequence_input_is_refused_naming_the_field(tmp_path):
+    g = graph_of([edge("g0", "g1", "gravity-slide", 15)])
+    g.save(tmp_path / "g.json")
+    (tmp_path / "bad.json").write_text("{}")
+    for args, field in ((["--from", "g0", "--to", "g7"], "to"), (["--from", "g5", "--to", "g1"], "from")):
+        r = run_cli("regrasp-sequence", str(tmp_path / "g.json"), *args)
+        assert r.returncode == 2 and f"`{field}`" in r.stderr, r.stderr
+    r = run_cli("regrasp-sequence", str(tmp_path / "bad.json"), "--from", "g0", "--to", "g1")
+    assert r.returncode == 2 and "`format`" in r.stderr, r.stderr

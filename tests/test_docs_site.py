@@ -29,6 +29,7 @@ EXPECTED = {
     "api/execution": ["regrasp.mujoco.spatial.execute_plan3d", "regrasp.mujoco.push.simulate_push"],
     "api/visualization": ["regrasp.viz.viewer.write_html"],
     "api/files-errors": ["regrasp.errors.ArgumentError", "regrasp.files.write_text"],
+    "api/dexterity": ["regrasp.dexterity.graph.build_graph", "regrasp.dexterity.taxonomy.taxonomy"],
 }
 
 

@@ -68,6 +68,7 @@ def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, sc
         ("world motion", run_world_motion),
         ("arm IK", lambda: _unless_missing("the arm's inverse kinematics", run_ik)),
         ("arm steps", lambda: _unless_missing("MuJoCo's speed with the arm", run_arm_steps)),
+        ("grasp graph", lambda: _unless_missing("the grasp graph (MuJoCo, the arm)", run_grasp_graph)),
     ]
     results = {}
     with progress.bar(len(benchmarks), "bench", unit="benchmark") as bar:
@@ -458,6 +459,39 @@ def run_mncp(reps: int = 11, ref_reps: int = 3) -> dict:
             "residual_reference": ref.max_residual,
         }
     return out
+
+
+def run_grasp_graph(trials: int = 3, name: str = "prism", workers: int = 1) -> dict:
+    """The grasp graph of bundled object ``name`` (:func:`regrasp.dexterity.graph.build_graph`)
+    with ``trials`` runs per edge in ``workers`` processes: the whole build's time (the
+    taxonomy, the hand check, every action's setup and its runs) and its time per trial, against
+    the same first edge's runs each in a freshly compiled world (what the reset of one compiled
+    model per edge saves) in the same run."""
+    need("mujoco", "robot")
+    need("mink", "robot")
+    need("networkx", "robot")
+    from .dexterity.actions import action
+    from .dexterity.graph import Settings, _object, build_graph, edges_to_measure, fitting, perturbations
+    from .dexterity.objects import object_path
+    from .dexterity.trial import Runner
+
+    path = str(object_path(name))
+    t0 = time.perf_counter()
+    g = build_graph(path, Settings(trials=trials), workers=workers)
+    build = time.perf_counter() - t0
+    n = sum(e.trials for e in g.edges)
+    scene, tax, obj = _object(path)
+    grasp, act, params = edges_to_measure(obj, Settings(trials=trials), fitting(scene, tax))[0]
+    setup = action(act).setup(obj, tax.grasp(grasp), params)
+    t1 = time.perf_counter()
+    for p in perturbations(Settings(trials=trials), "bench"):
+        Runner(scene, tax, tax.grasp(grasp), setup).run(p)
+    fresh = (time.perf_counter() - t1) / trials
+    per = build / max(n, 1)
+    return {"grasp_graph_trial": {"median_s": per, "baseline_median_s": fresh, "ratio": per / fresh,
+                                  "baseline": f"a trial in a freshly compiled world (with its IK); the {name}'s graph: "
+                                              f"{len(g.edges)} edges, {n} trials in {build:.1f} s with {workers} "
+                                              f"worker(s), {n / build:.2f} trials/s"}}
 
 
 def format_results(res: dict) -> str:

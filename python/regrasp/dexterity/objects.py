@@ -10,7 +10,7 @@ import tomllib
 from importlib.resources import files
 from pathlib import Path
 
-from ..errors import SceneError
+from ..errors import ArgumentError, SceneError
 
 OBJECTS = ("prism", "cylinder", "box")  # examples/objects/NAME.toml
 STILL_TASK = "\n[task]\nstart = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]\ngoal = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]\n" \
@@ -56,7 +56,8 @@ def load_object(path):
     try:
         text = path.read_text()
     except OSError as e:
-        raise SceneError(f"cannot read the object file {str(path)!r}: {e.strerror}", "(file)") from None
+        raise ArgumentError(f"invalid `object`: cannot read {str(path)!r}: {e.strerror}; the bundled objects: "
+                            f"{', '.join(OBJECTS)}", "object") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

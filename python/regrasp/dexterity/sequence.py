@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import ArgumentError
 from ..extras import need
 from .graph import GraspGraph
-from .trial import DROPPED, OTHER
+from .trial import DROPPED, OTHER, UNSTABLE
 
 OBJECTIVES = ("reliable", "expected")
 TRANSFER_SPEED = 0.25  # m/s, the hand's move between two actions (and 1 rad/s turning)
@@ -61,7 +61,7 @@ def transitions(graph: GraspGraph):
     G.add_nodes_from(graph.node_names)
     for e in graph.edges:
         for outcome, count in e.outcomes.items():
-            if outcome in (DROPPED, OTHER) or outcome == e.source or count == 0 or e.trials == 0:
+            if outcome in (DROPPED, OTHER, UNSTABLE) or outcome == e.source or count == 0 or e.trials == 0:
                 continue
             p = count / e.trials
             if not G.has_edge(e.source, outcome) or G[e.source][outcome]["p"] < p:

@@ -2,7 +2,8 @@
 perturbed world), the arm run along the action's path under its grip schedule, and the outcome
 classified to the nearest grasp of the taxonomy — ``dropped`` when the pads no longer hold the
 object, ``other`` when it is held but farther than the classification tolerance from every
-grasp (:data:`TOLERANCE` of the object's size)."""
+grasp (:data:`TOLERANCE` of the object's size), ``unstable`` when MuJoCo's integration blew up
+(it then resets the state: nothing after it is the action's doing; a failed run)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ import numpy as np
 
 from .world import HandWorld, Perturbation, solve_path
 
-DROPPED, OTHER = "dropped", "other"
+DROPPED, OTHER, UNSTABLE = "dropped", "other", "unstable"
 TOLERANCE = 0.15  # the classification tolerance: this share of the object's size (its hull's largest extent) [m/m]
 
 
@@ -43,6 +44,8 @@ def tolerance(taxonomy) -> float:
 
 def classify(world: HandWorld, taxonomy) -> tuple:
     """(outcome, distance [m], in-hand pose or None) of ``world`` now."""
+    if world.unstable():
+        return UNSTABLE, float("nan"), None
     if not world.held():
         return DROPPED, float("nan"), None
     pose = world.in_hand()

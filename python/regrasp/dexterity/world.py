@@ -260,6 +260,12 @@ class HandWorld:
         """Whether both pads press on the object now."""
         return bool(np.all(self.pad_forces() > 1e-3))
 
+    def unstable(self) -> bool:
+        """Whether MuJoCo's integration blew up since the trial began (a bad acceleration: it
+        then resets the state)."""
+        mujoco = need("mujoco", "robot")
+        return int(self.robot.data.warning[int(mujoco.mjtWarning.mjWARN_BADQACC)].number) > 0
+
     def on_table(self) -> bool:
         """Whether the object touches the table now."""
         from ..robot.grip import contact_normal_forces
