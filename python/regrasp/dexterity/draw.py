@@ -86,7 +86,7 @@ def draw_graph(graph, path, taxonomy=None) -> None:
             arrowstyle="-|>", lw=1.2, color="#1f4e79" if d["p"] >= SOLID else "#7f7f7f",
             ls="-" if d["p"] >= SOLID else "--", connectionstyle=f"arc3,rad={rad}", shrinkA=38, shrinkB=38))
         mid = (np.asarray(pos[u]) + np.asarray(pos[v])) / 2
-        normal = np.array([-(pos[v][1] - pos[u][1]), pos[v][0] - pos[u][0]])
+        normal = np.array([pos[v][1] - pos[u][1], -(pos[v][0] - pos[u][0])])  # the side arc3 bends to
         ax.text(*(mid + rad * 0.5 * normal), f"{d['action']} {d['p']:.0%}", fontsize=6.5, ha="center", va="center",
                 bbox=dict(fc="white", ec="none", alpha=0.8, pad=0.5))
     for n, (x, y) in pos.items():
