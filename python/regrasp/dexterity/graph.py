@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ArgumentError
-from ..extras import need
 from ..files import write_text
 from .. import progress as bars
 
@@ -255,13 +254,9 @@ def edges_to_measure(obj, settings: Settings, clear: dict | None = None) -> list
 
 def _each(jobs: list, workers: int, ray_address, take) -> None:
     if ray_address is not None:
-        ray = need("ray", "ray")
-        from ..sim.validation import _check_reachable
+        from ..sim.validation import ray_init
 
-        if not ray.is_initialized():
-            _check_reachable(ray_address)
-            ray.init(address=None if ray_address == "local" else ray_address, include_dashboard=False,
-                     log_to_driver=False, num_cpus=workers if ray_address == "local" else None)
+        ray = ray_init(ray_address, workers)
         remote = ray.remote(run_edge)
         pending = [remote.remote(j) for j in jobs]
         while pending:

@@ -119,24 +119,33 @@ def robot_pad_state(robot) -> tuple:
     return pad_state(robot.grasp_width, robot.name, robot.pads, robot.pad_friction, robot.contact)
 
 
-@lru_cache(maxsize=32)
-def _pad_state(grasp_width: float, robot_name: str, pads, pad_friction: float, contact) -> tuple:
+def _calibration_rig(grasp_width: float, robot_name: str, pads, pad_friction: float, contact) -> tuple:
+    """(model, data, pad geoms (left, right), [box geom]): the bare gripper of ``robot_name``,
+    gravity off, around a fixed tall box ``grasp_width`` [m] wide (the pads meet it wherever the
+    linkage puts them)."""
     mujoco = need("mujoco", "robot")
     from .model import ROBOTS, gripper_spec, set_options
-    from .pads import LENGTH
 
     kind = ROBOTS[robot_name]
     g = gripper_spec(kind, pads, pad_friction)
     set_options(g, contact)
     g.option.gravity = [0, 0, 0]
-    # a tall box: the pads meet it wherever the linkage puts them
     g.worldbody.add_geom(name="calibration_box", type=mujoco.mjtGeom.mjGEOM_BOX, size=[grasp_width / 2, 0.03, 0.035],
                          pos=[0, 0, 0.16])
     m = g.compile()
-    d = mujoco.MjData(m)
     pad_geoms = tuple(tuple(i for i in range(m.ngeom) if m.geom_bodyid[i] == m.body(b).id and m.geom_contype[i])
                       for b in kind.pad_bodies)
-    box = [m.geom("calibration_box").id]
+    return m, mujoco.MjData(m), pad_geoms, [m.geom("calibration_box").id]
+
+
+@lru_cache(maxsize=32)
+def _pad_state(grasp_width: float, robot_name: str, pads, pad_friction: float, contact) -> tuple:
+    mujoco = need("mujoco", "robot")
+    from .model import ROBOTS
+    from .pads import LENGTH
+
+    kind = ROBOTS[robot_name]
+    m, d, pad_geoms, box = _calibration_rig(grasp_width, robot_name, pads, pad_friction, contact)
     f = []
     for u in CALIBRATION_FORCES:
         d.ctrl[m.actuator("grip").id] = u
@@ -171,19 +180,7 @@ def low_force_curve(robot) -> tuple:
 @lru_cache(maxsize=32)
 def _low_force_curve(grasp_width: float, robot_name: str, pads, pad_friction: float, contact) -> tuple:
     mujoco = need("mujoco", "robot")
-    from .model import ROBOTS, gripper_spec, set_options
-
-    kind = ROBOTS[robot_name]
-    g = gripper_spec(kind, pads, pad_friction)
-    set_options(g, contact)
-    g.option.gravity = [0, 0, 0]
-    g.worldbody.add_geom(name="calibration_box", type=mujoco.mjtGeom.mjGEOM_BOX, size=[grasp_width / 2, 0.03, 0.035],
-                         pos=[0, 0, 0.16])
-    m = g.compile()
-    d = mujoco.MjData(m)
-    pad_geoms = tuple(tuple(i for i in range(m.ngeom) if m.geom_bodyid[i] == m.body(b).id and m.geom_contype[i])
-                      for b in kind.pad_bodies)
-    box = [m.geom("calibration_box").id]
+    m, d, pad_geoms, box = _calibration_rig(grasp_width, robot_name, pads, pad_friction, contact)
     forces = []
     for u in reversed((*LOW_FORCES, CALIBRATION_FORCES[0])):  # from closed down: the pads stay on the box
         d.ctrl[m.actuator("grip").id] = u

@@ -161,15 +161,23 @@ def _check_reachable(address: str, timeout: float = 5.0) -> None:
         raise ArgumentError(f"invalid `--ray`: no Ray cluster answers at {address!r} ({e})", "--ray") from e
 
 
+def ray_init(address: str, workers: int):
+    """The ``ray`` module, connected to the cluster at ``address`` (``local``: a cluster of
+    ``workers`` CPUs started here) unless it is already; an ArgumentError naming ``--ray`` when
+    no cluster answers there."""
+    ray = need("ray", "ray")
+    if not ray.is_initialized():
+        _check_reachable(address)
+        ray.init(address=None if address == "local" else address, include_dashboard=False,
+                 log_to_driver=False, num_cpus=workers if address == "local" else None)
+    return ray
+
+
 def _each_chunk(scene: Scene, chunks: list, workers: int, ray_address, take) -> None:
     """``take(outcomes)`` of every chunk, run on Ray (``ray_address``), here (one worker) or in a
     process pool."""
     if ray_address is not None:
-        ray = need("ray", "ray")
-        if not ray.is_initialized():
-            _check_reachable(ray_address)
-            ray.init(address=None if ray_address == "local" else ray_address, include_dashboard=False,
-                     log_to_driver=False, num_cpus=workers if ray_address == "local" else None)
+        ray = ray_init(ray_address, workers)
         remote = ray.remote(_mujoco_chunk)
         pending = [remote.remote(scene, c) for c in chunks]
         while pending:
