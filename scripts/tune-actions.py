@@ -1,6 +1,6 @@
 """Tunes one parameter of each of three actions per bundled object by a search in simulation
 (`regrasp.dexterity.tune`) and prints the README's table: the default and tuned value, the
-success rate of each on fresh worlds. Usage: python scripts/tune-actions.py [--trials N]."""
+success rate of each on fresh worlds. Usage: python scripts/tune-actions.py [--trials N] (6 by default)."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ SEARCH = [  # (action, parameter, candidates)
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--trials", type=int, default=10)
+    ap.add_argument("--trials", type=int, default=6)
     ap.add_argument("--objects", default=",".join(OBJECTS))
     ap.add_argument("--out", default=None)
     a = ap.parse_args()

@@ -177,7 +177,11 @@ class HandWorld:
         mesh = (np.asarray(v, float), np.asarray(t, int))
 
         def add(spec):
+            from ..execution.arm import OBJECT_RGBA
+
             add_object3d(spec, scene, np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]), mesh, 1.0)
+            for g in spec.body("object").geoms:
+                g.rgba = OBJECT_RGBA
 
         try:
             self.robot = build(robot or DEFAULT_ROBOT, pads=Pads.of_scene(scene),
