@@ -246,6 +246,8 @@ def test_the_pivot_breaks_away_at_the_limit_surface_angle_in_mujoco(box):
     ("box", "g4", "gravity-slide", {}),
     ("box", "g3", "inertial-slide", {}),
     ("box", "g6", "place-repick", {"target": "g12"}),
+    ("box", "g12", "place-repick", {"target": "g6"}),  # another width: the TCP corrected for the linkage
+    ("box", "g7", "topple-repick", {"target": "g12"}),
     ("prism", "g1", "table-pivot", {}),
 ])
 def test_an_action_reaches_its_intended_grasp_in_the_nominal_world(name, grasp, action, params):
@@ -263,6 +265,19 @@ def test_an_action_reaches_its_intended_grasp_in_the_nominal_world(name, grasp, 
     assert setup.intended not in (None, grasp)
     r = Runner(scene, tax, g, setup).run()
     assert r.outcome == setup.intended, (r.outcome, r.distance)
+
+
+def test_a_topple_rolls_the_outline_towards_its_centre_of_mass():
+    from regrasp.dexterity.actions import _topple
+
+    square = np.array([[0.0, 0.0], [0.02, 0.0], [0.02, 0.02], [0.0, 0.02]])
+    for a, turn in ((0.3, -0.3), (1.2, math.pi / 2 - 1.2)):  # turned by a (x towards z) onto its corner (0, 0)
+        tilted = square @ np.array([[math.cos(a), math.sin(a)], [-math.sin(a), math.cos(a)]])
+        tilted[:, 1] -= tilted[:, 1].min()
+        got, pivot = _topple(tilted, tilted.mean(axis=0))
+        # by less than 45° it falls back onto its face (clockwise), by more onto the next one (counter-clockwise)
+        assert got == pytest.approx(turn) and np.allclose(pivot, tilted[np.argmin(tilted[:, 1])])
+    assert _topple(square, square.mean(axis=0))[0] == 0.0  # flat: it stays
 
 
 def run_cli(*args):

@@ -509,22 +509,37 @@ class TablePivot(Action):
         return Setup(path.poses[0], path, grip, 0.3, pose, _intended(obj, pose), {"turn": float(target), "grip": low})
 
 
+def _corners(width: float = 0.0) -> np.ndarray:
+    """The pads' face corners (hand frame) [m], at y = ±``width``/2."""
+    from ..robot.pads import HALF_WIDTH, LENGTH
+
+    return np.array([[x, y, z] for x in (-HALF_WIDTH, HALF_WIDTH) for y in {-width / 2, width / 2}
+                     for z in (-LENGTH / 2, LENGTH / 2)])
+
+
+def _fingers_clear(alpha: float, height: float) -> bool:
+    """Whether the pads stay :data:`FINGER_ROOM` above the table with the TCP at ``height`` [m]
+    and the hand at angle ``alpha`` [rad]."""
+    R = P.quat_matrix(hand_pose(alpha)[3:])
+    return height + float(np.min((_corners() @ R.T)[:, 2])) >= FINGER_ROOM
+
+
 class PlaceRepick(Action):
     """Place the object on the table and pick it again with another grasp: the hand turns about
-    the grasp axis (at most until its fingers are level) so that a face of the object's hull on which it
-    rests stably (its centre of mass over the face) looks straight down, lowers it to ``drop``
-    above the table, opens, retreats ``clear`` along its fingers, comes down over the object
-    at the new grasp's pose (the object where it was let go) and closes on it for
-    ``close_time``, then lifts. The new grasp (``params["target"]``): one of :meth:`targets`."""
+    the grasp axis (at most until its fingers are level) so that a face of the object's hull on
+    which it rests stably (its centre of mass over the face) looks straight down, lowers it to
+    ``drop`` above the table, opens, retreats ``clear`` along its fingers, comes down over the
+    object at the new grasp's pose (the object where it was let go; the TCP corrected for where
+    the linkage holds the pads at the new width) and closes on it for ``close_time``, then
+    lifts. The new grasp (``params["target"]``): one of :meth:`targets`."""
 
-    def __init__(self):
-        super().__init__("place-repick", "contact", "place on the table and pick again with another grasp")
+    def __init__(self, name: str = "place-repick", summary: str = "place on the table and pick again with another grasp"):
+        super().__init__(name, "contact", summary)
 
-    def placing(self, obj, grasp) -> Optional[tuple]:
-        """(hand angle α [rad], the TCP's height above the table [m] with the face on it) of the
-        stable face nearest to straight down, or None."""
-        from ..robot.pads import HALF_WIDTH, LENGTH
-
+    def release(self, obj, grasp) -> Optional[tuple]:
+        """(hand angle α [rad], the TCP's height above the table [m] when the object touches it,
+        the object's resting pose (7,) with the table at z = 0 under the TCP) of the stable face
+        nearest to straight down, or None."""
         V = P.transform(grasp.pose, obj.taxonomy.vertices)
         com = P.transform(grasp.pose, obj.com)
         best = None
@@ -533,63 +548,55 @@ class PlaceRepick(Action):
             if abs(n[1]) > 1e-6:
                 continue  # not parallel to the grasp axis: the hand's turn cannot put it level
             alpha = float(np.angle(np.exp(1j * (-np.pi / 2 - np.arctan2(n[2], n[0])))))
-            if abs(alpha) > MAX_PLACE_TILT:
-                continue
-            poly = P.transform(grasp.pose, f.polygon)
             h = float(np.max(V @ n))  # the face's plane: p · n = h
-            if not _over(com, poly, n):
-                continue  # it would topple
-            R = P.quat_matrix(hand_pose(alpha)[3:])
-            corners = np.array([[x, 0.0, z] for x in (-HALF_WIDTH, HALF_WIDTH) for z in (-LENGTH / 2, LENGTH / 2)])
-            if h + float(np.min((corners @ R.T)[:, 2])) < FINGER_ROOM:
-                continue  # the fingers would reach the table first
+            if abs(alpha) > MAX_PLACE_TILT or not _over(com, P.transform(grasp.pose, f.polygon), n) \
+                    or not _fingers_clear(alpha, h):
+                continue  # too far turned, it would topple, or the fingers would reach the table first
             if best is None or abs(alpha) < abs(best[0]):
                 best = (alpha, h)
-        return best
+        if best is None:
+            return None
+        return (*best, P.compose(hand_pose(best[0], (0.0, 0.0, best[1])), grasp.pose))
 
     def targets(self, obj, grasp, usable=None) -> list:
         """The new grasps (names) reachable from above once the object rests where
-        :meth:`placing` puts it (the fingers within 45° of down, the pads above the table), other
+        :meth:`release` leaves it (the fingers within 45° of down, the pads above the table), other
         faces first, at most :data:`TARGETS`; ``usable``: the names allowed (default all)."""
-        from ..robot.pads import HALF_WIDTH, LENGTH
-
-        place = self.placing(obj, grasp)
-        if place is None:
+        rest = self.release(obj, grasp)
+        if rest is None:
             return []
-        alpha, h = place
-        resting = P.compose(hand_pose(alpha, (0.0, 0.0, h)), grasp.pose)  # the object on the table (z = 0)
         out = []
         for g in obj.taxonomy.grasps:
             if g.name == grasp.name or (usable is not None and g.name not in usable):
                 continue
-            tcp = P.compose(resting, P.inverse(g.pose))
+            tcp = P.compose(rest[2], P.inverse(g.pose))
             R = P.quat_matrix(tcp[3:])
-            if R[2, 2] < np.cos(MAX_PICK_TILT):
-                continue
-            corners = np.array([[x, y, z] for x in (-HALF_WIDTH, HALF_WIDTH) for y in (-g.width / 2, g.width / 2)
-                                for z in (-LENGTH / 2, LENGTH / 2)])
-            if tcp[2] + float(np.min((corners @ R.T)[:, 2])) < FINGER_ROOM:
+            if R[2, 2] < np.cos(MAX_PICK_TILT) or tcp[2] + float(np.min((_corners(g.width) @ R.T)[:, 2])) < FINGER_ROOM:
                 continue
             out.append((g.faces == grasp.faces, -R[2, 2], g.name))
         return [name for *_, name in sorted(out)[:TARGETS]]
 
     def applies(self, obj, grasp):
-        if self.placing(obj, grasp) is None:
-            return "no face to rest on with the fingers at most level and clear of the table"
+        if self.release(obj, grasp) is None:
+            return "no way to set it down with the fingers at most level and clear of the table"
         return None if self.targets(obj, grasp) else "no other grasp to pick it with from above"
 
     def setup(self, obj, grasp, params=None):
         p = _params(params)
         target = p.get("target") or (self.targets(obj, grasp) or [None])[0]
         if target is None:
-            raise ArgumentError(f"invalid `grasp`: place-repick does not apply to {grasp.name}", "grasp")
+            raise ArgumentError(f"invalid `grasp`: {self.name} does not apply to {grasp.name}", "grasp")
         new = obj.taxonomy.grasp(str(target))
-        alpha, h = self.placing(obj, grasp)
+        alpha, h, rest = self.release(obj, grasp)
         x, y = WORK_POINT[0], WORK_POINT[1]
         above = hand_pose(alpha, (x, y, h + p["drop"] + p["clear"]))
         place = hand_pose(alpha, (x, y, h + p["drop"]))
-        resting = P.compose(hand_pose(alpha, (x, y, h)), grasp.pose)  # let go, it falls `drop`
-        pick = P.compose(resting, P.inverse(new.pose))
+        resting = P.compose(np.array([x, y, 0.0, 1.0, 0.0, 0.0, 0.0]), rest)  # let go, it settles
+        # the robot's TCP sits between the pads closed at the first grasp's width; at the new width
+        # the linkage holds them elsewhere along the fingers (up to ≈ 7 mm): the TCP goes where the
+        # pads' centres meet the new grasp
+        lower = pad_height(obj, new.width) - pad_height(obj, grasp.width)
+        pick = P.compose(P.compose(resting, P.inverse(new.pose)), np.array([0.0, 0.0, lower, 1.0, 0.0, 0.0, 0.0]))
         over = P.compose(pick, np.array([0.0, 0.0, p["clear"], 1.0, 0.0, 0.0, 0.0]))  # back along its fingers
         down = HandPath.line(above, place, 1.0)
         t_open = down.times[-1]
@@ -601,6 +608,94 @@ class PlaceRepick(Action):
         path = path.then(HandPath.line(pick, over, 1.0))
         grip = _place_grip(obj.grip, t_open, t_close, t_lift)
         return Setup(above, path, grip, 0.3, new.pose, new.name, {"target": new.name, "alpha": alpha})
+
+
+TOPPLE_TILTS = np.radians(np.arange(-90.0, 91.0, 15.0))  # rad, the hand angles topple-repick tries
+
+
+class ToppleRepick(PlaceRepick):
+    """Topple on the table and pick again: the hand (at most level) sets the object down on an
+    edge with its centre of mass beyond it, lets go, and the object falls over onto a face
+    (quasi-static prediction: it rolls on the table about its lowest edge towards its centre of
+    mass, edge after edge, until the centre of mass is over the face it lies on); then the hand
+    picks it from above as :class:`PlaceRepick` does. It reaches resting faces that a placing
+    hand cannot put down (its fingers would touch the table first)."""
+
+    def __init__(self):
+        super().__init__("topple-repick", "let it fall over on the table from an edge, then pick it again")
+
+    def release(self, obj, grasp) -> Optional[tuple]:
+        """(hand angle α [rad], the TCP's height above the table [m] when the object's lowest edge
+        touches it, the resting pose after the fall) of the turn nearest to fingers-down at which it
+        falls over by more than 10°, or None."""
+        V = P.transform(grasp.pose, obj.taxonomy.vertices)
+        com = P.transform(grasp.pose, obj.com)
+        placed = PlaceRepick.release(self, obj, grasp)
+        for alpha in sorted(TOPPLE_TILTS, key=abs):
+            H = hand_pose(float(alpha), (0.0, 0.0, 0.0))
+            W, c = P.transform(H, V), P.transform(H, com)
+            h = -float(W[:, 2].min())
+            if not _fingers_clear(float(alpha), h):
+                continue
+            fall = _topple(W[:, [0, 2]], c[[0, 2]])
+            if fall is None or abs(fall[0]) < np.radians(10.0):
+                continue
+            turn, pivot = fall
+            held = P.compose(np.array([0.0, 0.0, h, 1.0, 0.0, 0.0, 0.0]), P.compose(H, grasp.pose))
+            about = np.array([pivot[0], 0.0, pivot[1] + h])
+            spin = np.array([np.cos(-turn / 2), 0.0, np.sin(-turn / 2), 0.0])  # x towards z by `turn`: −turn about y
+            rest = P.compose(np.array([*about, 1.0, 0.0, 0.0, 0.0]), P.compose(np.array([0.0, 0.0, 0.0, *spin]),
+                             P.compose(np.array([*-about, 1.0, 0.0, 0.0, 0.0]), held)))
+            rest[2] -= float(P.transform(rest, obj.taxonomy.vertices)[:, 2].min())
+            if placed is not None and _same_rest(obj, rest, placed[2]):
+                continue  # it would fall onto the face the hand can set it down on
+            return float(alpha), h, rest
+        return None
+
+
+def _same_rest(obj, a, b) -> bool:
+    """Whether resting poses ``a`` and ``b`` place the object alike: its hull within 1 mm, up to
+    its symmetry, once both are centred (a slide on the table does not count)."""
+    V = obj.taxonomy.vertices
+    centred = [np.array([*(q[:3] - P.transform(q, V).mean(axis=0)), *q[3:]]) for q in (a, b)]
+    return grasp_distance(V, *centred) < 1e-3
+
+
+def _topple(points, com, steps: int = 8) -> Optional[tuple]:
+    """(turn [rad], the first pivot (x, z) [m]) of the outline ``points`` (k, 2) (x, z, its lowest
+    point on the table) rolling on the table towards its centre of mass ``com`` (2,) until the
+    centre of mass is over its contact edge; None if it stands on a single point right over it."""
+    Q = np.asarray(points, float)
+    c = np.asarray(com, float)
+    total, first = 0.0, None
+    for _ in range(steps):
+        low = Q[:, 1].min()
+        touching = Q[Q[:, 1] < low + 1e-9]
+        lo, hi = touching[:, 0].min(), touching[:, 0].max()
+        if lo - 1e-9 <= c[0] <= hi + 1e-9:
+            return (total, first) if first is not None else (0.0, touching[0])
+        side = 1.0 if c[0] > hi else -1.0
+        p = touching[np.argmax(side * touching[:, 0])]
+        first = p if first is None else first
+        d = Q - p
+        ahead = side * d[:, 0] > 1e-9
+        # the angle each point ahead must turn through (towards the table) to touch it
+        angles = np.arctan2(d[ahead, 1], side * d[ahead, 0])
+        g = float(angles.min())
+        turn = -side * g  # x towards z: falling towards +x turns clockwise (−)
+        R = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+        Q, c = (Q - p) @ R.T + p, R @ (c - p) + p
+        total += turn
+    return None
+
+
+def pad_height(obj: ObjectModel, width: float) -> float:
+    """The pads' centres' distance [m] from the gripper's base along its fingers when closed on an
+    object ``width`` [m] wide (:func:`regrasp.robot.model.tcp_height`, with the scene's pads)."""
+    from ..robot.model import tcp_height
+    from ..robot.pads import Pads
+
+    return float(tcp_height(float(width), "", Pads.of_scene(obj.scene), float(obj.mu)))
 
 
 def _place_grip(force: float, t_open: float, t_close: float, t_lift: float):
@@ -623,7 +718,7 @@ def _over(point, polygon, normal) -> bool:
 
 
 ACTIONS = {a.name: a for a in (GravityPivot(), GravitySlide(), GripPivot(), InertialSlide(), PushDown(), TablePivot(),
-                                PlaceRepick())}
+                                PlaceRepick(), ToppleRepick())}
 
 
 def action(name: str) -> Action:

@@ -243,7 +243,7 @@ def edges_to_measure(obj, settings: Settings, clear: dict | None = None) -> list
         for n in names:
             if ACTIONS[n].applies(obj, g) is not None:
                 continue
-            if n == "place-repick":  # an edge per new grasp
+            if n in ("place-repick", "topple-repick"):  # an edge per new grasp
                 out.extend((g.name, n, {"target": t}) for t in ACTIONS[n].targets(obj, g, usable))
                 continue
             target = ACTIONS[n].setup(obj, g).intended
