@@ -23,6 +23,7 @@ SHOWN = [  # (action, object, grasp, params)
     ("push-down", "prism", "g0", {}),
     ("table-pivot", "prism", "g1", {}),
     ("place-repick", "box", "g6", {"target": "g12"}),
+    ("topple-repick", "box", "g7", {"target": "g12"}),
     ("grip-pivot", "box", "g17", {}),
     ("gravity-pivot", "box", "g17", {}),
 ]
