@@ -34,7 +34,7 @@ def cmd_grasp_graph(a) -> int:
     path = _object_file(a.object)
     check_outputs(a, {"out": (".json",), "plot": (".png", ".svg", ".pdf")}, [path])
     actions = None if a.actions is None else tuple(x.strip() for x in a.actions.split(",") if x.strip())
-    workers = a.workers or (1 if a.ray is not None else max(1, min(os.cpu_count() or 1, 8)))
+    workers = a.workers or max(1, min(os.cpu_count() or 1, 8))  # also a local Ray cluster's CPUs
     graph = build_graph(path, Settings(trials=a.trials, seed=a.seed, actions=actions), workers=workers,
                         ray_address=a.ray, robot=None, progress=True)
     if a.out:
@@ -72,8 +72,12 @@ def cmd_regrasp_sequence(a) -> int:
     if a.execute:
         from ..dexterity.graph import Settings, perturbations
 
+        if not Path(str(graph.object.get("file", ""))).is_file():
+            raise ArgumentError(f"invalid `object.file`: the graph's object file {graph.object.get('file')!r} is not "
+                                "there to execute on", "object.file")
+        spread = {k: graph.settings[k] for k in ("spread", "shift", "turn") if isinstance(graph.settings.get(k), (int, float))}
         runs = [execute(graph.object["file"], seq, p) for p in
-                perturbations(Settings(trials=a.runs, seed=a.seed), f"sequence/{a.source}/{a.target}")]
+                perturbations(Settings(trials=a.runs, seed=a.seed, **spread), f"sequence/{a.source}/{a.target}")]
         out["runs"] = [r.to_dict() for r in runs]
         out["measured"] = sum(r.success for r in runs) / len(runs)
     if a.json:

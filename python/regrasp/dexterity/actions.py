@@ -14,6 +14,7 @@ taxonomy's offset and turn steps) and stated in :data:`DEFAULTS`."""
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
@@ -153,6 +154,18 @@ def _angle(v) -> float:
     return float(np.arctan2(v[1], v[0]))
 
 
+def _turning(obj: ObjectModel, grasp, angle: Callable[[float], float]):
+    """The slip model's hand (its contact centre, angle) for a TCP fixed at the work point turning
+    by ``angle(t)`` [rad]: the contact centre, off the TCP, goes round it."""
+    centre = contact_centre(obj, grasp)
+    tcp = np.array([WORK_POINT[0], WORK_POINT[2]])
+
+    def hand(t: float) -> tuple:
+        a = angle(t)
+        return tcp + np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]]) @ centre, a
+    return hand
+
+
 def _still(alpha: float, point=WORK_POINT):
     return lambda t: (np.array([point[0], point[2]]), alpha)
 
@@ -177,7 +190,7 @@ def _offset_step(obj: ObjectModel, grasp, sign: int) -> Optional[float]:
 TURNS = np.radians(np.arange(-180, 180, 1.0))  # the turns that turn_target tries
 
 
-_TURNS: dict = {}
+_TURNS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # taxonomy -> {grasp name: turn_target}
 
 
 def turn_target(obj: ObjectModel, grasp) -> Optional[tuple]:
@@ -188,9 +201,9 @@ def turn_target(obj: ObjectModel, grasp) -> Optional[tuple]:
     away) — within the classification tolerance; None if no turn does."""
     from .trial import tolerance
 
-    key = (id(obj.taxonomy), grasp.name)
-    if key in _TURNS:
-        return _TURNS[key]
+    cache = _TURNS.setdefault(obj.taxonomy, {})
+    if grasp.name in cache:
+        return cache[grasp.name]
     best, tol = None, tolerance(obj.taxonomy)
     siblings = {g.name for g in _siblings(obj, grasp)}
     for turn in TURNS:
@@ -199,7 +212,7 @@ def turn_target(obj: ObjectModel, grasp) -> Optional[tuple]:
         name, dist = obj.taxonomy.nearest(moved(obj, grasp, Slip(np.zeros(2), float(turn), np.zeros(2))))
         if name in siblings and dist <= tol and (best is None or (round(dist, 4), abs(turn)) < (round(best[2], 4), abs(best[0]))):
             best = (float(turn), name, float(dist))
-    _TURNS[key] = best
+    cache[grasp.name] = best
     return best
 
 
@@ -290,7 +303,7 @@ class GravityPivot(Action):
             s = min(max((t - RAMP) / (T / 2), 0.0), 1.0)
             return start_angle + (end - start_angle) * s * s * (3 - 2 * s)
 
-        hand = lambda t: (np.array([WORK_POINT[0], WORK_POINT[2]]), angle(t))  # noqa: E731
+        hand = _turning(obj, grasp, angle)
         slip = simulate(body(obj, grasp), 2 * RAMP + T, hand, grip, (0.0, -obj.g))
         pose = moved(obj, grasp, slip)
         times = np.linspace(0.0, 2 * RAMP + T, int(np.ceil((2 * RAMP + T) / 0.01)) + 1)
@@ -363,8 +376,7 @@ class GripPivot(Action):
             s = min(max((t - RAMP) / T, 0.0), 1.0)
             return alpha0 + sweep * s * s * (3 - 2 * s)
 
-        slip = simulate(body(obj, grasp), 2 * RAMP + T, lambda t: (np.array([WORK_POINT[0], WORK_POINT[2]]), angle(t)),
-                        grip, (0.0, -obj.g))
+        slip = simulate(body(obj, grasp), 2 * RAMP + T, _turning(obj, grasp, angle), grip, (0.0, -obj.g))
         pose = moved(obj, grasp, slip)
         times = np.linspace(0.0, 2 * RAMP + T, int(np.ceil((2 * RAMP + T) / 0.01)) + 1)
         poses = np.array([hand_pose(angle(t)) for t in times])
@@ -418,7 +430,7 @@ class InertialSlide(Action):
             if slip.shift[1] >= step:
                 break
         T, hand, grip = self._run(obj, p, float(jab))
-        times = np.arange(0.0, T + 1e-9, 0.005)
+        times = np.linspace(0.0, T, int(np.ceil(T / 0.005)) + 1)
         poses = np.array([hand_pose(0.0, (hand(t)[0][0], WORK_POINT[1], hand(t)[0][1])) for t in times])
         pose = moved(obj, grasp, slip)
         return Setup(poses[0], HandPath(times, poses), grip, 0.3, pose, _intended(obj, pose),
@@ -471,20 +483,42 @@ class TablePivot(Action):
     def __init__(self):
         super().__init__("table-pivot", "contact", "pivot about an edge on the table by moving the hand on an arc")
 
-    def applies(self, obj, grasp):
-        from ..robot.pads import LENGTH
+    @staticmethod
+    def _plan(obj, grasp):
+        """(turn [rad], the pivot vertex (3,) and the contact centre (2,) in the hand frame), or
+        why the pivot cannot be done: the pivot is the lowest vertex on the side the object turns
+        away from (the rest of it rises), and along the arc neither the object goes into the table
+        nor the pads come within the arm's clearance (the IK's ``MIN_DISTANCE``) of it."""
+        from ..robot.ik import MIN_DISTANCE
 
-        if turn_target(obj, grasp) is None:
+        t = turn_target(obj, grasp)
+        if t is None:
             return "no other orientation on these faces"
-        reach = -lowest(grasp, obj.taxonomy.vertices)[2]
-        return None if reach - LENGTH / 2 > 0.012 else \
-            f"the object reaches {(reach - LENGTH / 2) * 1e3:.1f} mm below the pads (a table pivot needs 12 mm)"
+        target = t[0]
+        V = P.transform(grasp.pose, obj.taxonomy.vertices)
+        low = V[V[:, 2] < V[:, 2].min() + 1e-9]
+        v = low[np.argmax(low[:, 0])] if target < 0 else low[np.argmin(low[:, 0])]
+        c = contact_centre(obj, grasp)
+        for a in np.linspace(0.0, target, 25):
+            R = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+            q = (V[:, [0, 2]] - v[[0, 2]]) @ R.T
+            if q[:, 1].min() < -1e-4:
+                return f"turning {np.degrees(target):.0f}° about its lowest edge takes the object into the table"
+            tcp = (R @ (c - v[[0, 2]]))[1] - c[1]  # the TCP's height above the table (the hand does not turn)
+            if not _fingers_clear(obj, 0.0, float(tcp), MIN_DISTANCE):
+                return f"the pads would come within the arm's {MIN_DISTANCE * 1e3:.0f} mm of the table along the arc"
+        return target, v, c
+
+    def applies(self, obj, grasp):
+        plan = self._plan(obj, grasp)
+        return plan if isinstance(plan, str) else None
 
     def setup(self, obj, grasp, params=None):
         p = _params(params)
-        target = turn_target(obj, grasp)[0]
-        v = lowest(grasp, obj.taxonomy.vertices)
-        c = contact_centre(obj, grasp)
+        plan = self._plan(obj, grasp)
+        if isinstance(plan, str):
+            raise ArgumentError(f"invalid `grasp`: table-pivot does not apply to {grasp.name}: {plan}", "grasp")
+        target, v, c = plan
         r0 = np.array([c[0] - v[0], c[1] - v[2]])  # the contact centre from the vertex, in the plane (x, z)
         pivot = np.array([WORK_POINT[0], 0.0])  # the vertex on the table (world x, z)
         T = p["turn_time"]
@@ -509,19 +543,23 @@ class TablePivot(Action):
         return Setup(path.poses[0], path, grip, 0.3, pose, _intended(obj, pose), {"turn": float(target), "grip": low})
 
 
-def _corners(width: float = 0.0) -> np.ndarray:
-    """The pads' face corners (hand frame) [m], at y = ±``width``/2."""
+def _corners(reach: float, width: float = 0.0) -> np.ndarray:
+    """The corners (hand frame) [m] of a box about the fingers' tips: across the pads' face, at
+    y = ±``width``/2, from ``reach`` [m] below the TCP (:func:`~.world.finger_reach`) to the pads'
+    top."""
     from ..robot.pads import HALF_WIDTH, LENGTH
 
     return np.array([[x, y, z] for x in (-HALF_WIDTH, HALF_WIDTH) for y in {-width / 2, width / 2}
-                     for z in (-LENGTH / 2, LENGTH / 2)])
+                     for z in (-reach, LENGTH / 2)])
 
 
-def _fingers_clear(alpha: float, height: float) -> bool:
-    """Whether the pads stay :data:`FINGER_ROOM` above the table with the TCP at ``height`` [m]
+def _fingers_clear(obj: ObjectModel, alpha: float, height: float, room: float = FINGER_ROOM) -> bool:
+    """Whether the fingers' tips stay ``room`` [m] above the table with the TCP at ``height`` [m]
     and the hand at angle ``alpha`` [rad]."""
+    from .world import finger_reach
+
     R = P.quat_matrix(hand_pose(alpha)[3:])
-    return height + float(np.min((_corners() @ R.T)[:, 2])) >= FINGER_ROOM
+    return height + float(np.min((_corners(finger_reach(obj.scene)) @ R.T)[:, 2])) >= room
 
 
 class PlaceRepick(Action):
@@ -550,7 +588,7 @@ class PlaceRepick(Action):
             alpha = float(np.angle(np.exp(1j * (-np.pi / 2 - np.arctan2(n[2], n[0])))))
             h = float(np.max(V @ n))  # the face's plane: p · n = h
             if abs(alpha) > MAX_PLACE_TILT or not _over(com, P.transform(grasp.pose, f.polygon), n) \
-                    or not _fingers_clear(alpha, h):
+                    or not _fingers_clear(obj, alpha, h):
                 continue  # too far turned, it would topple, or the fingers would reach the table first
             if best is None or abs(alpha) < abs(best[0]):
                 best = (alpha, h)
@@ -562,6 +600,8 @@ class PlaceRepick(Action):
         """The new grasps (names) reachable from above once the object rests where
         :meth:`release` leaves it (the fingers within 45° of down, the pads above the table), other
         faces first, at most :data:`TARGETS`; ``usable``: the names allowed (default all)."""
+        from .world import finger_reach
+
         rest = self.release(obj, grasp)
         if rest is None:
             return []
@@ -571,7 +611,8 @@ class PlaceRepick(Action):
                 continue
             tcp = P.compose(rest[2], P.inverse(g.pose))
             R = P.quat_matrix(tcp[3:])
-            if R[2, 2] < np.cos(MAX_PICK_TILT) or tcp[2] + float(np.min((_corners(g.width) @ R.T)[:, 2])) < FINGER_ROOM:
+            if R[2, 2] < np.cos(MAX_PICK_TILT) or \
+                    tcp[2] + float(np.min((_corners(finger_reach(obj.scene), g.width) @ R.T)[:, 2])) < FINGER_ROOM:
                 continue
             out.append((g.faces == grasp.faces, -R[2, 2], g.name))
         return [name for *_, name in sorted(out)[:TARGETS]]
@@ -635,7 +676,7 @@ class ToppleRepick(PlaceRepick):
             H = hand_pose(float(alpha), (0.0, 0.0, 0.0))
             W, c = P.transform(H, V), P.transform(H, com)
             h = -float(W[:, 2].min())
-            if not _fingers_clear(float(alpha), h):
+            if not _fingers_clear(obj, float(alpha), h):
                 continue
             fall = _topple(W[:, [0, 2]], c[[0, 2]])
             if fall is None or abs(fall[0]) < np.radians(10.0):
@@ -662,27 +703,26 @@ def _same_rest(obj, a, b) -> bool:
 
 
 def _topple(points, com, steps: int = 8) -> Optional[tuple]:
-    """(turn [rad], the first pivot (x, z) [m]) of the outline ``points`` (k, 2) (x, z, its lowest
-    point on the table) rolling on the table towards its centre of mass ``com`` (2,) until the
-    centre of mass is over its contact edge; None if it stands on a single point right over it."""
-    Q = np.asarray(points, float)
-    c = np.asarray(com, float)
-    total, first = 0.0, None
+    """(turn [rad], pivot (x, z) [m]) of the outline ``points`` (k, 2) (x, z, its lowest point
+    on the table) rolling on the table towards its centre of mass ``com`` (2,), edge after edge,
+    until the centre of mass is over its contact edge: the roll is the turn about ``pivot`` (for
+    a roll over several edges, the point that turn leaves where the roll does); None if it stands
+    on a single point right over it or rolls on past ``steps`` edges."""
+    Q0 = np.asarray(points, float)
+    Q, c = Q0.copy(), np.asarray(com, float)
+    total = 0.0
     for _ in range(steps):
         low = Q[:, 1].min()
         touching = Q[Q[:, 1] < low + 1e-9]
         lo, hi = touching[:, 0].min(), touching[:, 0].max()
         if lo - 1e-9 <= c[0] <= hi + 1e-9:
-            return (total, first) if first is not None else (0.0, touching[0])
+            return total, _fixed_point(Q0, Q, total)
         side = 1.0 if c[0] > hi else -1.0
         p = touching[np.argmax(side * touching[:, 0])]
-        first = p if first is None else first
         d = Q - p
         ahead = side * d[:, 0] > 1e-9
         # the angle each point ahead must turn through (towards the table) to touch it
-        angles = np.arctan2(d[ahead, 1], side * d[ahead, 0])
-        g = float(angles.min())
-        turn = -side * g  # x towards z: falling towards +x turns clockwise (−)
+        turn = -side * float(np.arctan2(d[ahead, 1], side * d[ahead, 0]).min())  # x towards z: towards +x is clockwise
         R = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
         Q, c = (Q - p) @ R.T + p, R @ (c - p) + p
         total += turn
@@ -715,6 +755,17 @@ def _over(point, polygon, normal) -> bool:
         if np.dot(np.cross(b - a, point - a), normal) * np.dot(np.cross(b - a, c - a), normal) < 0:
             return False
     return True
+
+
+def _fixed_point(before, after, turn: float) -> np.ndarray:
+    """The point about which turning ``before`` (k, 2) by ``turn`` [rad] gives ``after`` (a rigid
+    motion in the plane: x' = R x + t; its fixed point solves (I − R) p = t); the first point of
+    ``before`` on the table when it does not turn."""
+    if abs(turn) < 1e-12:
+        return before[np.argmin(before[:, 1])]
+    R = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    t = after[0] - R @ before[0]
+    return np.linalg.solve(np.eye(2) - R, t)
 
 
 ACTIONS = {a.name: a for a in (GravityPivot(), GravitySlide(), GripPivot(), InertialSlide(), PushDown(), TablePivot(),

@@ -44,9 +44,11 @@ def draw_grasp(ax, vertices, pose, com=(0.0, 0.0, 0.0), title: str | None = None
         ax.set_title(title, fontsize=7, pad=1)
 
 
-def draw_graph(graph, path, taxonomy=None) -> None:
+def draw_graph(graph, path, taxonomy=None, com=(0.0, 0.0, 0.0)) -> None:
     """Draws the grasp graph (a :class:`~.graph.GraspGraph`) to image ``path``: the grasps that
-    some edge touches, each as a small drawing, and the edges (see the module's doc)."""
+    some edge touches, each as a small drawing, and the edges (see the module's doc). The
+    object's ``taxonomy`` and centre of mass ``com`` [m] (default: read from the graph's object
+    file)."""
     need("matplotlib", "plot")
     nx = need("networkx", "robot")
     import matplotlib
@@ -63,8 +65,6 @@ def draw_graph(graph, path, taxonomy=None) -> None:
 
         scene, taxonomy, obj = _object(graph.object["file"])
         com = obj.com
-    else:
-        com = np.zeros(3)
     G = nx.MultiDiGraph()
     for e in graph.edges:
         if e.trials and e.target is not None and e.target != e.source:

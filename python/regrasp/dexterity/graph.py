@@ -76,19 +76,43 @@ class Edge:
                 "trials": self.trials, "outcomes": dict(self.outcomes), "detail": self.detail, "seconds": self.seconds}
 
     @classmethod
-    def from_dict(cls, d: dict, i: int) -> "Edge":
-        """The edge of a graph file's ``edges[i]`` ``d``; an ArgumentError naming the field."""
+    def from_dict(cls, d: dict, i: int, names=None) -> "Edge":
+        """The edge of a graph file's ``edges[i]`` ``d`` (``names``: the nodes' names, which an
+        outcome other than dropped, other, unstable or refused must be); an ArgumentError naming the field."""
+        from .trial import DROPPED, OTHER, REFUSED, UNSTABLE
+
         f = f"edges[{i}]"
-        try:
-            e = cls(str(d["from"]), str(d["action"]), None if d["to"] is None else str(d["to"]), int(d["trials"]),
-                    {str(k): int(v) for k, v in dict(d["outcomes"]).items()}, dict(d.get("detail", {})),
-                    float(d.get("seconds", 0.0)))
-        except (KeyError, TypeError, ValueError) as ex:
-            raise ArgumentError(f"invalid `{f}`: {ex!s} (an edge has from, to, action, trials, outcomes)", f) from None
-        if e.trials < 0 or sum(e.outcomes.values()) != e.trials:
-            raise ArgumentError(f"invalid `{f}.outcomes`: the counts must add up to `trials` ({e.trials})",
+        if not isinstance(d, dict):
+            raise ArgumentError(f"invalid `{f}`: an object (got {type(d).__name__})", f)
+        for key in ("from", "action", "trials", "outcomes"):
+            if key not in d:
+                raise ArgumentError(f"invalid `{f}`: `{key}` is required (an edge has from, to, action, trials, "
+                                    f"outcomes)", f)
+        for key in ("from", "action"):
+            if not isinstance(d[key], str):
+                raise ArgumentError(f"invalid `{f}.{key}`: a string (got {d[key]!r:.40})", f"{f}.{key}")
+        if d.get("to") is not None and not isinstance(d["to"], str):
+            raise ArgumentError(f"invalid `{f}.to`: a grasp's name or null (got {d['to']!r:.40})", f"{f}.to")
+        count = lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0  # noqa: E731
+        if not count(d["trials"]):
+            raise ArgumentError(f"invalid `{f}.trials`: a whole number >= 0 (got {d['trials']!r:.40})", f"{f}.trials")
+        out = d["outcomes"]
+        known = set(names or ()) | {DROPPED, OTHER, UNSTABLE, REFUSED}
+        if not isinstance(out, dict) or not all(isinstance(k, str) and count(v) for k, v in out.items()):
+            raise ArgumentError(f"invalid `{f}.outcomes`: {{outcome: whole number >= 0}}", f"{f}.outcomes")
+        if names is not None and set(out) - known:
+            raise ArgumentError(f"invalid `{f}.outcomes`: {sorted(set(out) - known)} are neither nodes nor "
+                                f"{', '.join(sorted(known - set(names)))}", f"{f}.outcomes")
+        if sum(out.values()) != d["trials"]:
+            raise ArgumentError(f"invalid `{f}.outcomes`: the counts must add up to `trials` ({d['trials']})",
                                 f"{f}.outcomes")
-        return e
+        detail = d.get("detail", {})
+        if not isinstance(detail, dict):
+            raise ArgumentError(f"invalid `{f}.detail`: an object", f"{f}.detail")
+        seconds = d.get("seconds", 0.0)
+        if not isinstance(seconds, (int, float)) or isinstance(seconds, bool):
+            raise ArgumentError(f"invalid `{f}.seconds`: a number", f"{f}.seconds")
+        return cls(d["from"], d["action"], d.get("to"), d["trials"], dict(out), dict(detail), float(seconds))
 
 
 @dataclass
@@ -117,10 +141,10 @@ class GraspGraph:
     def load(cls, path) -> "GraspGraph":
         """The graph file ``path``; an ArgumentError naming the field of a bad file."""
         try:
-            d = json.loads(Path(path).read_text())
+            d = json.loads(Path(path).read_text(encoding="utf-8"))
         except OSError as e:
             raise ArgumentError(f"cannot read the grasp graph {str(path)!r}: {e.strerror}", "graph") from None
-        except json.JSONDecodeError as e:
+        except (json.JSONDecodeError, UnicodeDecodeError) as e:
             raise ArgumentError(f"invalid grasp graph {str(path)!r}: not JSON ({e})", "graph") from None
         return cls.from_dict(d)
 
@@ -131,19 +155,25 @@ class GraspGraph:
             raise ArgumentError(f"invalid `format`: a grasp graph file has \"format\": \"{FORMAT}\"", "format")
         if d.get("version") != VERSION:
             raise ArgumentError(f"invalid `version`: {d.get('version')!r} (this regrasp reads version {VERSION})", "version")
-        for key in ("object", "nodes", "edges", "actions", "settings"):
+        for key, kind in (("object", dict), ("nodes", list), ("edges", list), ("actions", list), ("settings", dict)):
             if key not in d:
                 raise ArgumentError(f"invalid `{key}`: is required", key)
-        if not isinstance(d["nodes"], list) or not all(isinstance(n, dict) and "name" in n for n in d["nodes"]):
-            raise ArgumentError("invalid `nodes`: a list of grasps, each with a `name`", "nodes")
-        names = {n["name"] for n in d["nodes"]}
-        edges = [Edge.from_dict(e, i) for i, e in enumerate(d["edges"])]
+            if not isinstance(d[key], kind):
+                raise ArgumentError(f"invalid `{key}`: a JSON {'object' if kind is dict else 'array'}", key)
+        if not all(isinstance(n, dict) and isinstance(n.get("name"), str) for n in d["nodes"]):
+            raise ArgumentError("invalid `nodes`: a list of grasps, each with a `name` (a string)", "nodes")
+        if not isinstance(d["object"].get("file", ""), str) or not isinstance(d["object"].get("name", ""), str):
+            raise ArgumentError("invalid `object`: its `name` and `file` are strings", "object")
+        seconds = d.get("seconds", 0.0)
+        if not isinstance(seconds, (int, float)) or isinstance(seconds, bool):
+            raise ArgumentError("invalid `seconds`: a number", "seconds")
+        names = [n["name"] for n in d["nodes"]]
+        edges = [Edge.from_dict(e, i, names) for i, e in enumerate(d["edges"])]
         for i, e in enumerate(edges):
             for key, v in (("from", e.source), ("to", e.target)):
                 if v is not None and v not in names:
                     raise ArgumentError(f"invalid `edges[{i}].{key}`: {v!r} is not a node", f"edges[{i}].{key}")
-        return cls(dict(d["object"]), list(d["nodes"]), edges, list(d["actions"]), dict(d["settings"]),
-                   float(d.get("seconds", 0.0)))
+        return cls(dict(d["object"]), list(d["nodes"]), edges, list(d["actions"]), dict(d["settings"]), float(seconds))
 
     @property
     def node_names(self) -> list:
@@ -196,7 +226,7 @@ def run_edge(job: tuple) -> Edge:
     """Runs the trials of one edge: ``job`` = (object path, grasp name, action name, the
     action's params (a dict: place-repick's ``target``), settings, robot)."""
     from .actions import action
-    from .trial import Runner
+    from .trial import REFUSED, Runner
 
     path, grasp_name, action_name, params, settings, robot = job
     scene, tax, obj = _object(path)
@@ -206,12 +236,15 @@ def run_edge(job: tuple) -> Edge:
     runner = Runner(scene, tax, grasp, setup, robot)
     outcomes: dict = {}
     key = "/".join([grasp_name, action_name, *(str(v) for v in params.values())])
-    try:
-        for p in perturbations(settings, key):
-            r = runner.run(p)
-            outcomes[r.outcome] = outcomes.get(r.outcome, 0) + 1
-    except ArgumentError as e:  # the arm cannot follow the action here (IK): no edge
-        return Edge(grasp_name, action_name, setup.intended, 0, {}, {"refused": str(e), **params}, time.perf_counter() - t0)
+    for i, p in enumerate(perturbations(settings, key)):
+        try:
+            r = runner.run(p).outcome
+        except ArgumentError as e:
+            if i == 0:  # the arm cannot do the action here at all (IK in the nominal world): no edge
+                return Edge(grasp_name, action_name, setup.intended, 0, {}, {"refused": str(e), **params},
+                            time.perf_counter() - t0)
+            r = REFUSED  # this world only (e.g. a grip beyond the gripper's range)
+        outcomes[r] = outcomes.get(r, 0) + 1
     detail = {k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in setup.detail.items()}
     return Edge(grasp_name, action_name, setup.intended, settings.trials, outcomes, detail, time.perf_counter() - t0)
 
@@ -296,6 +329,9 @@ def build_graph(path, settings: Settings = Settings(), workers: int = 1, ray_add
     order = {(j[1], j[2], j[3].get("target")): i for i, j in enumerate(jobs)}
     edges.sort(key=lambda e: order[(e.source, e.action, e.detail.get("target"))])
     used = sorted({e.action for e in edges})
-    nodes = [{**g.to_dict(), "clearance": clear[g.name], "fits": clear[g.name] >= FIT} for g in tax.grasps]
+    from ..execution.arm import HAND_REACH
+
+    nodes = [{**g.to_dict(), "clearance": float(min(clear[g.name], HAND_REACH)), "fits": clear[g.name] >= FIT}
+             for g in tax.grasps]
     return GraspGraph({"name": scene.name, "file": path}, nodes, edges,
                       [ACTIONS[a].to_dict() for a in used], settings.to_dict(), time.perf_counter() - t0)

@@ -31,12 +31,19 @@ def _placeholder(data: dict, base: Path) -> str:
         elif obj.get("shape") == "sphere":
             point = [float(obj["radius"]), 0.0, 0.0]
         else:
-            line = next(x for x in (base / obj["mesh"]).read_text().splitlines() if x.startswith("v "))
-            point = [float(c) for c in line.split()[1:4]]
-    except (KeyError, TypeError, ValueError, IndexError, OSError, StopIteration):
+            rows = [x.split()[1:4] for x in (base / obj["mesh"]).read_text().splitlines() if x.startswith("v ")]
+            vertices = [[float(c) for c in r] for r in rows]
+            point = vertices[0]
+            centre = [sum(v[k] for v in vertices) / len(vertices) for k in range(3)]
+            normal = [c - p for c, p in zip(centre, point)]  # into the object (towards its vertices' centroid)
+            return _pusher(point, normal)
+    except (KeyError, TypeError, ValueError, IndexError, OSError, StopIteration, ZeroDivisionError):
         return ""  # the loader names what is wrong with the object table
-    normal = [-c for c in point]  # into the object (its frame's origin inside it)
-    return f"\n[[pushers]]\nname = \"{PLACEHOLDER}\"\nfriction = 0.0\npoints = [{point}]\nnormal = {normal}\n"
+    return _pusher(point, [-c for c in point])  # into the object (a box or sphere about its origin)
+
+
+def _pusher(point, normal) -> str:
+    return f"\n[[pushers]]\nname = \"{PLACEHOLDER}\"\nfriction = 0.0\npoints = [{list(point)}]\nnormal = {list(normal)}\n"
 
 
 def object_path(name: str) -> Path:

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import ArgumentError
 from ..extras import need
 from .graph import GraspGraph
-from .trial import DROPPED, OTHER, UNSTABLE
+from .trial import DROPPED, OTHER, REFUSED, UNSTABLE
 
 OBJECTIVES = ("reliable", "expected")
 TRANSFER_SPEED = 0.25  # m/s, the hand's move between two actions (and 1 rad/s turning)
@@ -32,10 +32,13 @@ class Step:
     target: str
     p: float
     trials: int
+    params: dict | None = None
 
     def to_dict(self) -> dict:
-        """The step as JSON."""
-        return {"from": self.source, "action": self.action, "to": self.target, "p": self.p, "trials": self.trials}
+        """The step as JSON (``params``: the action's parameters as measured, e.g. a re-pick's
+        ``target``)."""
+        return {"from": self.source, "action": self.action, "to": self.target, "p": self.p, "trials": self.trials,
+                "params": dict(self.params or {})}
 
 
 @dataclass(frozen=True)
@@ -55,17 +58,18 @@ class Sequence:
 
 def transitions(graph: GraspGraph):
     """The networkx DiGraph of the best transition between each pair of grasps: edge attributes
-    ``action``, ``p`` (measured share of runs), ``trials``."""
+    ``action``, ``params`` (a re-pick's ``target``), ``p`` (measured share of runs), ``trials``."""
     nx = need("networkx", "robot")
     G = nx.DiGraph()
     G.add_nodes_from(graph.node_names)
     for e in graph.edges:
         for outcome, count in e.outcomes.items():
-            if outcome in (DROPPED, OTHER, UNSTABLE) or outcome == e.source or count == 0 or e.trials == 0:
+            if outcome in (DROPPED, OTHER, UNSTABLE, REFUSED) or outcome == e.source or count == 0 or e.trials == 0:
                 continue
             p = count / e.trials
             if not G.has_edge(e.source, outcome) or G[e.source][outcome]["p"] < p:
-                G.add_edge(e.source, outcome, action=e.action, p=p, trials=e.trials)
+                params = {"target": e.detail["target"]} if isinstance(e.detail.get("target"), str) else {}
+                G.add_edge(e.source, outcome, action=e.action, params=params, p=p, trials=e.trials)
     return G
 
 
@@ -88,7 +92,7 @@ def plan(graph: GraspGraph, start: str, goal: str, objective: str = "reliable") 
     except nx.NetworkXNoPath:
         raise ArgumentError(f"invalid `to`: no sequence of measured regrasps reaches {goal!r} from {start!r}",
                             "to") from None
-    steps = tuple(Step(u, G[u][v]["action"], v, float(G[u][v]["p"]), int(G[u][v]["trials"]))
+    steps = tuple(Step(u, G[u][v]["action"], v, float(G[u][v]["p"]), int(G[u][v]["trials"]), G[u][v]["params"])
                   for u, v in zip(nodes, nodes[1:]))
     return Sequence(steps, float(np.prod([s.p for s in steps])) if steps else 1.0, float(sum(1 / s.p for s in steps)))
 
@@ -110,7 +114,9 @@ def execute(path, sequence: Sequence, perturbation=None, robot: str | None = Non
     """Runs ``sequence`` on the object file ``path`` in MuJoCo, open loop: the world built at the
     first grasp and the first action's start; before each later action the hand moves to its
     start (:data:`TRANSFER_SPEED`, grip firm); each action set up for the grasp the plan expects
-    there. Stops at the first step that misses its target."""
+    there (with its measured parameters: a re-pick's target). Stops at the first step that misses
+    its target; a step the arm cannot reach from where the last one left it (IK) ends the run as
+    ``refused``."""
     from .actions import action
     from .graph import _object
     from .trial import classify
@@ -120,11 +126,14 @@ def execute(path, sequence: Sequence, perturbation=None, robot: str | None = Non
     if not sequence.steps:
         return SequenceRun((), True)
     p = perturbation or Perturbation()
-    first = action(sequence.steps[0].action).setup(obj, tax.grasp(sequence.steps[0].source))
-    world = HandWorld(scene, tax.grasp(sequence.steps[0].source).pose, first.start, p, robot)
+    first = action(sequence.steps[0].action).setup(obj, tax.grasp(sequence.steps[0].source), sequence.steps[0].params)
+    try:
+        world = HandWorld(scene, tax.grasp(sequence.steps[0].source).pose, first.start, p, robot)
+    except ArgumentError:  # no IK for the start: the run fails there
+        return SequenceRun((REFUSED,), False)
     outcomes = []
     for i, step in enumerate(sequence.steps):
-        setup = first if i == 0 else action(step.action).setup(obj, tax.grasp(step.source))
+        setup = first if i == 0 else action(step.action).setup(obj, tax.grasp(step.source), step.params)
         if i > 0:
             here = world.robot.tcp_pose()
             dist = float(np.linalg.norm(here[:3] - setup.start[:3]))
@@ -132,8 +141,12 @@ def execute(path, sequence: Sequence, perturbation=None, robot: str | None = Non
 
             T = max(0.5, dist / TRANSFER_SPEED, quat_angle(here[3:], setup.start[3:]) / 1.0)
             move = HandPath.line(here, setup.start, T)
-            world.follow(move, solve_path(world.robot, move, world.robot.q), constant(obj.grip), 0.2, observe)
-        q = solve_path(world.robot, setup.path, world.robot.q)
+        try:
+            if i > 0:
+                world.follow(move, solve_path(world.robot, move, world.robot.q), constant(obj.grip), 0.2, observe)
+            q = solve_path(world.robot, setup.path, world.robot.q)
+        except ArgumentError:  # the arm cannot go on from where the last action left it (IK)
+            return SequenceRun((*outcomes, REFUSED), False)
         world.follow(setup.path, q, setup.grip, setup.settle, observe)
         outcome = classify(world, tax)[0]
         outcomes.append(outcome)

@@ -3,7 +3,9 @@ perturbed world), the arm run along the action's path under its grip schedule, a
 classified to the nearest grasp of the taxonomy — ``dropped`` when the pads no longer hold the
 object, ``other`` when it is held but farther than the classification tolerance from every
 grasp (:data:`TOLERANCE` of the object's size), ``unstable`` when MuJoCo's integration blew up
-(it then resets the state: nothing after it is the action's doing; a failed run)."""
+(it then resets the state: nothing after it is the action's doing; a failed run), ``refused``
+when the action could not be set up in that world (e.g. a perturbed grip force beyond the
+gripper's range; a failed run)."""
 
 from __future__ import annotations
 
@@ -15,7 +17,7 @@ import numpy as np
 
 from .world import HandWorld, Perturbation, solve_path
 
-DROPPED, OTHER, UNSTABLE = "dropped", "other", "unstable"
+DROPPED, OTHER, UNSTABLE, REFUSED = "dropped", "other", "unstable", "refused"
 TOLERANCE = 0.15  # the classification tolerance: this share of the object's size (its hull's largest extent) [m/m]
 
 

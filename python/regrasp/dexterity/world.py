@@ -12,6 +12,7 @@ reads true."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Callable, Optional
 
 import numpy as np
@@ -30,7 +31,8 @@ OPEN = None  # a grip schedule's value for "fingers open"
 class Perturbation:
     """One trial's world: the pads' friction, the grip force and the object's mass scaled by
     ``friction``, ``grip``, ``mass``; the object's start pose in the hand moved by ``shift``
-    (3,) [m] (hand frame) and turned by ``turn`` [rad] about the grasp axis (y)."""
+    (3,) [m] (hand frame) and turned by ``turn`` [rad] about the grasp axis (+y: z towards x, the
+    opposite of a planar turn's sign; drawn symmetric, so no result depends on it)."""
 
     friction: float = 1.0
     grip: float = 1.0
@@ -116,8 +118,8 @@ class GripSchedule:
             return
         f = float(f) * self.world.perturbation.grip
         ff = self.feedforward(f)
-        # bounded below by the command of half the force (it never opens the hand: the pads would
-        # spring off), above as the grip controller (it may close harder where the map reads low)
+        # bounded below by the command of a quarter of the force (it never opens the hand: the pads
+        # would spring off), above as the grip controller (it may close harder where the map reads low)
         low, high = ff - self.feedforward(f / 4), max(self.correction * f, self.min_correction) / self.gain
         measured = float(np.mean(self.sensor(d)))
         self.integral = min(max(self.integral + period / self.TAU * (f - measured) / self.gain, -low), high)
@@ -344,3 +346,25 @@ def hand_clearances(scene, grasps, robot: str | None = None) -> dict:
         dist, _, part = clearance(r, r.tcp_pose(), [g.pose])
         out[g.name] = (dist, part)
     return out
+
+
+def finger_reach(scene, robot: str | None = None) -> float:
+    """How far [m] the gripper's lowest colliding part (a pad's grid, a finger's tip link) reaches
+    below the TCP along the fingers, closed, with ``scene``'s pads: measured once per pad model
+    (the arm's IK keeps it ``MIN_DISTANCE`` off the table)."""
+    return _finger_reach(float(scene._core.pad_radius), float(scene._core.grip_friction), robot or "")
+
+
+@lru_cache(maxsize=16)
+def _finger_reach(pad_radius: float, friction: float, robot: str) -> float:
+    from ..robot.grip import close_fingers
+    from ..robot.ik import solve_ik, table_distance
+    from ..robot.model import DEFAULT_ROBOT, build
+    from ..robot.pads import TIP_SOLREF, Pads
+
+    r = build(robot or DEFAULT_ROBOT, pads=Pads(5, 5, 0.001, ("circle", pad_radius, pad_radius), TIP_SOLREF),
+              pad_friction=friction)
+    close_fingers(r)
+    height = 0.04  # m, the TCP above the table: the fingers within the distance query's reach
+    q = solve_ik(r, np.array([WORK_POINT[0], WORK_POINT[1], height, 1.0, 0.0, 0.0, 0.0]), r.q)
+    return float(height - table_distance(r, q))
