@@ -110,5 +110,5 @@ def simulate(body: Body, duration: float, hand: Callable[[float], tuple], grip: 
             observe(t, x)
     ph, ah = hand(duration)
     com = _rot(-ah) @ (x - np.asarray(ph, float))
-    turn = (th - ah) - (a0 - a0)
+    turn = th - ah  # it started turned as the hand (th = a0)
     return Slip(com - _rot(turn) @ c0, float(turn), com)

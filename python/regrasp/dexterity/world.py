@@ -147,17 +147,6 @@ def ramps(*points) -> Callable[[float], Optional[float]]:
     return lambda x: float(np.interp(x, t, f))
 
 
-def steps(*pieces) -> Callable[[float], Optional[float]]:
-    """A grip schedule's force from ``(until [s], force [N] or OPEN)`` pieces in turn (the last
-    held after its time)."""
-    ends = [p[0] for p in pieces]
-
-    def force(t: float):
-        i = min(int(np.searchsorted(ends, t, side="right")), len(pieces) - 1)
-        return pieces[i][1]
-    return force
-
-
 class HandWorld:
     """The arm holding ``scene``'s object (a :class:`regrasp.Scene3D`) at in-hand pose ``grasp``
     (7,) with the TCP at world pose ``hand`` (7,) (or the arm at joint positions ``q`` [rad]),
@@ -271,13 +260,6 @@ class HandWorld:
         then resets the state)."""
         mujoco = need("mujoco", "robot")
         return int(self.robot.data.warning[int(mujoco.mjtWarning.mjWARN_BADQACC)].number) > 0
-
-    def on_table(self) -> bool:
-        """Whether the object touches the table now."""
-        from ..robot.grip import contact_normal_forces
-
-        r = self.robot
-        return bool(contact_normal_forces(r.model, r.data, [self.geoms], [r.table])[0] > 1e-6)
 
     # --- acting ---------------------------------------------------------------------------------
 
