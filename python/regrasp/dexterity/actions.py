@@ -44,6 +44,8 @@ DEFAULTS = {
     "drop": 0.002,      # m, place-repick: the object's face above the table when the fingers open
     "clear": 0.06,      # m, place-repick: the hand's retreat and approach along its fingers
     "close_time": 1.0,  # s, place-repick: the fingers close on the object on the table this long before the lift
+    "toss": 12.0,       # m/s², toss-catch: the hand's upward acceleration, fingers up, the grip firm
+    "toss_stop": 30.0,  # m/s², toss-catch: the hand's stop (more than g: the object flies on, free, while the fingers are open)
 }
 MAX_PLACE_TILT = np.radians(90.0) + 1e-9  # rad, place-repick: the hand placing at most this far from fingers-down (level)
 MAX_PICK_TILT = np.radians(45.0)  # rad, place-repick: the hand picking at most this far from fingers-down
@@ -437,6 +439,104 @@ class InertialSlide(Action):
                      {"jab": float(jab), "grip": obj.holding(p["jab_hold"]), "slide": float(slip.shift[1])})
 
 
+_RELEASE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # scene -> {width: (a, b)}
+
+
+def release(obj: ObjectModel, grasp) -> tuple:
+    """(a, b): the pads leave ``grasp``'s object free for a · δ + b [s] when the fingers are
+    opened for δ [s] (:func:`~.world.release_timing`, measured once per object and grasp width in
+    a :class:`~.world.HandWorld`, fingers down)."""
+    from .world import HandWorld, release_timing
+
+    cache = _RELEASE.setdefault(obj.scene, {})
+    key = round(float(grasp.width), 6)
+    if key not in cache:
+        cache[key] = release_timing(HandWorld(obj.scene, grasp.pose, hand_pose(0.0)))
+    return cache[key]
+
+
+def _opening(obj: ObjectModel, grasp, free: float) -> float:
+    """The opening δ [s] that leaves the object free for ``free`` [s] (:func:`release`)."""
+    a, b = release(obj, grasp)
+    return float(min(max((free - b) / a, 0.002), 0.05))
+
+
+class DropCatch(Action):
+    """Fingers down, the fingers open for a moment and close again: the object falls freely
+    while the pads are apart and is caught one offset step further towards the fingertips. The
+    opening δ from the fall ½ g t² of the step and the gripper's measured release (the free time
+    t = a δ + b, :func:`release`)."""
+
+    def __init__(self):
+        super().__init__("drop-catch", "gravity", "let go for a moment: fall one step and catch it")
+
+    def applies(self, obj, grasp):
+        return None if _offset_step(obj, grasp, -1) is not None else "no grasp further towards the fingertips"
+
+    def setup(self, obj, grasp, params=None):
+        _params(params)
+        step = _offset_step(obj, grasp, -1)
+        free = float(np.sqrt(2 * step / obj.g))
+        delta = _opening(obj, grasp, free)
+        a, b = release(obj, grasp)
+        fall = 0.5 * obj.g * (a * delta + b) ** 2
+        t0 = 0.1
+        start = hand_pose(0.0)
+        pose = P.compose(np.array([0.0, 0.0, -fall, 1.0, 0.0, 0.0, 0.0]), grasp.pose)
+        return Setup(start, HandPath(np.array([0.0, t0 + 3 * delta + 0.1]), np.array([start, start])),
+                     _released(obj.grip, t0, delta), 0.3, pose, _intended(obj, pose),
+                     {"opening": delta, "free_time": a * delta + b, "fall": fall})
+
+
+class TossCatch(Action):
+    """Toss and re-catch: fingers up, the hand accelerates upwards at ``toss`` (the grip firm),
+    then stops at ``toss_stop`` > g while the fingers open for a moment: the object flies on,
+    free, decelerated by gravity only — (``toss_stop`` − g) relative to the hand — and is caught
+    one offset step further towards the fingertips (½ (b − g) t² of the free time t = a δ + b,
+    :func:`release`)."""
+
+    def __init__(self):
+        super().__init__("toss-catch", "inertia", "toss it up along the fingers and catch it one step out")
+
+    def applies(self, obj, grasp):
+        return None if _offset_step(obj, grasp, -1) is not None else "no grasp further towards the fingertips"
+
+    def setup(self, obj, grasp, params=None):
+        p = _params(params)
+        step = _offset_step(obj, grasp, -1)
+        rel = p["toss_stop"] - obj.g  # m/s², the object's deceleration relative to the hand while free
+        if rel <= 0:
+            raise ArgumentError(f"invalid `params.toss_stop`: more than g = {obj.g:.2f} m/s² (got {p['toss_stop']})",
+                                "params.toss_stop")
+        free = float(np.sqrt(2 * step / rel))
+        delta = _opening(obj, grasp, free)
+        a, b = release(obj, grasp)
+        t_free = a * delta + b
+        fly = 0.5 * rel * t_free ** 2
+        stop = t_free + 0.02  # s, the stop lasts past the catch
+        v = p["toss_stop"] * stop  # m/s, the speed at which the stop begins
+        rise = v / p["toss"]  # s, the acceleration
+        T = rise + stop
+        base = np.asarray(WORK_POINT, float)  # the toss starts at the work point (the wrist, under the hand, clear of the table)
+
+        def up(t: float) -> float:  # the hand's rise [m] at time t
+            if t <= rise:
+                return 0.5 * p["toss"] * t * t
+            u = min(t - rise, stop)
+            return 0.5 * v * rise + v * u - 0.5 * p["toss_stop"] * u * u
+
+        times = np.linspace(0.0, T, int(np.ceil(T / 0.005)) + 1)
+        poses = np.array([hand_pose(np.pi, base + np.array([0.0, 0.0, up(t)])) for t in times])
+        pose = P.compose(np.array([0.0, 0.0, -fly, 1.0, 0.0, 0.0, 0.0]), grasp.pose)
+        return Setup(poses[0], HandPath(times, poses), _released(obj.grip, rise, delta), 0.3, pose, _intended(obj, pose),
+                     {"opening": delta, "free_time": t_free, "speed": v, "fly": fly})
+
+
+def _released(force: float, t0: float, delta: float):
+    """The grip schedule: ``force`` [N], the fingers open for ``delta`` [s] from ``t0`` [s]."""
+    return lambda t: None if t0 <= t < t0 + delta else force
+
+
 class PushDown(Action):
     """Fingers down, the object below the fingertips: the hand descends at ``speed`` with the
     grip at ``press_hold`` times the holding force until the table has pushed the object one
@@ -768,8 +868,8 @@ def _fixed_point(before, after, turn: float) -> np.ndarray:
     return np.linalg.solve(np.eye(2) - R, t)
 
 
-ACTIONS = {a.name: a for a in (GravityPivot(), GravitySlide(), GripPivot(), InertialSlide(), PushDown(), TablePivot(),
-                                PlaceRepick(), ToppleRepick())}
+ACTIONS = {a.name: a for a in (GravityPivot(), GravitySlide(), GripPivot(), DropCatch(), InertialSlide(), TossCatch(),
+                                PushDown(), TablePivot(), PlaceRepick(), ToppleRepick())}
 
 
 def action(name: str) -> Action:

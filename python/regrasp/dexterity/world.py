@@ -280,6 +280,31 @@ class HandWorld:
         self.follow(HandPath(np.array([0.0, duration]), np.zeros((2, 7))), np.array([q, q]), force, 0.0, observe)
 
 
+RELEASES = (0.008, 0.014, 0.020)  # s, the openings release_timing measures
+
+
+def release_timing(world: "HandWorld", releases=RELEASES) -> tuple:
+    """(a, b): the time [s] the pads leave the object free, ≈ a · δ + b, when the fingers are
+    commanded open for δ [s] and then closed again at the grip force — the 2F-85's driver runs
+    open at full force, and comes back from as far as it went (a least-squares line through the
+    free times measured in ``world``, the hand still, at each of ``releases``; the world is left
+    reset)."""
+    times = []
+    for delta in releases:
+        world.reset()
+        free: list = []
+        force = world.grip_force / world.perturbation.grip
+
+        def grip(t: float, delta=delta):
+            return OPEN if 0.05 <= t < 0.05 + delta else force
+
+        world.wait(0.05 + 3 * delta + 0.1, grip, lambda w: free.append(w.robot.data.time) if not w.held() else None)
+        times.append(free[-1] - free[0] if free else 0.0)
+    world.reset()
+    a, b = np.polyfit(np.asarray(releases, float), np.asarray(times, float), 1)
+    return float(a), float(b)
+
+
 def solve_ik_from_home(robot, hand) -> np.ndarray:
     """Joint positions [rad] putting the TCP at world pose ``hand``: solved from the robot's home
     for the fingers down at ``hand``'s point, then followed (IK continuation, 0.1 rad steps) to
