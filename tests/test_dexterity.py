@@ -254,6 +254,7 @@ def test_the_pivot_breaks_away_at_the_limit_surface_angle_in_mujoco(box):
     ("box", "g4", "inertial-slide", {}),
     ("box", "g7", "drop-catch", {}),
     ("box", "g7", "toss-catch", {}),
+    ("box", "g6", "post-push", {}),
     ("box", "g6", "place-repick", {"target": "g12"}),
     ("box", "g12", "place-repick", {"target": "g6"}),  # another width: the TCP corrected for the linkage
     ("box", "g7", "topple-repick", {"target": "g12"}),
@@ -293,6 +294,21 @@ def test_a_catch_lands_where_the_release_model_predicts(box, action):
     moved = -P.compose(r.pose, P.inverse(g.pose))[2]  # along the fingers, towards their tips
     assert predicted > 0.005
     assert moved == pytest.approx(predicted, rel=0.2)
+
+
+@pytest.mark.parametrize("ratio, found", [(1.6, False), (2.4, True)])
+def test_the_post_push_is_planned_where_the_posts_friction_carries_the_weight(box, ratio, found):
+    # the pads slide, so the post's friction, pressed by their friction 2 μ N = ratio · m g, must
+    # carry the weight across the push: μ_post · ratio ≥ 1 (at μ_post 0.5: ratio ≥ 2)
+    from regrasp import pose as P
+    from regrasp.dexterity.actions import post_scene
+
+    scene, tax, obj = box
+    g, deeper = tax.grasp("g6"), tax.grasp("g7")
+    plan = post_scene(obj, g.pose, deeper.pose, obj.holding(ratio), friction=0.5).plan(time_limit=1.0)
+    assert plan.found == found
+    if found:  # the push ends at the deeper grasp
+        assert np.linalg.norm(P.compose(plan.poses[-1], P.inverse(deeper.pose))[:3]) < 1.5e-3
 
 
 def test_a_topple_rolls_the_outline_towards_its_centre_of_mass():

@@ -21,10 +21,10 @@ from typing import Callable, Optional
 import numpy as np
 
 from .. import pose as P
-from ..errors import ArgumentError
+from ..errors import ArgumentError, SceneError
 from .slip import Body, Slip, simulate
 from .taxonomy import grasp_distance
-from .world import WORK_POINT, HandPath, ramps
+from .world import POST_FRICTION, POST_HALF, POST_X, POST_Y, WORK_POINT, HandPath, ramps
 
 G = 9.81  # m/s², the default gravity's norm (a scene's own is used: ObjectModel.g)
 RAMP = 0.05  # s, a grip change is ramped over this long (the linkage follows; a step springs the pads off)
@@ -44,6 +44,8 @@ DEFAULTS = {
     "drop": 0.002,      # m, place-repick: the object's face above the table when the fingers open
     "clear": 0.06,      # m, place-repick: the hand's retreat and approach along its fingers
     "close_time": 1.0,  # s, place-repick: the fingers close on the object on the table this long before the lift
+    "plan_time": 0.5,   # s, post-push: the motion-cone planner's time limit per grip tried
+    "push_speed": 0.01,  # m/s, post-push: the hand's speed along the plan (quasi-static: at 3 cm/s the pads chatter off a box)
     "toss": 12.0,       # m/s², toss-catch: the hand's upward acceleration, fingers up, the grip firm
     "toss_stop": 30.0,  # m/s², toss-catch: the hand's stop (more than g: the object flies on, free, while the fingers are open)
 }
@@ -573,6 +575,117 @@ class PushDown(Action):
                      _intended(obj, pose), {"push": step, "grip": low})
 
 
+POST_HOLDS = (1.5, 2.0, 3.0, 4.0)  # post-push: the grips tried (2 μ N / m g), the least the planner finds a push at
+POST_ROOM = 0.006  # m, post-push: the post's side at least this far from each pad (the IK keeps the gripper 5 mm off it)
+
+
+class PostPush(Action):
+    """A prehensile push against the workcell's post (thesis ch. 3–4): the hand level, its fingers
+    towards the post (:data:`~.world.POST_X`), which passes between them. The motion-cone planner
+    (:meth:`regrasp.Scene3D.plan`, inverse dynamics over the pads' limit surface) plans the push
+    one offset step deeper into the hand with the post's face as a plane pusher of the post's
+    friction and gravity across the push, at the least grip of :data:`POST_HOLDS` at which it
+    finds one — the post's friction, pressed by the pads' sliding friction, must carry the weight
+    (μ_post · 2μN ≥ m g). The hand renders the plan with the object held still by the post
+    (sticking): at knot k the TCP is O ∘ X_k⁻¹, O the object's world pose at contact and X_k its
+    planned pose in the hand; the hand comes in at ``speed`` and follows the plan at ``push_speed``."""
+
+    ALPHA = np.pi / 2  # rad, the hand level, its fingers along the world's +x (at the post)
+
+    def __init__(self):
+        super().__init__("post-push", "contact", "push it deeper against a post, the motion planned by motion cones")
+
+    def _plan(self, obj, grasp, plan_time: float):
+        """(grip ratio, the plan) or why there is none (cached per grasp)."""
+        cache = _PLANS.setdefault(obj.taxonomy, {})
+        key = (grasp.name, plan_time)
+        if key in cache:
+            return cache[key]
+        step = _offset_step(obj, grasp, +1)
+        if step is None:
+            out = "no grasp further towards the palm"
+        elif grasp.width / 2 - POST_HALF[1] < POST_ROOM:
+            out = f"the post ({2e3 * POST_HALF[1]:.0f} mm) does not pass between pads {grasp.width * 1e3:.1f} mm apart"
+        else:
+            goal = P.compose(np.array([0.0, 0.0, step, 1.0, 0.0, 0.0, 0.0]), grasp.pose)
+            out = f"the motion-cone planner finds no push at a grip up to {POST_HOLDS[-1]} times the holding force"
+            for ratio in POST_HOLDS:
+                try:
+                    plan = post_scene(obj, grasp.pose, goal, obj.holding(ratio)).plan(time_limit=plan_time)
+                except (ArgumentError, SceneError) as e:  # the pads do not touch it at the start or the goal
+                    out = f"the planner's pads do not hold it there ({e})"
+                    break
+                if plan.found:
+                    out = (ratio, plan)
+                    break
+        cache[key] = out
+        return out
+
+    def applies(self, obj, grasp):
+        plan = self._plan(obj, grasp, DEFAULTS["plan_time"])
+        return plan if isinstance(plan, str) else None
+
+    def setup(self, obj, grasp, params=None):
+        p = _params(params)
+        plan = self._plan(obj, grasp, p["plan_time"])
+        if isinstance(plan, str):
+            raise ArgumentError(f"invalid `grasp`: post-push does not apply to {grasp.name}: {plan}", "grasp")
+        ratio, plan = plan
+        X = np.asarray(plan.poses, float)
+        reach = -lowest(grasp, obj.taxonomy.vertices)[2]
+        press = 0.0005  # m, the object pressed this far into the post at contact (soft contact)
+        contact = hand_pose(self.ALPHA, (POST_X - reach + press, POST_Y, WORK_POINT[2]))
+        start = hand_pose(self.ALPHA, (POST_X - reach - p["approach"], POST_Y, WORK_POINT[2]))
+        O = P.compose(contact, X[0])  # the object's world pose, held by the post
+        knots = [P.compose(O, P.inverse(x)) for x in X]
+        path = HandPath.line(start, contact, 1.5 * p["approach"] / p["speed"])
+        t0 = path.times[-1]
+        for a, b in zip(knots, knots[1:]):
+            path = path.then(HandPath.line(a, b, max(float(np.linalg.norm(b[:3] - a[:3])) / p["push_speed"], 0.05),
+                                           profile=lambda s: s))
+        t1 = path.times[-1]
+        path = path.then(HandPath.line(knots[-1], P.compose(knots[-1], np.array([0.0, 0.0, p["approach"], 1.0, 0.0, 0.0, 0.0])), 1.0))
+        low = obj.holding(ratio)
+        grip = ramps((0.0, obj.grip), (t0 - RAMP, obj.grip), (t0, low), (t1, low), (t1 + RAMP, obj.grip))
+        pose = X[-1]
+        return Setup(start, path, grip, 0.3, pose, _intended(obj, pose),
+                     {"grip": low, "hold": ratio, "knots": len(X), "push": float(X[-1][2] - X[0][2])})
+
+
+_PLANS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # taxonomy -> {(grasp name, plan_time): _plan}
+
+
+def post_scene(obj: ObjectModel, start, goal, force: float, friction: float = POST_FRICTION):
+    """The :class:`regrasp.Scene3D` of a push against the post with the hand level: ``obj``'s object
+    file's ``[object]``, its pads at ``force`` [N] each, gravity along the hand's −x, the post's
+    face a plane pusher (``friction``, by default the post's) pushing towards the palm (+z),
+    the task from in-hand pose ``start`` to ``goal`` (1 mm, 1°)."""
+    import tomllib
+
+    from ..scene.spatial import Scene3D
+
+    data = tomllib.loads(obj.scene.path.read_text())
+    lines = ["dimension = 3", 'name = "post-push"', "", "[object]"]
+    lines += [f"{k} = {_toml(v)}" for k, v in data["object"].items()]
+    grasp = dict(data["grasp"], force=float(force))
+    lines += ["", "[grasp]"] + [f"{k} = {_toml(v)}" for k, v in grasp.items()]
+    lines += ["", "[gravity]", "direction = [-1.0, 0.0, 0.0]", f"g = {obj.g!r}"]
+    lines += ["", "[[pushers]]", 'name = "post"', f"friction = {float(friction)!r}", "plane = true", "normal = [0.0, 0.0, 1.0]"]
+    lines += ["", "[task]", f"start = {_toml(start)}", f"goal = {_toml(goal)}", "tolerance = [0.001, 0.001, 0.001, 0.0175]"]
+    return Scene3D.from_toml("\n".join(lines) + "\n", obj.scene.path.parent)
+
+
+def _toml(v) -> str:
+    """A TOML value of a string, a number or a list of them."""
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(_toml(x) for x in v) + "]"
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    return str(v) if isinstance(v, int) else repr(float(v))
+
+
 class TablePivot(Action):
     """Fingers down, the object's lowest vertex on the table: the hand moves on an arc about that
     vertex, keeping its orientation, so that the object (held on the table by friction) turns in
@@ -869,7 +982,7 @@ def _fixed_point(before, after, turn: float) -> np.ndarray:
 
 
 ACTIONS = {a.name: a for a in (GravityPivot(), GravitySlide(), GripPivot(), DropCatch(), InertialSlide(), TossCatch(),
-                                PushDown(), TablePivot(), PlaceRepick(), ToppleRepick())}
+                                PushDown(), PostPush(), TablePivot(), PlaceRepick(), ToppleRepick())}
 
 
 def action(name: str) -> Action:

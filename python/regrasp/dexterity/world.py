@@ -22,6 +22,9 @@ from ..errors import ArgumentError
 from ..extras import need
 
 WORK_POINT = (0.40, 0.30, 0.40)  # m, world: where the hand works, 0.40 m above the table's top
+POST_X, POST_Y = 0.55, 0.0  # m, world: the face of the workcell's fixed post (facing −x) for prehensile pushes, clear of the arm at the work point
+POST_HALF = (0.005, 0.004, 0.30)  # m, the post's half-extents (x, y, z), standing on the table: 8 mm wide, it passes between the fingers
+POST_FRICTION = 1.0  # the post's Coulomb friction with the object (a rubber-faced post)
 PATH_STEP = 0.01  # s, a hand path's sample spacing for the IK (dense: followed piecewise linearly)
 SETTLE = 0.3  # s, after each path, the arm's servo holds its end
 OPEN = None  # a grip schedule's value for "fingers open"
@@ -147,12 +150,23 @@ def ramps(*points) -> Callable[[float], Optional[float]]:
     return lambda x: float(np.interp(x, t, f))
 
 
+def add_post(spec) -> None:
+    """The workcell's fixed post (:data:`POST_X`, :data:`POST_HALF`, :data:`POST_FRICTION`): a
+    bar standing on the table, its face towards the robot (−x), narrow enough to pass between the
+    fingers; it touches the object only."""
+    from ..mujoco.model import FEATURE_BITS, add_geom
+
+    c = (POST_X + POST_HALF[0], POST_Y, POST_HALF[2])
+    add_geom(spec.worldbody, "box", list(POST_HALF), FEATURE_BITS, [POST_FRICTION], pos=list(c), name="post",
+             rgba=[0.6, 0.6, 0.65, 1.0])
+
+
 class HandWorld:
     """The arm holding ``scene``'s object (a :class:`regrasp.Scene3D`) at in-hand pose ``grasp``
     (7,) with the TCP at world pose ``hand`` (7,) (or the arm at joint positions ``q`` [rad]),
     the fingers closed on it at the scene's grip force, in the world ``perturbation``;
     ``robot``: the robot's name (default the default robot's). The object is on a free joint;
-    the table under the work point. The model is compiled once: :meth:`reset` starts another
+    the table under the work point, a post beyond it (:func:`add_post`). The model is compiled once: :meth:`reset` starts another
     trial in it (another perturbation), as a fresh build would, in a fraction of the time."""
 
     def __init__(self, scene, grasp, hand, perturbation: Perturbation = Perturbation(), robot: str | None = None,
@@ -173,6 +187,7 @@ class HandWorld:
             add_object3d(spec, scene, np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]), mesh, 1.0)
             for g in spec.body("object").geoms:
                 g.rgba = OBJECT_RGBA
+            add_post(spec)
 
         try:
             self.robot = build(robot or DEFAULT_ROBOT, pads=Pads.of_scene(scene),
@@ -320,10 +335,12 @@ def solve_ik_from_home(robot, hand) -> np.ndarray:
 
 
 def solve_path(robot, path: HandPath, q0) -> np.ndarray:
-    """The arm's joint positions (n, 6) [rad] along ``path`` from ``q0`` (IK, one solve per sample)."""
+    """The arm's joint positions (n, 6) [rad] along ``path`` from ``q0`` (IK, one solve per sample;
+    the arm and gripper clear of the table and of the post, :func:`add_post`, when there is one)."""
     from ..robot.ik import ik_path
 
-    return ik_path(robot, path.poses, q0)
+    avoid = ("post",) if any(robot.model.geom(g).name == "post" for g in range(robot.model.ngeom)) else ()
+    return ik_path(robot, path.poses, q0, avoid=avoid)
 
 
 def hand_clearances(scene, grasps, robot: str | None = None) -> dict:
