@@ -20,6 +20,9 @@ SIZE = (320, 240)
 SHOWN = [  # (action, object, grasp, params)
     ("gravity-slide", "box", "g4", {}),
     ("inertial-slide", "box", "g3", {}),
+    ("drop-catch", "box", "g7", {}),
+    ("toss-catch", "box", "g7", {}),
+    ("post-push", "box", "g6", {}),
     ("push-down", "prism", "g0", {}),
     ("table-pivot", "prism", "g1", {}),
     ("place-repick", "box", "g6", {"target": "g12"}),
