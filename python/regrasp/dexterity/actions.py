@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Callable, Optional
 
 import numpy as np
@@ -28,6 +29,7 @@ from .world import POST_FRICTION, POST_HALF, POST_X, POST_Y, WORK_POINT, HandPat
 
 G = 9.81  # m/s², the default gravity's norm (a scene's own is used: ObjectModel.g)
 RAMP = 0.05  # s, a grip change is ramped over this long (the linkage follows; a step springs the pads off)
+ARM_LAG = 0.005  # s, toss-catch: how far the arm's hand lags its commanded braking (the joint servo, robot.tracking; measured: the box's toss brakes 5–6 ms late)
 DEFAULTS = {
     "overdrive": 1.4,   # gravity-pivot: the gravity moment at the start over the pads' torsion capacity at the lowered grip
     "max_tilt": 2.618,  # rad, gravity-pivot: the centre of mass at most this far from hanging at the start (150°)
@@ -44,7 +46,7 @@ DEFAULTS = {
     "drop": 0.002,      # m, place-repick: the object's face above the table when the fingers open
     "clear": 0.06,      # m, place-repick: the hand's retreat and approach along its fingers
     "close_time": 1.0,  # s, place-repick: the fingers close on the object on the table this long before the lift
-    "plan_time": 0.5,   # s, post-push: the motion-cone planner's time limit per grip tried
+    "plan_iterations": 20,  # post-push: the motion-cone planner's iterations per grip tried (seed 0: the same plan on every machine; a push it finds, it finds at once)
     "push_speed": 0.01,  # m/s, post-push: the hand's speed along the plan (quasi-static: at 3 cm/s the pads chatter off a box)
     "toss": 12.0,       # m/s², toss-catch: the hand's upward acceleration, fingers up, the grip firm
     "toss_stop": 30.0,  # m/s², toss-catch: the hand's stop (more than g: the object flies on, free, while the fingers are open)
@@ -191,6 +193,16 @@ def _offset_step(obj: ObjectModel, grasp, sign: int) -> Optional[float]:
     return min(steps) if steps else None
 
 
+def _step(obj: ObjectModel, grasp, sign: int, action: str) -> float:
+    """:func:`_offset_step`, or an ArgumentError naming ``grasp`` when there is no such grasp."""
+    step = _offset_step(obj, grasp, sign)
+    if step is None:
+        where = "palm" if sign > 0 else "fingertips"
+        raise ArgumentError(f"invalid `grasp`: {action} does not apply to {grasp.name}: no grasp further towards "
+                            f"the {where}", "grasp")
+    return step
+
+
 TURNS = np.radians(np.arange(-180, 180, 1.0))  # the turns that turn_target tries
 
 
@@ -329,7 +341,7 @@ class GravitySlide(Action):
 
     def setup(self, obj, grasp, params=None):
         p = _params(params)
-        step = _offset_step(obj, grasp, -1)
+        step = _step(obj, grasp, -1, self.name)
         a = (1 - min(p["slide_ratio"], 0.99)) * obj.g
         T = float(np.sqrt(2 * step / a))
         low = obj.holding(p["slide_ratio"])
@@ -426,7 +438,7 @@ class InertialSlide(Action):
 
     def setup(self, obj, grasp, params=None):
         p = _params(params)
-        step = _offset_step(obj, grasp, +1)
+        step = _step(obj, grasp, +1, self.name)
         jab, slip = 0.0, None
         for jab in np.linspace(0.005, 0.1, 39):  # the shortest jab that slides the object one step
             T, hand, grip = self._run(obj, p, float(jab))
@@ -441,84 +453,98 @@ class InertialSlide(Action):
                      {"jab": float(jab), "grip": obj.holding(p["jab_hold"]), "slide": float(slip.shift[1])})
 
 
-_RELEASE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # scene -> {width: (a, b)}
+_RELEASE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # scene -> {grasp pose: Release or why none}
 
 
-def release(obj: ObjectModel, grasp) -> tuple:
-    """(a, b): the pads leave ``grasp``'s object free for a · δ + b [s] when the fingers are
-    opened for δ [s] (:func:`~.world.release_timing`, measured once per object and grasp width in
-    a :class:`~.world.HandWorld`, fingers down)."""
+def release(obj: ObjectModel, grasp):
+    """The gripper's :class:`~.world.Release` of ``grasp``'s object: measured once per object and
+    grasp in a :class:`~.world.HandWorld`, fingers down (:func:`~.world.release_timing`; the
+    object then moves towards the fingertips when loose, as in both catches — the timing is
+    the gripper's: fingers up it is the same within 2 ms). An ArgumentError naming ``grasp``
+    when the gripper cannot let go and catch it."""
     from .world import HandWorld, release_timing
 
     cache = _RELEASE.setdefault(obj.scene, {})
-    key = round(float(grasp.width), 6)
+    key = tuple(np.round(np.asarray(grasp.pose, float), 6))
     if key not in cache:
-        cache[key] = release_timing(HandWorld(obj.scene, grasp.pose, hand_pose(0.0)))
+        try:
+            cache[key] = release_timing(HandWorld(obj.scene, grasp.pose, hand_pose(0.0)))
+        except SceneError as e:
+            cache[key] = str(e)
+    if isinstance(cache[key], str):
+        raise ArgumentError(f"invalid `grasp`: {grasp.name}: {cache[key]}", "grasp")
     return cache[key]
 
 
-def _opening(obj: ObjectModel, grasp, free: float) -> float:
-    """The opening δ [s] that leaves the object free for ``free`` [s] (:func:`release`)."""
-    a, b = release(obj, grasp)
-    return float(min(max((free - b) / a, 0.002), 0.05))
+def _catch_applies(obj: ObjectModel, grasp) -> Optional[str]:
+    """Why a catch does not apply to ``grasp`` (None when it does)."""
+    if _offset_step(obj, grasp, -1) is None:
+        return "no grasp further towards the fingertips"
+    try:
+        release(obj, grasp)
+    except ArgumentError as e:
+        return str(e)
+    return None
 
 
 class DropCatch(Action):
     """Fingers down, the fingers open for a moment and close again: the object falls freely
-    while the pads are apart and is caught one offset step further towards the fingertips. The
-    opening δ from the fall ½ g t² of the step and the gripper's measured release (the free time
-    t = a δ + b, :func:`release`)."""
+    while the pads are apart and is caught one offset step further towards the fingertips: the
+    fall ½ g t² of the free time t = a δ + b, the opening δ from the gripper's measured release
+    (:func:`release`; the closing pads' impact stops it)."""
 
     def __init__(self):
         super().__init__("drop-catch", "gravity", "let go for a moment: fall one step and catch it")
 
     def applies(self, obj, grasp):
-        return None if _offset_step(obj, grasp, -1) is not None else "no grasp further towards the fingertips"
+        return _catch_applies(obj, grasp)
 
     def setup(self, obj, grasp, params=None):
         _params(params)
-        step = _offset_step(obj, grasp, -1)
-        free = float(np.sqrt(2 * step / obj.g))
-        delta = _opening(obj, grasp, free)
-        a, b = release(obj, grasp)
-        fall = 0.5 * obj.g * (a * delta + b) ** 2
+        step = _step(obj, grasp, -1, self.name)
+        rel = release(obj, grasp)
+        delta = rel.opening(float(np.sqrt(2 * step / obj.g)))
+        t = rel.free(delta)
+        fall = 0.5 * obj.g * t * t
         t0 = 0.1
         start = hand_pose(0.0)
         pose = P.compose(np.array([0.0, 0.0, -fall, 1.0, 0.0, 0.0, 0.0]), grasp.pose)
         return Setup(start, HandPath(np.array([0.0, t0 + 3 * delta + 0.1]), np.array([start, start])),
                      _released(obj.grip, t0, delta), 0.3, pose, _intended(obj, pose),
-                     {"opening": delta, "free_time": a * delta + b, "fall": fall})
+                     {"opening": delta, "free_time": t, "fall": fall})
 
 
 class TossCatch(Action):
     """Toss and re-catch: fingers up, the hand accelerates upwards at ``toss`` (the grip firm),
     then stops at ``toss_stop`` > g while the fingers open for a moment: the object flies on,
     free, decelerated by gravity only — (``toss_stop`` − g) relative to the hand — and is caught
-    one offset step further towards the fingertips (½ (b − g) t² of the free time t = a δ + b,
-    :func:`release`)."""
+    one offset step further towards the fingertips as the hand comes to rest: the flight
+    ½ (b − g) t² of the free time t = a δ + b (:func:`release`; the fingers commanded open so
+    that the pads let go, ``delay`` after the command, as the arm begins to brake, ARM_LAG
+    behind its own command)."""
 
     def __init__(self):
         super().__init__("toss-catch", "inertia", "toss it up along the fingers and catch it one step out")
 
     def applies(self, obj, grasp):
-        return None if _offset_step(obj, grasp, -1) is not None else "no grasp further towards the fingertips"
+        return _catch_applies(obj, grasp)
 
     def setup(self, obj, grasp, params=None):
         p = _params(params)
-        step = _offset_step(obj, grasp, -1)
+        step = _step(obj, grasp, -1, self.name)
         rel = p["toss_stop"] - obj.g  # m/s², the object's deceleration relative to the hand while free
         if rel <= 0:
             raise ArgumentError(f"invalid `params.toss_stop`: more than g = {obj.g:.2f} m/s² (got {p['toss_stop']})",
                                 "params.toss_stop")
-        free = float(np.sqrt(2 * step / rel))
-        delta = _opening(obj, grasp, free)
-        a, b = release(obj, grasp)
-        t_free = a * delta + b
+        r = release(obj, grasp)
+        delta = r.opening(float(np.sqrt(2 * step / rel)))
+        t_free = r.free(delta)
         fly = 0.5 * rel * t_free ** 2
-        stop = t_free + 0.02  # s, the stop lasts past the catch
+        stop = t_free  # s, the hand brakes while the object is free and is at rest as the pads catch it
         v = p["toss_stop"] * stop  # m/s, the speed at which the stop begins
         rise = v / p["toss"]  # s, the acceleration
-        T = rise + stop
+        opening = rise + ARM_LAG - r.delay  # s, the pads let go as the arm (ARM_LAG behind its command) begins to brake
+        T = rise + stop + 0.05
         base = np.asarray(WORK_POINT, float)  # the toss starts at the work point (the wrist, under the hand, clear of the table)
 
         def up(t: float) -> float:  # the hand's rise [m] at time t
@@ -530,8 +556,8 @@ class TossCatch(Action):
         times = np.linspace(0.0, T, int(np.ceil(T / 0.005)) + 1)
         poses = np.array([hand_pose(np.pi, base + np.array([0.0, 0.0, up(t)])) for t in times])
         pose = P.compose(np.array([0.0, 0.0, -fly, 1.0, 0.0, 0.0, 0.0]), grasp.pose)
-        return Setup(poses[0], HandPath(times, poses), _released(obj.grip, rise, delta), 0.3, pose, _intended(obj, pose),
-                     {"opening": delta, "free_time": t_free, "speed": v, "fly": fly})
+        return Setup(poses[0], HandPath(times, poses), _released(obj.grip, opening, delta), 0.3, pose,
+                     _intended(obj, pose), {"opening": delta, "free_time": t_free, "speed": v, "fly": fly})
 
 
 def _released(force: float, t0: float, delta: float):
@@ -560,7 +586,7 @@ class PushDown(Action):
 
     def setup(self, obj, grasp, params=None):
         p = _params(params)
-        step = _offset_step(obj, grasp, +1)
+        step = _step(obj, grasp, +1, self.name)
         reach = -lowest(grasp, obj.taxonomy.vertices)[2]
         top = reach + p["approach"]  # the TCP's height above the table at the start
         low = obj.holding(p["press_hold"])
@@ -576,6 +602,7 @@ class PushDown(Action):
 
 
 POST_HOLDS = (1.5, 2.0, 3.0, 4.0)  # post-push: the grips tried (2 μ N / m g), the least the planner finds a push at
+PLAN_TIME_CAP = 60.0  # s, post-push: a safety cap on the planner's time (its iterations limit it first)
 POST_ROOM = 0.006  # m, post-push: the post's side at least this far from each pad (the IK keeps the gripper 5 mm off it)
 
 
@@ -595,10 +622,10 @@ class PostPush(Action):
     def __init__(self):
         super().__init__("post-push", "contact", "push it deeper against a post, the motion planned by motion cones")
 
-    def _plan(self, obj, grasp, plan_time: float):
+    def _plan(self, obj, grasp, iterations: int):
         """(grip ratio, the plan) or why there is none (cached per grasp)."""
         cache = _PLANS.setdefault(obj.taxonomy, {})
-        key = (grasp.name, plan_time)
+        key = (grasp.name, iterations)
         if key in cache:
             return cache[key]
         step = _offset_step(obj, grasp, +1)
@@ -611,23 +638,24 @@ class PostPush(Action):
             out = f"the motion-cone planner finds no push at a grip up to {POST_HOLDS[-1]} times the holding force"
             for ratio in POST_HOLDS:
                 try:
-                    plan = post_scene(obj, grasp.pose, goal, obj.holding(ratio)).plan(time_limit=plan_time)
-                except (ArgumentError, SceneError) as e:  # the pads do not touch it at the start or the goal
-                    out = f"the planner's pads do not hold it there ({e})"
+                    plan = post_scene(obj, grasp.pose, goal, obj.holding(ratio)).plan(
+                        seed=0, max_iterations=iterations, time_limit=PLAN_TIME_CAP)
+                except (ArgumentError, SceneError) as e:  # no scene file, or the pads do not touch it at the start or the goal
+                    out = f"no push to plan: {e}"
                     break
-                if plan.found:
+                if plan.found and plan.valid:
                     out = (ratio, plan)
                     break
         cache[key] = out
         return out
 
     def applies(self, obj, grasp):
-        plan = self._plan(obj, grasp, DEFAULTS["plan_time"])
+        plan = self._plan(obj, grasp, int(DEFAULTS["plan_iterations"]))
         return plan if isinstance(plan, str) else None
 
     def setup(self, obj, grasp, params=None):
         p = _params(params)
-        plan = self._plan(obj, grasp, p["plan_time"])
+        plan = self._plan(obj, grasp, int(p["plan_iterations"]))
         if isinstance(plan, str):
             raise ArgumentError(f"invalid `grasp`: post-push does not apply to {grasp.name}: {plan}", "grasp")
         ratio, plan = plan
@@ -652,38 +680,36 @@ class PostPush(Action):
                      {"grip": low, "hold": ratio, "knots": len(X), "push": float(X[-1][2] - X[0][2])})
 
 
-_PLANS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # taxonomy -> {(grasp name, plan_time): _plan}
+_PLANS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # taxonomy -> {(grasp name, iterations): _plan}
 
 
 def post_scene(obj: ObjectModel, start, goal, force: float, friction: float = POST_FRICTION):
     """The :class:`regrasp.Scene3D` of a push against the post with the hand level: ``obj``'s object
-    file's ``[object]``, its pads at ``force`` [N] each, gravity along the hand's −x, the post's
-    face a plane pusher (``friction``, by default the post's) pushing towards the palm (+z),
-    the task from in-hand pose ``start`` to ``goal`` (1 mm, 1°)."""
+    file's ``[object]`` (an ArgumentError naming ``scene`` when the scene has no readable file),
+    its pads at ``force`` [N] each, gravity along the hand's −x, the post's face a plane pusher
+    (``friction``, by default the post's) pushing towards the palm (+z), the task from in-hand
+    pose ``start`` to ``goal`` (1 mm, 1°)."""
     import tomllib
 
     from ..scene.spatial import Scene3D
+    from ..workcell.file import toml_value
 
-    data = tomllib.loads(obj.scene.path.read_text())
+    path = getattr(obj.scene, "path", None)
+    if path is None:
+        raise ArgumentError("invalid `scene`: a post push needs the object's scene file (load it from a file)", "scene")
+    try:
+        data = tomllib.loads(Path(path).read_text())
+    except (OSError, tomllib.TOMLDecodeError) as e:
+        raise ArgumentError(f"invalid `scene`: cannot read the object's scene file {str(path)!r}: {e}", "scene") from None
     lines = ["dimension = 3", 'name = "post-push"', "", "[object]"]
-    lines += [f"{k} = {_toml(v)}" for k, v in data["object"].items()]
-    grasp = dict(data["grasp"], force=float(force))
-    lines += ["", "[grasp]"] + [f"{k} = {_toml(v)}" for k, v in grasp.items()]
+    lines += [f"{k} = {toml_value(v)}" for k, v in data["object"].items()]
+    grasp = dict(data.get("grasp", {}), force=float(force))
+    lines += ["", "[grasp]"] + [f"{k} = {toml_value(v)}" for k, v in grasp.items()]
     lines += ["", "[gravity]", "direction = [-1.0, 0.0, 0.0]", f"g = {obj.g!r}"]
     lines += ["", "[[pushers]]", 'name = "post"', f"friction = {float(friction)!r}", "plane = true", "normal = [0.0, 0.0, 1.0]"]
-    lines += ["", "[task]", f"start = {_toml(start)}", f"goal = {_toml(goal)}", "tolerance = [0.001, 0.001, 0.001, 0.0175]"]
-    return Scene3D.from_toml("\n".join(lines) + "\n", obj.scene.path.parent)
-
-
-def _toml(v) -> str:
-    """A TOML value of a string, a number or a list of them."""
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(v, (list, tuple, np.ndarray)):
-        return "[" + ", ".join(_toml(x) for x in v) + "]"
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    return str(v) if isinstance(v, int) else repr(float(v))
+    lines += ["", "[task]", f"start = {toml_value(np.asarray(start, float))}", f"goal = {toml_value(np.asarray(goal, float))}",
+              "tolerance = [0.001, 0.001, 0.001, 0.0175]"]
+    return Scene3D.from_toml("\n".join(lines) + "\n", Path(path).parent)
 
 
 class TablePivot(Action):

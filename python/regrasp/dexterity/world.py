@@ -18,7 +18,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from .. import pose as P
-from ..errors import ArgumentError
+from ..errors import ArgumentError, SceneError
 from ..extras import need
 
 WORK_POINT = (0.40, 0.30, 0.40)  # m, world: where the hand works, 0.40 m above the table's top
@@ -153,7 +153,8 @@ def ramps(*points) -> Callable[[float], Optional[float]]:
 def add_post(spec) -> None:
     """The workcell's fixed post (:data:`POST_X`, :data:`POST_HALF`, :data:`POST_FRICTION`): a
     bar standing on the table, its face towards the robot (−x), narrow enough to pass between the
-    fingers; it touches the object only."""
+    fingers; it collides with the object, the arm and the gripper (the arm's paths keep clear of
+    it, :func:`solve_path`)."""
     from ..mujoco.model import FEATURE_BITS, add_geom
 
     c = (POST_X + POST_HALF[0], POST_Y, POST_HALF[2])
@@ -270,6 +271,13 @@ class HandWorld:
         """Whether both pads press on the object now."""
         return bool(np.all(self.pad_forces() > 1e-3))
 
+    def loose(self) -> bool:
+        """Whether the pads' friction capacity μ (N₁ + N₂) is below the object's weight now (it
+        falls, or is free)."""
+        m = self.robot.model
+        weight = float(m.body_mass[self.body]) * float(np.linalg.norm(m.opt.gravity))
+        return bool(float(m.geom_friction[self.pads[0], 0]) * float(self.pad_forces().sum()) < weight)
+
     def unstable(self) -> bool:
         """Whether MuJoCo's integration blew up since the trial began (a bad acceleration: it
         then resets the state)."""
@@ -295,29 +303,63 @@ class HandWorld:
         self.follow(HandPath(np.array([0.0, duration]), np.zeros((2, 7))), np.array([q, q]), force, 0.0, observe)
 
 
-RELEASES = (0.008, 0.014, 0.020)  # s, the openings release_timing measures
+RELEASES = (0.004, 0.008, 0.012, 0.016, 0.020)  # s, the openings release_timing measures
+RELEASE_AT = 0.05  # s, release_timing: when the fingers are commanded open
 
 
-def release_timing(world: "HandWorld", releases=RELEASES) -> tuple:
-    """(a, b): the time [s] the pads leave the object free, ≈ a · δ + b, when the fingers are
-    commanded open for δ [s] and then closed again at the grip force — the 2F-85's driver runs
-    open at full force, and comes back from as far as it went (a least-squares line through the
-    free times measured in ``world``, the hand still, at each of ``releases``; the world is left
-    reset)."""
-    times = []
+@dataclass(frozen=True)
+class Release:
+    """How the 2F-85 lets go (:func:`release_timing`): commanded open for δ [s], the pads' grip
+    cannot hold the object's weight (:meth:`HandWorld.loose`) for ``a`` δ + ``b`` [s], from
+    ``delay`` [s] after the command; measured for δ in [``low``, ``high``]."""
+
+    a: float
+    b: float
+    delay: float
+    low: float
+    high: float
+
+    def free(self, delta: float) -> float:
+        """The free time [s] of an opening of ``delta`` [s]."""
+        return self.a * delta + self.b
+
+    def opening(self, free: float) -> float:
+        """The opening δ [s] (within the measured range) that leaves the object free for ``free`` [s]."""
+        return float(min(max((free - self.b) / self.a, self.low), self.high))
+
+
+def release_timing(world: "HandWorld", releases=RELEASES) -> Release:
+    """The :class:`Release` of ``world``'s grasp: the fingers commanded open for each δ of
+    ``releases`` [s] and then closed again at the grip force — the 2F-85's driver runs open at
+    full force, and comes back from as far as it went — with the hand still; the free time (the
+    object loose, :meth:`HandWorld.loose`: the catch that ends it is an impact of the closing
+    pads, which stops the object within a millimetre) a
+    least-squares line through the measured ones (the openings that never free the object, or
+    let it fall out, left out). ``world`` is left reset in its perturbation. A SceneError (field ``grasp``) when fewer
+    than two openings free it or the free time does not grow with δ."""
+    times, delays, used = [], [], []
+    perturbation = world.perturbation
     for delta in releases:
-        world.reset()
+        world.reset(perturbation)
         free: list = []
-        force = world.grip_force / world.perturbation.grip
+        force, t0 = world.grip_force / perturbation.grip, world.robot.data.time
 
         def grip(t: float, delta=delta):
-            return OPEN if 0.05 <= t < 0.05 + delta else force
+            return OPEN if RELEASE_AT <= t < RELEASE_AT + delta else force
 
-        world.wait(0.05 + 3 * delta + 0.1, grip, lambda w: free.append(w.robot.data.time) if not w.held() else None)
-        times.append(free[-1] - free[0] if free else 0.0)
-    world.reset()
-    a, b = np.polyfit(np.asarray(releases, float), np.asarray(times, float), 1)
-    return float(a), float(b)
+        world.wait(RELEASE_AT + 3 * delta + 0.1, grip, lambda w: free.append(w.robot.data.time) if w.loose() else None)
+        if free and world.held():  # freed, and caught again
+            times.append(free[-1] - free[0])
+            delays.append(free[0] - t0 - RELEASE_AT)
+            used.append(delta)
+    world.reset(perturbation)
+    if len(used) < 2:
+        raise SceneError("scene field `grasp`: the gripper does not let the object go and catch it again at "
+                         f"fewer than two of the openings {', '.join(f'{1e3 * d:g}' for d in releases)} ms", "grasp")
+    a, b = np.polyfit(np.asarray(used, float), np.asarray(times, float), 1)
+    if a <= 0:
+        raise SceneError("scene field `grasp`: the object's free time does not grow with the opening", "grasp")
+    return Release(float(a), float(b), float(np.mean(delays)), float(used[0]), float(used[-1]))
 
 
 def solve_ik_from_home(robot, hand) -> np.ndarray:
@@ -337,10 +379,9 @@ def solve_ik_from_home(robot, hand) -> np.ndarray:
 def solve_path(robot, path: HandPath, q0) -> np.ndarray:
     """The arm's joint positions (n, 6) [rad] along ``path`` from ``q0`` (IK, one solve per sample;
     the arm and gripper clear of the table and of the post, :func:`add_post`, when there is one)."""
-    from ..robot.ik import ik_path
+    from ..robot.ik import fixed_geoms, ik_path
 
-    avoid = ("post",) if any(robot.model.geom(g).name == "post" for g in range(robot.model.ngeom)) else ()
-    return ik_path(robot, path.poses, q0, avoid=avoid)
+    return ik_path(robot, path.poses, q0, avoid=fixed_geoms(robot))
 
 
 def hand_clearances(scene, grasps, robot: str | None = None) -> dict:

@@ -120,11 +120,19 @@ def to_dict(w: Workcell) -> dict:
     return d
 
 
-def _value(v) -> str:
+def toml_value(v) -> str:
+    """The TOML text of a value: a string, a bool, an int, a finite float or a list (or array)
+    of them (floats written exactly: ``repr``)."""
     if isinstance(v, str):
         return json.dumps(v, ensure_ascii=False)  # a JSON string is a TOML basic string
-    if isinstance(v, list):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
+    if hasattr(v, "tolist"):  # a numpy array or scalar
+        v = v.tolist()
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
     assert isinstance(v, float) and math.isfinite(v)
     return repr(v)
 
@@ -132,11 +140,11 @@ def _value(v) -> str:
 def to_toml(w: Workcell) -> str:
     """The workcell's TOML text (floats written exactly: ``from_toml`` reads back the same numbers)."""
     d = to_dict(w)
-    lines = [f"{k} = {_value(d[k])}" for k in ("name", "description") if k in d]
+    lines = [f"{k} = {toml_value(d[k])}" for k in ("name", "description") if k in d]
     for table in ("table", "robot", "object"):
-        lines += ["", f"[{table}]"] + [f"{k} = {_value(v)}" for k, v in d[table].items()]
+        lines += ["", f"[{table}]"] + [f"{k} = {toml_value(v)}" for k, v in d[table].items()]
     for f in d["features"]:
-        lines += ["", "[[features]]"] + [f"{k} = {_value(v)}" for k, v in f.items()]
+        lines += ["", "[[features]]"] + [f"{k} = {toml_value(v)}" for k, v in f.items()]
     return "\n".join(lines) + "\n"
 
 
