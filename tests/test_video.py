@@ -266,3 +266,21 @@ def test_no_gl_is_a_clear_error():
         """)
     out = python(code, MUJOCO_GL="glfw", DISPLAY=None, WAYLAND_DISPLAY=None)  # GLFW needs a display
     assert out.startswith("--video |") and "OpenGL backend (EGL or OSMesa)" in out and "MUJOCO_GL=egl" in out
+
+
+@needs_gl
+def test_a_slowed_video_plays_slow_times_longer(tmp_path):
+    rec, _, _ = run(PAN, duration=0.3, fps=100.0, slow=5.0)
+    assert abs(rec.frames - 30) <= 1 and rec.frame_rate == 100.0  # captured at 100 fps of simulated time
+    assert abs(sum(rec.durations()) - 5.0 * rec.frames / rec.frame_rate) <= video.GIF_TICK / 2 + 1e-9
+    out = rec.save(tmp_path / "slow.gif")
+    with Image.open(out) as im:  # Pillow reads back 50 ms a frame
+        assert im.info["duration"] == 50
+
+
+@pytest.mark.parametrize("slow", [0.5, 101, True, "2"])
+def test_a_bad_slow_down_is_refused_naming_it(slow):
+    robot = build()
+    with pytest.raises(ArgumentError) as e:
+        Recorder(robot.model, robot.data, slow=slow)
+    assert e.value.field == "slow"

@@ -72,13 +72,17 @@ class Recorder:
     [Hz] of simulated time, from ``camera``: a :class:`Camera` (None: ``Camera()``), or the name
     or id of a camera in the model. Call :meth:`capture` after every ``mj_step``; the first frame
     is at ``data.time`` when the recorder is made. ``shadows``: MuJoCo's shadows (about 2/3 of the
-    rendering time in software OpenGL). An ArgumentError naming ``--video`` when no OpenGL
+    rendering time in software OpenGL). ``slow``: the saved video plays this many times slower
+    than simulated time (≥ 1; e.g. 5 for an action over in a fraction of a second; raise ``fps``
+    with it to keep the playback smooth). An ArgumentError naming ``--video`` when no OpenGL
     context can be made. Raises the model's offscreen buffer (``vis.global_.offwidth``/
     ``offheight``) to ``size`` when smaller. Use as a context manager, or :meth:`close`."""
 
     def __init__(self, model, data, fps: float = FPS, size=SIZE, camera: Union[Camera, str, int, None] = None,
-                 shadows: bool = True):
+                 shadows: bool = True, slow: float = 1.0):
         mujoco = need("mujoco", "mujoco")
+        if isinstance(slow, bool) or not isinstance(slow, (int, float)) or not 1 <= slow <= 100:
+            raise ArgumentError(f"invalid `slow`: a slow-down factor in [1, 100] (got {slow!r})", "slow")
         if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not 0 < fps <= 1000:
             raise ArgumentError(f"invalid `fps`: frames per second in (0, 1000] [Hz] (got {fps!r})", "fps")
         try:
@@ -88,6 +92,7 @@ class Recorder:
         if not (16 <= width <= 8192 and 16 <= height <= 8192):
             raise ArgumentError(f"invalid `size`: width and height in [16, 8192] px (got {size!r})", "size")
         self.model, self.data, self.fps, self.size = model, data, float(fps), (width, height)
+        self.slow = float(slow)
         self._camera = self._make_camera(model, camera)
         target = getattr(self._camera, "target", None)  # the default fixed now: the view does not follow the TCP
         self._target = default_camera(model, data) if target is None else np.asarray(target, float)
@@ -181,9 +186,9 @@ class Recorder:
                       f"({self.frame_rate:.3g} frames/s)", RuntimeWarning, stacklevel=3)
 
     def durations(self) -> list:
-        """Each kept frame's display time [s] in a GIF: ``1 / frame_rate`` rounded to GIF ticks
-        (10 ms) so that the sum keeps to real time (e.g. 30 fps: 30, 40, 30 ms, …)."""
-        ticks = np.round(np.arange(self.frames + 1) / self.frame_rate / GIF_TICK)
+        """Each kept frame's display time [s] in a GIF: ``slow / frame_rate`` rounded to GIF ticks
+        (10 ms) so that the sum keeps to real time (e.g. 30 fps: 30, 40, 30 ms, …) times ``slow``."""
+        ticks = np.round(np.arange(self.frames + 1) * self.slow / self.frame_rate / GIF_TICK)
         return list(np.diff(ticks) * GIF_TICK)
 
     def save(self, path, name: str = FIELD) -> Path:
@@ -225,7 +230,7 @@ class Recorder:
     def _write_mp4(self, ffmpeg: str, tmp: Path, name: str) -> None:
         width, height = self.size
         cmd = [ffmpeg, "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
-               "-s", f"{width}x{height}", "-r", f"{self.frame_rate:.6g}", "-i", "-",
+               "-s", f"{width}x{height}", "-r", f"{self.frame_rate / self.slow:.6g}", "-i", "-",
                "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p",
                "-movflags", "+faststart", str(tmp)]
         proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
