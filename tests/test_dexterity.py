@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from regrasp.dexterity.graph import Edge, GraspGraph
 from regrasp.dexterity.sequence import plan
 from regrasp.dexterity.slip import Body, simulate
-from regrasp.errors import ArgumentError
+from regrasp.errors import ArgumentError, SceneError
 
 G = 9.81
 
@@ -300,7 +300,7 @@ def test_the_release_line_predicts_an_opening_it_was_not_fitted_on(box):
     # the free time a δ + b, fitted at 4–20 ms, at δ = 10 ms against MuJoCo's, within 2 ms;
     # openings outside the measured range are clamped into it
     from regrasp.dexterity.actions import hand_pose, release
-    from regrasp.dexterity.world import OPEN, RELEASE_AT, HandWorld
+    from regrasp.dexterity.world import OPEN, RELEASE_AT, HandWorld, release_timing
 
     scene, tax, obj = box
     g = tax.grasp("g7")
@@ -314,6 +314,12 @@ def test_the_release_line_predicts_an_opening_it_was_not_fitted_on(box):
            lambda w: loose.append(w.robot.data.time) if w.loose() else None)
     assert w.held()
     assert loose[-1] - loose[0] == pytest.approx(rel.free(0.010), abs=0.002)
+    with pytest.raises(ArgumentError) as e:
+        release_timing(w, (0.01, 0.01))
+    assert e.value.field == "releases"
+    with pytest.raises(SceneError) as e:  # opened this long, the object falls out every time
+        release_timing(w, (0.2, 0.3))
+    assert e.value.field == "grasp"
 
 
 @pytest.mark.parametrize("friction, ratio, found", [(0.5, 1.6, False), (0.5, 2.4, True), (1.0, 1.6, True)])
@@ -342,12 +348,15 @@ def test_actions_refuse_a_grasp_they_do_not_apply_to_naming_it(box):
         assert ACTIONS[name].applies(obj, shallow) is not None
         with pytest.raises(ArgumentError) as e:
             ACTIONS[name].setup(obj, shallow)
-        assert e.value.field == "grasp"
+        assert e.value.field == "grasp" and "g6" in str(e.value)
     for name in ("inertial-slide", "push-down", "post-push"):
         assert ACTIONS[name].applies(obj, deep) is not None
         with pytest.raises(ArgumentError) as e:
             ACTIONS[name].setup(obj, deep)
-        assert e.value.field == "grasp"
+        assert e.value.field == "grasp" and "g8" in str(e.value)
+    with pytest.raises(ArgumentError) as e:  # counts are whole
+        ACTIONS["post-push"].setup(obj, shallow, {"plan_iterations": 0.5})
+    assert e.value.field == "params.plan_iterations"
     path, scene.path = scene.path, None  # a scene that was not loaded from a file
     try:
         with pytest.raises(ArgumentError) as e:

@@ -295,3 +295,22 @@ def test_a_rolled_gripper_gets_inclines_that_serve_its_line_pushers_level():
         if name != "block-tilted-gripper":
             cell = default_workcell(regrasp.load_scene(regrasp.examples.path(name)))
             assert not any(f.name.startswith("incline-") for f in cell.features), name
+
+
+def test_toml_values_read_back_and_a_value_toml_has_no_text_for_is_refused():
+    import math
+    import tomllib
+
+    import numpy as np
+
+    from regrasp.workcell.file import toml_value
+
+    values = {"s": 'a "quoted" \\ name', "b": True, "i": 3, "f": 0.1 + 0.2, "a": np.array([1.5, -2.0]),
+              "t": {"mesh": "m.obj", "scale": [1e-3, 1e-3, 1e-3]}}
+    text = "\n".join(f"{k} = {toml_value(v)}" for k, v in values.items())
+    back = tomllib.loads(text)
+    assert back["s"] == values["s"] and back["b"] is True and back["i"] == 3 and back["f"] == 0.1 + 0.2
+    assert back["a"] == [1.5, -2.0] and back["t"] == {"mesh": "m.obj", "scale": [1e-3, 1e-3, 1e-3]}
+    for bad in (math.nan, None, object()):
+        with pytest.raises(ValueError):
+            toml_value(bad)

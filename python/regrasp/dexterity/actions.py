@@ -257,6 +257,9 @@ class Action:
         return {"name": self.name, "resource": self.resource, "summary": self.summary}
 
 
+WHOLE = ("plan_iterations",)  # the DEFAULTS that count something
+
+
 def _params(params: dict | None) -> dict:
     p = dict(DEFAULTS)
     for k, v in (params or {}).items():
@@ -265,8 +268,10 @@ def _params(params: dict | None) -> dict:
             continue
         if k not in DEFAULTS:
             raise ArgumentError(f"invalid `params.{k}`: unknown parameter (known: {', '.join(DEFAULTS)})", f"params.{k}")
-        if not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
+        if isinstance(v, bool) or not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
             raise ArgumentError(f"invalid `params.{k}`: a number > 0 (got {v!r})", f"params.{k}")
+        if k in WHOLE and v != int(v):
+            raise ArgumentError(f"invalid `params.{k}`: a whole number ≥ 1 (got {v!r})", f"params.{k}")
         p[k] = float(v)
     return p
 
@@ -519,7 +524,7 @@ class TossCatch(Action):
     then stops at ``toss_stop`` > g while the fingers open for a moment: the object flies on,
     free, decelerated by gravity only — (``toss_stop`` − g) relative to the hand — and is caught
     one offset step further towards the fingertips as the hand comes to rest: the flight
-    ½ (b − g) t² of the free time t = a δ + b (:func:`release`; the fingers commanded open so
+    ½ (``toss_stop`` − g) t² of the free time t = a δ + b (:func:`release`; the fingers commanded open so
     that the pads let go, ``delay`` after the command, as the arm begins to brake, ARM_LAG
     behind its own command)."""
 
@@ -701,10 +706,14 @@ def post_scene(obj: ObjectModel, start, goal, force: float, friction: float = PO
         data = tomllib.loads(Path(path).read_text())
     except (OSError, tomllib.TOMLDecodeError) as e:
         raise ArgumentError(f"invalid `scene`: cannot read the object's scene file {str(path)!r}: {e}", "scene") from None
-    lines = ["dimension = 3", 'name = "post-push"', "", "[object]"]
-    lines += [f"{k} = {toml_value(v)}" for k, v in data["object"].items()]
-    grasp = dict(data.get("grasp", {}), force=float(force))
-    lines += ["", "[grasp]"] + [f"{k} = {toml_value(v)}" for k, v in grasp.items()]
+    lines = ["dimension = 3", 'name = "post-push"']
+    for table, values in (("object", data.get("object", {})), ("grasp", dict(data.get("grasp", {}), force=float(force)))):
+        lines += ["", f"[{table}]"]
+        for k, v in values.items():
+            try:
+                lines.append(f"{k} = {toml_value(v)}")
+            except ValueError as e:
+                raise SceneError(f"scene field `{table}.{k}`: {e}", f"{table}.{k}") from None
     lines += ["", "[gravity]", "direction = [-1.0, 0.0, 0.0]", f"g = {obj.g!r}"]
     lines += ["", "[[pushers]]", 'name = "post"', f"friction = {float(friction)!r}", "plane = true", "normal = [0.0, 0.0, 1.0]"]
     lines += ["", "[task]", f"start = {toml_value(np.asarray(start, float))}", f"goal = {toml_value(np.asarray(goal, float))}",

@@ -153,8 +153,8 @@ def ramps(*points) -> Callable[[float], Optional[float]]:
 def add_post(spec) -> None:
     """The workcell's fixed post (:data:`POST_X`, :data:`POST_HALF`, :data:`POST_FRICTION`): a
     bar standing on the table, its face towards the robot (−x), narrow enough to pass between the
-    fingers; it collides with the object, the arm and the gripper (the arm's paths keep clear of
-    it, :func:`solve_path`)."""
+    fingers; it collides with the object, the arm and the gripper's body, not the pads (the arm's
+    paths keep clear of it, :func:`solve_path`)."""
     from ..mujoco.model import FEATURE_BITS, add_geom
 
     c = (POST_X + POST_HALF[0], POST_Y, POST_HALF[2])
@@ -337,6 +337,9 @@ def release_timing(world: "HandWorld", releases=RELEASES) -> Release:
     least-squares line through the measured ones (the openings that never free the object, or
     let it fall out, left out). ``world`` is left reset in its perturbation. A SceneError (field ``grasp``) when fewer
     than two openings free it or the free time does not grow with δ."""
+    releases = sorted(float(d) for d in releases)
+    if len(set(releases)) != len(releases) or not releases or releases[0] <= 0:
+        raise ArgumentError(f"invalid `releases`: distinct openings > 0 [s] (got {releases})", "releases")
     times, delays, used = [], [], []
     perturbation = world.perturbation
     for delta in releases:
@@ -357,7 +360,7 @@ def release_timing(world: "HandWorld", releases=RELEASES) -> Release:
         raise SceneError("scene field `grasp`: the gripper does not let the object go and catch it again at "
                          f"fewer than two of the openings {', '.join(f'{1e3 * d:g}' for d in releases)} ms", "grasp")
     a, b = np.polyfit(np.asarray(used, float), np.asarray(times, float), 1)
-    if a <= 0:
+    if not (np.isfinite(a) and np.isfinite(b) and a > 0):
         raise SceneError("scene field `grasp`: the object's free time does not grow with the opening", "grasp")
     return Release(float(a), float(b), float(np.mean(delays)), float(used[0]), float(used[-1]))
 
@@ -381,7 +384,7 @@ def solve_path(robot, path: HandPath, q0) -> np.ndarray:
     the arm and gripper clear of the table and of the post, :func:`add_post`, when there is one)."""
     from ..robot.ik import fixed_geoms, ik_path
 
-    return ik_path(robot, path.poses, q0, avoid=fixed_geoms(robot))
+    return ik_path(robot, path.poses, q0, avoid=[g for g in fixed_geoms(robot) if g != robot.table])
 
 
 def hand_clearances(scene, grasps, robot: str | None = None) -> dict:

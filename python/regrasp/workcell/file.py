@@ -121,20 +121,24 @@ def to_dict(w: Workcell) -> dict:
 
 
 def toml_value(v) -> str:
-    """The TOML text of a value: a string, a bool, an int, a finite float or a list (or array)
-    of them (floats written exactly: ``repr``)."""
-    if isinstance(v, str):
-        return json.dumps(v, ensure_ascii=False)  # a JSON string is a TOML basic string
+    """The TOML text of a value: a string, a bool, an int, a finite float, a list (or numpy
+    array) or a table (an inline one) of them (floats written exactly: ``repr``). A ValueError
+    for anything else (a datetime, a NaN)."""
     if hasattr(v, "tolist"):  # a numpy array or scalar
         v = v.tolist()
+    if isinstance(v, str):
+        return json.dumps(v, ensure_ascii=False)  # a JSON string is a TOML basic string
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{json.dumps(str(k))} = {toml_value(x)}" for k, x in v.items()) + "}"
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, int):
         return str(v)
-    assert isinstance(v, float) and math.isfinite(v)
-    return repr(v)
+    if isinstance(v, float) and math.isfinite(v):
+        return repr(v)
+    raise ValueError(f"no TOML value for {v!r}")
 
 
 def to_toml(w: Workcell) -> str:
