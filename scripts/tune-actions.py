@@ -1,6 +1,7 @@
 """Tunes one parameter of each of four actions per bundled object by a search in simulation
 (`regrasp.dexterity.tune`) and prints the README's table: the default and tuned value, the
-success rate of each on fresh worlds. Usage: python scripts/tune-actions.py [--trials N] (6 by default)."""
+success rate of each on fresh worlds. Usage: python scripts/tune-actions.py [--trials N] (6 by
+default) [--objects A,B] [--actions A,B] (all by default) [--out JSON]."""
 
 from __future__ import annotations
 
@@ -22,13 +23,17 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--trials", type=int, default=6)
     ap.add_argument("--objects", default=",".join(OBJECTS))
+    ap.add_argument("--actions", default=",".join(s[0] for s in SEARCH))
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
+    only = set(a.actions.split(","))
     rows = []
     print("| object | action | parameter | default | tuned | success, default | success, tuned | runs each |")
     print("|---|---|---|---|---|---|---|---|")
     for name in a.objects.split(","):
         for action, param, values in SEARCH:
+            if action not in only:
+                continue
             try:
                 t = tune(object_path(name), action, param, values, a.trials)
             except Exception as e:  # an action that applies to no grasp of this object
