@@ -446,3 +446,24 @@ def test_bad_regrasp_sequence_input_is_refused_naming_the_field(tmp_path):
         assert r.returncode == 2 and f"`{field}`" in r.stderr, r.stderr
     r = run_cli("regrasp-sequence", str(tmp_path / "bad.json"), "--from", "g0", "--to", "g1")
     assert r.returncode == 2 and "`format`" in r.stderr, r.stderr
+
+
+def test_a_transfer_the_arm_cannot_turn_in_place_goes_through_the_hand_level_above():
+    # fingers up (a toss's end) to fingers down (an inertial slide's start) at the work point:
+    # the straight turn has no IK; the transfer lifts the hand and turns it level on the way
+    from regrasp.dexterity.actions import WORK_POINT, hand_pose
+    from regrasp.dexterity.objects import load_object
+    from regrasp.dexterity.sequence import TRANSFER_LIFT, _line, transfer
+    from regrasp.dexterity.taxonomy import taxonomy_of
+    from regrasp.dexterity.world import HandWorld, solve_path
+    from regrasp.robot.ik import IKError
+
+    scene = load_object("prism")
+    g = taxonomy_of(scene).grasp("g3")
+    up, down = hand_pose(np.pi, WORK_POINT + np.array([0.0, 0.0, 0.095])), hand_pose(0.0, WORK_POINT + np.array([0.0, 0.0, 0.05]))
+    w = HandWorld(scene, g.pose, up)
+    with pytest.raises(IKError):
+        solve_path(w.robot, _line(w.robot.tcp_pose(), down), w.robot.q)
+    path, q = transfer(w.robot, w.robot.tcp_pose(), down)
+    assert q.shape == (len(path.times), 6) and np.allclose(path.poses[-1], down)
+    assert path.poses[:, 2].max() == pytest.approx(up[2] + TRANSFER_LIFT, abs=1e-4)  # from the measured TCP

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 
@@ -20,6 +21,7 @@ from .trial import DROPPED, OTHER, REFUSED, UNSTABLE
 
 OBJECTIVES = ("reliable", "expected")
 TRANSFER_SPEED = 0.25  # m/s, the hand's move between two actions (and 1 rad/s turning)
+TRANSFER_LIFT = 0.1  # m, a move between two actions that cannot turn the hand in place turns it this much higher
 
 
 @dataclass(frozen=True)
@@ -110,6 +112,35 @@ class SequenceRun:
         return {"outcomes": list(self.outcomes), "success": self.success}
 
 
+def _line(a, b) -> "HandPath":
+    """The hand's move from world pose ``a`` to ``b`` at :data:`TRANSFER_SPEED` (and 1 rad/s)."""
+    from ..pose import quat_angle
+    from .world import HandPath
+
+    return HandPath.line(a, b, max(0.5, float(np.linalg.norm(a[:3] - b[:3])) / TRANSFER_SPEED, quat_angle(a[3:], b[3:])))
+
+
+def transfer(robot, here, start) -> tuple:
+    """(the hand's path, the arm's joint path) between two actions, from TCP pose ``here`` to
+    ``start``: straight, or else (a turn the arm cannot make in place, e.g. fingers up to
+    fingers down) through the hand level :data:`TRANSFER_LIFT` above the higher end, turned one
+    way or the other. An IKError (ArgumentError) when none can be followed."""
+    from .actions import hand_pose
+    from .world import solve_path
+
+    here, start = np.asarray(here, float), np.asarray(start, float)
+    ways = [None] + [hand_pose(a, ((here[0] + start[0]) / 2, (here[1] + start[1]) / 2,
+                                   max(here[2], start[2]) + TRANSFER_LIFT)) for a in (np.pi / 2, -np.pi / 2)]
+    error: Optional[ArgumentError] = None
+    for way in ways:
+        path = _line(here, start) if way is None else _line(here, way).then(_line(way, start))
+        try:
+            return path, solve_path(robot, path, robot.q)
+        except ArgumentError as e:
+            error = error or e
+    raise error  # type: ignore[misc]
+
+
 def execute(path, sequence: Sequence, perturbation=None, robot: str | None = None, observe=None) -> SequenceRun:
     """Runs ``sequence`` on the object file ``path`` in MuJoCo, open loop: the world built at the
     first grasp and the first action's start; before each later action the hand moves to its
@@ -120,7 +151,7 @@ def execute(path, sequence: Sequence, perturbation=None, robot: str | None = Non
     from .actions import action
     from .graph import _object
     from .trial import classify
-    from .world import HandPath, HandWorld, Perturbation, constant, solve_path
+    from .world import HandWorld, Perturbation, constant, solve_path
 
     scene, tax, obj = _object(str(path))
     if not sequence.steps:
@@ -134,16 +165,10 @@ def execute(path, sequence: Sequence, perturbation=None, robot: str | None = Non
     outcomes = []
     for i, step in enumerate(sequence.steps):
         setup = first if i == 0 else action(step.action).setup(obj, tax.grasp(step.source), step.params)
-        if i > 0:
-            here = world.robot.tcp_pose()
-            dist = float(np.linalg.norm(here[:3] - setup.start[:3]))
-            from ..pose import quat_angle
-
-            T = max(0.5, dist / TRANSFER_SPEED, quat_angle(here[3:], setup.start[3:]) / 1.0)
-            move = HandPath.line(here, setup.start, T)
         try:
             if i > 0:
-                world.follow(move, solve_path(world.robot, move, world.robot.q), constant(obj.grip), 0.2, observe)
+                move, q_move = transfer(world.robot, world.robot.tcp_pose(), setup.start)
+                world.follow(move, q_move, constant(obj.grip), 0.2, observe)
             q = solve_path(world.robot, setup.path, world.robot.q)
         except ArgumentError:  # the arm cannot go on from where the last action left it (IK)
             return SequenceRun((*outcomes, REFUSED), False)
