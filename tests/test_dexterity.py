@@ -322,6 +322,20 @@ def test_the_release_line_predicts_an_opening_it_was_not_fitted_on(box):
     assert e.value.field == "grasp"
 
 
+def test_the_release_is_the_grippers_fingers_up_as_down(box):
+    # the toss (fingers up) uses the release measured fingers down: the free times agree within
+    # 2 ms over the measured openings
+    from regrasp.dexterity.actions import hand_pose, release
+    from regrasp.dexterity.world import HandWorld, release_timing
+
+    scene, tax, obj = box
+    g = tax.grasp("g7")
+    down = release(obj, g)
+    up = release_timing(HandWorld(scene, g.pose, hand_pose(np.pi)))
+    for delta in np.linspace(max(down.low, up.low), min(down.high, up.high), 5):
+        assert up.free(delta) == pytest.approx(down.free(delta), abs=0.002)
+
+
 @pytest.mark.parametrize("friction, ratio, found", [(0.5, 1.6, False), (0.5, 2.4, True), (1.0, 1.6, True)])
 def test_the_post_push_is_planned_where_the_posts_friction_carries_the_weight(box, friction, ratio, found):
     # the pads slide, so the post's friction, pressed by their friction 2 μ N = ratio · m g, must
