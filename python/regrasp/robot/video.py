@@ -73,7 +73,7 @@ class Recorder:
     or id of a camera in the model. Call :meth:`capture` after every ``mj_step``; the first frame
     is at ``data.time`` when the recorder is made. ``shadows``: MuJoCo's shadows (about 2/3 of the
     rendering time in software OpenGL). ``slow``: the saved video plays this many times slower
-    than simulated time (≥ 1; e.g. 5 for an action over in a fraction of a second; raise ``fps``
+    than simulated time (in [1, 100]; e.g. 5 for an action over in a fraction of a second; raise ``fps``
     with it to keep the playback smooth). An ArgumentError naming ``--video`` when no OpenGL
     context can be made. Raises the model's offscreen buffer (``vis.global_.offwidth``/
     ``offheight``) to ``size`` when smaller. Use as a context manager, or :meth:`close`."""
