@@ -27,6 +27,7 @@ SHOWN = [  # (action, object, grasp, params)
     ("toss-catch", "box", "g7", {}),
     ("post-push", "box", "g6", {}),
     ("push-down", "prism", "g0", {}),
+    ("table-slide", "box", "g7", {}),
     ("table-pivot", "prism", "g1", {}),
     ("place-repick", "box", "g6", {"target": "g12"}),
     ("topple-repick", "box", "g7", {"target": "g12"}),

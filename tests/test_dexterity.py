@@ -254,6 +254,8 @@ def test_the_pivot_breaks_away_at_the_limit_surface_angle_in_mujoco(box):
     ("box", "g4", "inertial-slide", {}),
     ("box", "g7", "drop-catch", {}),
     ("box", "g7", "toss-catch", {}),
+    ("box", "g7", "table-slide", {}),
+    ("prism", "g4", "table-slide", {}),
     ("box", "g6", "post-push", {}),
     ("box", "g6", "place-repick", {"target": "g12"}),
     ("box", "g12", "place-repick", {"target": "g6"}),  # another width: the TCP corrected for the linkage
@@ -294,6 +296,44 @@ def test_a_catch_lands_where_the_release_model_predicts(box, action):
     moved = -P.compose(r.pose, P.inverse(g.pose))[2]  # along the fingers, towards their tips
     assert predicted > 0.005
     assert moved == pytest.approx(predicted, rel=0.2)
+
+
+def test_a_table_slide_moves_the_object_in_the_hand_by_the_hands_rise(box):
+    # the table, not a timed fall, sets the distance: the object stays on it while the pads slide up
+    # it, so MuJoCo's slide is the hand's rise (one offset step) within 1 mm, and the object ends
+    # no higher in the world than it stood
+    from regrasp import pose as P
+    from regrasp.dexterity.actions import ACTIONS
+    from regrasp.dexterity.trial import Runner
+
+    scene, tax, obj = box
+    g = tax.grasp("g7")
+    setup = ACTIONS["table-slide"].setup(obj, g)
+    heights = []
+    runner = Runner(scene, tax, g, setup)
+    r = runner.run(observe=lambda w: heights.append((float(w.robot.data.time), float(w.object_pose()[2]))))
+    moved = -P.compose(r.pose, P.inverse(g.pose))[2]  # along the fingers, towards their tips
+    assert setup.detail["slide"] > 0.005
+    assert moved == pytest.approx(setup.detail["slide"], abs=1e-3)
+    t, z = np.array(heights).T
+    t -= t[0]
+    standing = (t > setup.detail["stand"][0]) & (t < setup.detail["stand"][1])  # from the touch to the lift
+    assert standing.sum() > 100 and np.ptp(z[standing]) < 1e-3
+
+
+def test_a_table_slide_needs_the_gripper_to_come_down_to_its_grip(box):
+    from regrasp.dexterity.actions import ACTIONS
+
+    scene, tax, obj = box
+    g = tax.grasp("g13")  # 70 mm wide: the 2F-85's linkage springs alone press more than the slide's grip
+    why = ACTIONS["table-slide"].applies(obj, g)
+    assert why is not None and "presses at least" in why
+    with pytest.raises(ArgumentError) as e:
+        ACTIONS["table-slide"].setup(obj, g)
+    assert e.value.field == "grasp" and "g13" in str(e.value)
+    with pytest.raises(ArgumentError) as e:  # the table must keep part of the weight
+        ACTIONS["table-slide"].setup(obj, tax.grasp("g7"), {"rest_ratio": 1.2})
+    assert e.value.field == "params.rest_ratio"
 
 
 def test_the_release_line_predicts_an_opening_it_was_not_fitted_on(box):
@@ -358,7 +398,7 @@ def test_actions_refuse_a_grasp_they_do_not_apply_to_naming_it(box):
 
     scene, tax, obj = box
     shallow, deep = tax.grasp("g6"), tax.grasp("g8")  # the outermost and the deepest of one face pair and turn
-    for name in ("gravity-slide", "drop-catch", "toss-catch"):
+    for name in ("gravity-slide", "drop-catch", "toss-catch", "table-slide"):
         assert ACTIONS[name].applies(obj, shallow) is not None
         with pytest.raises(ArgumentError) as e:
             ACTIONS[name].setup(obj, shallow)

@@ -42,7 +42,8 @@ DEFAULTS = {
     "jab_hold": 1.3,    # inertial-slide: 2 μ N / m g during the jab (holds the weight, lets the jab slide it)
     "press_hold": 1.5,  # push-down and table-pivot: 2 μ N / m g while the table pushes
     "approach": 0.02,   # m, push-down and table-pivot: the object's lowest point above the table at the start
-    "speed": 0.03,      # m/s, push-down: the hand's descent
+    "speed": 0.03,      # m/s, push-down: the hand's descent; table-slide: its rise
+    "rest_ratio": 0.5,  # table-slide: 2 μ N / m g while the object stands on the table (0.9 at +20 % friction and grip, −20 % mass: the table keeps part of the weight)
     "drop": 0.002,      # m, place-repick: the object's face above the table when the fingers open
     "clear": 0.06,      # m, place-repick: the hand's retreat and approach along its fingers
     "close_time": 1.0,  # s, place-repick: the fingers close on the object on the table this long before the lift
@@ -606,6 +607,88 @@ class PushDown(Action):
                      _intended(obj, pose), {"push": step, "grip": low})
 
 
+class TableSlide(Action):
+    """Fingers down, the object standing on the table on a face below the fingertips: the grip
+    lowered until the pads' friction 2 μ N carries ``rest_ratio`` (< 1) of the weight, the hand
+    rises by one offset step at ``speed`` — the object, its weight more than the pads' friction,
+    stays on the table while the pads slide up it (the object slides towards the fingertips by
+    exactly the rise) — then the grip comes back and the hand lifts it. The mirror of
+    ``push-down``; unlike ``gravity-slide``, the table, not a timed fall, sets the distance."""
+
+    def __init__(self):
+        super().__init__("table-slide", "contact", "stand the object on the table at a light grip and raise the hand: "
+                                                   "the pads slide up it")
+
+    @staticmethod
+    def _support(obj, grasp) -> tuple:
+        """(reach [m]: the object's lowest point below the TCP, the face it stands on: its x-range
+        (2,) in the hand frame) — the hull's vertices within 0.1 mm of the lowest."""
+        V = P.transform(grasp.pose, obj.taxonomy.vertices)
+        low = V[V[:, 2] < V[:, 2].min() + 1e-4]
+        return float(-V[:, 2].min()), np.array([low[:, 0].min(), low[:, 0].max()])
+
+    @staticmethod
+    def least_grip(obj, grasp) -> float:
+        """The least per-pad force [N] the gripper presses the object with at ``grasp``'s width
+        (:func:`~regrasp.robot.grip.least_force`, with the scene's pads)."""
+        from ..execution.arm import grasp_of
+        from ..robot.grip import least_force
+        from ..robot.pads import Pads
+
+        width, _ = grasp_of(obj.scene, grasp.pose)
+        return least_force(width, "", Pads.of_scene(obj.scene), obj.mu)
+
+    def applies(self, obj, grasp):
+        from ..robot.ik import MIN_DISTANCE
+
+        if _offset_step(obj, grasp, -1) is None:
+            return "no grasp further towards the fingertips"
+        reach, (x0, x1) = self._support(obj, grasp)
+        if not _fingers_clear(obj, 0.0, reach, MIN_DISTANCE):
+            return f"standing on the table, the pads come within the arm's {MIN_DISTANCE * 1e3:.0f} mm of it"
+        r = DEFAULTS["rest_ratio"]
+        least = self.least_grip(obj, grasp)
+        if least > 0.8 * obj.holding(r):  # the gripper must come down to the grip, with room for the force loop
+            return f"the gripper presses at least {least:.2f} N per pad at this width (the slide needs " \
+                   f"{obj.holding(r):.2f} N)"
+        # the weight less the pads' pull (at the contact centre) must press inside the face it stands on
+        x = (P.transform(grasp.pose, obj.com)[0] - r * contact_centre(obj, grasp)[0]) / (1 - r)
+        margin = 0.002  # m
+        return None if x0 + margin <= x <= x1 - margin else \
+            f"it would not stand on the table: the load lies {x * 1e3:.1f} mm across the fingers, its face spans " \
+            f"{x0 * 1e3:.1f} to {x1 * 1e3:.1f} mm"
+
+    def setup(self, obj, grasp, params=None):
+        p = _params(params)
+        why = self.applies(obj, grasp)
+        if why is not None:
+            raise ArgumentError(f"invalid `grasp`: table-slide does not apply to {grasp.name}: {why}", "grasp")
+        if p["rest_ratio"] >= 1.0:
+            raise ArgumentError(f"invalid `params.rest_ratio`: below 1 (the table must keep part of the weight; got "
+                                f"{p['rest_ratio']!r})", "params.rest_ratio")
+        step = _offset_step(obj, grasp, -1)
+        reach, _ = self._support(obj, grasp)
+        press = 0.0005  # m, the object pressed this far into the table (soft contact) while it stands on it
+
+        def at(height: float) -> np.ndarray:
+            return hand_pose(0.0, (WORK_POINT[0], WORK_POINT[1], height))
+
+        start, touch, top = at(reach + p["approach"]), at(reach - press), at(reach - press + step)
+        down = HandPath.line(start, touch, 1.5 * p["approach"] / p["speed"])
+        rest = HandPath.line(touch, touch, 2 * RAMP)
+        rise = HandPath.line(touch, top, 1.5 * step / p["speed"])
+        hold = HandPath.line(top, top, 2 * RAMP)
+        lift = HandPath.line(top, at(reach + step + p["approach"]), 1.0)
+        path = down.then(rest).then(rise).then(hold).then(lift)
+        t0 = down.times[-1]
+        t1 = t0 + rest.times[-1] + rise.times[-1]
+        low = obj.holding(p["rest_ratio"])
+        grip = ramps((0.0, obj.grip), (t0, obj.grip), (t0 + RAMP, low), (t1, low), (t1 + RAMP, obj.grip))
+        pose = P.compose(np.array([0.0, 0.0, -step, 1.0, 0.0, 0.0, 0.0]), grasp.pose)
+        stand = [float(t0), float(path.times[-1] - lift.times[-1])]  # s, from the touch to the lift
+        return Setup(start, path, grip, 0.3, pose, _intended(obj, pose), {"slide": step, "grip": low, "stand": stand})
+
+
 POST_HOLDS = (1.5, 2.0, 3.0, 4.0)  # post-push: the grips tried (2 μ N / m g), the least the planner finds a push at
 PLAN_TIME_CAP = 60.0  # s, post-push: a safety cap on the planner's time (its iterations limit it first)
 POST_ROOM = 0.006  # m, post-push: the post's side at least this far from each pad (the IK keeps the gripper 5 mm off it)
@@ -1017,7 +1100,7 @@ def _fixed_point(before, after, turn: float) -> np.ndarray:
 
 
 ACTIONS = {a.name: a for a in (GravityPivot(), GravitySlide(), GripPivot(), DropCatch(), InertialSlide(), TossCatch(),
-                                PushDown(), PostPush(), TablePivot(), PlaceRepick(), ToppleRepick())}
+                                PushDown(), TableSlide(), PostPush(), TablePivot(), PlaceRepick(), ToppleRepick())}
 
 
 def action(name: str) -> Action:

@@ -177,6 +177,21 @@ def low_force_curve(robot) -> tuple:
     return _low_force_curve(robot.grasp_width, robot.name, robot.pads, robot.pad_friction, robot.contact)
 
 
+def least_force(grasp_width: float, robot_name: str = "", pads=None, pad_friction: float | None = None,
+                contact=None) -> float:
+    """The least per-pad force [N] the gripper presses an object ``grasp_width`` [m] wide with: its
+    pads' force at a zero actuator force (:func:`low_force_curve`; the linkage's springs alone —
+    2.6 N at 70 mm with the bundled objects' pads, about 0 at 30 mm). The arguments and their
+    defaults: :func:`pad_state`'s."""
+    from ..mujoco.model import Contact
+    from .model import DEFAULT_ROBOT
+    from .pads import PAD_FRICTION, Pads
+
+    return float(_low_force_curve(float(grasp_width), robot_name or DEFAULT_ROBOT, pads or Pads(),
+                                  float(PAD_FRICTION if pad_friction is None else pad_friction),
+                                  contact or Contact())[1][0])
+
+
 @lru_cache(maxsize=32)
 def _low_force_curve(grasp_width: float, robot_name: str, pads, pad_friction: float, contact) -> tuple:
     mujoco = need("mujoco", "robot")
