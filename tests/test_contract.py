@@ -236,8 +236,9 @@ def check_plan(plan: dict, header: str) -> None:
     """``plan`` has exactly the keys of the table headed ``header``, with their types."""
     rows = documented(DOCS / "plan-file.md", header)
     spec = {k: (code_names(r[1])[0], r[2]) for k, r in rows.items()}
-    assert all(p in ("always", "steps") for _, p in spec.values())
-    top = {k for k in spec if "[]." not in k}
+    assert all(p in ("always", "steps", "unreachable") for _, p in spec.values())
+    unreachable = plan.get("stop_reason") == "unreachable"  # a `reason` only then
+    top = {k for k, (_, p) in spec.items() if "[]." not in k and (p != "unreachable" or unreachable)}
     entry = {k.split("[].", 1)[1]: v for k, v in spec.items() if k.startswith("path[].")}
     assert set(plan) == top, f"keys: written but undocumented {sorted(set(plan) - top)}, " \
                              f"documented but not written {sorted(top - set(plan))}"
@@ -250,7 +251,7 @@ def check_plan(plan: dict, header: str) -> None:
         for k in step:
             assert _type_ok(step[k], entry[k][0]), f"path[{i}].{k} = {step[k]!r} is not {entry[k][0]}"
         assert (step["pusher"] is None) == (i == 0), f"path[{i}].pusher = {step['pusher']!r}"
-    assert plan["stop_reason"] in ("goal_reached", "time_limit", "node_limit", "iteration_limit")
+    assert plan["stop_reason"] in ("goal_reached", "time_limit", "node_limit", "iteration_limit", "unreachable")
     assert plan["found"] == (plan["stop_reason"] == "goal_reached")
 
 
@@ -267,6 +268,7 @@ def written_plans(tmp_path_factory):
         ["plan", EXAMPLES / "offset-3d.toml", "--out", d / "3d.json", "--time-limit", "5"],
         ["plan", d / "top-only.toml", "--out", d / "none.json", "--time-limit", "0.2"],
         ["plan", EXAMPLES / "t-shape.toml", "--time-limit", "5", "--json"],
+        ["plan", ROOT / "benches" / "scenes" / "neck-unreachable.toml", "--out", d / "unreachable.json"],
     ])
     return d, runs
 
@@ -299,6 +301,20 @@ def test_a_plan_not_found_is_written_with_the_documented_keys_and_exits_1(writte
     plan = _strict_json((d / "none.json").read_text())
     check_plan(plan, "planar plan key")
     assert plan["found"] is False and plan["stop_reason"] != "goal_reached"
+
+
+def test_an_unreachable_goal_is_written_with_its_reason_and_exits_1(written_plans):
+    # two lobes joined by a neck narrower than the pad: decided before any search
+    d, runs = written_plans
+    assert runs[4].returncode == 1, runs[4].stdout + runs[4].stderr
+    assert "no plan found: unreachable: the pad's centre must stay" in runs[4].stderr
+    plan = _strict_json((d / "unreachable.json").read_text())
+    check_plan(plan, "planar plan key")
+    assert plan["stop_reason"] == "unreachable" and "different parts" in plan["reason"]
+    assert plan["planning_time_s"] < 1.0 and len(plan["path"]) == 1
+    from regrasp.planning.plan import Plan
+
+    assert Plan.from_json(plan).reason == plan["reason"]  # read back
 
 
 def test_a_3d_plan_file_has_exactly_the_documented_keys(written_plans):

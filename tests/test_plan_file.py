@@ -57,7 +57,7 @@ def test_load_scene_tells_the_kinds_apart(tmp_path):
 def test_to_json_is_the_plan_file_and_reads_back(which, request, tmp_path):
     scene, p = request.getfixturevalue(which)
     d = p.to_json()
-    assert tuple(d) == KEYS[p.dimension]
+    assert tuple(d) == tuple(k for k in KEYS[p.dimension] if k != "reason")  # a reason only when unreachable
     assert len(d["path"][0]["pose"]) == {2: 3, 3: 7}[p.dimension] and d["path"][0]["pusher"] is None
     assert ("pusher_twist" in d["path"][1]) == (p.dimension == 3)
     assert regrasp.Plan.from_json(d).to_json() == d

@@ -225,7 +225,6 @@ def test_unwritable_output(argv, which, tmp_path_factory):
 CONFLICTS = [
     ["plan", "{scene}", "--robust", "--fixtureless", "--time-limit", "0.1"],
     ["plan", "{scene3}", "--robust", "--time-limit", "0.1"],
-    ["plan", "{scene3}", "--plot", "{base}/x.png", "--time-limit", "0.1"],
     ["bench", "--quick", "-n", "5"],  # -n has no effect with --quick: refused (plan --html now views planar plans)
     ["plan", "{scene}", "--start", "0,0,0", "--time-limit", "0.1", "--propagation", "nope"],
     ["plan", "{scene}", "--uncertainty", "0.1,0.1,0.1,1.5", "--time-limit", "0.1"],

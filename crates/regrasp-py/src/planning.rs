@@ -55,7 +55,7 @@ fn plan_dict<'py, Q, E>(
         "scene" => about.scene, "found" => r.found, "stop_reason" => r.stop_reason.label(),
         "planning_time_s" => r.planning_time_s, "nodes" => r.nodes, "iterations" => r.iterations,
         "switch_overs" => r.switch_overs, "cost" => r.cost, "goal_distance" => r.goal_distance,
-        "propagation" => about.propagation, "seed" => about.seed, "path" => path,
+        "propagation" => about.propagation, "seed" => about.seed, "path" => path, "reason" => r.reason.as_deref(),
     ))
 }
 

@@ -102,7 +102,9 @@ def summary(scene, p: Plan) -> str:
                      f"{min(p.step_margins, default=0):.3f})")
     else:
         lines.append(f"  every step passes the step check (inverse or forward dynamics): {p.valid}")
-    if not p.found:
+    if p.reason:
+        lines.append(f"  unreachable: {p.reason}")
+    elif not p.found:
         lines.append(f"  the best partial plan ends {1e3 * p.goal_distance:.2f} mm (metric) from the goal")
     return "\n".join(lines)
 
@@ -124,7 +126,7 @@ def cmd_plan(a) -> int:
     if p.found and p.dimension == 2 and not p.valid:
         progress.note(f"regrasp: {SLIP_WARNING.format(propagation=p.propagation)}")
     if not p.found:
-        progress.note(f"regrasp: no plan found: {p.stop_reason}")
+        progress.note(f"regrasp: no plan found: {p.stop_reason}" + (f": {p.reason}" if p.reason else ""))
         for line in said:
             progress.note(f"regrasp: {line}")
         return CANNOT

@@ -23,9 +23,9 @@ from ..files import as_path, same_file as _same_file, write_text
 
 #: the keys of a plan file, in the order they are written (docs/plan-file.md), by dimension
 KEYS = {
-    2: ("scene", "found", "stop_reason", "planning_time_s", "nodes", "switch_overs", "path", "iterations", "cost",
+    2: ("scene", "found", "stop_reason", "reason", "planning_time_s", "nodes", "switch_overs", "path", "iterations", "cost",
         "goal_distance", "propagation", "seed", "step_margins", "valid"),
-    3: ("scene", "found", "stop_reason", "planning_time_s", "nodes", "iterations", "switch_overs", "cost",
+    3: ("scene", "found", "stop_reason", "reason", "planning_time_s", "nodes", "iterations", "switch_overs", "cost",
         "goal_distance", "propagation", "seed", "solves", "path", "valid"),
 }
 #: numbers in a pose: planar [x, z, theta], 3-D [x, y, z, qw, qx, qy, qz]
@@ -33,7 +33,7 @@ POSE_SIZE = {2: 3, 3: 7}
 POSE_TEXT = {2: "[x, z, theta]", 3: "[x, y, z, qw, qx, qy, qz]"}
 #: the JSON type of each summary key (docs/plan-file.md)
 SUMMARY_TYPES = {
-    "scene": "str", "found": "bool", "stop_reason": "str", "planning_time_s": "float", "nodes": "int",
+    "scene": "str", "found": "bool", "stop_reason": "str", "reason": "str", "planning_time_s": "float", "nodes": "int",
     "iterations": "int", "switch_overs": "int", "cost": "float", "goal_distance": "float", "propagation": "str",
     "seed": "int", "solves": "int", "step_margins": "float[]", "valid": "bool",
 }
@@ -147,6 +147,8 @@ class Plan:
     scene: Optional[str] = None
     found: Optional[bool] = None
     stop_reason: Optional[str] = None
+    #: why no plan can exist, with ``stop_reason`` "unreachable" (decided before the search)
+    reason: Optional[str] = None
     planning_time_s: Optional[float] = None
     nodes: Optional[int] = None
     iterations: Optional[int] = None

@@ -351,8 +351,29 @@ pub fn plan_tree(
     let start = start.or(task.map(|t| t.start)).ok_or_else(|| Error::arg("start", "the scene has no task: give a start"))?;
     let goal = goal.or(task.map(|t| t.goal)).ok_or_else(|| Error::arg("goal", "the scene has no task: give a goal"))?;
     let tol = task.map(|t| t.tolerance).unwrap_or([1e-3, 1e-3, 0.0175]);
+    let t0 = std::time::Instant::now();
     let space = PlanarSpace::new(scene, start, goal, tol, settings)?;
+    if let Some(reason) = crate::planning::reachability::unreachable(scene, &start, &goal, &tol) {
+        let root = crate::planning::tree::TreeNode { q: start, parent: None, pusher: None, edge: (), cost: 0.0, children: vec![] };
+        return Ok((unreachable_plan(&space, start, reason, t0), vec![root]));
+    }
     trrt::plan_tree(&space, start)
+}
+
+/// The answer for a goal decided unreachable: the start alone, its distance to the goal.
+fn unreachable_plan(space: &PlanarSpace, start: [f64; 3], reason: String, t0: std::time::Instant) -> PlanarPlan {
+    trrt::Plan {
+        found: false,
+        stop_reason: StopReason::Unreachable,
+        goal_distance: space.dist(&start, space.goal()),
+        cost: 0.0,
+        switch_overs: 0,
+        path: vec![(start, None, ())],
+        nodes: 1,
+        iterations: 0,
+        planning_time_s: t0.elapsed().as_secs_f64(),
+        reason: Some(reason),
+    }
 }
 
 /// ICRA 2018 "stable check": is there a pusher force in its friction cone that, with the

@@ -135,6 +135,8 @@ pub enum StopReason {
     TimeLimit,
     NodeLimit,
     IterationLimit,
+    /// Decided before the search: no plan exists ([`crate::planning::reachability`]).
+    Unreachable,
 }
 
 impl StopReason {
@@ -144,6 +146,7 @@ impl StopReason {
             StopReason::TimeLimit => "time_limit",
             StopReason::NodeLimit => "node_limit",
             StopReason::IterationLimit => "iteration_limit",
+            StopReason::Unreachable => "unreachable",
         }
     }
 }
@@ -251,6 +254,8 @@ pub struct Plan<Q, E> {
     pub cost: f64,
     /// Distance (metric, m) from the path's end to the goal.
     pub goal_distance: f64,
+    /// Why the goal is unreachable (with [`StopReason::Unreachable`]).
+    pub reason: Option<String>,
 }
 
 impl<Q: Clone, E> Plan<Q, E> {
@@ -543,6 +548,7 @@ pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<
         nodes: search.nodes.len(),
         iterations,
         planning_time_s: t0.elapsed().as_secs_f64(),
+        reason: None,
     };
     Ok((plan, search.nodes.into_nodes()))
 }

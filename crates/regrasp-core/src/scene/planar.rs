@@ -157,6 +157,17 @@ impl Scene {
         }
     }
 
+    /// The finger pad's centre in the object frame at pose `q` and the radius [m] of the largest
+    /// disc inside the pad (a rectangle's half shorter side); None on a surface.
+    pub fn pad_disc(&self, q: &[f64; 3]) -> Option<(Vec2, f64)> {
+        let Support::Grasp(g) = &self.support else { return None };
+        let c = -(rot(-q[2]) * Vec2::new(q[0], q[1]));
+        Some(match g.pad {
+            PadShape::Circle { radius } => (c, radius),
+            PadShape::Rectangle { width, height } => (c, 0.5 * width.min(height)),
+        })
+    }
+
     /// Signed clearance of the pad inside the outline [m] (circular pads; ≥ 0 admissible).
     pub fn pad_clearance(&self, q: &[f64; 3]) -> f64 {
         match self.pad_in_object(q) {

@@ -1,0 +1,168 @@
+//! Infeasibility certificates (`planning::reachability`) against a brute-force flood fill of the
+//! pad centres where the whole pad lies on the object, and never on a reachable task.
+
+mod common;
+
+use common::pad_pose;
+use proptest::prelude::*;
+use regrasp::mechanics::geometry::Vec2;
+use regrasp::planning::planar::{plan, PlanarSettings, StopReason};
+use regrasp::planning::reachability::unreachable;
+use regrasp::scene::planar_file::{RawGrasp, RawObject, RawPusher, RawScene, RawTask};
+use regrasp::Scene;
+use std::time::Instant;
+
+const TOL: [f64; 3] = [1e-3, 1e-3, 0.0175];
+
+/// A scene of `outline` (CCW) held by a disc pad of radius `pad`, the pad centre at `at` for the
+/// task's start and goal; one line pusher on the first edge.
+fn scene(outline: Vec<[f64; 2]>, pad: f64, at: [f64; 2]) -> Scene {
+    try_scene(outline, pad, at).unwrap()
+}
+
+/// [`scene`], or None when the loader refuses it (the pad off the object at `at`).
+fn try_scene(outline: Vec<[f64; 2]>, pad: f64, at: [f64; 2]) -> Option<Scene> {
+    let (a, b) = (outline[0], outline[1]);
+    let (dx, dz) = (b[0] - a[0], b[1] - a[1]);
+    let pose = pad_pose(at[0], at[1], 0.0);
+    Scene::from_raw(RawScene {
+        name: Some("reach".into()),
+        object: Some(RawObject { outline: Some(outline.clone()), mass: Some(0.02), com: None, material: None }),
+        grasp: Some(RawGrasp { force: Some(40.0), friction: Some(0.8), pad_radius: Some(pad), ..Default::default() }),
+        pushers: Some(vec![RawPusher {
+            name: Some("p".into()),
+            friction: Some(0.5),
+            points: Some(vec![[a[0] + 0.3 * dx, a[1] + 0.3 * dz], [a[0] + 0.7 * dx, a[1] + 0.7 * dz]]),
+            normal: Some([-dz, dx]),
+        }]),
+        task: Some(RawTask { start: Some(pose), goal: Some(pose), tolerance: Some(TOL) }),
+        ..Default::default()
+    })
+    .ok()
+}
+
+/// Two 30 × 30 mm lobes joined by a neck `neck` [m] wide and 20 mm long.
+fn dumbbell(neck: f64) -> Vec<[f64; 2]> {
+    let n = neck / 2.0;
+    vec![
+        [-0.04, -0.015], [-0.01, -0.015], [-0.01, -n], [0.01, -n], [0.01, -0.015], [0.04, -0.015],
+        [0.04, 0.015], [0.01, 0.015], [0.01, n], [-0.01, n], [-0.01, 0.015], [-0.04, 0.015],
+    ]
+}
+
+/// Brute force: whether pad centres `a` and `b` are joined through the grid (spacing `h` [m]) of
+/// the centres where the pad fits (signed distance ≥ its radius).
+fn connected(s: &Scene, r: f64, a: Vec2, b: Vec2, h: f64) -> bool {
+    let v = s.outline.vertices();
+    let (lo, hi) = v.iter().fold((v[0], v[0]), |(l, u), p| (l.inf(p), u.sup(p)));
+    let (nx, nz) = (((hi.x - lo.x) / h) as usize + 1, ((hi.y - lo.y) / h) as usize + 1);
+    let fits = |i: usize, j: usize| s.outline.signed_distance(&Vec2::new(lo.x + i as f64 * h, lo.y + j as f64 * h)) >= r;
+    let cell = |p: Vec2| (((p.x - lo.x) / h).round() as usize, ((p.y - lo.y) / h).round() as usize);
+    let (start, goal) = (cell(a), cell(b));
+    let mut seen = vec![false; nx * nz];
+    let mut stack = vec![start];
+    while let Some((i, j)) = stack.pop() {
+        if (i, j) == goal {
+            return true;
+        }
+        if i >= nx || j >= nz || seen[i * nz + j] || !fits(i, j) {
+            continue;
+        }
+        seen[i * nz + j] = true;
+        stack.extend([(i + 1, j), (i.wrapping_sub(1), j), (i, j + 1), (i, j.wrapping_sub(1))]);
+    }
+    false
+}
+
+#[test]
+fn a_neck_narrower_than_the_pad_is_unreachable_at_once() {
+    let (pad, a, b) = (0.006, [-0.025, 0.0], [0.025, 0.0]);
+    let s = scene(dumbbell(0.008), pad, a);
+    assert!(!connected(&s, pad, Vec2::new(a[0], a[1]), Vec2::new(b[0], b[1]), 2e-4));
+    let t0 = Instant::now();
+    let r = plan(&s, None, Some(pad_pose(b[0], b[1], 0.3)), &PlanarSettings::default()).unwrap();
+    assert!(t0.elapsed().as_secs_f64() < 1.0);
+    assert!(!r.found && r.stop_reason == StopReason::Unreachable && r.path.len() == 1);
+    let why = r.reason.unwrap();
+    assert!(why.contains("different parts") && why.contains("12.00 mm across"), "{why}");
+}
+
+#[test]
+fn a_densely_sampled_outline_is_simplified_before_it_is_eroded() {
+    // the dumbbell's edges cut into 9,600 vertices (the buffer alone would take seconds): the
+    // simplified outline decides it the same
+    let d = dumbbell(0.008);
+    let mut dense = vec![];
+    for (i, a) in d.iter().enumerate() {
+        let b = d[(i + 1) % d.len()];
+        dense.extend((0..800).map(|k| {
+            let t = k as f64 / 800.0;
+            [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+        }));
+    }
+    let (a, b) = ([-0.025, 0.0], [0.025, 0.0]);
+    let s = scene(dense, 0.006, a);
+    assert!(unreachable(&s, &pad_pose(a[0], a[1], 0.0), &pad_pose(b[0], b[1], 0.0), &TOL).is_some());
+}
+
+#[test]
+fn a_neck_wider_than_the_pad_is_left_to_the_search() {
+    let (pad, a, b) = (0.006, [-0.025, 0.0], [0.025, 0.0]);
+    let s = scene(dumbbell(0.016), pad, a);
+    assert!(connected(&s, pad, Vec2::new(a[0], a[1]), Vec2::new(b[0], b[1]), 2e-4));
+    assert_eq!(unreachable(&s, &pad_pose(a[0], a[1], 0.0), &pad_pose(b[0], b[1], 0.0), &TOL), None);
+    // exactly as wide as the pad: the pad passes (touching both sides), so it must not be refused
+    let s = scene(dumbbell(0.012), pad, a);
+    assert_eq!(unreachable(&s, &pad_pose(a[0], a[1], 0.0), &pad_pose(b[0], b[1], 0.0), &TOL), None);
+}
+
+#[test]
+fn a_goal_within_tolerance_of_the_start_part_is_not_refused() {
+    // the goal's pad centre just across a thin wall, within the tolerance's reach of the start's part
+    let (pad, a) = (0.006, [-0.025, 0.0]);
+    let s = scene(dumbbell(0.008), pad, a);
+    let goal = pad_pose(-0.0095, 0.0, 0.0); // in the neck, off the start part by less than 1 mm
+    let wide = [0.01, 0.01, 0.0175];
+    assert_eq!(unreachable(&s, &pad_pose(a[0], a[1], 0.0), &goal, &wide), None);
+}
+
+/// A star-shaped outline about the origin: `radii` [m] at equal angles, CCW.
+fn star(radii: &[f64]) -> Vec<[f64; 2]> {
+    let n = radii.len() as f64;
+    radii.iter().enumerate().map(|(i, r)| {
+        let a = 2.0 * std::f64::consts::PI * i as f64 / n;
+        [r * a.cos(), r * a.sin()]
+    }).collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(250))]
+    /// A goal that a chain of short admissible pad moves reaches from the start is never declared
+    /// unreachable (random star-shaped outlines, pads, walks and turns).
+    #[test]
+    fn a_reachable_goal_is_never_declared_unreachable(
+        radii in prop::collection::vec(0.01f64..0.04, 5..150),
+        pad in 0.001f64..0.006,
+        walk in prop::collection::vec((-1.0f64..1.0, -1.0f64..1.0), 1..60),
+        turns in (-3.0f64..3.0, -3.0f64..3.0),
+    ) {
+        let outline = star(&radii);
+        let probe = try_scene(outline, pad, [0.0, 0.0]);
+        prop_assume!(probe.is_some());
+        let s = probe.unwrap();
+        let fits = |c: Vec2| s.outline.signed_distance(&c) >= pad;
+        let mut c = Vec2::new(0.0, 0.0);
+        prop_assume!(fits(c));
+        let start = c;
+        for (dx, dz) in walk {
+            let next = c + Vec2::new(dx, dz) * 0.002;
+            // the whole move admissible (sampled every 0.1 mm)
+            if (0..=20).all(|k| fits(c + (next - c) * (k as f64 / 20.0))) {
+                c = next;
+            }
+        }
+        let q0 = pad_pose(start.x, start.y, turns.0);
+        let q1 = pad_pose(c.x, c.y, turns.1);
+        prop_assert_eq!(unreachable(&s, &q0, &q1, &[1e-4, 1e-4, 1e-3]), None);
+    }
+}
