@@ -294,22 +294,24 @@ def test_a_planar_plan_file_has_exactly_the_documented_keys(written_plans):
     check_plan(_strict_json(runs[3].stdout), "planar plan key")
 
 
-def test_a_plan_not_found_is_written_with_the_documented_keys_and_exits_1(written_plans):
+def _not_found(written_plans, k: int, file: str, says: str) -> dict:
+    """Plan file `file` written by run `k`, which found no plan: exit 1, `says` on stderr, the documented keys."""
     d, runs = written_plans
-    assert runs[2].returncode == 1, runs[2].stdout + runs[2].stderr
-    assert "no plan found" in runs[2].stderr
-    plan = _strict_json((d / "none.json").read_text())
+    assert runs[k].returncode == 1, runs[k].stdout + runs[k].stderr
+    assert says in runs[k].stderr
+    plan = _strict_json((d / file).read_text())
     check_plan(plan, "planar plan key")
     assert plan["found"] is False and plan["stop_reason"] != "goal_reached"
+    return plan
+
+
+def test_a_plan_not_found_is_written_with_the_documented_keys_and_exits_1(written_plans):
+    _not_found(written_plans, 2, "none.json", "no plan found")
 
 
 def test_an_unreachable_goal_is_written_with_its_reason_and_exits_1(written_plans):
     # two lobes joined by a neck narrower than the pad: decided before any search
-    d, runs = written_plans
-    assert runs[4].returncode == 1, runs[4].stdout + runs[4].stderr
-    assert "no plan found: unreachable: the pad's centre must stay" in runs[4].stderr
-    plan = _strict_json((d / "unreachable.json").read_text())
-    check_plan(plan, "planar plan key")
+    plan = _not_found(written_plans, 4, "unreachable.json", "no plan found: unreachable: the pad's centre must stay")
     assert plan["stop_reason"] == "unreachable" and "different parts" in plan["reason"]
     assert plan["planning_time_s"] < 1.0 and len(plan["path"]) == 1
     from regrasp.planning.plan import Plan

@@ -202,6 +202,8 @@ def test_bench_json_without_reference_is_valid_json(blocker):
         from regrasp import bench
         import regrasp.cli
         full_run, planner, plan3d, wm = bench.run, bench.run_planner, bench.run_plan3d, bench.run_world_motion
+        hard = bench.run_hard_plans
+        bench.run_hard_plans = lambda: hard(seeds=1, time_limit=1.0, names=("neck-unreachable",))
         bench.run = lambda **kw: full_run(**{**kw, "n": 300, "reps": 1, "baseline_reps": 1})
         bench.run_planner = lambda: planner(seeds=1, time_limit=5.0, examples=("block-high-friction",))
         bench.run_plan3d = lambda: plan3d(seeds=1, examples=("offset-3d",))
@@ -216,3 +218,4 @@ def test_bench_json_without_reference_is_valid_json(blocker):
     assert "regrasp[reference]" in skipped["baseline"]
     assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_", "mujoco_", "ik_", "arm_")) for k in res), sorted(res)
     assert res["world_motion_block-low-friction"]["median_s"] > 0  # needs no extra
+    assert res["hard_neck-unreachable"]["unreachable"] == 1 and res["hard_neck-unreachable"]["median_s"] < 1.0

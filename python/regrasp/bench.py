@@ -62,6 +62,7 @@ def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, sc
         ("projection", lambda: _projection(scene, pusher, poses, twists, reps)),
         ("MNCP solver", lambda: _unless_missing("the MNCP solver against IPOPT", lambda: run_mncp(reps=reps))),
         ("planner", run_planner),
+        ("hard plans", lambda: run_hard_plans()),
         ("MuJoCo", lambda: _unless_missing("MuJoCo's speed", run_mujoco)),
         ("MPC", lambda: _unless_missing("the MPC step against SciPy", run_mpc)),
         ("3-D planner", run_plan3d),
@@ -429,6 +430,41 @@ def run_planner(seeds: int = 10, time_limit: float = 30.0, examples=PLANNED) -> 
                 "valid": mc["valid"], "baseline_valid": b["valid"],
                 "switch_overs": mc["switch_overs"], "baseline_switch_overs": b["switch_overs"],
             }
+    return out
+
+
+#: issue 18's hard planar scenes (``regrasp/examples/hard/``, ``benches/scenes/`` in a clone)
+HARD = tuple(sorted(p.stem for p in (bundled.ROOT / "hard").glob("*.toml")))
+#: issue 18's targets for the hard scenes: the median and the 90th percentile of the time to a first plan [s]
+HARD_TARGETS = (0.05, 0.2)
+
+
+def run_hard_plans(seeds: int = 20, time_limit: float = 10.0, names=HARD) -> dict:
+    """The hard planar scenes (:data:`HARD`): per scene, ``seeds`` plans (each stopped at
+    ``time_limit`` [s]); the median and 90th percentile of the planning time (the time to the first
+    plan, or to the answer "unreachable"), how many found a plan, how many of those pass the exact
+    test along every step, how many were answered unreachable, the switch-overs (median, and the
+    fewest over the seeds). No baseline: the targets are :data:`HARD_TARGETS`."""
+    from .planning.plan import plan
+
+    out = {}
+    for name in names:
+        scene = Scene.load(bundled.ROOT / "hard" / f"{name}.toml")
+        runs = [plan(scene, seed=k, time_limit=time_limit) for k in range(seeds)]
+        t = np.array([r.planning_time_s for r in runs])
+        found = [r for r in runs if r.found]
+        switch = [r.switch_overs for r in found]
+        median, p90 = float(np.median(t)), float(np.percentile(t, 90))
+        out[f"hard_{name}"] = {
+            "median_s": median, "p90_s": p90, "n": seeds, "found": len(found),
+            "valid": sum(bool(r.valid) for r in found), "unreachable": sum(r.stop_reason == "unreachable" for r in runs),
+            "switch_overs": float(np.median(switch)) if switch else None, "best_switch_overs": min(switch, default=None),
+            "baseline_median_s": None, "ratio": None,
+            "baseline": f"found {len(found)}/{seeds}, unreachable {sum(r.stop_reason == 'unreachable' for r in runs)}, "
+                        f"p90 {p90 * 1e3:.1f} ms (targets: median < {HARD_TARGETS[0] * 1e3:.0f} ms, p90 < "
+                        f"{HARD_TARGETS[1] * 1e3:.0f} ms), switch-overs {np.median(switch) if switch else '-'} "
+                        f"(best {min(switch, default='-')})",
+        }
     return out
 
 
