@@ -1,7 +1,9 @@
 """Why the grip pivot misses its grasp: runs it once in the nominal world (the arm in MuJoCo) on a
 grasp for lags of 30–70° and turn times of 1.2 and 3 s, and prints the model's turn and grip beside
 MuJoCo's turn and where the centre of mass ended in the hand (x, z [mm]) against the target
-grasp's. Usage: python scripts/pivot-shortfall.py [OBJECT GRASP] (default: prism g2)."""
+grasp's. With --all: both gravity pivots, at their defaults, once each in the nominal world on
+every grasp of the three bundled objects' graphs they apply to, and where each ended. Usage: python
+scripts/pivot-shortfall.py [OBJECT GRASP] (default: prism g2) | --all."""
 
 import sys
 
@@ -13,7 +15,25 @@ from regrasp.dexterity.graph import _object
 from regrasp.dexterity.trial import Runner
 
 
+def every_grasp() -> None:
+    from regrasp.dexterity.graph import FIT, fitting
+    from regrasp.dexterity.objects import OBJECTS
+
+    for name in OBJECTS:
+        scene, tax, obj = _object(name)
+        clear = fitting(scene, tax)
+        for g in (g for g in tax.grasps if g.holds and clear[g.name] >= FIT):  # the graph's grasps
+            for action in ("gravity-pivot", "grip-pivot"):
+                if A.action(action).applies(obj, g) is not None:
+                    continue
+                s = A.action(action).setup(obj, g)
+                r = Runner(scene, tax, g, s).run()
+                print(f"{name} {g.name} {action}: meant to reach {s.intended}, reached {r.outcome}", flush=True)
+
+
 def main() -> None:
+    if sys.argv[1:] == ["--all"]:
+        return every_grasp()
     name, grasp = (sys.argv[1:3] if len(sys.argv) > 2 else ("prism", "g2"))
     scene, tax, obj = _object(name)
     g = tax.grasp(grasp)
