@@ -639,6 +639,10 @@ class TableSlide(Action):
         return least_force(width, "", Pads.of_scene(obj.scene), obj.mu)
 
     def applies(self, obj, grasp):
+        return self._why_not(obj, grasp, DEFAULTS["rest_ratio"])
+
+    def _why_not(self, obj, grasp, r: float) -> Optional[str]:
+        """Why the slide cannot be done at the grip ``r`` (2 μ N / m g), or None."""
         from ..robot.ik import MIN_DISTANCE
 
         if _offset_step(obj, grasp, -1) is None:
@@ -646,7 +650,6 @@ class TableSlide(Action):
         reach, (x0, x1) = self._support(obj, grasp)
         if not _fingers_clear(obj, 0.0, reach, MIN_DISTANCE):
             return f"standing on the table, the pads come within the arm's {MIN_DISTANCE * 1e3:.0f} mm of it"
-        r = DEFAULTS["rest_ratio"]
         least = self.least_grip(obj, grasp)
         if least > 0.8 * obj.holding(r):  # the gripper must come down to the grip, with room for the force loop
             return f"the gripper presses at least {least:.2f} N per pad at this width (the slide needs " \
@@ -660,12 +663,12 @@ class TableSlide(Action):
 
     def setup(self, obj, grasp, params=None):
         p = _params(params)
-        why = self.applies(obj, grasp)
-        if why is not None:
-            raise ArgumentError(f"invalid `grasp`: table-slide does not apply to {grasp.name}: {why}", "grasp")
         if p["rest_ratio"] >= 1.0:
             raise ArgumentError(f"invalid `params.rest_ratio`: below 1 (the table must keep part of the weight; got "
                                 f"{p['rest_ratio']!r})", "params.rest_ratio")
+        why = self._why_not(obj, grasp, p["rest_ratio"])
+        if why is not None:
+            raise ArgumentError(f"invalid `grasp`: table-slide does not apply to {grasp.name}: {why}", "grasp")
         step = _offset_step(obj, grasp, -1)
         reach, _ = self._support(obj, grasp)
         press = 0.0005  # m, the object pressed this far into the table (soft contact) while it stands on it
