@@ -121,9 +121,10 @@ fn a_goal_within_tolerance_of_the_start_part_is_not_refused() {
     // the goal's pad centre just across a thin wall, within the tolerance's reach of the start's part
     let (pad, a) = (0.006, [-0.025, 0.0]);
     let s = scene(dumbbell(0.008), pad, a);
-    let goal = pad_pose(-0.0095, 0.0, 0.0); // in the neck, off the start part by less than 1 mm
-    let wide = [0.01, 0.01, 0.0175];
-    assert_eq!(unreachable(&s, &pad_pose(a[0], a[1], 0.0), &goal, &wide), None);
+    let goal = pad_pose(-0.0095, 0.0, 0.0); // in the neck, 2.3 mm off the start's part as eroded
+    let start = pad_pose(a[0], a[1], 0.0);
+    assert_eq!(unreachable(&s, &start, &goal, &[1.7e-3, 1.7e-3, 0.0]), None); // reaches 2.40 mm
+    assert!(unreachable(&s, &start, &goal, &[1.5e-3, 1.5e-3, 0.0]).is_some()); // reaches 2.12 mm
 }
 
 /// A star-shaped outline about the origin: `radii` [m] at equal angles, CCW.

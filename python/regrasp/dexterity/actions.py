@@ -652,8 +652,8 @@ class TableSlide(Action):
             return f"standing on the table, the pads come within the arm's {MIN_DISTANCE * 1e3:.0f} mm of it"
         least = self.least_grip(obj, grasp)
         if least > 0.8 * obj.holding(r):  # the gripper must come down to the grip, with room for the force loop
-            return f"the gripper presses at least {least:.2f} N per pad at this width (the slide needs " \
-                   f"{obj.holding(r):.2f} N)"
+            return f"the gripper presses at least {least:.2f} N per pad at this width (the slide's grip, " \
+                   f"{obj.holding(r):.2f} N, needs it below {0.8 * obj.holding(r):.2f} N)"
         # the weight less the pads' pull (at the contact centre) must press inside the face it stands on
         x = (P.transform(grasp.pose, obj.com)[0] - r * contact_centre(obj, grasp)[0]) / (1 - r)
         margin = 0.002  # m

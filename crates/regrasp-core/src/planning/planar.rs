@@ -357,7 +357,11 @@ pub fn plan_tree(
         let root = crate::planning::tree::TreeNode { q: start, parent: None, pusher: None, edge: (), cost: 0.0, children: vec![] };
         return Ok((unreachable_plan(&space, start, reason, t0), vec![root]));
     }
-    trrt::plan_tree(&space, start)
+    let before = t0.elapsed().as_secs_f64(); // the checks and the certificate count as planning time
+    trrt::plan_tree(&space, start).map(|(mut r, nodes)| {
+        r.planning_time_s += before;
+        (r, nodes)
+    })
 }
 
 /// The answer for a goal decided unreachable: the start alone, its distance to the goal.

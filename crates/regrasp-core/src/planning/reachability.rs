@@ -59,8 +59,9 @@ fn pad_region(scene: &Scene, r: f64) -> Option<MultiPolygon<f64>> {
     let outline = Polygon::new(LineString::from(ring), vec![]);
     let eps = SIMPLIFY * r;
     let simple = outline.simplify(eps);
-    let (shape, eps) = if simple.is_valid() { (simple, eps) } else { (outline, 0.0) };
-    if shape.exterior().0.len() > MAX_VERTICES {
+    let small = |p: &Polygon<f64>| p.exterior().0.len() <= MAX_VERTICES; // the validity test is quadratic too
+    let (shape, eps) = if small(&simple) && simple.is_valid() { (simple, eps) } else { (outline, 0.0) };
+    if !small(&shape) {
         return None;
     }
     Some(shape.buffer_with_style(BufferStyle::new(-(ERODE * r - 2.0 * eps)).line_join(LineJoin::Bevel)))
