@@ -62,7 +62,7 @@ def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, sc
         ("projection", lambda: _projection(scene, pusher, poses, twists, reps)),
         ("MNCP solver", lambda: _unless_missing("the MNCP solver against IPOPT", lambda: run_mncp(reps=reps))),
         ("planner", run_planner),
-        ("hard plans", lambda: run_hard_plans()),
+        ("hard plans", run_hard_plans),
         ("MuJoCo", lambda: _unless_missing("MuJoCo's speed", run_mujoco)),
         ("MPC", lambda: _unless_missing("the MPC step against SciPy", run_mpc)),
         ("3-D planner", run_plan3d),
@@ -455,12 +455,13 @@ def run_hard_plans(seeds: int = 20, time_limit: float = 10.0, names=HARD) -> dic
         found = [r for r in runs if r.found]
         switch = [r.switch_overs for r in found]
         median, p90 = float(np.median(t)), float(np.percentile(t, 90))
+        refused = sum(r.stop_reason == "unreachable" for r in runs)
         out[f"hard_{name}"] = {
             "median_s": median, "p90_s": p90, "n": seeds, "found": len(found),
-            "valid": sum(bool(r.valid) for r in found), "unreachable": sum(r.stop_reason == "unreachable" for r in runs),
+            "valid": sum(bool(r.valid) for r in found), "unreachable": refused,
             "switch_overs": float(np.median(switch)) if switch else None, "best_switch_overs": min(switch, default=None),
             "baseline_median_s": None, "ratio": None,
-            "baseline": f"found {len(found)}/{seeds}, unreachable {sum(r.stop_reason == 'unreachable' for r in runs)}, "
+            "baseline": f"found {len(found)}/{seeds}, unreachable {refused}, "
                         f"p90 {p90 * 1e3:.1f} ms (targets: median < {HARD_TARGETS[0] * 1e3:.0f} ms, p90 < "
                         f"{HARD_TARGETS[1] * 1e3:.0f} ms), switch-overs {np.median(switch) if switch else '-'} "
                         f"(best {min(switch, default='-')})",
