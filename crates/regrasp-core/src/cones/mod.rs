@@ -4,6 +4,7 @@
 pub mod batch;
 pub mod frame;
 pub mod motion_cone;
+pub mod point_pusher;
 pub mod polyhedral;
 pub mod projection;
 pub mod robust;

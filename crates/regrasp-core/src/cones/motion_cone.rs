@@ -22,7 +22,7 @@
 
 use crate::error::{Error, Result};
 use crate::mechanics::friction_cone::{ConeShape, EdgeWrench, PolyhedralCone, PusherContact};
-use crate::mechanics::geometry::{cross2, perp, Mat3, Vec2, Vec3};
+use crate::mechanics::geometry::{perp, Mat3, Vec2, Vec3};
 use crate::mechanics::limit_surface::LimitSurface;
 use crate::mechanics::metric::Metric;
 pub use crate::cones::frame::{Classification, ConeMode, PusherModel, SupportFrame, MEMBERSHIP_TOL};
@@ -215,47 +215,10 @@ impl PlanarPush {
     /// `None` when no rotation rate balances the moments.
     pub fn point_pusher_twist(&self, u: &Vec2, s: f64) -> Option<Vec3> {
         let r = *self.spec.pusher.points.first()?;
-        let l = self.spec.metric.length;
-        let un = u.norm();
-        let uhat = if un > 0.0 { u / un } else { Vec2::zeros() };
-        let pr = perp(&r);
-        let twist = |phi: f64| -> Vec3 {
-            let (sp, cp) = phi.sin_cos();
-            let w = sp / l;
-            let lin = uhat * cp - pr * w;
-            Vec3::new(lin.x, lin.y, w)
-        };
-        let binv = self.spec.limit_surface.b_inv;
-        let js = self.spec.support_jacobian;
-        // moment about r of the required pusher wrench; non-decreasing in phi because the
-        // load wrench is the gradient of a convex dissipation function (a monotone map)
-        let h = |phi: f64| -> f64 {
-            let v = twist(phi);
-            let w = js.tr_mul(&LimitSurface::wrench_for_twist(&binv, &(js * v))) * s - self.spec.gravity;
-            w.z - cross2(&r, &Vec2::new(w.x, w.y))
-        };
-        let half = std::f64::consts::FRAC_PI_2;
-        if un == 0.0 {
-            // the contact point does not move: a pure rotation about it, either way
-            return [half, -half].into_iter().find(|&phi| h(phi).abs() < 1e-12 * (1.0 + s)).map(twist);
-        }
-        let (mut lo, mut hi) = (-half, half);
-        if h(lo) > 0.0 || h(hi) < 0.0 {
-            return None;
-        }
-        for _ in 0..100 {
-            let mid = 0.5 * (lo + hi);
-            if h(mid) < 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-            if hi - lo < 1e-15 {
-                break;
-            }
-        }
-        let phi = 0.5 * (lo + hi);
-        (phi.abs() < half - 1e-12).then(|| twist(phi))
+        let (binv, js) = (self.spec.limit_surface.b_inv, self.spec.support_jacobian);
+        crate::cones::point_pusher::contact_twist(&r, u, self.spec.metric.length, |v| {
+            js.tr_mul(&LimitSurface::wrench_for_twist(&binv, &(js * v))) * s - self.spec.gravity
+        })
     }
 
     /// The same push with another friction scale (another grip force).

@@ -2,6 +2,7 @@
 //! (planar) or inverse-dynamics steps (spatial), sharing one search tree.
 
 pub mod planar;
+pub mod point_step;
 pub mod reachability;
 pub mod spatial;
 pub mod tree;

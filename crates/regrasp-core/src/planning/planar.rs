@@ -16,8 +16,9 @@ use crate::dynamics::mncp;
 use crate::dynamics::planar::{push_problem, Options as QsOptions, SupportModel};
 use crate::error::{Error, Result};
 use crate::mechanics::geometry::{rot, Vec2, Vec3};
+use crate::planning::point_step;
 use crate::planning::tree::pusher_order;
-use crate::planning::trrt::{self, gauss, SearchSettings, Space, SpaceCore, Step};
+use crate::planning::trrt::{self, gauss, Chain, SearchSettings, Space, SpaceCore, Step};
 use crate::pose::planar::{body_twist, distance, integrate};
 use crate::scene::Scene;
 use rand::Rng;
@@ -138,32 +139,40 @@ impl<'a> PlanarSpace<'a> {
 
     /// Whether pusher `p` can move the object with body twist `tw` (unit time) from `q`: the
     /// exact test at `checks` poses along the step (margin ≥ `margin` at the start, ≥ half
-    /// of it further on), and the pad on the object all along: at each interior pose its
-    /// clearance exceeds how far it moves to the neighbouring poses, so it cannot leave the
-    /// object between them.
+    /// of it further on), and the pad on the object all along ([`Self::pad_stays_on`]). A point
+    /// pusher's step is its flow ([`point_step`]), which must land on `integrate(q, tw, 1)`.
     fn step_feasible(&self, q: &[f64; 3], tw: &Vec3, p: usize) -> bool {
-        let model = &self.scene.pushers[p].model;
         let n = self.s.search.checks.max(1);
+        if point_step::contact_point(self.scene, p).is_some() {
+            return point_step::check(self.scene, p, q, &integrate(q, tw, 1.0), n)
+                .is_some_and(|(fl, miss)| miss <= point_step::LANDING_TOL && self.flow_feasible(&fl));
+        }
+        let model = &self.scene.pushers[p].model;
         let poses: Vec<[f64; 3]> = (0..=n).map(|k| if k == 0 { *q } else { integrate(q, tw, k as f64 / n as f64) }).collect();
-        let pad = |x: &[f64; 3]| rot(-x[2]) * Vec2::new(-x[0], -x[1]);
-        let pads: Vec<Vec2> = poses.iter().map(pad).collect();
-        for k in 0..=n {
-            let Some(f) = self.frame(&poses[k]) else { return false };
-            if k > 0 && k < n {
-                let reach = (pads[k] - pads[k - 1]).norm().max((pads[k + 1] - pads[k]).norm());
-                if self.scene.pad_clearance(&poses[k]) < 1.1 * reach {
-                    return false;
-                }
-            }
-            if k == n {
-                break; // the end pose: on the object and held; its twist is the next step's
-            }
-            let m = f.classify(model, tw).margin;
-            if m < if k == 0 { self.s.margin } else { 0.5 * self.s.margin } {
+        for (k, qk) in poses[..n].iter().enumerate() {
+            let Some(f) = self.frame(qk) else { return false };
+            if f.classify(model, tw).margin < if k == 0 { self.s.margin } else { 0.5 * self.s.margin } {
                 return false;
             }
         }
-        true
+        self.frame(&poses[n]).is_some() && self.pad_stays_on(&poses)
+    }
+
+    /// A point pusher's flow ([`point_step`]): margin ≥ `margin` at the start, ≥ half of it
+    /// further on, and the pad on the object all along.
+    fn flow_feasible(&self, fl: &point_step::Flow) -> bool {
+        fl.first_margin >= self.s.margin && fl.margin >= 0.5 * self.s.margin && self.pad_stays_on(&fl.poses)
+    }
+
+    /// Whether the pad stays on the object between consecutive `poses`: at each interior pose
+    /// its clearance exceeds how far it moves to the neighbouring poses.
+    fn pad_stays_on(&self, poses: &[[f64; 3]]) -> bool {
+        let pad = |x: &[f64; 3]| rot(-x[2]) * Vec2::new(-x[0], -x[1]);
+        let pads: Vec<Vec2> = poses.iter().map(pad).collect();
+        (1..poses.len().saturating_sub(1)).all(|k| {
+            let reach = (pads[k] - pads[k - 1]).norm().max((pads[k + 1] - pads[k]).norm());
+            self.scene.pad_clearance(&poses[k]) >= 1.1 * reach
+        })
     }
 
     /// Whether the inverse quasi-static dynamics find pusher forces for step `tw` with pusher `p`.
@@ -195,23 +204,35 @@ impl<'a> PlanarSpace<'a> {
     }
 
     /// Propagation by motion cones: the desired step if some cone contains it (parent's pusher
-    /// first), else its projections, the closest in angle kept (parent's pusher preferred).
+    /// first), else its projections, the closest in angle kept (parent's pusher preferred). A
+    /// point pusher's candidate is its step with the desired contact-point velocity
+    /// ([`Self::point_candidate`]).
     fn propagate_cones(&self, q: &[f64; 3], parent_pusher: Option<usize>, target: &[f64; 3]) -> Option<Step<[f64; 3], ()>> {
         let (want, len) = self.desired(q, target)?;
         let m = self.scene.metric();
         let frame = self.frame(q)?;
         let order = pusher_order(self.scene.pushers.len(), if self.s.plain { None } else { parent_pusher });
+        let point = |p: usize| point_step::contact_point(self.scene, p);
         // 1. the desired step itself
-        for &p in &order {
+        for &p in order.iter().filter(|&&p| point(p).is_none()) {
             if frame.classify(&self.scene.pushers[p].model, &want).margin >= self.s.margin && self.step_feasible(q, &want, p) {
                 return Some(self.step_to(q, p, want));
             }
         }
-        // 2. projections on each cone
+        // 2. projections on each cone; a point pusher's step with the desired contact velocity
         let wn = m.twist_norm(&want);
-        let mut best: Option<(f64, usize, Vec3)> = None;
+        let mut best: Option<(f64, usize, Vec3, bool)> = None;
         for &p in &order {
-            let Some(v) = project_with_margin(&frame, &self.scene.pushers[p].model, &want, self.s.margin) else { continue };
+            let (v, done) = match point(p) {
+                Some(r) => match self.point_candidate(q, &frame, p, &r, &want) {
+                    Some(v) => (v, true),
+                    None => continue,
+                },
+                None => match project_with_margin(&frame, &self.scene.pushers[p].model, &want, self.s.margin) {
+                    Some(v) => (v, false),
+                    None => continue,
+                },
+            };
             let vn = m.twist_norm(&v);
             if vn < 1e-12 {
                 continue;
@@ -219,10 +240,13 @@ impl<'a> PlanarSpace<'a> {
             let cos = m.twist(&v).dot(&m.twist(&want)) / (vn * wn);
             let bonus = if Some(p) == parent_pusher && !self.s.plain { 0.05 } else { 0.0 };
             if cos > 0.2 && best.as_ref().is_none_or(|b| cos + bonus > b.0) {
-                best = Some((cos + bonus, p, v));
+                best = Some((cos + bonus, p, v, done));
             }
         }
-        let (_, p, v) = best?;
+        let (_, p, v, done) = best?;
+        if done {
+            return Some(self.step_to(q, p, v)); // a point pusher's step, feasible along its flow
+        }
         // a step of the unit length along the projection, halved until feasible along it
         let mut tw = v * (self.core.step.min(len) / m.twist_norm(&v));
         for _ in 0..4 {
@@ -232,6 +256,48 @@ impl<'a> PlanarSpace<'a> {
             tw *= 0.5;
         }
         None
+    }
+
+    /// Point pusher `p` (contact `r`): of the contact-point velocity directions (32 around, and
+    /// the one of `want`) whose twist at `q` has margin ≥ `margin`, the one whose twist is
+    /// closest in angle to `want`; then the pusher twist of [`point_step::steer`] for that
+    /// direction with about `want`'s length, halved until its flow is feasible.
+    fn point_candidate(&self, q: &[f64; 3], frame: &SupportFrame, p: usize, r: &Vec2, want: &Vec3) -> Option<Vec3> {
+        let m = self.scene.metric();
+        let (mw, wn) = (m.twist(want), m.twist_norm(want));
+        let own = Vec2::new(want.x, want.y) + crate::mechanics::geometry::perp(r) * want.z;
+        let dirs = (0..32).map(|k| {
+            let a = k as f64 * std::f64::consts::PI / 16.0;
+            Vec2::new(a.cos(), a.sin())
+        });
+        let mut best: Option<(f64, Vec2, f64)> = None;
+        for d in std::iter::once(own).chain(dirs) {
+            let Some(v) = frame.point_twist(r, &d, self.scene.length) else { continue };
+            let vn = m.twist_norm(&v);
+            let cos = m.twist(&v).dot(&mw) / (vn * wn);
+            if cos > 0.2 && best.is_none_or(|b| cos > b.0) && frame.classify(&self.scene.pushers[p].model, &v).margin >= self.s.margin {
+                best = Some((cos, d, vn));
+            }
+        }
+        let (_, d, vn) = best?;
+        let mut ub = d * (wn / vn); // the object moves about as far as `want`
+        for _ in 0..4 {
+            if let Some((xi, fl)) = point_step::steer(self.scene, p, q, &ub, self.s.search.checks) {
+                if self.flow_feasible(&fl) {
+                    return Some(xi);
+                }
+            }
+            ub *= 0.5;
+        }
+        None
+    }
+
+    /// Two steps of point pushers from `q` into the goal's tolerance ([`point_step::connect`]).
+    fn connect_points(&self, q: &[f64; 3], order: &[usize]) -> Option<Chain<[f64; 3], ()>> {
+        let m = self.scene.metric();
+        let accept = |fl: &point_step::Flow| self.flow_feasible(fl);
+        let (ps, st) = point_step::connect(self.scene, order, q, &self.core.goal, &self.tol, self.s.search.checks, self.s.margin, accept)?;
+        Some(vec![(st[0].2, ps[0], (), m.twist_norm(&st[0].0)), (st[1].2, ps[1], (), m.twist_norm(&st[1].0))])
     }
 
     /// Random unit steps for the baselines: the stable check (directions in the target's
@@ -306,8 +372,9 @@ impl Space<3> for PlanarSpace<'_> {
         self.step_feasible(a, tw, p).then_some(())
     }
     /// Straight push to the goal: unit steps of one constant body twist, all feasible for one
-    /// pusher (the node's first), at most 200 of them.
-    fn connect_goal(&self, q: &[f64; 3], pusher: Option<usize>) -> Option<(usize, Vec<([f64; 3], (), f64)>)> {
+    /// pusher (the node's first), at most 200 of them; else, within two unit steps of the goal,
+    /// two steps of point pushers ([`point_step::connect`]).
+    fn connect_goal(&self, q: &[f64; 3], pusher: Option<usize>) -> Option<Chain<[f64; 3], ()>> {
         let xi = body_twist(q, &self.core.goal);
         let len = self.scene.metric().twist_norm(&xi);
         if len < 1e-12 {
@@ -323,8 +390,14 @@ impl Space<3> for PlanarSpace<'_> {
             Some(*qk)
         }).collect();
         let starts = std::iter::once(*q).chain(poses.iter().copied().take(n - 1)).collect::<Vec<_>>();
-        let p = pusher_order(self.scene.pushers.len(), pusher).into_iter().find(|&p| starts.iter().all(|qk| self.feasible(qk, &tw, p)))?;
-        Some((p, poses.into_iter().map(|qk| (qk, (), len / n as f64)).collect()))
+        let order = pusher_order(self.scene.pushers.len(), pusher);
+        if let Some(p) = order.iter().copied().find(|&p| starts.iter().all(|qk| self.feasible(qk, &tw, p))) {
+            return Some(trrt::one_pusher(p, poses.into_iter().map(|qk| (qk, (), len / n as f64)).collect()));
+        }
+        if n > 2 || self.s.propagation != Propagation::MotionCone {
+            return None;
+        }
+        self.connect_points(q, &order)
     }
     fn rewires(&self) -> bool {
         self.s.propagation == Propagation::MotionCone
@@ -421,8 +494,10 @@ pub fn stable_push_lp(scene: &Scene, q: &[f64; 3], pusher: usize, tw: &Vec3) -> 
 
 /// Checks a path with the exact motion-cone test at `checks` poses along each step; returns
 /// the smallest margin of each step (negative: the pusher would slip somewhere along it; −1:
-/// the finger pad leaves the object or the grasp cannot hold it somewhere along the step). An
-/// error names a step whose pusher is missing or unknown.
+/// the finger pad leaves the object or the grasp cannot hold it somewhere along the step). A
+/// point pusher's step is its flow ([`point_step`], `checks` RK4 steps): the margins along it,
+/// and minus the miss (over L) when it lands farther than [`point_step::LANDING_TOL`] from the
+/// step's end. An error names a step whose pusher is missing or unknown.
 pub fn validate_path(scene: &Scene, path: &[([f64; 3], Option<usize>)], checks: usize) -> Result<Vec<f64>> {
     let mut out = Vec::new();
     for (i, w) in path.windows(2).enumerate() {
@@ -435,6 +510,13 @@ pub fn validate_path(scene: &Scene, path: &[([f64; 3], Option<usize>)], checks: 
         let tw = body_twist(&a, &b);
         let mut worst = f64::INFINITY;
         let n = checks.max(1);
+        if point_step::contact_point(scene, p).is_some() && tw.amax() > 0.0 {
+            out.push(match point_step::check(scene, p, &a, &b, n) {
+                None => -1.0,
+                Some((fl, miss)) => fl.first_margin.min(fl.margin).min(if miss > point_step::LANDING_TOL { -miss } else { f64::INFINITY }),
+            });
+            continue;
+        }
         for k in 0..=n {
             let qk = integrate(&a, &tw, k as f64 / n as f64);
             if !scene.admissible(&qk) || !(scene.frame(&qk).hold_ratio < 1.0) {

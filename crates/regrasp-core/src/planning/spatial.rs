@@ -22,7 +22,7 @@ use crate::dynamics::mncp;
 use crate::dynamics::spatial::{push_problem, simulate_push};
 use crate::error::{Error, Result};
 use crate::planning::tree::pusher_order;
-use crate::planning::trrt::{self, gauss, SearchSettings, Space, SpaceCore, Step};
+use crate::planning::trrt::{self, gauss, one_pusher, Chain, SearchSettings, Space, SpaceCore, Step};
 use crate::pose::spatial::{distance, integrate, log as se3_log, twist_length, Twist6, V3};
 use crate::scene::spatial::Scene3;
 use nalgebra::{DVector, Isometry3, UnitQuaternion};
@@ -332,7 +332,7 @@ impl Space<7> for SpatialSpace<'_> {
     }
     /// Straight push to the goal (unit steps of one constant twist, one pusher, at most 100);
     /// when no pusher can take it (and it is at most 20 steps), rolling with a plane.
-    fn connect_goal(&self, q: &Isometry3<f64>, pusher: Option<usize>) -> Option<(usize, Vec<(Isometry3<f64>, Twist6, f64)>)> {
+    fn connect_goal(&self, q: &Isometry3<f64>, pusher: Option<usize>) -> Option<Chain<Isometry3<f64>, Twist6>> {
         let xi = se3_log(q, &self.core.goal);
         let len = twist_length(self.l(), &xi);
         if len < 1e-12 {
@@ -350,9 +350,9 @@ impl Space<7> for SpatialSpace<'_> {
             .map(|&p| std::iter::once(q).chain(poses.iter().take(n - 1)).all(|qk| self.exact(qk, &u, p, &self.solves)))
             .collect();
         let Some(p) = order.iter().zip(ok).find(|(_, o)| *o).map(|(p, _)| *p) else {
-            return if n <= 20 { self.connect_rolling(q, pusher, n) } else { None };
+            return if n <= 20 { self.connect_rolling(q, pusher, n).map(|(p, c)| one_pusher(p, c)) } else { None };
         };
-        Some((p, poses.into_iter().map(|qk| (qk, u, len / n as f64)).collect()))
+        Some(one_pusher(p, poses.into_iter().map(|qk| (qk, u, len / n as f64)).collect()))
     }
     fn nearest_candidates(&self) -> usize {
         8

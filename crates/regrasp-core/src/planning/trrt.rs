@@ -160,6 +160,14 @@ pub struct Step<Q, E> {
     pub length: f64,
 }
 
+/// Steps to the goal: (pose, pusher, step data, length [m]) each.
+pub type Chain<Q, E> = Vec<(Q, usize, E, f64)>;
+
+/// A chain of steps all taken by pusher `p`.
+pub fn one_pusher<Q, E>(p: usize, steps: Vec<(Q, E, f64)>) -> Chain<Q, E> {
+    steps.into_iter().map(|(q, e, len)| (q, p, e, len)).collect()
+}
+
 /// What every space holds: the search settings, the object's characteristic length L [m]
 /// (radius of gyration), the unit step [m], the number of pushers and the goal.
 #[derive(Clone, Debug)]
@@ -214,9 +222,9 @@ pub trait Space<const K: usize>: Sync {
     fn interpolate(&self, a: &Self::Q, b: &Self::Q) -> (Self::Motion, f64);
     /// Whether pusher `p` can take `motion` from `a`; the step's data if so.
     fn take(&self, a: &Self::Q, motion: &Self::Motion, p: usize) -> Option<Self::Edge>;
-    /// A chain of steps from `q` (reached with `pusher`) to the goal, one pusher, if the space
-    /// can reach it directly: (pusher, [(pose, step data, length)]).
-    fn connect_goal(&self, q: &Self::Q, pusher: Option<usize>) -> Option<(usize, Vec<(Self::Q, Self::Edge, f64)>)>;
+    /// A chain of steps from `q` (reached with `pusher`) to the goal, if the space can reach it
+    /// directly.
+    fn connect_goal(&self, q: &Self::Q, pusher: Option<usize>) -> Option<Chain<Self::Q, Self::Edge>>;
     /// Whether choose-parent and rewiring apply (the space's propagation may rule them out).
     fn rewires(&self) -> bool {
         true
@@ -459,9 +467,9 @@ impl<'a, S: Space<K>, const K: usize> Search<'a, S, K> {
         if !self.space.search().connect || self.space.plain() {
             return None;
         }
-        let (p, chain) = self.space.connect_goal(&self.nodes[i].q, self.nodes[i].pusher)?;
+        let chain = self.space.connect_goal(&self.nodes[i].q, self.nodes[i].pusher)?;
         let mut last = i;
-        for (q, e, len) in chain {
+        for (q, p, e, len) in chain {
             let c = self.nodes[last].cost + self.edge_cost(self.nodes[last].pusher, p, len);
             last = self.add(q, last, p, c, e);
         }
