@@ -39,3 +39,16 @@ fn survey() {
     t.sort_by(f64::total_cmp);
     eprintln!("median {:.1} ms p90 {:.1} ms", 0.5 * (t[9] + t[10]), t[18]);
 }
+
+#[test]
+#[ignore]
+fn debug_connect() {
+    let s = hard("point-pushers.toml");
+    let goal = s.task.unwrap().goal;
+    let tol = s.task.unwrap().tolerance;
+    for a in [[0.0, 0.0, 0.0], [0.004, 0.003, 0.0], [0.008, 0.005, 0.01]] {
+        let t = std::time::Instant::now();
+        let r = point_step::connect(&s, &[0, 1, 2, 3], &a, &goal, &tol, 16, 0.01, |f| f.first_margin >= 0.01 && f.margin >= 0.005);
+        eprintln!("a {a:?}: {:?} {:.2} ms", r.map(|(ps, st)| (ps, st[1].2)), t.elapsed().as_secs_f64() * 1e3);
+    }
+}

@@ -19,7 +19,7 @@ pub fn contact_twist(r: &Vec2, u: &Vec2, length: f64, wrench: impl Fn(&Vec3) -> 
     contact_twist_near(r, u, length, wrench, None).map(|(v, _)| v)
 }
 
-/// [`contact_twist`] and its angle φ, the search started from a bracket of ±0.05 rad about
+/// [`contact_twist`] and its angle φ, the search started from a bracket of ±0.01 rad about
 /// `hint` when it holds the root (a warm start along a motion), else from (−π/2, π/2).
 pub fn contact_twist_near(r: &Vec2, u: &Vec2, length: f64, wrench: impl Fn(&Vec3) -> Vec3, hint: Option<f64>) -> Option<(Vec3, f64)> {
     let un = u.norm();
@@ -40,8 +40,8 @@ pub fn contact_twist_near(r: &Vec2, u: &Vec2, length: f64, wrench: impl Fn(&Vec3
         let scale = |phi: f64| wrench(&twist(phi)).norm();
         return [half, -half].into_iter().find(|&phi| h(phi).abs() < 1e-12 * (1.0 + scale(phi))).map(|phi| (twist(phi), phi));
     }
-    let near = hint.filter(|p| p.abs() < half - 0.05).and_then(|p| {
-        let (a, b) = (p - 0.05, p + 0.05);
+    let near = hint.filter(|p| p.abs() < half - 0.01).and_then(|p| {
+        let (a, b) = (p - 0.01, p + 0.01);
         let (ha, hb) = (h(a), h(b));
         (ha <= 0.0 && hb >= 0.0).then_some((a, b, ha, hb))
     });

@@ -222,16 +222,24 @@ impl<'a> PlanarSpace<'a> {
         // 2. projections on each cone; a point pusher's step with the desired contact velocity
         let wn = m.twist_norm(&want);
         let mut best: Option<(f64, usize, Vec3, bool)> = None;
-        for &p in &order {
-            let (v, done) = match point(p) {
-                Some(r) => match self.point_candidate(q, &frame, p, &r, &want) {
-                    Some(v) => (v, true),
-                    None => continue,
-                },
-                None => match project_with_margin(&frame, &self.scene.pushers[p].model, &want, self.s.margin) {
-                    Some(v) => (v, false),
-                    None => continue,
-                },
+        // point pushers: the best contact direction of each, steered in order of its angle
+        let mut points: Vec<(f64, usize, Vec2, Vec2)> = order
+            .iter()
+            .filter_map(|&p| {
+                let r = point(p)?;
+                let (cos, d) = self.point_direction(&frame, p, &r, &want)?;
+                let bonus = if Some(p) == parent_pusher && !self.s.plain { 0.05 } else { 0.0 };
+                Some((cos + bonus, p, r, d))
+            })
+            .collect();
+        points.sort_by(|a, b| b.0.total_cmp(&a.0));
+        if let Some(step) = points.iter().find_map(|(_, p, r, d)| self.point_step(q, &frame, *p, r, d, &want)) {
+            best = Some(step);
+        }
+        for &p in order.iter().filter(|&&p| point(p).is_none()) {
+            let (v, done) = match project_with_margin(&frame, &self.scene.pushers[p].model, &want, self.s.margin) {
+                Some(v) => (v, false),
+                None => continue,
             };
             let vn = m.twist_norm(&v);
             if vn < 1e-12 {
@@ -260,9 +268,8 @@ impl<'a> PlanarSpace<'a> {
 
     /// Point pusher `p` (contact `r`): of the contact-point velocity directions (32 around, and
     /// the one of `want`) whose twist at `q` has margin ≥ `margin`, the one whose twist is
-    /// closest in angle to `want`; then the pusher twist of [`point_step::steer`] for that
-    /// direction with about `want`'s length, halved until its flow is feasible.
-    fn point_candidate(&self, q: &[f64; 3], frame: &SupportFrame, p: usize, r: &Vec2, want: &Vec3) -> Option<Vec3> {
+    /// closest in angle to `want` (cosine > 0.2): (cosine, direction).
+    fn point_direction(&self, frame: &SupportFrame, p: usize, r: &Vec2, want: &Vec3) -> Option<(f64, Vec2)> {
         let m = self.scene.metric();
         let (mw, wn) = (m.twist(want), m.twist_norm(want));
         let own = Vec2::new(want.x, want.y) + crate::mechanics::geometry::perp(r) * want.z;
@@ -270,21 +277,29 @@ impl<'a> PlanarSpace<'a> {
             let a = k as f64 * std::f64::consts::PI / 16.0;
             Vec2::new(a.cos(), a.sin())
         });
-        let mut best: Option<(f64, Vec2, f64)> = None;
+        let mut best: Option<(f64, Vec2)> = None;
         for d in std::iter::once(own).chain(dirs) {
             let Some(v) = frame.point_twist(r, &d, self.scene.length) else { continue };
-            let vn = m.twist_norm(&v);
-            let cos = m.twist(&v).dot(&mw) / (vn * wn);
+            let cos = m.twist(&v).dot(&mw) / (m.twist_norm(&v) * wn);
             if cos > 0.2 && best.is_none_or(|b| cos > b.0) && frame.classify(&self.scene.pushers[p].model, &v).margin >= self.s.margin {
-                best = Some((cos, d, vn));
+                best = Some((cos, d));
             }
         }
-        let (_, d, vn) = best?;
-        let mut ub = d * (wn / vn); // the object moves about as far as `want`
+        best
+    }
+
+    /// The step of point pusher `p` along contact direction `d`: the pusher twist of
+    /// [`point_step::steer`] moving the object about as far as `want`, halved until its flow is
+    /// feasible; (cosine to `want`, pusher, twist, true) for [`Self::propagate_cones`].
+    fn point_step(&self, q: &[f64; 3], frame: &SupportFrame, p: usize, r: &Vec2, d: &Vec2, want: &Vec3) -> Option<(f64, usize, Vec3, bool)> {
+        let m = self.scene.metric();
+        let v = frame.point_twist(r, d, self.scene.length)?;
+        let mut ub = d * (m.twist_norm(want) / m.twist_norm(&v));
         for _ in 0..4 {
             if let Some((xi, fl)) = point_step::steer(self.scene, p, q, &ub, self.s.search.checks) {
                 if self.flow_feasible(&fl) {
-                    return Some(xi);
+                    let cos = m.twist(&xi).dot(&m.twist(want)) / (m.twist_norm(&xi) * m.twist_norm(want));
+                    return (cos > 0.2).then_some((cos, p, xi, true));
                 }
             }
             ub *= 0.5;
@@ -368,7 +383,13 @@ impl Space<3> for PlanarSpace<'_> {
         let tw = body_twist(a, b);
         (tw, self.scene.metric().twist_norm(&tw))
     }
+    /// RRT*'s steps between tree nodes. Not for a point pusher: the poses one of its steps
+    /// reaches from `a` form a surface (the rotation follows the contact velocity), which
+    /// another node lies on with probability zero, so its flow is not tried.
     fn take(&self, a: &[f64; 3], tw: &Vec3, p: usize) -> Option<()> {
+        if point_step::contact_point(self.scene, p).is_some() {
+            return None;
+        }
         self.step_feasible(a, tw, p).then_some(())
     }
     /// Straight push to the goal: unit steps of one constant body twist, all feasible for one
