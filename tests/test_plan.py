@@ -10,7 +10,7 @@ import pytest
 import regrasp
 from regrasp.sim.quasistatic import replay_plan
 
-from .conftest import EXAMPLES
+from .conftest import EXAMPLES, ROOT
 
 PLANNED = ["block-low-friction", "block-high-friction", "block-xztheta", "t-shape", "block-tilted-gripper"]
 
@@ -97,3 +97,38 @@ def test_bad_requests():
         regrasp.plan(sc, propagation="teleport")
     p = regrasp.plan(sc, time_limit=0.0, connect=False)
     assert not p.found and p.stop_reason == "time_limit" and len(p.path) == 1
+
+
+def test_point_pushers_only_plans_replay_in_the_simulator():
+    """Issue 18, item 1: a scene whose pushers are all points is planned (steps in contact-point
+    velocity, each the object's flow under the pusher's motion); every plan passes the exact test
+    along its flows, and the quasi-static simulator (an independent solver, same ellipsoidal pad
+    model) driving the pushers as planned ends within the task's tolerance."""
+    sc = regrasp.Scene.load(ROOT / "benches" / "scenes" / "point-pushers.toml")
+    t = sc.task
+    for seed in range(3):
+        p = regrasp.plan(sc, seed=seed, time_limit=10.0)
+        assert p.found and p.valid, (seed, p.stop_reason)
+        assert np.all(np.abs(p.poses[-1] - t.goal) <= t.tolerance)
+        r = replay_plan(sc, p, support="limit_surface")
+        assert r.success, (seed, r.goal_error)
+        assert r.max_pusher_slip < 1e-9
+
+
+def test_a_point_pushers_step_that_does_not_land_is_invalid():
+    """A point pusher imposes only its contact point's velocity: a step whose rotation is not the
+    one its mechanics give (here, the pure translation of a planned step kept, its rotation
+    doubled) lands elsewhere and fails the check with a negative margin."""
+    sc = regrasp.Scene.load(ROOT / "benches" / "scenes" / "point-pushers.toml")
+    p = regrasp.plan(sc, seed=0, time_limit=10.0)
+    assert p.found and p.valid
+    d = p.to_json()
+    k = next(i for i in range(1, len(p.poses)) if abs(p.poses[i][2] - p.poses[i - 1][2]) > 1e-3)
+    a, b = p.poses[k - 1], np.array(p.poses[k], float)
+    b[2] = a[2] + 2.0 * (b[2] - a[2])
+    d["path"][k]["pose"] = b.tolist()
+    d.pop("step_margins", None)
+    bad = regrasp.Plan.from_json(d, sc)
+    bad.check(sc)
+    assert not bad.valid and bad.step_margins[k - 1] < 0
+    assert all(m >= 0 for i, m in enumerate(bad.step_margins) if i not in (k - 1, k))
