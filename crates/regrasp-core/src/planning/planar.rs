@@ -307,10 +307,21 @@ impl<'a> PlanarSpace<'a> {
         None
     }
 
-    /// Two steps of point pushers from `q` into the goal's tolerance ([`point_step::connect`]).
+    /// Two steps of point pushers from `q` into the goal's tolerance ([`point_step::connect`]),
+    /// each feasible; a step longer than the unit step is checked again with `checks` poses per
+    /// unit step (as dense as a unit step's).
     fn connect_points(&self, q: &[f64; 3], order: &[usize]) -> Option<Chain<[f64; 3], ()>> {
         let m = self.scene.metric();
-        let accept = |fl: &point_step::Flow| self.flow_feasible(fl);
+        let accept = |fl: &point_step::Flow| {
+            let (a, b) = (fl.poses[0], fl.end());
+            let units = (self.dist(&a, &b) / self.core.step).ceil();
+            if !self.flow_feasible(fl) || units > 20.0 {
+                return false;
+            }
+            units <= 1.0
+                || point_step::check(self.scene, fl.pusher, &a, &b, self.s.search.checks * units as usize)
+                    .is_some_and(|(dense, miss)| miss <= point_step::LANDING_TOL && self.flow_feasible(&dense))
+        };
         let (ps, st) = point_step::connect(self.scene, order, q, &self.core.goal, &self.tol, self.s.search.checks, self.s.margin, accept)?;
         Some(vec![(st[0].2, ps[0], (), m.twist_norm(&st[0].0)), (st[1].2, ps[1], (), m.twist_norm(&st[1].0))])
     }

@@ -30,6 +30,7 @@ const SETTLE_TOL: f64 = 1e-11;
 /// The object's motion over a point pusher's step.
 #[derive(Clone, Debug)]
 pub struct Flow {
+    pub pusher: usize,
     /// Poses at the `n + 1` integration nodes (the start first).
     pub poses: Vec<[f64; 3]>,
     /// Smallest margin of the exact test at the integration nodes before the end (the first
@@ -106,7 +107,7 @@ pub fn flow(scene: &Scene, p: usize, a: &[f64; 3], xi: &Vec3, n: usize) -> Optio
         q = [0, 1, 2].map(|i| q[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
         poses.push(q);
     }
-    (scene.admissible(&q) && scene.frame(&q).hold_ratio < 1.0).then_some(Flow { poses, first_margin, margin })
+    (scene.admissible(&q) && scene.frame(&q).hold_ratio < 1.0).then_some(Flow { pusher: p, poses, first_margin, margin })
 }
 
 /// The step of point pusher `p` from `a` whose contact point moves with `u_b` (pusher frame,
