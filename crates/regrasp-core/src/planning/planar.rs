@@ -222,7 +222,7 @@ impl<'a> PlanarSpace<'a> {
         // 2. projections on each cone; a point pusher's step with the desired contact velocity
         let wn = m.twist_norm(&want);
         let mut best: Option<(f64, usize, Vec3, bool)> = None;
-        // point pushers: the best contact direction of each, steered in order of its angle
+        // point pushers: the best contact direction of each; the two best steered, in order
         let mut points: Vec<(f64, usize, Vec2, Vec2)> = order
             .iter()
             .filter_map(|&p| {
@@ -233,7 +233,7 @@ impl<'a> PlanarSpace<'a> {
             })
             .collect();
         points.sort_by(|a, b| b.0.total_cmp(&a.0));
-        if let Some(step) = points.iter().find_map(|(_, p, r, d)| self.point_step(q, &frame, *p, r, d, &want)) {
+        if let Some(step) = points.iter().take(2).find_map(|(_, p, r, d)| self.point_step(q, &frame, *p, r, d, &want)) {
             best = Some(step);
         }
         for &p in order.iter().filter(|&&p| point(p).is_none()) {
@@ -266,26 +266,45 @@ impl<'a> PlanarSpace<'a> {
         None
     }
 
-    /// Point pusher `p` (contact `r`): of the contact-point velocity directions (32 around, and
-    /// the one of `want`) whose twist at `q` has margin ≥ `margin`, the one whose twist is
-    /// closest in angle to `want` (cosine > 0.2): (cosine, direction).
+    /// Point pusher `p` (contact `r`): of the contact-point velocity directions (16 around, the
+    /// one of `want`, and the two halfway beside the best) whose twist at `q` has margin ≥
+    /// `margin`, the one whose twist is closest in angle to `want` (cosine > 0.2): (cosine,
+    /// direction). Each root search is warm-started at its neighbour's.
     fn point_direction(&self, frame: &SupportFrame, p: usize, r: &Vec2, want: &Vec3) -> Option<(f64, Vec2)> {
         let m = self.scene.metric();
         let (mw, wn) = (m.twist(want), m.twist_norm(want));
-        let own = Vec2::new(want.x, want.y) + crate::mechanics::geometry::perp(r) * want.z;
-        let dirs = (0..32).map(|k| {
-            let a = k as f64 * std::f64::consts::PI / 16.0;
-            Vec2::new(a.cos(), a.sin())
-        });
-        let mut best: Option<(f64, Vec2)> = None;
-        for d in std::iter::once(own).chain(dirs) {
-            let Some(v) = frame.point_twist(r, &d, self.scene.length) else { continue };
+        let model = &self.scene.pushers[p].model;
+        let mut hint = None;
+        let mut score = |d: &Vec2| -> Option<f64> {
+            let (v, phi) = frame.point_twist_near(r, d, self.scene.length, hint)?;
+            hint = Some(phi);
             let cos = m.twist(&v).dot(&mw) / (m.twist_norm(&v) * wn);
-            if cos > 0.2 && best.is_none_or(|b| cos > b.0) && frame.classify(&self.scene.pushers[p].model, &v).margin >= self.s.margin {
-                best = Some((cos, d));
+            (cos > 0.2 && frame.classify(model, &v).margin >= self.s.margin).then_some(cos)
+        };
+        let at = |a: f64| Vec2::new(a.cos(), a.sin());
+        let step = std::f64::consts::PI / 8.0;
+        let mut best: Option<(f64, f64)> = None; // (cosine, angle)
+        for k in 0..16 {
+            let a = k as f64 * step;
+            if let Some(c) = score(&at(a)) {
+                if best.is_none_or(|b| c > b.0) {
+                    best = Some((c, a));
+                }
             }
         }
-        best
+        let own = Vec2::new(want.x, want.y) + crate::mechanics::geometry::perp(r) * want.z;
+        let mut candidates = vec![own.y.atan2(own.x)];
+        if let Some((_, a)) = best {
+            candidates.extend([a - 0.5 * step, a + 0.5 * step]);
+        }
+        for a in candidates {
+            if let Some(c) = score(&at(a)) {
+                if best.is_none_or(|b| c > b.0) {
+                    best = Some((c, a));
+                }
+            }
+        }
+        best.map(|(c, a)| (c, at(a)))
     }
 
     /// The step of point pusher `p` along contact direction `d`: the pusher twist of
@@ -404,8 +423,8 @@ impl Space<3> for PlanarSpace<'_> {
         self.step_feasible(a, tw, p).then_some(())
     }
     /// Straight push to the goal: unit steps of one constant body twist, all feasible for one
-    /// pusher (the node's first), at most 200 of them; else, within two unit steps of the goal,
-    /// two steps of point pushers ([`point_step::connect`]).
+    /// pusher (the node's first), at most 200 of them; else, within three unit steps of the
+    /// goal, two steps of point pushers ([`point_step::connect`]).
     fn connect_goal(&self, q: &[f64; 3], pusher: Option<usize>) -> Option<Chain<[f64; 3], ()>> {
         let xi = body_twist(q, &self.core.goal);
         let len = self.scene.metric().twist_norm(&xi);
@@ -423,10 +442,12 @@ impl Space<3> for PlanarSpace<'_> {
         }).collect();
         let starts = std::iter::once(*q).chain(poses.iter().copied().take(n - 1)).collect::<Vec<_>>();
         let order = pusher_order(self.scene.pushers.len(), pusher);
-        if let Some(p) = order.iter().copied().find(|&p| starts.iter().all(|qk| self.feasible(qk, &tw, p))) {
+        // a point pusher's step lands on a surface of poses: the straight push is not its
+        let line = |p: usize| point_step::contact_point(self.scene, p).is_none();
+        if let Some(p) = order.iter().copied().filter(|&p| line(p)).find(|&p| starts.iter().all(|qk| self.feasible(qk, &tw, p))) {
             return Some(trrt::one_pusher(p, poses.into_iter().map(|qk| (qk, (), len / n as f64)).collect()));
         }
-        if n > 2 || self.s.propagation != Propagation::MotionCone {
+        if n > 3 || self.s.propagation != Propagation::MotionCone {
             return None;
         }
         self.connect_points(q, &order)

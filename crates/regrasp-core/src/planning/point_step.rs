@@ -113,7 +113,7 @@ pub fn flow(scene: &Scene, p: usize, a: &[f64; 3], xi: &Vec3, n: usize) -> Optio
 /// The step of point pusher `p` from `a` whose contact point moves with `u_b` (pusher frame,
 /// m per unit time): the pusher twist `ξ = (u_b − ξ_ω r⊥, ξ_ω)` whose flow lands on `a·exp(ξ)`,
 /// i.e. the root of `g(ξ_ω) = θ_end(ξ_ω) − θ_a − ξ_ω` by secant steps from the start's rotation
-/// rate (at most 12 flows), and its flow. `None` when a flow fails or the rotation does not
+/// rate, on a flow of a quarter of the `n` steps first (at most 16 flows), and its flow. `None` when a flow fails or the rotation does not
 /// settle within [`SETTLE_TOL`] or the flow does not land within [`LANDING_TOL`].
 pub fn steer(scene: &Scene, p: usize, a: &[f64; 3], ub: &Vec2, n: usize) -> Option<(Vec3, Flow)> {
     let r = contact_point(scene, p)?;
@@ -122,12 +122,19 @@ pub fn steer(scene: &Scene, p: usize, a: &[f64; 3], ub: &Vec2, n: usize) -> Opti
         Vec3::new(lin.x, lin.y, w)
     };
     let mut w = scene.frame(a).point_twist(&r, ub, scene.length)?.z;
+    // secant steps on a coarse flow (a quarter of the steps) first, then on the flow itself
+    let coarse = (n / 4).max(2);
     let mut prev: Option<(f64, f64)> = None;
-    for _ in 0..12 {
-        let fl = flow(scene, p, a, &xi(w), n)?;
+    let mut fine = coarse >= n;
+    for _ in 0..16 {
+        let fl = flow(scene, p, a, &xi(w), if fine { n } else { coarse })?;
         let end = fl.end();
         let g = end[2] - a[2] - w;
-        if g.abs() <= SETTLE_TOL {
+        if g.abs() <= if fine { SETTLE_TOL } else { 1e-3 * LANDING_TOL.max(SETTLE_TOL) } {
+            if !fine {
+                (fine, prev) = (true, None);
+                continue;
+            }
             // the rotation settled; the contact point lands by construction, to the integration's error
             let lands = distance(scene.length, &end, &integrate(a, &xi(w), 1.0)) <= 0.5 * LANDING_TOL * scene.length;
             return lands.then(|| (xi(w), fl));
@@ -221,7 +228,7 @@ pub fn connect(
 }
 
 /// How many linearized guesses [`connect`] refines.
-pub const GUESSES: usize = 6;
+pub const GUESSES: usize = 4;
 
 /// Gauss–Newton on the four contact-velocity components `x` of two steps (weighted
 /// minimum-norm steps that prefer changing speeds to turning, forward-difference Jacobian, halved until the miss shrinks; at most 8 rounds) until the end
