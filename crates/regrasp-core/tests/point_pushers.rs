@@ -66,6 +66,7 @@ fn survey() {
         let r = plan(&s, None, None, &settings).unwrap();
         t.push(r.planning_time_s * 1e3);
         found += r.found as usize;
+        eprintln!("seed {seed}: {:.1} ms, {} nodes, {} iterations, {} steps", r.planning_time_s * 1e3, r.nodes, r.iterations, r.path.len() - 1);
     }
     t.sort_by(f64::total_cmp);
     eprintln!("found {found} median {:.1} ms p90 {:.1} ms", 0.5 * (t[9] + t[10]), t[18]);

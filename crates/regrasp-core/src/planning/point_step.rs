@@ -113,8 +113,9 @@ pub fn flow(scene: &Scene, p: usize, a: &[f64; 3], xi: &Vec3, n: usize) -> Optio
 /// The step of point pusher `p` from `a` whose contact point moves with `u_b` (pusher frame,
 /// m per unit time): the pusher twist `ξ = (u_b − ξ_ω r⊥, ξ_ω)` whose flow lands on `a·exp(ξ)`,
 /// i.e. the root of `g(ξ_ω) = θ_end(ξ_ω) − θ_a − ξ_ω` by secant steps from the start's rotation
-/// rate, on a flow of a quarter of the `n` steps first (at most 16 flows), and its flow. `None` when a flow fails or the rotation does not
-/// settle within [`SETTLE_TOL`] or the flow does not land within [`LANDING_TOL`].
+/// rate, on a flow of a quarter of the `n` steps first (at most 16 flows), and its flow. `None`
+/// when a flow fails, the rotation does not settle within [`SETTLE_TOL`] or the flow does not
+/// land within [`LANDING_TOL`].
 pub fn steer(scene: &Scene, p: usize, a: &[f64; 3], ub: &Vec2, n: usize) -> Option<(Vec3, Flow)> {
     let r = contact_point(scene, p)?;
     let xi = |w: f64| {
@@ -231,26 +232,33 @@ pub fn connect(
 pub const GUESSES: usize = 4;
 
 /// Gauss–Newton on the four contact-velocity components `x` of two steps (weighted
-/// minimum-norm steps that prefer changing speeds to turning, forward-difference Jacobian, halved until the miss shrinks; at most 8 rounds) until the end
-/// lies within half of `tol` of `goal`.
+/// minimum-norm steps that prefer changing speeds to turning; a forward-difference Jacobian,
+/// then Broyden's updates, fresh again when a step fails; halved until the miss shrinks; at most
+/// 10 rounds) until the end lies within half of `tol` of `goal`.
 fn refine(scene: &Scene, ps: [usize; 2], a: &[f64; 3], goal: &[f64; 3], tol: &[f64; 3], n: usize, mut x: [f64; 4]) -> Option<[(Vec3, Flow, [f64; 3]); 2]> {
     let l = scene.length;
     let miss = |end: &[f64; 3]| Vec3::new(end[0] - goal[0], end[1] - goal[1], l * (end[2] - goal[2]));
     let inside = |end: &[f64; 3]| (0..3).all(|k| (end[k] - goal[k]).abs() <= 0.5 * tol[k]);
     let mut steps = two_steps(scene, ps, a, &x, n)?;
     let mut e = miss(&steps[1].2);
-    for _ in 0..8 {
+    let mut jac: Option<nalgebra::Matrix3x4<f64>> = None;
+    for _ in 0..10 {
         if inside(&steps[1].2) {
             return Some(steps);
         }
-        let h = 1e-5 * x.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-6);
-        let mut jac = nalgebra::Matrix3x4::zeros();
-        for j in 0..4 {
-            let mut xj = x;
-            xj[j] += h;
-            let ej = miss(&two_steps(scene, ps, a, &xj, n)?[1].2);
-            jac.set_column(j, &((ej - e) / h));
-        }
+        let j = match jac {
+            Some(j) => j,
+            None => {
+                let h = 1e-5 * x.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-6);
+                let mut j = nalgebra::Matrix3x4::zeros();
+                for c in 0..4 {
+                    let mut xc = x;
+                    xc[c] += h;
+                    j.set_column(c, &((miss(&two_steps(scene, ps, a, &xc, n)?[1].2) - e) / h));
+                }
+                j
+            }
+        };
         // weighted minimum-norm step: a contact velocity turns (which may lose the margin the
         // guess had) 10x less readily than it changes speed
         let mut w = nalgebra::Matrix4::zeros();
@@ -260,14 +268,17 @@ fn refine(scene: &Scene, ps: [usize; 2], a: &[f64; 3], goal: &[f64; 3], tol: &[f
             let blk = d * d.transpose() + (nalgebra::Matrix2::identity() - d * d.transpose()) * 0.01;
             w.fixed_view_mut::<2, 2>(2 * i, 2 * i).copy_from(&blk);
         }
-        let dx = w * jac.transpose() * (jac * w * jac.transpose()).try_inverse()? * (-e);
+        let dx = w * j.transpose() * (j * w * j.transpose()).try_inverse()? * (-e);
         let mut alpha = 1.0;
         let mut improved = false;
         for _ in 0..4 {
-            let xt = [0, 1, 2, 3].map(|j| x[j] + alpha * dx[j]);
+            let xt = [0, 1, 2, 3].map(|k| x[k] + alpha * dx[k]);
             if let Some(st) = two_steps(scene, ps, a, &xt, n) {
                 let et = miss(&st[1].2);
                 if et.norm() < e.norm() {
+                    // Broyden's update of the Jacobian along the step taken
+                    let s = nalgebra::Vector4::from(xt) - nalgebra::Vector4::from(x);
+                    jac = Some(j + (et - e - j * s) * s.transpose() / s.norm_squared());
                     (x, steps, e, improved) = (xt, st, et, true);
                     break;
                 }
@@ -275,7 +286,10 @@ fn refine(scene: &Scene, ps: [usize; 2], a: &[f64; 3], goal: &[f64; 3], tol: &[f
             alpha *= 0.5;
         }
         if !improved {
-            return None;
+            if jac.is_none() {
+                return None;
+            }
+            jac = None; // a fresh finite-difference Jacobian before giving up
         }
     }
     inside(&steps[1].2).then_some(steps)
