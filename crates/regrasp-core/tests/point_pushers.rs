@@ -55,19 +55,3 @@ fn steered_steps_land_and_the_contact_sticks() {
     assert!(steered >= 16, "only {steered} of 64 contact directions steered");
 }
 
-#[test]
-#[ignore]
-fn survey() {
-    let s = hard("point-pushers.toml");
-    let mut t = vec![];
-    let mut found = 0;
-    for seed in 0..20 {
-        let settings = PlanarSettings { search: SearchSettings { seed, time_limit: 10.0, ..SearchSettings::default() }, ..PlanarSettings::default() };
-        let r = plan(&s, None, None, &settings).unwrap();
-        t.push(r.planning_time_s * 1e3);
-        found += r.found as usize;
-        eprintln!("seed {seed}: {:.1} ms, {} nodes, {} iterations, {} steps", r.planning_time_s * 1e3, r.nodes, r.iterations, r.path.len() - 1);
-    }
-    t.sort_by(f64::total_cmp);
-    eprintln!("found {found} median {:.1} ms p90 {:.1} ms", 0.5 * (t[9] + t[10]), t[18]);
-}

@@ -176,11 +176,11 @@ fn two_steps(scene: &Scene, ps: [usize; 2], a: &[f64; 3], x: &[f64; 4], n: usize
 /// A local planner for point pushers (issue 18, item 2): two steps of point pushers from `a`
 /// to within `tol` (per component, m, m, rad) of `goal`. One step of a point pusher reaches
 /// only a surface of poses (the rotation follows the contact velocity); two reach a
-/// neighbourhood. Guesses from the linearized motion (the start's twists of each point
-/// pusher's sticking contact directions, margin ≥ `margin`, on 32 directions; the pair of
-/// directions and non-negative speeds whose twists sum closest to the straight motion), the
-/// best [`GUESSES`] refined by [`refine`]; `accept` decides each flow. Returns the pushers and
-/// both steps (pusher twist, flow, pose reached).
+/// neighbourhood. Guesses from the linearized motion: the start's twists of each point
+/// pusher's contact directions (32 around) with margin ≥ [`GUESS_MARGIN`] × `margin`, and the
+/// pairs of them with non-negative speeds whose twists sum closest to the straight motion. The
+/// best [`GUESSES`] are refined by [`refine`]; `accept` decides each flow. Returns the pushers
+/// and both steps (pusher twist, flow, pose reached).
 pub fn connect(
     scene: &Scene,
     pushers: &[usize],
@@ -201,7 +201,7 @@ pub fn connect(
         for k in 0..32 {
             let d = Vec2::new((k as f64 * PI / 16.0).cos(), (k as f64 * PI / 16.0).sin());
             if let Some(v) = f.point_twist(&r, &d, scene.length) {
-                if f.classify(&scene.pushers[p].model, &v).margin >= margin {
+                if f.classify(&scene.pushers[p].model, &v).margin >= GUESS_MARGIN * margin {
                     dirs.push((p, d, m.twist(&v)));
                 }
             }
@@ -230,6 +230,11 @@ pub fn connect(
 
 /// How many linearized guesses [`connect`] refines.
 pub const GUESSES: usize = 4;
+
+/// A guess's contact directions lie this many times `margin` inside the pusher's cone at the
+/// start: the refinement and the flow erode the margin (on the point-pusher bench scene, 60
+/// seeds: 3x, 6x and 10x gave p90s of 110, 78 and 105 ms).
+pub const GUESS_MARGIN: f64 = 6.0;
 
 /// Gauss–Newton on the four contact-velocity components `x` of two steps (weighted
 /// minimum-norm steps that prefer changing speeds to turning; a forward-difference Jacobian,
@@ -260,12 +265,12 @@ fn refine(scene: &Scene, ps: [usize; 2], a: &[f64; 3], goal: &[f64; 3], tol: &[f
             }
         };
         // weighted minimum-norm step: a contact velocity turns (which may lose the margin the
-        // guess had) 10x less readily than it changes speed
+        // guess had) ~30x less readily than it changes speed (weight 1e-3 on the squared turn)
         let mut w = nalgebra::Matrix4::zeros();
         for i in 0..2 {
             let u = Vec2::new(x[2 * i], x[2 * i + 1]);
             let d = if u.norm() > 0.0 { u / u.norm() } else { Vec2::x() };
-            let blk = d * d.transpose() + (nalgebra::Matrix2::identity() - d * d.transpose()) * 0.01;
+            let blk = d * d.transpose() + (nalgebra::Matrix2::identity() - d * d.transpose()) * 1e-3;
             w.fixed_view_mut::<2, 2>(2 * i, 2 * i).copy_from(&blk);
         }
         let dx = w * j.transpose() * (j * w * j.transpose()).try_inverse()? * (-e);
@@ -294,3 +299,4 @@ fn refine(scene: &Scene, ps: [usize; 2], a: &[f64; 3], goal: &[f64; 3], tol: &[f
     }
     inside(&steps[1].2).then_some(steps)
 }
+
