@@ -24,7 +24,7 @@ fn point_pushers_only_scene_is_planned_and_every_step_lands() {
 }
 
 /// A step of a point pusher lands where its flow ends: the flow integrated with 16 and with 256
-/// RK4 steps ends within the landing tolerance, and the steered pusher twist's flow lands on
+/// RK4 steps (per tenth of L) ends within the landing tolerance, and the steered pusher twist's flow lands on
 /// `a·exp(ξ)`; the object's contact point stays on the pusher's all along (sticking).
 #[test]
 fn steered_steps_land_and_the_contact_sticks() {
@@ -45,8 +45,9 @@ fn steered_steps_land_and_the_contact_sticks() {
             let fine = point_step::flow(&s, p, &a, &xi, 256).unwrap();
             assert!(distance(s.length, &fine.end(), &b) <= point_step::LANDING_TOL * s.length, "pusher {p} direction {k}");
             // the contact point in the grasp frame: the object's and the pusher's (constant twist)
+            let m = (fine.poses.len() - 1) as f64;
             for (i, q) in fine.poses.iter().enumerate() {
-                let pusher = integrate(&a, &xi, i as f64 / 256.0);
+                let pusher = integrate(&a, &xi, i as f64 / m);
                 let (po, pp) = (rot(q[2]) * r + Vec2::new(q[0], q[1]), rot(pusher[2]) * r + Vec2::new(pusher[0], pusher[1]));
                 assert!((po - pp).norm() < 1e-9, "pusher {p} direction {k}: the contact slides {:.2e} m", (po - pp).norm());
             }
@@ -54,4 +55,5 @@ fn steered_steps_land_and_the_contact_sticks() {
     }
     assert!(steered >= 16, "only {steered} of 64 contact directions steered");
 }
+
 

@@ -327,20 +327,10 @@ impl<'a> PlanarSpace<'a> {
     }
 
     /// Two steps of point pushers from `q` into the goal's tolerance ([`point_step::connect`]),
-    /// each feasible; a step longer than the unit step is checked again with `checks` poses per
-    /// unit step (as dense as a unit step's).
+    /// each feasible and at most 20 unit steps long.
     fn connect_points(&self, q: &[f64; 3], order: &[usize]) -> Option<Chain<[f64; 3], ()>> {
         let m = self.scene.metric();
-        let accept = |fl: &point_step::Flow| {
-            let (a, b) = (fl.poses[0], fl.end());
-            let units = (self.dist(&a, &b) / self.core.step).ceil();
-            if !self.flow_feasible(fl) || units > 20.0 {
-                return false;
-            }
-            units <= 1.0
-                || point_step::check(self.scene, fl.pusher, &a, &b, self.s.search.checks * units as usize)
-                    .is_some_and(|(dense, miss)| miss <= point_step::LANDING_TOL && self.flow_feasible(&dense))
-        };
+        let accept = |fl: &point_step::Flow| self.flow_feasible(fl) && self.dist(&fl.poses[0], &fl.end()) <= 20.0 * self.core.step;
         let (ps, st) = point_step::connect(self.scene, order, q, &self.core.goal, &self.tol, self.s.search.checks, self.s.margin, accept)?;
         Some(vec![(st[0].2, ps[0], (), m.twist_norm(&st[0].0)), (st[1].2, ps[1], (), m.twist_norm(&st[1].0))])
     }
@@ -548,7 +538,8 @@ pub fn stable_push_lp(scene: &Scene, q: &[f64; 3], pusher: usize, tw: &Vec3) -> 
 /// Checks a path with the exact motion-cone test at `checks` poses along each step; returns
 /// the smallest margin of each step (negative: the pusher would slip somewhere along it; −1:
 /// the finger pad leaves the object or the grasp cannot hold it somewhere along the step). A
-/// point pusher's step is its flow ([`point_step`], `checks` RK4 steps): the margins along it,
+/// point pusher's step is its flow ([`point_step`], `checks` RK4 steps per tenth of L of the
+/// step's length, as a unit step of the planner has at its defaults): the margins along it,
 /// and minus the miss (over L) when it lands farther than [`point_step::LANDING_TOL`] from the
 /// step's end. An error names a step whose pusher is missing or unknown.
 pub fn validate_path(scene: &Scene, path: &[([f64; 3], Option<usize>)], checks: usize) -> Result<Vec<f64>> {

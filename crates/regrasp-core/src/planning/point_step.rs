@@ -80,12 +80,14 @@ fn axpy(q: &[f64; 3], h: f64, d: &[f64; 3]) -> [f64; 3] {
 }
 
 /// The object's flow over a step from `a` with pusher twist `xi` by pusher `p` (a point
-/// pusher), `n` RK4 steps. `None` when the pusher is not a point, the pad leaves the object or
+/// pusher), `n` RK4 steps per tenth of L of the pusher's motion (metric length of `xi`). `None` when the pusher is not a point, the pad leaves the object or
 /// the grasp cannot hold somewhere, or no rotation rate balances the moment.
 pub fn flow(scene: &Scene, p: usize, a: &[f64; 3], xi: &Vec3, n: usize) -> Option<Flow> {
     let r = contact_point(scene, p)?;
     let model = &scene.pushers[p].model;
-    let n = n.max(1);
+    // `n` steps per tenth of L of the pusher's motion (a unit step's at the planner's defaults)
+    let tenths = (scene.metric().twist_norm(xi) / (0.1 * scene.length)).ceil().clamp(1.0, 1000.0);
+    let n = n.max(1) * tenths as usize;
     let h = 1.0 / n as f64;
     let mut poses = Vec::with_capacity(n + 1);
     poses.push(*a);
@@ -179,7 +181,8 @@ fn two_steps(scene: &Scene, ps: [usize; 2], a: &[f64; 3], x: &[f64; 4], n: usize
 /// neighbourhood. Guesses from the linearized motion: the start's twists of each point
 /// pusher's contact directions (32 around) with margin ≥ [`GUESS_MARGIN`] × `margin`, and the
 /// pairs of them with non-negative speeds whose twists sum closest to the straight motion. The
-/// best [`GUESSES`] are refined by [`refine`]; `accept` decides each flow. Returns the pushers
+/// best [`GUESSES`] are refined by [`refine`] on flows of a sixteenth of the `n` steps, then the
+/// steps taken with `n` must end within `tol`; `accept` decides each flow. Returns the pushers
 /// and both steps (pusher twist, flow, pose reached).
 pub fn connect(
     scene: &Scene,
@@ -223,8 +226,12 @@ pub fn connect(
     }
     guesses.sort_by(|x, y| x.0.total_cmp(&y.0));
     guesses.into_iter().take(GUESSES).find_map(|(_, ps, x)| {
-        let st = refine(scene, ps, a, goal, tol, n, x)?;
-        (accept(&st[0].1) && accept(&st[1].1)).then_some((ps, st))
+        // refined on flows of a sixteenth of the steps (one per tenth of L at the defaults), then
+        // the steps themselves taken
+        let x = refine(scene, ps, a, goal, tol, (n / 16).max(1), x)?;
+        let st = two_steps(scene, ps, a, &x, n)?;
+        let inside = (0..3).all(|k| (st[1].2[k] - goal[k]).abs() <= tol[k]);
+        (inside && accept(&st[0].1) && accept(&st[1].1)).then_some((ps, st))
     })
 }
 
@@ -239,8 +246,8 @@ pub const GUESS_MARGIN: f64 = 6.0;
 /// Gauss–Newton on the four contact-velocity components `x` of two steps (weighted
 /// minimum-norm steps that prefer changing speeds to turning; a forward-difference Jacobian,
 /// then Broyden's updates, fresh again when a step fails; halved until the miss shrinks; at most
-/// 10 rounds) until the end lies within half of `tol` of `goal`.
-fn refine(scene: &Scene, ps: [usize; 2], a: &[f64; 3], goal: &[f64; 3], tol: &[f64; 3], n: usize, mut x: [f64; 4]) -> Option<[(Vec3, Flow, [f64; 3]); 2]> {
+/// 10 rounds) until the end lies within half of `tol` of `goal`; the contact velocities.
+fn refine(scene: &Scene, ps: [usize; 2], a: &[f64; 3], goal: &[f64; 3], tol: &[f64; 3], n: usize, mut x: [f64; 4]) -> Option<[f64; 4]> {
     let l = scene.length;
     let miss = |end: &[f64; 3]| Vec3::new(end[0] - goal[0], end[1] - goal[1], l * (end[2] - goal[2]));
     let inside = |end: &[f64; 3]| (0..3).all(|k| (end[k] - goal[k]).abs() <= 0.5 * tol[k]);
@@ -249,7 +256,7 @@ fn refine(scene: &Scene, ps: [usize; 2], a: &[f64; 3], goal: &[f64; 3], tol: &[f
     let mut jac: Option<nalgebra::Matrix3x4<f64>> = None;
     for _ in 0..10 {
         if inside(&steps[1].2) {
-            return Some(steps);
+            return Some(x);
         }
         let j = match jac {
             Some(j) => j,
@@ -297,6 +304,6 @@ fn refine(scene: &Scene, ps: [usize; 2], a: &[f64; 3], goal: &[f64; 3], tol: &[f
             jac = None; // a fresh finite-difference Jacobian before giving up
         }
     }
-    inside(&steps[1].2).then_some(steps)
+    inside(&steps[1].2).then_some(x)
 }
 
