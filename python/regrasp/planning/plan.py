@@ -289,7 +289,8 @@ class Plan:
 
     def check(self, scene) -> bool:
         """Re-validates every step on ``scene`` and sets ``valid`` (planar: also ``step_margins``,
-        the exact motion-cone test at 64 poses along each step; 3-D: ``Scene3D.validate_path``)."""
+        the exact motion-cone test at 64 poses along each step, a point pusher's along its flow; 3-D:
+        ``Scene3D.validate_path``)."""
         self.check_for(scene)
         if self.dimension == 2:
             self.step_margins = [float(m) for m in validate(scene, self)] if len(self.poses) > 1 else []
