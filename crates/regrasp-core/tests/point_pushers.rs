@@ -57,3 +57,31 @@ fn steered_steps_land_and_the_contact_sticks() {
 }
 
 
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 200, ..Default::default() })]
+    /// `SupportFrame::point_twist`: the object's contact point moves with the velocity asked for,
+    /// and the pusher wrench the twist needs passes through the contact (no moment about it), at
+    /// random admissible poses and contact velocities.
+    #[test]
+    fn point_twist_moves_the_contact_as_asked_and_needs_no_moment(
+        x in -0.01f64..0.01, z in -0.02f64..0.02, th in -0.5f64..0.5, p in 0usize..4, ang in 0.0f64..6.283, speed in 1e-4f64..0.05,
+    ) {
+        use regrasp::mechanics::geometry::{cross2, perp, Vec2};
+        let s = hard("point-pushers.toml");
+        let q = [x, z, th];
+        proptest::prop_assume!(s.admissible(&q));
+        let f = s.frame(&q);
+        proptest::prop_assume!(f.hold_ratio < 1.0);
+        let r = point_step::contact_point(&s, p).unwrap();
+        let u = Vec2::new(ang.cos(), ang.sin()) * speed;
+        if let Some(v) = f.point_twist(&r, &u, s.length) {
+            proptest::prop_assert!(v.iter().all(|c| c.is_finite()));
+            let c = Vec2::new(v.x, v.y) + perp(&r) * v.z;
+            proptest::prop_assert!((c - u).norm() <= 1e-9 * speed, "contact velocity {c:?} vs {u:?}");
+            let w = f.support_load(&v) - f.gravity;
+            let moment = w.z - cross2(&r, &Vec2::new(w.x, w.y));
+            proptest::prop_assert!(moment.abs() <= 1e-9 * (w.norm() * s.length + w.z.abs()), "moment {moment:e} about the contact");
+        }
+    }
+}
