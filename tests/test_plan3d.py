@@ -207,7 +207,7 @@ def test_solves_are_deterministic_under_a_seed():
     """The 3-D plan's `solves` counts the solves a sequential search makes (the parallel
     search's extra work is not counted): the same seed and budget give the same count."""
     s = _core.Scene3D.from_toml((EXAMPLES / "pivot-3d.toml").read_text(), str(EXAMPLES))
-    settings = {"seed": 3, "time_limit": 600.0, "max_iterations": 20, "cost_threshold": -1.0}
+    settings = {"seed": 3, "time_limit": 600.0, "max_iterations": 20, "cost_threshold": -1.0, "refine": float("inf")}
     runs = [s.plan(None, None, settings) for _ in range(3)]
     assert len({r["solves"] for r in runs}) == 1, [r["solves"] for r in runs]
     assert len({r["nodes"] for r in runs}) == 1 and runs[0]["solves"] > 0

@@ -28,10 +28,10 @@ print("started", flush=True)
 
 # each call would run for minutes (a goal that cannot be reached, a tiny step, no node limit)
 LONG = {
-    "planar plan": "planar.plan(None, None, {'time_limit': 600, 'max_nodes': 10**8, 'max_iterations': 10**12, 'cost_threshold': -1.0})",
+    "planar plan": "planar.plan(None, None, {'time_limit': 600, 'max_nodes': 10**8, 'max_iterations': 10**12, 'cost_threshold': -1.0, 'refine': float('inf')})",
     "python plan": "regrasp.plan(regrasp.load_scene(E / 'block-low-friction.toml'), time_limit=600, max_nodes=10**8,"
-                   " max_iterations=10**12, cost_threshold=-1.0)",
-    "3-d plan": "s3.plan(None, None, {'time_limit': 600, 'max_nodes': 10**8, 'max_iterations': 10**12, 'cost_threshold': -1.0})",
+                   " max_iterations=10**12, cost_threshold=-1.0, refine=float('inf'))",
+    "3-d plan": "s3.plan(None, None, {'time_limit': 600, 'max_nodes': 10**8, 'max_iterations': 10**12, 'cost_threshold': -1.0, 'refine': float('inf')})",
     "planar simulate_push": "planar.simulate_push([0, 0, 0], 'left', [1e-9, 0, 0], 1e5, 0.1)",
     "push_outcomes": "planar.push_outcomes(np.zeros((10**6, 3)), 'left', np.tile([0.01, 0, 0], (10**6, 1)))",
     # slow single solves (about 1 s each on the incline's footprint): stopped inside the solver

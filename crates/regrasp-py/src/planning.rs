@@ -56,6 +56,7 @@ fn plan_dict<'py, Q, E>(
         "planning_time_s" => r.planning_time_s, "nodes" => r.nodes, "iterations" => r.iterations,
         "switch_overs" => r.switch_overs, "cost" => r.cost, "goal_distance" => r.goal_distance,
         "propagation" => about.propagation, "seed" => about.seed, "path" => path, "reason" => r.reason.as_deref(),
+        "first_time_s" => r.first.map(|f| f.planning_time_s), "first_switch_overs" => r.first.map(|f| f.switch_overs),
     ))
 }
 

@@ -33,7 +33,7 @@ macro_rules! fields {
 
 fields!(search_dict, set_search, SearchSettings;
     seed, time_limit, max_nodes, max_iterations, goal_bias, step, checks, k, t0, alpha, n_fail, c_max,
-    neighbour_steps, same_pusher_cost, switch_cost, length_weight, cost_threshold, random_tries,
+    neighbour_steps, same_pusher_cost, switch_cost, length_weight, cost_threshold, refine, random_tries,
     theta_margin, connect);
 
 fields!(mpc_dict, set_mpc, MpcSettings;

@@ -97,6 +97,9 @@ def summary(scene, p: Plan) -> str:
              f"{plural(p.nodes, 'node')}{solves}, "
              f"{1e3 * p.planning_time_s:.2f} ms ({p.propagation}, seed {p.seed})",
              "  pushes: " + pusher_runs(p.pushers)]
+    if p.first_time_s is not None:
+        lines.append(f"  first plan after {1e3 * p.first_time_s:.2f} ms with {plural(p.first_switch_overs, 'switch-over')}, "
+                     "then refined (RRT*, setting `refine`)")
     if p.dimension == 2:
         lines.append(f"  every step sticks along its length (exact test): {p.valid} (smallest margin "
                      f"{min(p.step_margins, default=0):.3f})")

@@ -24,9 +24,9 @@ from ..files import as_path, same_file as _same_file, write_text
 #: the keys of a plan file, in the order they are written (docs/plan-file.md), by dimension
 KEYS = {
     2: ("scene", "found", "stop_reason", "reason", "planning_time_s", "nodes", "switch_overs", "path", "iterations", "cost",
-        "goal_distance", "propagation", "seed", "step_margins", "valid"),
+        "goal_distance", "propagation", "seed", "first_time_s", "first_switch_overs", "step_margins", "valid"),
     3: ("scene", "found", "stop_reason", "reason", "planning_time_s", "nodes", "iterations", "switch_overs", "cost",
-        "goal_distance", "propagation", "seed", "solves", "path", "valid"),
+        "goal_distance", "propagation", "seed", "first_time_s", "first_switch_overs", "solves", "path", "valid"),
 }
 #: numbers in a pose: planar [x, z, theta], 3-D [x, y, z, qw, qx, qy, qz]
 POSE_SIZE = {2: 3, 3: 7}
@@ -35,7 +35,8 @@ POSE_TEXT = {2: "[x, z, theta]", 3: "[x, y, z, qw, qx, qy, qz]"}
 SUMMARY_TYPES = {
     "scene": "str", "found": "bool", "stop_reason": "str", "reason": "str", "planning_time_s": "float", "nodes": "int",
     "iterations": "int", "switch_overs": "int", "cost": "float", "goal_distance": "float", "propagation": "str",
-    "seed": "int", "solves": "int", "step_margins": "float[]", "valid": "bool",
+    "seed": "int", "solves": "int", "step_margins": "float[]", "valid": "bool", "first_time_s": "float",
+    "first_switch_overs": "int",
 }
 #: the scene object of each plan made by :func:`plan` (for its display), outside the plan's
 #: state: its file, equality and copies are unchanged
@@ -157,6 +158,10 @@ class Plan:
     goal_distance: Optional[float] = None
     propagation: Optional[str] = None
     seed: Optional[int] = None
+    #: the first plan found, before the anytime refinement (setting ``refine``): when [s], and its
+    #: switch-overs (``planning_time_s`` and ``switch_overs`` are the final plan's)
+    first_time_s: Optional[float] = None
+    first_switch_overs: Optional[int] = None
     #: 3-D: inverse and forward dynamics problems solved during the search
     solves: Optional[int] = None
     #: planar: smallest exact-test margin along each step (≥ 0: the step sticks along its length)

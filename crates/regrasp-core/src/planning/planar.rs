@@ -476,6 +476,9 @@ pub fn plan_tree(
     let before = t0.elapsed().as_secs_f64(); // the checks and the certificate count as planning time
     trrt::plan_tree(&space, start).map(|(mut r, nodes)| {
         r.planning_time_s += before;
+        if let Some(f) = r.first.as_mut() {
+            f.planning_time_s += before;
+        }
         (r, nodes)
     })
 }
@@ -493,6 +496,7 @@ fn unreachable_plan(space: &PlanarSpace, start: [f64; 3], reason: String, t0: st
         iterations: 0,
         planning_time_s: t0.elapsed().as_secs_f64(),
         reason: Some(reason),
+        first: None,
     }
 }
 
@@ -595,7 +599,7 @@ mod tests {
     fn rewiring_keeps_costs_consistent() {
         let s = scene("t-shape.toml");
         let mut settings = PlanarSettings::default();
-        settings.search = SearchSettings { seed: 5, cost_threshold: 0.0, max_iterations: 3000, connect: false, ..SearchSettings::default() };
+        settings.search = SearchSettings { seed: 5, refine: f64::INFINITY, max_iterations: 3000, connect: false, ..SearchSettings::default() };
         let (_, nodes) = plan_tree(&s, None, None, &settings).unwrap();
         assert!(nodes.len() > 100);
         let m = s.metric();
@@ -646,5 +650,25 @@ mod tests {
         let end = a.path.last().unwrap().0;
         let goal = s.task.unwrap().goal;
         assert!((0..3).all(|k| (end[k] - goal[k]).abs() <= s.task.unwrap().tolerance[k]));
+    }
+
+    /// Anytime refinement (`refine`): the final plan costs no more than the first, which is
+    /// recorded; with `refine` 0 the first plan is the answer; the same seed gives the same plan.
+    #[test]
+    fn refinement_never_costs_more_than_the_first_plan() {
+        for name in ["t-shape.toml", "block-xztheta.toml", "block-low-friction.toml"] {
+            let s = scene(name);
+            for seed in 0..5 {
+                let r = plan(&s, None, None, &with(SearchSettings { seed, ..SearchSettings::default() })).unwrap();
+                let f = r.first.expect("a first plan");
+                assert!(r.found && r.cost <= f.cost + 1e-12, "{name} {seed}: {} > {}", r.cost, f.cost);
+                assert!(r.iterations >= f.iterations && f.planning_time_s <= r.planning_time_s);
+                let again = plan(&s, None, None, &with(SearchSettings { seed, ..SearchSettings::default() })).unwrap();
+                assert_eq!(again.path, r.path);
+                let first = plan(&s, None, None, &with(SearchSettings { seed, refine: 0.0, ..SearchSettings::default() })).unwrap();
+                assert_eq!(first.switch_overs, f.switch_overs);
+                assert!((first.cost - f.cost).abs() < 1e-12 && first.iterations == f.iterations);
+            }
+        }
     }
 }

@@ -49,8 +49,13 @@ pub struct SearchSettings {
     pub switch_cost: f64,
     /// Weight of the path length (per L of length) in the edge cost.
     pub length_weight: f64,
-    /// Stop at the first path to the goal whose cost is at most this (∞: the first).
+    /// Stop at once at a path to the goal whose cost is at most this (∞: the first path; 0, the
+    /// default: none, the refinement below decides).
     pub cost_threshold: f64,
+    /// Anytime refinement: after the first path to the goal, RRT* goes on for this fraction of
+    /// the iterations the first took (deterministic for a seed), within the other budgets; the
+    /// cheapest goal node is returned. 0: stop at the first; ∞: the other budgets decide.
+    pub refine: f64,
     /// Random directions tried per step when the desired one is not feasible.
     pub random_tries: usize,
     /// Bounds of the rotations explored: the start and goal widened by this [rad].
@@ -78,7 +83,8 @@ impl Default for SearchSettings {
             same_pusher_cost: 0.1,
             switch_cost: 1.0,
             length_weight: 1.0,
-            cost_threshold: f64::INFINITY,
+            cost_threshold: 0.0,
+            refine: 0.5,
             random_tries: 8,
             theta_margin: 0.5,
             connect: true,
@@ -114,6 +120,9 @@ impl SearchSettings {
         for (name, v) in [("neighbour_steps", self.neighbour_steps), ("same_pusher_cost", self.same_pusher_cost),
                           ("switch_cost", self.switch_cost), ("length_weight", self.length_weight), ("theta_margin", self.theta_margin)] {
             finite_nonneg(name, v)?;
+        }
+        if !(self.refine >= 0.0) {
+            return Err(Error::arg("refine", format!("must be a non-negative fraction of the iterations, or inf (got {})", self.refine)));
         }
         if self.cost_threshold.is_nan() {
             return Err(Error::arg("cost_threshold", "is NaN"));
@@ -264,6 +273,18 @@ pub struct Plan<Q, E> {
     pub goal_distance: f64,
     /// Why the goal is unreachable (with [`StopReason::Unreachable`]).
     pub reason: Option<String>,
+    /// The first path to the goal found, before the refinement: when it was found [s] (from the
+    /// search's start) and its switch-overs. `None` when no path was found.
+    pub first: Option<FirstPlan>,
+}
+
+/// The first path to the goal a search found (the anytime refinement's starting point).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FirstPlan {
+    pub planning_time_s: f64,
+    pub iterations: usize,
+    pub switch_overs: usize,
+    pub cost: f64,
 }
 
 impl<Q: Clone, E> Plan<Q, E> {
@@ -524,7 +545,19 @@ pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<
     }
     let mut closest = best.unwrap_or(0);
     let mut iterations = 0;
+    let mut first: Option<FirstPlan> = None;
     let stop = loop {
+        if let Some(g) = best {
+            let f = *first.get_or_insert_with(|| FirstPlan {
+                planning_time_s: t0.elapsed().as_secs_f64(),
+                iterations,
+                switch_overs: switch_overs(&search.nodes.path_to(g)),
+                cost: search.nodes[g].cost,
+            });
+            if s.refine.is_finite() && iterations >= f.iterations + (s.refine * f.iterations as f64).ceil() as usize {
+                break StopReason::GoalReached;
+            }
+        }
         if let Some(r) = stop_reason(s, best.map(|g| search.nodes[g].cost), &t0, search.nodes.len(), iterations) {
             break r;
         }
@@ -557,6 +590,7 @@ pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<
         iterations,
         planning_time_s: t0.elapsed().as_secs_f64(),
         reason: None,
+        first,
     };
     Ok((plan, search.nodes.into_nodes()))
 }
