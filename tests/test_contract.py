@@ -236,9 +236,10 @@ def check_plan(plan: dict, header: str) -> None:
     """``plan`` has exactly the keys of the table headed ``header``, with their types."""
     rows = documented(DOCS / "plan-file.md", header)
     spec = {k: (code_names(r[1])[0], r[2]) for k, r in rows.items()}
-    assert all(p in ("always", "steps", "unreachable") for _, p in spec.values())
+    assert all(p in ("always", "steps", "unreachable", "found") for _, p in spec.values())
     unreachable = plan.get("stop_reason") == "unreachable"  # a `reason` only then
-    top = {k for k, (_, p) in spec.items() if "[]." not in k and (p != "unreachable" or unreachable)}
+    present = {"unreachable": unreachable, "found": plan.get("found") is True}  # `first_*` only with a plan
+    top = {k for k, (_, p) in spec.items() if "[]." not in k and present.get(p, True)}
     entry = {k.split("[].", 1)[1]: v for k, v in spec.items() if k.startswith("path[].")}
     assert set(plan) == top, f"keys: written but undocumented {sorted(set(plan) - top)}, " \
                              f"documented but not written {sorted(top - set(plan))}"
