@@ -239,8 +239,9 @@ pub fn connect(
 pub const GUESSES: usize = 4;
 
 /// A guess's contact directions lie this many times `margin` inside the pusher's cone at the
-/// start: the refinement and the flow erode the margin (on the point-pusher bench scene, 60
-/// seeds: 3x, 6x and 10x gave p90s of 110, 78 and 105 ms).
+/// start: the refinement and the flow erode the margin (chosen on the point-pusher bench scene
+/// over 60 seeds, before the refinement ran on coarse flows: 3x, 6x and 10x gave p90s of 110, 78
+/// and 105 ms).
 pub const GUESS_MARGIN: f64 = 6.0;
 
 /// Gauss–Newton on the four contact-velocity components `x` of two steps (weighted
