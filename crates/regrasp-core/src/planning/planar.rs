@@ -205,8 +205,8 @@ impl<'a> PlanarSpace<'a> {
 
     /// Propagation by motion cones: the desired step if some cone contains it (parent's pusher
     /// first), else its projections, the closest in angle kept (parent's pusher preferred). A
-    /// point pusher's candidate is its step with the desired contact-point velocity
-    /// ([`Self::point_candidate`]).
+    /// point pusher's candidate is its steered step along its best contact direction
+    /// ([`Self::point_direction`], [`Self::point_step`]).
     fn propagate_cones(&self, q: &[f64; 3], parent_pusher: Option<usize>, target: &[f64; 3]) -> Option<Step<[f64; 3], ()>> {
         let (want, len) = self.desired(q, target)?;
         let m = self.scene.metric();
@@ -233,7 +233,7 @@ impl<'a> PlanarSpace<'a> {
             })
             .collect();
         points.sort_by(|a, b| b.0.total_cmp(&a.0));
-        if let Some(step) = points.iter().take(2).find_map(|(_, p, r, d)| self.point_step(q, &frame, *p, r, d, &want)) {
+        if let Some(step) = points.iter().take(2).find_map(|(_, p, r, d)| self.point_step(q, &frame, *p, parent_pusher, r, d, &want)) {
             best = Some(step);
         }
         for &p in order.iter().filter(|&&p| point(p).is_none()) {
@@ -309,8 +309,10 @@ impl<'a> PlanarSpace<'a> {
 
     /// The step of point pusher `p` along contact direction `d`: the pusher twist of
     /// [`point_step::steer`] moving the object about as far as `want`, halved until its flow is
-    /// feasible; (cosine to `want`, pusher, twist, true) for [`Self::propagate_cones`].
-    fn point_step(&self, q: &[f64; 3], frame: &SupportFrame, p: usize, r: &Vec2, d: &Vec2, want: &Vec3) -> Option<(f64, usize, Vec3, bool)> {
+    /// feasible; (cosine to `want` with the parent's bonus, pusher, twist, true: a finished step)
+    /// for [`Self::propagate_cones`].
+    #[allow(clippy::too_many_arguments)]
+    fn point_step(&self, q: &[f64; 3], frame: &SupportFrame, p: usize, parent_pusher: Option<usize>, r: &Vec2, d: &Vec2, want: &Vec3) -> Option<(f64, usize, Vec3, bool)> {
         let m = self.scene.metric();
         let v = frame.point_twist(r, d, self.scene.length)?;
         let mut ub = d * (m.twist_norm(want) / m.twist_norm(&v));
@@ -318,7 +320,8 @@ impl<'a> PlanarSpace<'a> {
             if let Some((xi, fl)) = point_step::steer(self.scene, p, q, &ub, self.s.search.checks) {
                 if self.flow_feasible(&fl) {
                     let cos = m.twist(&xi).dot(&m.twist(want)) / (m.twist_norm(&xi) * m.twist_norm(want));
-                    return (cos > 0.2).then_some((cos, p, xi, true));
+                    let bonus = if Some(p) == parent_pusher && !self.s.plain { 0.05 } else { 0.0 };
+                    return (cos > 0.2).then_some((cos + bonus, p, xi, true));
                 }
             }
             ub *= 0.5;
