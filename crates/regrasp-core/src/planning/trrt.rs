@@ -386,10 +386,15 @@ impl<'a, S: Space<K>, const K: usize> Search<'a, S, K> {
         edge_cost(s.same_pusher_cost, s.switch_cost, s.length_weight, self.space.length(), parent_pusher, pusher, length)
     }
 
+    /// Adds a node to the tree; to the k-d index only when no indexed node has the same key (a
+    /// goal reached again and again by goal connections during the refinement would overflow a
+    /// k-d leaf, and a duplicate adds nothing to nearest-neighbour queries).
     fn add(&mut self, q: S::Q, parent: usize, pusher: usize, cost: f64, edge: S::Edge) -> usize {
         let key = self.space.key(&q);
         let i = self.nodes.add(q, parent, pusher, cost, edge);
-        self.index.add(&key, i as u64);
+        if self.index.size() == 0 || self.index.nearest_one::<SquaredEuclidean>(&key).distance > 0.0 {
+            self.index.add(&key, i as u64);
+        }
         i
     }
 
