@@ -200,7 +200,7 @@ def test_pages_load_in_headless_chromium_without_errors(tmp_path):
         for fr in got["frames"]:  # the table at least; following the gripper, the gripper
             assert fr["ink"] > (0.002 if fr.get("follow") else 0.05) * W * H, name
         if name in ("motion", "bare"):
-            assert np.allclose(got["frames"][4]["gripper"], m.gripper[-1]) and got["frames"][4]["t"] == m.times[-1]
+            assert np.allclose(got["frames"][4]["gripper"], m.gripper[-1]) and got["frames"][4]["t"] == pytest.approx(m.times[-1], rel=1e-14)
             assert np.allclose(got["frames"][0]["gripper"], m.gripper[0])
 
 

@@ -9,7 +9,7 @@ use regrasp::scene::Scene;
 fn refining_long_past_the_first_plan_keeps_the_plan_valid_and_no_costlier() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../python/regrasp/examples/hard/u-shape.toml");
     let s = Scene::load(&path).unwrap();
-    let search = SearchSettings { seed: 0, refine: 2.0, time_limit: 60.0, ..SearchSettings::default() };
+    let search = SearchSettings { seed: 0, refine: 10.0, time_limit: 60.0, ..SearchSettings::default() };
     let r = plan(&s, None, None, &PlanarSettings { search, ..PlanarSettings::default() }).unwrap();
     let f = r.first.expect("a first plan");
     assert!(r.found && r.iterations > f.iterations + 10_000 && r.cost <= f.cost + 1e-12, "{} iterations, first {f:?}", r.iterations);

@@ -53,7 +53,7 @@ pub fn items<'py>(settings: Option<&Arg<'py>>) -> PyResult<Vec<(String, Arg<'py>
 
 /// The planar planner's settings as a dict.
 fn planar_dict<'py>(py: Python<'py>, s: &PlanarSettings) -> PyResult<Bound<'py, PyDict>> {
-    let d = dict!(py; "margin" => s.margin, "propagation" => s.propagation.label(), "plain" => s.plain);
+    let d = dict!(py; "margin" => s.margin, "propagation" => s.propagation.label(), "plain" => s.plain, "guide" => s.guide);
     search_dict(&s.search, &d)?;
     Ok(d)
 }
@@ -69,6 +69,7 @@ pub fn planar(overrides: Option<&Arg<'_>>) -> PyResult<PlanarSettings> {
             "margin" => s.margin = arg(&k, &v)?,
             "propagation" => s.propagation = Propagation::parse(&arg::<String>(&k, &v)?).map_err(to_py)?,
             "plain" => s.plain = arg(&k, &v)?,
+            "guide" => s.guide = arg(&k, &v)?,
             _ => return Err(arg_err(&k, "is not a setting of the planar planner")),
         }
     }

@@ -218,7 +218,9 @@ class ControlRun:
         """What the world's refusal ``e`` of a push means, in the user's terms, with the time [s]
         and the object's pose (m, m, rad)."""
         q = [round(float(v), 5) + 0.0 for v in self.plant.pose()]
-        if getattr(e, "field", None) == "pose" and "not admissible" in str(e):
+        field = getattr(e, "field", None)
+        # the pose refused, or a push the simulator stopped because the pad left the object
+        if (field == "pose" and "not admissible" in str(e)) or (field == "push" and "finger pad leaves the object" in str(e)):
             return (f"the object left the admissible region at t = {self.t:.2f} s (the finger pad no longer "
                     f"entirely on the object): pose {q} (m, m, rad)")
         return f"the world could not go on at t = {self.t:.2f} s, pose {q} (m, m, rad): {e}"

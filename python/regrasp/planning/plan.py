@@ -375,7 +375,9 @@ def plan(scene, start=None, goal=None, **settings) -> Plan:
     ``planner_defaults(scene.dimension)`` lists them (``seed``, ``time_limit`` [s],
     ``max_nodes``, ``step``, ``goal_bias``, ...; planar also ``propagation``: "motion_cone" (this
     library), "stable_check" (random steps kept when a force-balance LP passes, ICRA 2018) or
-    "mncp" (inverse quasi-static dynamics), ``margin`` and ``plain``). An unknown setting is an
+    "mncp" (inverse quasi-static dynamics), ``margin``, ``plain`` and ``guide``: the share of
+    samples drawn along the pad's path around walls when the straight one leaves the object). An
+    unknown setting is an
     ArgumentError naming it.
     """
     if "seed" in settings:

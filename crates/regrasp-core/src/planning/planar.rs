@@ -16,6 +16,7 @@ use crate::dynamics::mncp;
 use crate::dynamics::planar::{push_problem, Options as QsOptions, SupportModel};
 use crate::error::{Error, Result};
 use crate::mechanics::geometry::{rot, Vec2, Vec3};
+use crate::planning::guide::Guide;
 use crate::planning::point_step;
 use crate::planning::tree::pusher_order;
 use crate::planning::trrt::{self, gauss, Chain, SearchSettings, Space, SpaceCore, Step};
@@ -66,11 +67,15 @@ pub struct PlanarSettings {
     /// A plain goal-biased RRT (no transition test, no RRT*, no preference for the parent's
     /// pusher, no straight-push connection): the reference for the switch-over count.
     pub plain: bool,
+    /// When the pad's straight path leaves the object, the share of samples drawn along its guide
+    /// path just ahead of the tree, whose length left is then T-RRT's cost map ([`Guide`]; 0: no
+    /// guide, uniform samples and the metric's distance).
+    pub guide: f64,
 }
 
 impl Default for PlanarSettings {
     fn default() -> Self {
-        Self { search: SearchSettings::default(), margin: 0.01, propagation: Propagation::MotionCone, plain: false }
+        Self { search: SearchSettings::default(), margin: 0.01, propagation: Propagation::MotionCone, plain: false, guide: 0.7 }
     }
 }
 
@@ -80,6 +85,9 @@ impl PlanarSettings {
         self.search.check()?;
         if !(self.margin.is_finite() && self.margin >= 0.0) {
             return Err(Error::arg("margin", format!("must be a finite, non-negative number (got {})", self.margin)));
+        }
+        if !(0.0..=1.0).contains(&self.guide) {
+            return Err(Error::arg("guide", format!("must be in [0, 1] (got {})", self.guide)));
         }
         Ok(())
     }
@@ -96,6 +104,8 @@ pub struct PlanarSpace<'a> {
     tol: [f64; 3],
     bounds: ([f64; 2], [f64; 2], [f64; 2]),
     qs_opts: QsOptions,
+    /// The pad's path around walls, when the straight one leaves the object.
+    guide: Option<Guide>,
 }
 
 impl<'a> PlanarSpace<'a> {
@@ -125,6 +135,7 @@ impl<'a> PlanarSpace<'a> {
             tol,
             bounds: ([-reach, reach], [-reach, reach], [tlo, thi]),
             qs_opts: QsOptions { support: SupportModel::Points { rings: 2, points: 0, merge_fingers: true }, ..QsOptions::default() },
+            guide: if s.guide > 0.0 { Guide::new(scene, &start, &goal) } else { None },
         })
     }
 
@@ -386,10 +397,25 @@ impl Space<3> for PlanarSpace<'_> {
     fn at_goal(&self, q: &[f64; 3]) -> bool {
         (0..3).all(|k| (q[k] - self.core.goal[k]).abs() <= self.tol[k])
     }
-    fn sample(&self, rng: &mut ChaCha8Rng, _start: &[f64; 3]) -> [f64; 3] {
+    /// Around walls, the pad's distance left along its guide path combined with the turn left.
+    fn cost_to_go(&self, q: &[f64; 3]) -> f64 {
+        let l = self.scene.length;
+        match (&self.guide, self.scene.pad_disc(q)) {
+            (Some(g), Some((c, _))) => g.to_go(&c).hypot(l * (q[2] - self.core.goal[2])) / l,
+            _ => self.dist(q, &self.core.goal) / l,
+        }
+    }
+    /// Uniform in the bounds; around walls, a share `guide` of the samples just ahead of the
+    /// closest node along the pad's guide path ([`Guide::sample`]).
+    fn sample(&self, rng: &mut ChaCha8Rng, _start: &[f64; 3], closest: &[f64; 3]) -> [f64; 3] {
         let (bx, bz, bt) = self.bounds;
+        let guided = self.guide.as_ref().filter(|_| rng.random::<f64>() < self.s.guide);
+        let from = guided.zip(self.scene.pad_disc(closest)).map_or(0.0, |(g, (c, _))| g.project(&c).0);
         for _ in 0..100 {
-            let q = [rng.random_range(bx[0]..=bx[1]), rng.random_range(bz[0]..=bz[1]), rng.random_range(bt[0]..=bt[1])];
+            let q = match guided {
+                Some(g) => g.sample(rng, from, self.core.step, self.scene.length, self.core.goal[2]),
+                None => [rng.random_range(bx[0]..=bx[1]), rng.random_range(bz[0]..=bz[1]), rng.random_range(bt[0]..=bt[1])],
+            };
             if self.scene.admissible(&q) {
                 return q;
             }

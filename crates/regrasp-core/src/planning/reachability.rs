@@ -33,7 +33,7 @@ pub const MAX_VERTICES: usize = 1000;
 pub fn unreachable(scene: &Scene, start: &[f64; 3], goal: &[f64; 3], tol: &[f64; 3]) -> Option<String> {
     let (cs, r) = scene.pad_disc(start)?;
     let (cg, _) = scene.pad_disc(goal)?;
-    let region = pad_region(scene, r)?;
+    let region = pad_region(scene, r, LineJoin::Bevel)?;
     let point = |c: &Vec2| Point::new(c.x, c.y);
     let part = region.0.iter().find(|p| p.contains(&point(&cs)))?;
     // how far the goal region's pad centres reach from the goal's: the tolerance's translation,
@@ -53,8 +53,9 @@ pub fn unreachable(scene: &Scene, start: &[f64; 3], goal: &[f64; 3], tol: &[f64;
 }
 
 /// The pad centres' region: the outline eroded by a little less than `r` (see the module's
-/// notes); None when the outline is too large to erode quickly.
-fn pad_region(scene: &Scene, r: f64) -> Option<MultiPolygon<f64>> {
+/// notes), the arcs about reflex corners joined by `join`; None when the outline is too large to
+/// erode quickly.
+pub(crate) fn pad_region(scene: &Scene, r: f64, join: LineJoin<f64>) -> Option<MultiPolygon<f64>> {
     let ring: Vec<(f64, f64)> = scene.outline.vertices().iter().map(|v| (v.x, v.y)).collect();
     let outline = Polygon::new(LineString::from(ring), vec![]);
     let eps = SIMPLIFY * r;
@@ -64,5 +65,5 @@ fn pad_region(scene: &Scene, r: f64) -> Option<MultiPolygon<f64>> {
     if !small(&shape) {
         return None;
     }
-    Some(shape.buffer_with_style(BufferStyle::new(-(ERODE * r - 2.0 * eps)).line_join(LineJoin::Bevel)))
+    Some(shape.buffer_with_style(BufferStyle::new(-(ERODE * r - 2.0 * eps)).line_join(join)))
 }

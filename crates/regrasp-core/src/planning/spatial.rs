@@ -298,7 +298,7 @@ impl Space<7> for SpatialSpace<'_> {
     }
     /// A random pose near the start–goal region: translation within the object's reach, rotation
     /// a random interpolation between start and goal perturbed by up to `theta_margin`.
-    fn sample(&self, rng: &mut ChaCha8Rng, start: &Isometry3<f64>) -> Isometry3<f64> {
+    fn sample(&self, rng: &mut ChaCha8Rng, start: &Isometry3<f64>, _closest: &Isometry3<f64>) -> Isometry3<f64> {
         let t: f64 = rng.random();
         let rot = start.rotation.slerp(&self.core.goal.rotation, t);
         let ax = V3::new(gauss(rng), gauss(rng), gauss(rng));

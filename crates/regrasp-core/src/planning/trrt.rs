@@ -223,8 +223,14 @@ pub trait Space<const K: usize>: Sync {
     /// The metric distance [m].
     fn dist(&self, a: &Self::Q, b: &Self::Q) -> f64;
     fn at_goal(&self, q: &Self::Q) -> bool;
-    /// A random pose to grow towards (goal bias is the planner's).
-    fn sample(&self, rng: &mut ChaCha8Rng, start: &Self::Q) -> Self::Q;
+    /// T-RRT's cost map: how far `q` is from the goal, in units of L (default: the metric's
+    /// distance; a space may know a better one, e.g. around walls).
+    fn cost_to_go(&self, q: &Self::Q) -> f64 {
+        self.dist(q, self.goal()) / self.length()
+    }
+    /// A random pose to grow towards (goal bias is the planner's), given the start and the tree's
+    /// node closest to the goal by [`Space::cost_to_go`].
+    fn sample(&self, rng: &mut ChaCha8Rng, start: &Self::Q, closest: &Self::Q) -> Self::Q;
     /// A unit step from `q` (reached with `pusher`) towards `target`.
     fn propagate(&self, rng: &mut ChaCha8Rng, q: &Self::Q, pusher: Option<usize>, target: &Self::Q) -> Option<Step<Self::Q, Self::Edge>>;
     /// The constant motion from `a` to `b` and its length [m].
@@ -352,13 +358,14 @@ pub fn stop_reason(s: &SearchSettings, best_cost: Option<f64>, t0: &Instant, nod
     }
 }
 
-/// The search state: the space, the tree, its k-d index, the random source and the transition
-/// test's temperature.
+/// The search state: the space, the tree, its k-d index, the node closest to the goal by the
+/// cost map, the random source and the transition test's temperature.
 struct Search<'a, S: Space<K>, const K: usize> {
     space: &'a S,
     rng: ChaCha8Rng,
     nodes: Tree<S::Q, S::Edge>,
     index: KdTree<f64, K>,
+    closest: (usize, f64),
     transition: Transition,
 }
 
@@ -370,6 +377,7 @@ impl<'a, S: Space<K>, const K: usize> Search<'a, S, K> {
             rng: ChaCha8Rng::seed_from_u64(s.seed),
             nodes: Tree::new(start.clone(), space.root_edge()),
             index: KdTree::new(),
+            closest: (0, space.cost_to_go(&start)),
             transition: Transition::new(s, 0.0),
         };
         search.transition.c_max = s.c_max * search.cost_to_go(&start).max(1.0);
@@ -378,7 +386,7 @@ impl<'a, S: Space<K>, const K: usize> Search<'a, S, K> {
     }
 
     fn cost_to_go(&self, q: &S::Q) -> f64 {
-        self.space.dist(q, self.space.goal()) / self.space.length()
+        self.space.cost_to_go(q)
     }
 
     fn edge_cost(&self, parent_pusher: Option<usize>, pusher: usize, length: f64) -> f64 {
@@ -391,7 +399,11 @@ impl<'a, S: Space<K>, const K: usize> Search<'a, S, K> {
     /// k-d leaf, and a duplicate adds nothing to nearest-neighbour queries).
     fn add(&mut self, q: S::Q, parent: usize, pusher: usize, cost: f64, edge: S::Edge) -> usize {
         let key = self.space.key(&q);
+        let to_go = self.cost_to_go(&q);
         let i = self.nodes.add(q, parent, pusher, cost, edge);
+        if to_go < self.closest.1 {
+            self.closest = (i, to_go);
+        }
         if self.index.size() == 0 || self.index.nearest_one::<SquaredEuclidean>(&key).distance > 0.0 {
             self.index.add(&key, i as u64);
         }
@@ -402,8 +414,8 @@ impl<'a, S: Space<K>, const K: usize> Search<'a, S, K> {
         if self.rng.random::<f64>() < self.space.search().goal_bias {
             return self.space.goal().clone();
         }
-        let start = self.nodes[0].q.clone();
-        self.space.sample(&mut self.rng, &start)
+        let (start, closest) = (self.nodes[0].q.clone(), self.nodes[self.closest.0].q.clone());
+        self.space.sample(&mut self.rng, &start, &closest)
     }
 
     /// The tree node nearest to `q` in the metric.
@@ -548,7 +560,6 @@ pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<
     if best.is_none() {
         best = search.connect_goal(0);
     }
-    let mut closest = best.unwrap_or(0);
     let mut iterations = 0;
     let mut first: Option<FirstPlan> = None;
     let stop = loop {
@@ -569,9 +580,6 @@ pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<
         crate::interrupt::check()?;
         iterations += 1;
         let Some(i) = search.grow() else { continue };
-        if search.cost_to_go(&search.nodes[i].q) < search.cost_to_go(&search.nodes[closest].q) {
-            closest = i;
-        }
         if space.at_goal(&search.nodes[i].q) {
             search.nodes.keep_cheaper(&mut best, i);
         } else if let Some(g) = search.connect_goal(i) {
@@ -582,7 +590,7 @@ pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<
     if best.is_some() {
         best = search.nodes.cheapest(|q| space.at_goal(q));
     }
-    let end = best.unwrap_or(closest);
+    let end = best.unwrap_or(search.closest.0);
     let path = search.nodes.path_to(end);
     let plan = Plan {
         found: best.is_some(),
