@@ -3,39 +3,17 @@
 
 mod common;
 
-use common::pad_pose;
+use common::{outline_scene, star};
 use proptest::prelude::*;
 use regrasp::mechanics::geometry::Vec2;
 use regrasp::planning::guide::Guide;
 use regrasp::planning::planar::{plan, validate_path, PlanarSettings};
 use regrasp::planning::trrt::SearchSettings;
-use regrasp::scene::planar_file::{RawGrasp, RawObject, RawPusher, RawScene, RawTask};
 use regrasp::Scene;
 use std::collections::BinaryHeap;
 
 fn bundled(name: &str) -> Scene {
     Scene::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../python/regrasp/examples/{name}.toml"))).unwrap()
-}
-
-/// A scene of `outline` (CCW) held by a disc pad of radius `pad` with its centre at `a` (start)
-/// and `b` (goal); one line pusher on the first edge. None when the loader refuses it.
-fn scene(outline: Vec<[f64; 2]>, pad: f64, a: [f64; 2], b: [f64; 2]) -> Option<Scene> {
-    let (p, q) = (outline[0], outline[1]);
-    let (dx, dz) = (q[0] - p[0], q[1] - p[1]);
-    Scene::from_raw(RawScene {
-        name: Some("guide".into()),
-        object: Some(RawObject { outline: Some(outline.clone()), mass: Some(0.02), com: None, material: None }),
-        grasp: Some(RawGrasp { force: Some(40.0), friction: Some(0.8), pad_radius: Some(pad), ..Default::default() }),
-        pushers: Some(vec![RawPusher {
-            name: Some("p".into()),
-            friction: Some(0.5),
-            points: Some(vec![[p[0] + 0.3 * dx, p[1] + 0.3 * dz], [p[0] + 0.7 * dx, p[1] + 0.7 * dz]]),
-            normal: Some([-dz, dx]),
-        }]),
-        task: Some(RawTask { start: Some(pad_pose(a[0], a[1], 0.0)), goal: Some(pad_pose(b[0], b[1], 0.0)), tolerance: Some([1e-3, 1e-3, 0.0175]) }),
-        ..Default::default()
-    })
-    .ok()
 }
 
 /// Brute force: the shortest 8-connected path [m] between pad centres `a` and `b` through the
@@ -112,15 +90,6 @@ fn the_guide_cuts_the_us_search_and_its_plans_stay_valid() {
     assert!(4 * w < wo, "iterations to the first plan with the guide {with:?}, without {without:?}");
 }
 
-/// A star-shaped outline about the origin: `radii` [m] at equal angles, CCW.
-fn star(radii: &[f64]) -> Vec<[f64; 2]> {
-    let n = radii.len() as f64;
-    radii.iter().enumerate().map(|(i, r)| {
-        let a = 2.0 * std::f64::consts::PI * i as f64 / n;
-        [r * a.cos(), r * a.sin()]
-    }).collect()
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
     /// On random star-shaped outlines, between random pad centres that the grid joins: the guide
@@ -144,7 +113,7 @@ proptest! {
         };
         // the ends out in lobes a turn of 1 to 2.5 rad apart
         let (a, b) = (centre(ends.0), centre((ends.1 .0, ends.0 .1 + ends.1 .1)));
-        let s = scene(outline.clone(), pad, a, b);
+        let s = outline_scene(outline.clone(), pad, a, b);
         prop_assume!(s.is_some());
         let s = s.unwrap();
         let (va, vb) = (Vec2::new(a[0], a[1]), Vec2::new(b[0], b[1]));

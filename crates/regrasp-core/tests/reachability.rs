@@ -3,12 +3,11 @@
 
 mod common;
 
-use common::pad_pose;
+use common::{outline_scene, pad_pose, star};
 use proptest::prelude::*;
 use regrasp::mechanics::geometry::Vec2;
 use regrasp::planning::planar::{plan, PlanarSettings, StopReason};
 use regrasp::planning::reachability::unreachable;
-use regrasp::scene::planar_file::{RawGrasp, RawObject, RawPusher, RawScene, RawTask};
 use regrasp::Scene;
 use std::time::Instant;
 
@@ -22,23 +21,7 @@ fn scene(outline: Vec<[f64; 2]>, pad: f64, at: [f64; 2]) -> Scene {
 
 /// [`scene`], or None when the loader refuses it (the pad off the object at `at`).
 fn try_scene(outline: Vec<[f64; 2]>, pad: f64, at: [f64; 2]) -> Option<Scene> {
-    let (a, b) = (outline[0], outline[1]);
-    let (dx, dz) = (b[0] - a[0], b[1] - a[1]);
-    let pose = pad_pose(at[0], at[1], 0.0);
-    Scene::from_raw(RawScene {
-        name: Some("reach".into()),
-        object: Some(RawObject { outline: Some(outline.clone()), mass: Some(0.02), com: None, material: None }),
-        grasp: Some(RawGrasp { force: Some(40.0), friction: Some(0.8), pad_radius: Some(pad), ..Default::default() }),
-        pushers: Some(vec![RawPusher {
-            name: Some("p".into()),
-            friction: Some(0.5),
-            points: Some(vec![[a[0] + 0.3 * dx, a[1] + 0.3 * dz], [a[0] + 0.7 * dx, a[1] + 0.7 * dz]]),
-            normal: Some([-dz, dx]),
-        }]),
-        task: Some(RawTask { start: Some(pose), goal: Some(pose), tolerance: Some(TOL) }),
-        ..Default::default()
-    })
-    .ok()
+    outline_scene(outline, pad, at, at)
 }
 
 /// Two 30 × 30 mm lobes joined by a neck `neck` [m] wide and 20 mm long.
@@ -125,15 +108,6 @@ fn a_goal_within_tolerance_of_the_start_part_is_not_refused() {
     let start = pad_pose(a[0], a[1], 0.0);
     assert_eq!(unreachable(&s, &start, &goal, &[1.7e-3, 1.7e-3, 0.0]), None); // reaches 2.40 mm
     assert!(unreachable(&s, &start, &goal, &[1.5e-3, 1.5e-3, 0.0]).is_some()); // reaches 2.12 mm
-}
-
-/// A star-shaped outline about the origin: `radii` [m] at equal angles, CCW.
-fn star(radii: &[f64]) -> Vec<[f64; 2]> {
-    let n = radii.len() as f64;
-    radii.iter().enumerate().map(|(i, r)| {
-        let a = 2.0 * std::f64::consts::PI * i as f64 / n;
-        [r * a.cos(), r * a.sin()]
-    }).collect()
 }
 
 proptest! {

@@ -62,6 +62,41 @@ pub fn pad_pose(cx: f64, cz: f64, th: f64) -> [f64; 3] {
     [-(c * cx - s * cz), -(s * cx + c * cz), th]
 }
 
+/// A scene of `outline` (CCW) held by a disc pad of radius `pad` with its centre at `start` and
+/// at `goal` (object frame) for the task; one line pusher on the middle of the first edge. None
+/// when the loader refuses it (e.g. the pad off the object).
+pub fn outline_scene(outline: Vec<[f64; 2]>, pad: f64, start: [f64; 2], goal: [f64; 2]) -> Option<Scene> {
+    let (a, b) = (outline[0], outline[1]);
+    let (dx, dz) = (b[0] - a[0], b[1] - a[1]);
+    Scene::from_raw(RawScene {
+        name: Some("outline".into()),
+        object: Some(RawObject { outline: Some(outline), mass: Some(0.02), com: None, material: None }),
+        grasp: Some(RawGrasp { force: Some(40.0), friction: Some(0.8), pad_radius: Some(pad), ..Default::default() }),
+        pushers: Some(vec![RawPusher {
+            name: Some("p".into()),
+            friction: Some(0.5),
+            points: Some(vec![[a[0] + 0.3 * dx, a[1] + 0.3 * dz], [a[0] + 0.7 * dx, a[1] + 0.7 * dz]]),
+            normal: Some([-dz, dx]),
+        }]),
+        task: Some(RawTask {
+            start: Some(pad_pose(start[0], start[1], 0.0)),
+            goal: Some(pad_pose(goal[0], goal[1], 0.0)),
+            tolerance: Some([1e-3, 1e-3, 0.0175]),
+        }),
+        ..Default::default()
+    })
+    .ok()
+}
+
+/// A star-shaped outline about the origin: `radii` [m] at equal angles, CCW.
+pub fn star(radii: &[f64]) -> Vec<[f64; 2]> {
+    let n = radii.len() as f64;
+    radii.iter().enumerate().map(|(i, r)| {
+        let a = 2.0 * std::f64::consts::PI * i as f64 / n;
+        [r * a.cos(), r * a.sin()]
+    }).collect()
+}
+
 pub fn raw_scene(b: &BlockCase) -> RawScene {
     let (hw, hh) = (b.w / 2.0, b.h / 2.0);
     let outline = vec![[-hw, -hh], [hw, -hh], [hw, hh], [-hw, hh]];
