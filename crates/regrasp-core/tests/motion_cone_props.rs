@@ -120,6 +120,39 @@ proptest! {
         }
     }
 
+    /// The projection with a margin delivers it whenever a line pusher's cone has room: when some twist (the
+    /// ray of one of 64 random pusher wrenches inside W_p, brute force) has twice the margin asked,
+    /// `project_with_margin` of any direction the cone has a part of returns a twist with at
+    /// least the margin asked.
+    #[test]
+    fn the_projection_keeps_its_margin_when_the_cone_has_room(
+        b in block_case(), ws in proptest::collection::vec(proptest::collection::vec(0.0f64..1.0, 4), 64),
+        dir in (-3.1f64..3.1, -1.5f64..1.5), margin in 0.002f64..0.03,
+    ) {
+        // a point pusher's exact cone is a surface in twist space (no interior to keep a margin
+        // in; the planner steps point pushers by their contact velocity instead)
+        let b = BlockCase { line: true, ..b };
+        let Some(scene) = scene(&b) else { return Ok(()) };
+        let push = scene.push(&b.pose, 0).unwrap();
+        let edges = push.pusher_edges();
+        let room = ws.iter().filter_map(|w| {
+            let p: Vec3 = edges.iter().zip(w).map(|(e, x)| e.wrench * *x).sum();
+            push.ray(&p).map(|v| push.classify(&v).unwrap().margin)
+        }).fold(f64::NEG_INFINITY, f64::max);
+        prop_assume!(room >= 2.0 * margin);
+        let want = twist_from_angles(dir.0, dir.1, scene.length);
+        let frame = push.frame();
+        let model = &scene.pushers[0].model;
+        match regrasp::cones::motion_cone::project_with_margin(frame, model, &want, margin) {
+            // only a direction the cone has no part of (its projection is zero)
+            None => prop_assert!(regrasp::cones::motion_cone::project_exact(frame, model, &want).amax() == 0.0),
+            Some(v) => {
+                let m = frame.classify(model, &v).margin;
+                prop_assert!(m >= margin - 1e-9, "margin {m} asked {margin}, room {room}");
+            }
+        }
+    }
+
     /// Rays from random wrenches inside W_p are feasible, with the pusher wrench along them.
     #[test]
     fn interior_rays_are_feasible(b in block_case(), w in proptest::collection::vec(0.01f64..1.0, 4)) {
@@ -367,6 +400,24 @@ fn exact_test_matches_brute_force_lp() {
     assert!(checked[0] > 500 && checked[1] > 1000, "checked {checked:?}");
     assert!(inside[1] > 200 && checked[1] - inside[1] > 200, "line pushers: inside {inside:?} of {checked:?}");
     assert!(inside[0] > 100 && checked[0] - inside[0] > 100, "point pushers: inside {inside:?} of {checked:?}");
+}
+
+/// A μ 0.05 side pusher on the block of the low-friction diagonal: the mean of its cone's rays
+/// lies far outside the cone (gravity bends it), yet the projection keeps the margin asked.
+#[test]
+fn a_thin_bent_cone_still_gives_a_margin() {
+    let s = Scene::from_toml_str(include_str!("../../../python/regrasp/examples/hard/diagonal-mu005.toml")).unwrap();
+    let q = [0.02, 0.0265, 0.0];
+    let frame = s.frame(&q);
+    let want = Vec3::new(-0.04, -0.053, 0.0); // the diagonal to the goal
+    for p in [1, 2] {
+        let model = &s.pushers[p].model;
+        let gens = regrasp::cones::robust::generators(&frame, model);
+        let mean: Vec3 = gens.iter().sum();
+        assert!(frame.classify(model, &mean).margin < -0.1, "pusher {p}: the mean of the rays is outside");
+        let v = regrasp::cones::motion_cone::project_with_margin(&frame, model, &want, 0.01).unwrap();
+        assert!(frame.classify(model, &v).margin >= 0.01 - 1e-12, "pusher {p}");
+    }
 }
 
 fn low_friction_block() -> Scene {
