@@ -15,7 +15,8 @@ from regrasp.viz.viewer import write_html
 
 from .conftest import EXAMPLES, ROOT
 
-THREE_D = ["offset-3d", "light-side-3d", "pivot-single-3d", "pivot-3d", "block-3d", "prism-3d", "ball-roll-3d"]
+THREE_D = ["offset-3d", "light-side-3d", "pivot-single-3d", "pivot-3d", "block-3d", "prism-3d", "ball-roll-3d", "pivot-90-3d",
+           "offset-pivot-3d"]
 
 
 @pytest.mark.parametrize("name", THREE_D)
@@ -109,7 +110,7 @@ def test_3d_plans_execute_in_mujoco(tmp_path):
     pytest.importorskip("mujoco")
     from regrasp.mujoco.spatial import execute_plan3d
 
-    for name in ("offset-3d", "pivot-single-3d", "pivot-3d", "prism-3d"):
+    for name in ("offset-3d", "pivot-single-3d", "pivot-3d", "prism-3d", "pivot-90-3d", "offset-pivot-3d"):
         s = Scene3D.load(EXAMPLES / f"{name}.toml")
         p = s.plan(seed=0)
         for view in ("world", "planner"):
