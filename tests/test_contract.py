@@ -264,12 +264,14 @@ def written_plans(tmp_path_factory):
     parts = text.split("[[pushers]]")
     top = [p for p in parts[1:] if 'name = "top"' in p][0]
     (d / "top-only.toml").write_text(parts[0] + "[[pushers]]" + top)  # can only push down; the goal is up
+    (d / "weak.toml").write_text(text.replace("force = 20.0", "force = 4.0"))  # holds the task, not a pad far off
     runs = cli_many([
         ["plan", EXAMPLES / "t-shape.toml", "--out", d / "planar.json", "--time-limit", "5"],
         ["plan", EXAMPLES / "offset-3d.toml", "--out", d / "3d.json", "--time-limit", "5"],
         ["plan", d / "top-only.toml", "--out", d / "none.json", "--time-limit", "0.2"],
         ["plan", EXAMPLES / "t-shape.toml", "--time-limit", "5", "--json"],
         ["plan", ROOT / "benches" / "scenes" / "neck-unreachable.toml", "--out", d / "unreachable.json"],
+        ["plan", d / "weak.toml", "--goal", "0.0175,0,0", "--out", d / "cannot-hold.json"],
     ])
     return d, runs
 
@@ -318,6 +320,12 @@ def test_an_unreachable_goal_is_written_with_its_reason_and_exits_1(written_plan
     from regrasp.planning.plan import Plan
 
     assert Plan.from_json(plan).reason == plan["reason"]  # read back
+
+
+def test_a_goal_the_grasp_cannot_hold_is_unreachable_and_exits_1(written_plans):
+    plan = _not_found(written_plans, 5, "cannot-hold.json", "no plan found: unreachable: the grasp cannot hold")
+    assert plan["stop_reason"] == "unreachable" and "within the goal's tolerance" in plan["reason"]
+    assert plan["planning_time_s"] < 1.0 and len(plan["path"]) == 1
 
 
 def test_a_3d_plan_file_has_exactly_the_documented_keys(written_plans):

@@ -110,6 +110,62 @@ fn a_goal_within_tolerance_of_the_start_part_is_not_refused() {
     assert!(unreachable(&s, &start, &goal, &[1.5e-3, 1.5e-3, 0.0]).is_some()); // reaches 2.12 mm
 }
 
+/// The low-friction block held by a weak grip (4 N): it holds the task's poses, not a pad far
+/// from the centre of mass.
+fn weak_block() -> Scene {
+    let text = include_str!("../../../examples/block-low-friction.toml").replace("force = 20.0", "force = 4.0");
+    Scene::from_toml_str(&text).unwrap()
+}
+
+/// Brute force: whether some pose of a 21³ grid of the goal's box holds.
+fn holds_somewhere(s: &Scene, goal: &[f64; 3], tol: &[f64; 3]) -> bool {
+    let at = |k: usize, i: usize| goal[k] + tol[k] * (i as f64 / 10.0 - 1.0);
+    (0..21).any(|i| (0..21).any(|j| (0..21).any(|k| s.hold_ratio(&[at(0, i), at(1, j), at(2, k)]) < 1.0)))
+}
+
+#[test]
+fn a_goal_the_grasp_cannot_hold_is_unreachable_at_once() {
+    let s = weak_block();
+    let goal = [0.0175, 0.0, 0.0];
+    assert!(s.hold_ratio(&goal) > 1.0 && !holds_somewhere(&s, &goal, &TOL));
+    let t0 = Instant::now();
+    let r = plan(&s, None, Some(goal), &PlanarSettings::default()).unwrap();
+    assert!(t0.elapsed().as_secs_f64() < 1.0);
+    assert!(!r.found && r.stop_reason == StopReason::Unreachable && r.path.len() == 1);
+    let why = r.reason.unwrap();
+    assert!(why.contains("cannot hold") && why.contains("tolerance"), "{why}");
+    // of the goals on a 9 x 9 grid over the block (1 mm, 1°) whose boxes hold nowhere, the
+    // certificate refuses nearly all (it leaves to the search only those near the limit)
+    let (mut nowhere, mut refused) = (0, 0);
+    for i in 0..9 {
+        for j in 0..9 {
+            let g = [-0.018 + 0.0045 * i as f64, -0.033 + 0.00825 * j as f64, 0.0];
+            if s.admissible(&g) && !holds_somewhere(&s, &g, &TOL) {
+                nowhere += 1;
+                refused += regrasp::planning::reachability::cannot_hold(&s, &g, &TOL).is_some() as usize;
+            }
+        }
+    }
+    assert!(nowhere >= 10 && 10 * refused >= 9 * nowhere, "{refused} of {nowhere} refused");
+    // a start the grasp cannot hold is a bad request, not a question for the planner
+    assert!(plan(&s, Some(goal), None, &PlanarSettings::default()).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+    /// On the weak grip, across the block: a goal declared unreachable for holding has no
+    /// holding pose in its tolerance box (21³ grid).
+    #[test]
+    fn a_goal_refused_for_holding_holds_nowhere(x in -0.02f64..0.02, z in -0.03f64..0.03, th in -1.0f64..1.0, t in 0.0005f64..0.004) {
+        let s = weak_block();
+        let (goal, tol) = ([x, z, th], [t, t, 10.0 * t]);
+        prop_assume!(s.admissible(&goal));
+        let refused = regrasp::planning::reachability::cannot_hold(&s, &goal, &tol).is_some();
+        let holds = holds_somewhere(&s, &goal, &tol);
+        prop_assert!(!(refused && holds), "refused a goal whose box holds somewhere");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(250))]
     /// A goal that a chain of short admissible pad moves reaches from the start is never declared

@@ -118,7 +118,9 @@ impl<'a> PlanarSpace<'a> {
             if !scene.admissible(q) {
                 return Err(Error::arg(name, format!("{q:?} is not admissible: the finger pad is not entirely on the object")));
             }
-            if !(scene.hold_ratio(q) < 1.0) {
+            // a goal may lie where the grasp cannot hold: the certificate decides
+            // ([`crate::planning::reachability::cannot_hold`])
+            if name == "start" && !(scene.hold_ratio(q) < 1.0) {
                 return Err(Error::arg(name, format!("{q:?}: the grasp cannot hold the object against gravity there")));
             }
         }
@@ -498,7 +500,8 @@ pub fn plan_tree(
     let tol = task.map(|t| t.tolerance).unwrap_or([1e-3, 1e-3, 0.0175]);
     let t0 = std::time::Instant::now();
     let space = PlanarSpace::new(scene, start, goal, tol, settings)?;
-    if let Some(reason) = crate::planning::reachability::unreachable(scene, &start, &goal, &tol) {
+    let reach = crate::planning::reachability::unreachable(scene, &start, &goal, &tol);
+    if let Some(reason) = reach.or_else(|| crate::planning::reachability::cannot_hold(scene, &goal, &tol)) {
         let root = crate::planning::tree::TreeNode { q: start, parent: None, pusher: None, edge: (), cost: 0.0, children: vec![] };
         return Ok((unreachable_plan(&space, start, reason, t0), vec![root]));
     }

@@ -12,6 +12,9 @@
 //! steeply with the vertices: 0.04 s at 1,000, 5 s at 10,000), by [`ERODE`]·r − 2ε: every
 //! shortening only enlarges the set, so the certificate errs towards "reachable", never the other
 //! way.
+//!
+//! A goal where the grasp cannot hold the object against gravity is unreachable too: the object
+//! cannot rest there ([`cannot_hold`]).
 
 use crate::mechanics::geometry::Vec2;
 use crate::scene::Scene;
@@ -48,6 +51,52 @@ pub fn unreachable(scene: &Scene, start: &[f64; 3], goal: &[f64; 3], tol: &[f64;
              ({:.2}, {:.2}) mm and the goal's ({:.2}, {:.2}) mm lie in different parts, the goal's \
              {:.2} mm beyond the start's part (the goal tolerance reaches {:.2} mm)",
             2e3 * r, 1e3 * r, region.0.len(), 1e3 * cs.x + 0.0, 1e3 * cs.y + 0.0, 1e3 * cg.x + 0.0, 1e3 * cg.y + 0.0, 1e3 * gap, 1e3 * slack
+        )
+    })
+}
+
+/// Grid points per axis of the goal's tolerance box where [`cannot_hold`] evaluates the grasp.
+pub const HOLD_GRID: usize = 5;
+
+/// Why the object cannot end within the goal's tolerance `tol` of `goal` (`[x, z, θ]`, m, m,
+/// rad): the grasp holds it nowhere there. The hold ratio (≥ 1: the pads' friction cannot carry
+/// the weight) is evaluated on a [`HOLD_GRID`]³ grid of the box and must exceed 1 everywhere by
+/// the largest change between neighbouring grid points (a smooth ratio cannot dip below 1
+/// between them), so the answer errs towards "reachable"; None when some pose may hold.
+pub fn cannot_hold(scene: &Scene, goal: &[f64; 3], tol: &[f64; 3]) -> Option<String> {
+    let n = HOLD_GRID;
+    let at = |k: usize, i: usize| goal[k] + tol[k] * (2.0 * i as f64 / (n - 1) as f64 - 1.0);
+    let mut h = vec![0.0; n * n * n];
+    let idx = |i: usize, j: usize, k: usize| (i * n + j) * n + k;
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                h[idx(i, j, k)] = scene.hold_ratio(&[at(0, i), at(1, j), at(2, k)]);
+            }
+        }
+    }
+    if !h.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let mut step: f64 = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let here = h[idx(i, j, k)];
+                for (a, b, c) in [(i + 1, j, k), (i, j + 1, k), (i, j, k + 1)] {
+                    if a < n && b < n && c < n {
+                        step = step.max((h[idx(a, b, c)] - here).abs());
+                    }
+                }
+            }
+        }
+    }
+    let low = h.iter().copied().fold(f64::INFINITY, f64::min);
+    (low >= 1.0 + step).then(|| {
+        format!(
+            "the grasp cannot hold the object against gravity anywhere within the goal's tolerance: the weight needs \
+             at least {:.0} % of what the pads' friction can carry there (grip force or pad friction too low for that pose)",
+            100.0 * low
         )
     })
 }
