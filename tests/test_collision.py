@@ -90,6 +90,12 @@ def test_every_example_moves_clear_of_the_workcell_by_mujocos_distances(name):
     finds the object, at every sample, at most PENETRATION_LIMIT into the feature of a push during
     its approach, push and retreat and out of every other body (and out of all in transfers)."""
     scene, plan = plan_of(name)
+    if name == "pivot-90-3d":
+        # the quarter turn's last push is by the patch under the block, turned 77° with it in the
+        # grasp: only a face tilted as much could serve it, and the default workcell has none
+        with pytest.raises(ExecutionError, match=r"no feature of workcell `default-pivot-90-3d` serves .*max_tilt"):
+            world_motion(scene, plan)
+        return
     m = world_motion(scene, plan)
     D = mujoco_depths(scene, m.workcell, m.object)
     names = [s.name for s in shapes(m.workcell)]
