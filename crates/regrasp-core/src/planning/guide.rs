@@ -19,7 +19,7 @@ use super::trrt::gauss;
 use crate::mechanics::geometry::{rot, Vec2};
 use crate::scene::Scene;
 use geo::algorithm::buffer::LineJoin;
-use geo::{Contains, Covers, Line, Point, Polygon};
+use geo::{Contains, Line, Point, Polygon, PreparedGeometry, Relate};
 use petgraph::graph::UnGraph;
 use rand::Rng;
 
@@ -36,12 +36,15 @@ pub const SPREAD: f64 = 0.12;
 /// The spread of a guided sample's turn about the goal's [rad].
 pub const TURN: f64 = 0.1;
 
-/// A polyline of pad centres [m], object frame, from the start's to the goal's.
+/// A polyline of pad centres [m], object frame, from the start's to the goal's, with the walls
+/// of the region it runs in.
 #[derive(Clone, Debug)]
 pub struct Guide {
     points: Vec<Vec2>,
     /// Arc length at each point [m].
     along: Vec<f64>,
+    /// The region's boundary edges: a pad centre is matched only to guide points it sees.
+    walls: Vec<(Vec2, Vec2)>,
 }
 
 impl Guide {
@@ -53,11 +56,14 @@ impl Guide {
         let (cg, _) = scene.pad_disc(goal)?;
         let region = pad_region(scene, r, LineJoin::Bevel)?;
         let part = region.0.into_iter().find(|p| p.contains(&point(&cs)))?;
-        if part.covers(&line(&cs, &cg)) {
-            return None;
-        }
         let corners = reflex_corners(&part);
         if corners.len() > MAX_CORNERS {
+            return None;
+        }
+        // the part indexed once (an R-tree of its edges) for the many segment tests
+        let prepared = PreparedGeometry::from(&part);
+        let sees = |a: &Vec2, b: &Vec2| prepared.relate(&line(a, b)).is_covers();
+        if sees(&cs, &cg) {
             return None;
         }
         let points: Vec<Vec2> = [cs, cg].into_iter().chain(corners).collect();
@@ -65,24 +71,29 @@ impl Guide {
         let ids: Vec<_> = points.iter().map(|p| graph.add_node(*p)).collect();
         for i in 0..points.len() {
             for j in i + 1..points.len() {
-                if part.covers(&line(&points[i], &points[j])) {
+                if sees(&points[i], &points[j]) {
                     graph.add_edge(ids[i], ids[j], (points[i] - points[j]).norm());
                 }
             }
         }
         let (_, route) = petgraph::algo::astar(&graph, ids[0], |n| n == ids[1], |e| *e.weight(), |n| (graph[n] - cg).norm())?;
-        Some(Self::through(route.iter().map(|&n| graph[n]).collect()))
+        let walls = std::iter::once(part.exterior())
+            .chain(part.interiors())
+            .flat_map(|ring| ring.lines().map(|l| (Vec2::new(l.start.x, l.start.y), Vec2::new(l.end.x, l.end.y))))
+            .collect();
+        Some(Self { walls, ..Self::through(route.iter().map(|&n| graph[n]).collect()) })
     }
 
-    /// The polyline through `points` (at least two).
-    pub fn through(points: Vec<Vec2>) -> Self {
+    /// The polyline through `points` (at least two), with no walls.
+    fn through(points: Vec<Vec2>) -> Self {
+        assert!(points.len() >= 2, "a guide joins two points at least");
         let along = std::iter::once(0.0)
             .chain(points.windows(2).scan(0.0, |s, w| {
                 *s += (w[1] - w[0]).norm();
                 Some(*s)
             }))
             .collect();
-        Self { points, along }
+        Self { points, along, walls: Vec::new() }
     }
 
     pub fn points(&self) -> &[Vec2] {
@@ -94,22 +105,35 @@ impl Guide {
         *self.along.last().unwrap_or(&0.0)
     }
 
-    /// The arc length of the guide's point nearest to `c` and the distance to it [m].
+    /// The arc length of the guide's point nearest to `c` among those `c` sees (no wall between
+    /// them; else the nearest of all), and the distance to it [m]. Across a thin wall the nearest
+    /// guide point can lie far further along the guide than the pad can get to directly.
     pub fn project(&self, c: &Vec2) -> (f64, f64) {
-        let mut best = (0.0, f64::INFINITY);
-        for (k, w) in self.points.windows(2).enumerate() {
-            let d = w[1] - w[0];
-            let n2 = d.norm_squared();
-            let u = if n2 > 0.0 { ((c - w[0]).dot(&d) / n2).clamp(0.0, 1.0) } else { 0.0 };
-            let dist = (w[0] + u * d - c).norm();
-            if dist < best.1 {
-                best = (self.along[k] + u * n2.sqrt(), dist);
-            }
-        }
-        best
+        let mut near: Vec<(f64, f64, Vec2)> = self
+            .points
+            .windows(2)
+            .enumerate()
+            .map(|(k, w)| {
+                let d = w[1] - w[0];
+                let n2 = d.norm_squared();
+                let u = if n2 > 0.0 { ((c - w[0]).dot(&d) / n2).clamp(0.0, 1.0) } else { 0.0 };
+                let p = w[0] + u * d;
+                (self.along[k] + u * n2.sqrt(), (p - c).norm(), p)
+            })
+            .collect();
+        near.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let seen = near.iter().find(|(_, _, p)| self.sees(c, p)).unwrap_or(&near[0]);
+        (seen.0, seen.1)
     }
 
-    /// The distance left to the goal's pad centre from `c` [m]: to the guide, then along it.
+    /// Whether no wall properly crosses the segment from `a` to `b`.
+    fn sees(&self, a: &Vec2, b: &Vec2) -> bool {
+        let side = |p: &Vec2, q: &Vec2, x: &Vec2| (q - p).perp(&(x - p));
+        !self.walls.iter().any(|(p, q)| side(p, q, a) * side(p, q, b) < 0.0 && side(a, b, p) * side(a, b, q) < 0.0)
+    }
+
+    /// The distance left to the goal's pad centre from `c` [m]: to the guide point it sees, then
+    /// along the guide.
     pub fn to_go(&self, c: &Vec2) -> f64 {
         let (s, d) = self.project(c);
         self.length() - s + d

@@ -69,7 +69,7 @@ pub struct PlanarSettings {
     pub plain: bool,
     /// When the pad's straight path leaves the object, the share of samples drawn along its guide
     /// path just ahead of the tree, whose length left is then T-RRT's cost map ([`Guide`]; 0: no
-    /// guide, uniform samples and the metric's distance).
+    /// guide, uniform samples and the metric's distance; none for a `plain` RRT).
     pub guide: f64,
 }
 
@@ -137,7 +137,7 @@ impl<'a> PlanarSpace<'a> {
             tol,
             bounds: ([-reach, reach], [-reach, reach], [tlo, thi]),
             qs_opts: QsOptions { support: SupportModel::Points { rings: 2, points: 0, merge_fingers: true }, ..QsOptions::default() },
-            guide: if s.guide > 0.0 { Guide::new(scene, &start, &goal) } else { None },
+            guide: None, // built once the certificates have let the search go ([`plan_tree`])
         })
     }
 
@@ -499,13 +499,17 @@ pub fn plan_tree(
     let goal = goal.or(task.map(|t| t.goal)).ok_or_else(|| Error::arg("goal", "the scene has no task: give a goal"))?;
     let tol = task.map(|t| t.tolerance).unwrap_or([1e-3, 1e-3, 0.0175]);
     let t0 = std::time::Instant::now();
-    let space = PlanarSpace::new(scene, start, goal, tol, settings)?;
+    let mut space = PlanarSpace::new(scene, start, goal, tol, settings)?;
     let reach = crate::planning::reachability::unreachable(scene, &start, &goal, &tol);
     if let Some(reason) = reach.or_else(|| crate::planning::reachability::cannot_hold(scene, &goal, &tol)) {
         let root = crate::planning::tree::TreeNode { q: start, parent: None, pusher: None, edge: (), cost: 0.0, children: vec![] };
         return Ok((unreachable_plan(&space, start, reason, t0), vec![root]));
     }
-    let before = t0.elapsed().as_secs_f64(); // the checks and the certificate count as planning time
+    // the guide around walls (not for the plain RRT, the switch-overs' reference)
+    if settings.guide > 0.0 && !settings.plain {
+        space.guide = Guide::new(scene, &start, &goal);
+    }
+    let before = t0.elapsed().as_secs_f64(); // the checks, the certificates and the guide count as planning time
     trrt::plan_tree(&space, start).map(|(mut r, nodes)| {
         r.planning_time_s += before;
         if let Some(f) = r.first.as_mut() {
