@@ -365,8 +365,10 @@ def plot_plan(scene, plan, path) -> Path:
     b.legend(fontsize=8)
     b.grid(alpha=0.3)
     b.set_title("pose in the grasp (bands: pusher of each step)")
-    fig.suptitle(f"{scene.name}: {'plan' if plan.found else 'best partial plan'} with {n - 1} steps, "
-                 f"{plan.switch_overs} switch-overs, found in {1e3 * plan.planning_time_s:.1f} ms ({plan.propagation})")
+    steps = f"{n - 1} step" + ("" if n - 1 == 1 else "s")
+    switches = f"{plan.switch_overs} switch-over" + ("" if plan.switch_overs == 1 else "s")
+    fig.suptitle(f"{scene.name}: {'plan' if plan.found else 'best partial plan'} with {steps}, "
+                 f"{switches}, found in {1e3 * plan.planning_time_s:.1f} ms ({plan.propagation})")
     return _save(fig, path)
 
 
