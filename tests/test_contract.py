@@ -268,10 +268,11 @@ def written_plans(tmp_path_factory):
     runs = cli_many([
         ["plan", EXAMPLES / "t-shape.toml", "--out", d / "planar.json", "--time-limit", "5"],
         ["plan", EXAMPLES / "offset-3d.toml", "--out", d / "3d.json", "--time-limit", "5"],
-        ["plan", d / "top-only.toml", "--out", d / "none.json", "--time-limit", "0.2"],
+        ["plan", ROOT / "benches" / "scenes" / "u-shape.toml", "--out", d / "none.json", "--time-limit", "0.002"],
         ["plan", EXAMPLES / "t-shape.toml", "--time-limit", "5", "--json"],
         ["plan", ROOT / "benches" / "scenes" / "neck-unreachable.toml", "--out", d / "unreachable.json"],
         ["plan", d / "weak.toml", "--goal", "0.0175,0,0", "--out", d / "cannot-hold.json"],
+        ["plan", d / "top-only.toml", "--out", d / "one-way.json"],
     ])
     return d, runs
 
@@ -309,7 +310,8 @@ def _not_found(written_plans, k: int, file: str, says: str) -> dict:
 
 
 def test_a_plan_not_found_is_written_with_the_documented_keys_and_exits_1(written_plans):
-    _not_found(written_plans, 2, "none.json", "no plan found")
+    plan = _not_found(written_plans, 2, "none.json", "no plan found")
+    assert plan["stop_reason"] == "time_limit" and "reason" not in plan
 
 
 def test_an_unreachable_goal_is_written_with_its_reason_and_exits_1(written_plans):
@@ -437,3 +439,10 @@ def test_cone_json_prints_the_documented_keys():
     (keys,) = documented_json_keys("regrasp cone")
     assert set(json.loads(r.stdout)) == set(keys)
     assert bad.returncode == 2 and "--pose" in bad.stderr, bad.stderr
+
+
+def test_a_goal_no_push_can_move_towards_is_unreachable_and_exits_1(written_plans):
+    # only the top pusher (it pushes the block down in the grasp, as gravity does); the goal is up
+    plan = _not_found(written_plans, 6, "one-way.json", "no plan found: unreachable: no push can move the pad's centre")
+    assert plan["stop_reason"] == "unreachable" and "the planner's range" in plan["reason"]
+    assert plan["planning_time_s"] < 1.0 and len(plan["path"]) == 1

@@ -72,18 +72,30 @@ def test_plan_cli_writes_the_contract_file(tmp_path):
     assert r.returncode == 0 and json.loads(r.stdout)["success"], r.stdout + r.stderr
 
 
-def test_unreachable_goal_exits_1_with_the_best_partial_plan(tmp_path):
+def test_a_search_out_of_time_exits_1_with_the_best_partial_plan(tmp_path):
+    out = tmp_path / "p.json"
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "plan", str(ROOT / "benches" / "scenes" / "u-shape.toml"),
+                        "--time-limit", "0.002", "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode == 1 and "no plan found" in r.stderr
+    d = json.loads(out.read_text())
+    assert d["found"] is False and d["stop_reason"] == "time_limit" and len(d["path"]) >= 1
+
+
+def test_a_goal_no_push_can_move_towards_exits_1_unreachable(tmp_path):
+    # only the top pusher, which pushes the block down in the grasp (gravity too): the task's
+    # goal is up and right
     text = (EXAMPLES / "block-low-friction.toml").read_text()
     parts = text.split("[[pushers]]")
     top = [p for p in parts[1:] if 'name = "top"' in p][0]
     f = tmp_path / "top-only.toml"
     f.write_text(parts[0] + "[[pushers]]" + top)
     out = tmp_path / "p.json"
-    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "plan", str(f), "--time-limit", "0.3", "--out", str(out)],
+    r = subprocess.run([sys.executable, "-m", "regrasp.cli", "plan", str(f), "--out", str(out)],
                        capture_output=True, text=True)
-    assert r.returncode == 1 and "no plan found" in r.stderr
+    assert r.returncode == 1 and "no plan found: unreachable: no push can move the pad's centre" in r.stderr, r.stderr
     d = json.loads(out.read_text())
-    assert d["found"] is False and d["stop_reason"] == "time_limit" and len(d["path"]) >= 1
+    assert d["found"] is False and d["stop_reason"] == "unreachable" and len(d["path"]) == 1
+    assert d["planning_time_s"] < 1.0
 
 
 def test_bad_requests():

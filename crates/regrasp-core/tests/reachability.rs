@@ -7,7 +7,7 @@ use common::{outline_scene, pad_pose, star};
 use proptest::prelude::*;
 use regrasp::mechanics::geometry::Vec2;
 use regrasp::planning::planar::{plan, PlanarSettings, StopReason};
-use regrasp::planning::reachability::unreachable;
+use regrasp::planning::reachability::{blocked, one_way, unreachable};
 use regrasp::Scene;
 use std::time::Instant;
 
@@ -196,4 +196,125 @@ proptest! {
         let q1 = pad_pose(c.x, c.y, turns.1);
         prop_assert_eq!(unreachable(&s, &q0, &q1, &[1e-4, 1e-4, 1e-3]), None);
     }
+}
+
+/// The low-friction block with only its top pusher (it pushes down): the object can only move
+/// down in the grasp, so the pad's centre only up in the object's frame.
+fn top_only() -> Scene {
+    let text = include_str!("../../../examples/block-low-friction.toml");
+    let kept: String = text
+        .split("[[pushers]]")
+        .enumerate()
+        .filter(|(i, p)| *i == 0 || p.contains("name = \"top\""))
+        .map(|(i, p)| if i == 0 { p.to_string() } else { format!("[[pushers]]{p}") })
+        .collect();
+    let s = Scene::from_toml_str(&kept).unwrap();
+    assert_eq!(s.pushers.len(), 1);
+    s
+}
+
+#[test]
+fn a_goal_no_push_can_move_towards_is_unreachable_at_once() {
+    let s = top_only();
+    let t0 = Instant::now();
+    let r = plan(&s, None, Some([0.0, 0.01, 0.0]), &PlanarSettings::default()).unwrap(); // the object 10 mm up
+    assert!(t0.elapsed().as_secs_f64() < 1.0);
+    assert!(!r.found && r.stop_reason == StopReason::Unreachable && r.path.len() == 1, "{r:?}");
+    let why = r.reason.unwrap();
+    assert!(why.contains("no push can move the pad's centre") && why.contains("10.00 mm"), "{why}");
+    // down is the pusher's way: left to the search, which finds it
+    let r = plan(&s, None, Some([0.0, -0.01, 0.0]), &PlanarSettings::default()).unwrap();
+    assert!(r.found, "{r:?}");
+    // sideways by less than the friction cone's bend allows is not decided either
+    let turn = [-0.5, 0.5];
+    assert_eq!(one_way(&s, &[0.0; 3], &[0.005, -0.01, 0.0], &TOL, turn), None);
+    // every pusher of the example together: nothing blocked
+    let all = Scene::from_toml_str(include_str!("../../../examples/block-low-friction.toml")).unwrap();
+    assert_eq!(blocked(&all, turn), None);
+}
+
+/// Brute force for [`blocked`]: at random poses within the turn range, the pad's centre moved by
+/// a short step along random non-negative combinations of each pusher's motion-cone generators
+/// (the planner's own model) never has a component along a blocked direction.
+fn check_blocked(s: &Scene, turn: [f64; 2], mid: f64, half: f64, rng: &mut impl rand::Rng) -> Result<usize, TestCaseError> {
+    let ends = [Vec2::new((mid - half).cos(), (mid - half).sin()), Vec2::new((mid + half).cos(), (mid + half).sin())];
+    let pad = |q: &[f64; 3]| s.pad_disc(q).unwrap().0;
+    let mut moves = 0;
+    for _ in 0..20 {
+        let th = turn[0] + (turn[1] - turn[0]) * rng.random::<f64>();
+        let q = pad_pose(0.01 * (rng.random::<f64>() - 0.5), 0.01 * (rng.random::<f64>() - 0.5), th);
+        for p in 0..s.pushers.len() {
+            let Ok(push) = s.push(&q, p) else { continue };
+            let Ok(gens) = push.generators() else { continue };
+            for _ in 0..4 {
+                let tw = gens.iter().fold(regrasp::mechanics::geometry::Vec3::zeros(), |a, g| a + g * rng.random::<f64>());
+                let step = tw * (1e-4 / tw.norm().max(1e-12));
+                let u = pad(&regrasp::pose::planar::integrate(&q, &step, 1.0)) - pad(&q);
+                for d in &ends {
+                    prop_assert!(d.dot(&u) <= 1e-9 * (1.0 + u.norm()) + 1e-12, "pad moved {:?} along blocked {:?}", u, d);
+                }
+                moves += 1;
+            }
+        }
+    }
+    Ok(moves)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+    /// On random blocks with one pusher (any face, line or point, any friction and gravity), the
+    /// blocked directions are never moved along by the motion cones at any turn of the range.
+    #[test]
+    fn blocked_directions_are_never_moved_along(b in common::block_case(), seed in 0u64..1000) {
+        let s = common::scene(&b);
+        prop_assume!(s.is_some());
+        let s = s.unwrap();
+        let turn = [b.pose[2] - 0.5, b.pose[2] + 0.5];
+        let Some((mid, half)) = blocked(&s, turn) else { return Ok(()) };
+        prop_assert!(half > 0.0 && half <= std::f64::consts::FRAC_PI_2);
+        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(seed);
+        check_blocked(&s, turn, mid, half, &mut rng)?;
+    }
+}
+
+#[test]
+fn one_pusher_blocks_directions_on_most_random_blocks() {
+    // the property above is not vacuous: one pusher of friction < 1 with gravity over a turn
+    // range of 1 rad leaves blocked directions on many blocks, whose cones move the pad
+    use proptest::strategy::ValueTree;
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let (mut scenes, mut some, mut moves) = (0, 0, 0);
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(7);
+    for _ in 0..300 {
+        let b = common::block_case().new_tree(&mut runner).unwrap().current();
+        let Some(s) = common::scene(&b) else { continue };
+        scenes += 1;
+        let turn = [b.pose[2] - 0.5, b.pose[2] + 0.5];
+        if let Some((mid, half)) = blocked(&s, turn) {
+            some += 1;
+            moves += check_blocked(&s, turn, mid, half, &mut rng).unwrap();
+        }
+    }
+    assert!(scenes >= 100 && 4 * some >= scenes && moves >= 1000, "{some} of {scenes} blocked, {moves} moves checked");
+}
+
+#[test]
+fn the_bundled_one_way_scene_is_unreachable_and_its_full_example_is_not() {
+    let s = Scene::from_toml_str(include_str!("../../../python/regrasp/examples/hard/one-way-unreachable.toml")).unwrap();
+    let t0 = Instant::now();
+    let r = plan(&s, None, None, &PlanarSettings::default()).unwrap();
+    assert!(t0.elapsed().as_secs_f64() < 1.0 && r.stop_reason == StopReason::Unreachable, "{r:?}");
+    assert!(r.reason.unwrap().contains("no push can move the pad's centre"));
+    // with the bottom and left pushers too (the bundled example), the same task is planned
+    let full = Scene::from_toml_str(include_str!("../../../examples/block-low-friction.toml")).unwrap();
+    assert!(plan(&full, None, None, &PlanarSettings::default()).unwrap().found);
+    // and with the left pusher alone added, nothing is blocked any more
+    let text = include_str!("../../../python/regrasp/examples/hard/one-way-unreachable.toml").replace(
+        "[[pushers]]\nname = \"top\"",
+        "[[pushers]]\nname = \"left\"\nfriction = 0.25\npoints = [[-0.025, -0.03], [-0.025, 0.03]]\nnormal = [1.0, 0.0]\n\n[[pushers]]\nname = \"top\"",
+    );
+    let three = Scene::from_toml_str(&text).unwrap();
+    assert_eq!(three.pushers.len(), 3);
+    let (start, goal, tol) = (s.task.unwrap().start, s.task.unwrap().goal, s.task.unwrap().tolerance);
+    assert_eq!(one_way(&three, &start, &goal, &tol, [-0.5, 0.5]), None);
 }

@@ -501,7 +501,10 @@ pub fn plan_tree(
     let t0 = std::time::Instant::now();
     let mut space = PlanarSpace::new(scene, start, goal, tol, settings)?;
     let reach = crate::planning::reachability::unreachable(scene, &start, &goal, &tol);
-    if let Some(reason) = reach.or_else(|| crate::planning::reachability::cannot_hold(scene, &goal, &tol)) {
+    let reach = reach
+        .or_else(|| crate::planning::reachability::cannot_hold(scene, &goal, &tol))
+        .or_else(|| crate::planning::reachability::one_way(scene, &start, &goal, &tol, space.bounds.2));
+    if let Some(reason) = reach {
         let root = crate::planning::tree::TreeNode { q: start, parent: None, pusher: None, edge: (), cost: 0.0, children: vec![] };
         return Ok((unreachable_plan(&space, start, reason, t0), vec![root]));
     }
@@ -669,7 +672,7 @@ mod tests {
         let s2 = Scene::from_toml_str(&top_only).unwrap();
         assert_eq!(s2.pushers.len(), 1);
         let r = plan(&s2, None, Some([0.0, 0.01, 0.0]), &with(SearchSettings { time_limit: 0.3, ..SearchSettings::default() })).unwrap();
-        assert!(!r.found && r.stop_reason == StopReason::TimeLimit);
+        assert!(!r.found && r.stop_reason == StopReason::Unreachable && r.reason.is_some());
         assert!(r.goal_distance > 0.0);
     }
 

@@ -14,9 +14,13 @@
 //! way.
 //!
 //! A goal where the grasp cannot hold the object against gravity is unreachable too: the object
-//! cannot rest there ([`cannot_hold`]).
+//! cannot rest there ([`cannot_hold`]). So is a goal whose pad centre lies, beyond its
+//! tolerance, in a direction no push can move the pad's centre: when the pushers' friction cones
+//! and gravity over the planner's turn range all push it within less than a half-plane
+//! ([`blocked`], [`one_way`]).
 
 use crate::mechanics::geometry::Vec2;
+use crate::scene::planar::Support;
 use crate::scene::Scene;
 use geo::algorithm::buffer::{BufferStyle, LineJoin};
 use geo::{Buffer, Contains, Distance, Euclidean, LineString, MultiPolygon, Point, Polygon, Simplify, Validation};
@@ -124,4 +128,102 @@ pub(crate) fn pad_region(scene: &Scene, r: f64, join: LineJoin<f64>) -> Option<M
         return None;
     }
     Some(shape.buffer_with_style(BufferStyle::new(-(ERODE * r - 2.0 * eps)).line_join(join)))
+}
+
+/// The directions the pad's centre can never move in (object frame), as an arc of unit
+/// vectors `d` with `d·u ≤ 0` for every velocity `u` of the pad's centre, at every turn in
+/// `turn` (rad): its middle angle and half-width (rad). None when every direction is possible.
+///
+/// On the grasp's ellipsoidal limit surface (eq 3.7), the object's velocity at the pad's centre
+/// is `B_ff` times the force on it (pushers' plus gravity's; `B` has no force–moment coupling for
+/// the disc and rectangle pads), so the pad's centre moves along `−B_ff (f_p + f_g)`: within the
+/// cone of the pushers' Coulomb edges `−f` and of gravity's directions `−Rᵀ(θ) d` over the turn,
+/// each widened by the angle `B_ff`'s anisotropy can bend a vector. When that cone is pointed
+/// (narrower than π), the directions at least 90° from all of it are blocked.
+pub fn blocked(scene: &Scene, turn: [f64; 2]) -> Option<(f64, f64)> {
+    let Support::Grasp(g) = &scene.support else { return None };
+    let b = &g.limit_surface.b;
+    let beta = 0.5 * (b[(0, 0)] + b[(1, 1)]);
+    let coupling = b[(0, 2)].abs() + b[(1, 2)].abs();
+    let aniso = (0.5 * (b[(0, 0)] - b[(1, 1)])).hypot(b[(0, 1)]);
+    if !(beta > 0.0) || coupling > 1e-9 * beta || aniso >= 0.5 * beta || !turn.iter().all(|t| t.is_finite()) {
+        return None;
+    }
+    let bend = (aniso / beta).asin() + 1e-9;
+    // velocity directions of the pad's centre: arcs [a, a + w]
+    let mut arcs: Vec<(f64, f64)> = Vec::new();
+    for p in &scene.pushers {
+        for e in p.contact.edge_wrenches() {
+            let f = Vec2::new(e.wrench.x, e.wrench.y);
+            if f.norm() > 0.0 {
+                arcs.push(((-f.y).atan2(-f.x) - bend, 2.0 * bend));
+            }
+        }
+    }
+    if gravity_in_plane(scene) {
+        let a = (-scene.gravity_dir.y).atan2(-scene.gravity_dir.x); // −d; Rᵀ(θ) turns it by −θ
+        arcs.push((a - turn[1] - bend, turn[1] - turn[0] + 2.0 * bend));
+    }
+    let mut angles: Vec<f64> = Vec::new();
+    for (a, w) in arcs {
+        if w >= std::f64::consts::PI {
+            return None;
+        }
+        let n = (w / 0.25).ceil() as usize + 1; // samples 0.25 rad apart at most: no gap inside an arc
+        angles.extend((0..n).map(|k| (a + w * k as f64 / (n - 1).max(1) as f64).rem_euclid(std::f64::consts::TAU)));
+    }
+    if angles.is_empty() {
+        return None;
+    }
+    angles.sort_by(f64::total_cmp);
+    // the largest gap between neighbouring directions: the velocities lie in its complement
+    let (mut gap, mut after) = (angles[0] + std::f64::consts::TAU - angles[angles.len() - 1], angles[0]);
+    for w in angles.windows(2) {
+        if w[1] - w[0] > gap {
+            (gap, after) = (w[1] - w[0], w[1]);
+        }
+    }
+    let span = std::f64::consts::TAU - gap;
+    (span < std::f64::consts::PI - 1e-9).then(|| (after + 0.5 * span + std::f64::consts::PI, 0.5 * (std::f64::consts::PI - span)))
+}
+
+/// Why no plan whose turn stays within `turn` (rad: the range the planner samples, the start's
+/// and the goal's turns widened by `theta_margin`) can take the pad's centre from the start's to
+/// the goal's: it would have to move in a direction no push can move it ([`blocked`]) by more
+/// than the goal tolerance `tol` allows; None when that does not decide it. Without in-plane
+/// gravity the turn does not matter and the answer holds for every plan; with it, a plan turning
+/// the object further (gravity then pulls another way in the object's frame) is not excluded.
+pub fn one_way(scene: &Scene, start: &[f64; 3], goal: &[f64; 3], tol: &[f64; 3], turn: [f64; 2]) -> Option<String> {
+    let (mid, half) = blocked(scene, turn)?;
+    let (cs, _) = scene.pad_disc(start)?;
+    let (cg, _) = scene.pad_disc(goal)?;
+    let delta = cg - cs;
+    // the blocked direction closest to Δ: its angle clamped into the arc
+    let off = (delta.y.atan2(delta.x) - mid + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    let a = mid + off.clamp(-half, half);
+    let d = Vec2::new(a.cos(), a.sin());
+    let shift = tol[0].hypot(tol[1]);
+    let slack = shift + (goal[0].hypot(goal[1]) + shift) * tol[2];
+    let need = d.dot(&delta);
+    let within = if gravity_in_plane(scene) {
+        format!(
+            " while the object's turn in the grasp stays within {:.3}..{:.3} rad (the planner's range, the start's and the goal's \
+             turns widened by theta_margin: widen it to consider larger turns, which let gravity pull another way)",
+            turn[0], turn[1]
+        )
+    } else {
+        String::new()
+    };
+    (need > slack + 1e-9).then(|| {
+        format!(
+            "no push can move the pad's centre along ({:.3}, {:.3}) in the object's frame{within} (the pushers' friction cones and \
+             gravity all push it the other way), and the goal needs {:.2} mm of it (the goal tolerance reaches {:.2} mm)",
+            d.x + 0.0, d.y + 0.0, 1e3 * need, 1e3 * slack
+        )
+    })
+}
+
+/// Whether gravity pulls in the object's plane (it then depends on the turn).
+fn gravity_in_plane(scene: &Scene) -> bool {
+    scene.mass * scene.g_plane() > 0.0 && scene.gravity_dir.norm() > 0.0
 }
