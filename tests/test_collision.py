@@ -41,7 +41,7 @@ def task_examples():
 
 def mujoco_rig(scene, workcell):
     """A MuJoCo model with the workcell's bodies (from shapes()) and the object on a mocap body:
-    a planar object as its outline's convex pieces extruded ±6 mm, a 3-D one as its mesh or sphere."""
+    a planar object as its outline's convex pieces extruded ±6 mm, a 3-D one as its sphere or convex parts."""
     from regrasp.mujoco.model import THICKNESS, convex_pieces
 
     spec = mujoco.MjSpec()
@@ -56,10 +56,10 @@ def mujoco_rig(scene, workcell):
             body.add_geom(name=f"object{k}", type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"piece{k}")
     elif scene._core.sphere is not None:
         body.add_geom(name="object0", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[scene._core.sphere, 0, 0])
-    else:
-        v, _ = scene.mesh()
-        spec.add_mesh(name="piece0", uservert=np.ravel(np.asarray(v, float)).tolist())
-        body.add_geom(name="object0", type=mujoco.mjtGeom.mjGEOM_MESH, meshname="piece0")
+    else:  # its convex parts (the mesh alone for a convex object)
+        for k, (v, _) in enumerate(scene.parts()):
+            spec.add_mesh(name=f"piece{k}", uservert=np.ravel(np.asarray(v, float)).tolist())
+            body.add_geom(name=f"object{k}", type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"piece{k}")
     m = spec.compile()
     return m, mujoco.MjData(m)
 

@@ -16,7 +16,7 @@ from regrasp.viz.viewer import write_html
 from .conftest import EXAMPLES, ROOT
 
 THREE_D = ["offset-3d", "light-side-3d", "pivot-single-3d", "pivot-3d", "block-3d", "prism-3d", "ball-roll-3d", "pivot-90-3d",
-           "offset-pivot-3d"]
+           "offset-pivot-3d", "bracket-pivot-3d"]
 
 
 @pytest.mark.parametrize("name", THREE_D)
@@ -110,7 +110,7 @@ def test_3d_plans_execute_in_mujoco(tmp_path):
     pytest.importorskip("mujoco")
     from regrasp.mujoco.spatial import execute_plan3d
 
-    for name in ("offset-3d", "pivot-single-3d", "pivot-3d", "prism-3d", "pivot-90-3d", "offset-pivot-3d"):
+    for name in ("offset-3d", "pivot-single-3d", "pivot-3d", "prism-3d", "pivot-90-3d", "offset-pivot-3d", "bracket-pivot-3d"):
         s = Scene3D.load(EXAMPLES / f"{name}.toml")
         p = s.plan(seed=0)
         for view in ("world", "planner"):
@@ -212,3 +212,36 @@ def test_solves_are_deterministic_under_a_seed():
     runs = [s.plan(None, None, settings) for _ in range(3)]
     assert len({r["solves"] for r in runs}) == 1, [r["solves"] for r in runs]
     assert len({r["nodes"] for r in runs}) == 1 and runs[0]["solves"] > 0
+
+
+def test_a_non_convex_object_is_its_parts_in_mujoco():
+    """The L-bracket (two convex parts): MuJoCo, given the parts as mesh geoms of aluminium's
+    density and left to compute the body's mass properties itself, agrees with the scene's (ours
+    from the parts' closed triangle meshes); the hull would not. The object's geoms are the parts."""
+    mujoco = pytest.importorskip("mujoco")
+    from regrasp.mujoco.spatial import build
+
+    s = Scene3D.load(EXAMPLES / "bracket-pivot-3d.toml")
+    parts = s.parts()
+    assert len(parts) == 2 and len(s.mesh()[0]) == 10
+    spec = mujoco.MjSpec()
+    body = spec.worldbody.add_body(name="b")
+    for k, (v, t) in enumerate(parts):
+        spec.add_mesh(name=f"p{k}", uservert=np.ravel(v).tolist(), userface=np.ravel(t).tolist())
+        body.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"p{k}", density=2700.0)
+    m = spec.compile()
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    mass = m.body_mass[1]
+    assert abs(mass - 2700.0 * 31.2e-6) < 1e-9
+    assert np.allclose(d.xipos[1], s._core.com, atol=1e-9)
+    # MuJoCo's principal inertia (its own frame) against the scene's, scaled to MuJoCo's mass
+    I = np.asarray(s.inertia, float) * mass / s.mass
+    assert np.allclose(np.sort(np.linalg.eigvalsh(I)), np.sort(m.body_inertia[1]), rtol=1e-6)
+    # the execution's model: one mesh geom per part
+    model = build(s, s.task[0]).compile()
+    obj = model.body("object").id
+    assert sum(int(model.geom_bodyid[g] == obj and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH) for g in range(model.ngeom)) == 2
+    # the surface drawn: both parts' triangles
+    v, t = s.surface()
+    assert len(v) == 16 and len(t) == 24 and t.max() == 15

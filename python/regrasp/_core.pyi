@@ -345,7 +345,11 @@ class Scene3D:
     def pad_radius(self) -> float:
         """Radius of the finger pads [m]."""
     def mesh(self) -> tuple[_Floats, NDArray[np.uint32]]:
-        """Vertices (n, 3) and triangles (m, 3) of the object's mesh."""
+        """Vertices (n, 3) and triangles (m, 3) of the object's mesh (a non-convex object's convex
+        hull)."""
+    def parts(self) -> list[tuple[_Floats, NDArray[np.uint32]]]:
+        """The object's convex parts, each its vertices (n, 3) and triangles (m, 3): the mesh alone
+        for a convex object."""
     def pad_contacts(self, pose: ArrayLike) -> list[list[list[float]]]:
         """Contact points (object frame, m) of the two finger pads at `pose` `[x, y, z, qw, qx, qy, qz]`
         (m, unit quaternion)."""

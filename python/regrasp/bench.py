@@ -356,7 +356,7 @@ def run_mpc(reps: int = 200) -> dict:
 
 
 PLANNED_3D = ("offset-3d", "light-side-3d", "pivot-single-3d", "pivot-3d", "block-3d", "prism-3d", "ball-roll-3d",
-              "pivot-90-3d", "offset-pivot-3d")
+              "pivot-90-3d", "offset-pivot-3d", "bracket-pivot-3d")
 
 
 def run_plan3d(seeds: int = 10, examples=PLANNED_3D) -> dict:

@@ -121,10 +121,18 @@ impl Scene3D {
     /// Radius of the finger pads [m].
     #[getter] fn pad_radius(&self) -> f64 { self.inner.pad_radius }
 
-    /// Vertices (n, 3) and triangles (m, 3) of the object's mesh.
+    /// Vertices (n, 3) and triangles (m, 3) of the object's mesh (a non-convex object's convex
+    /// hull).
     fn mesh<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>) {
-        let m = &self.inner.mesh;
-        (rows_array(py, m.vertices.iter().map(|&v| v.into()).collect()), rows_array(py, m.triangles.iter().map(|t| t.map(|i| i as u32)).collect()))
+        mesh_arrays(py, &self.inner.mesh)
+    }
+    /// The object's convex parts, each its vertices (n, 3) and triangles (m, 3): the mesh alone
+    /// for a convex object.
+    fn parts<'py>(&self, py: Python<'py>) -> Vec<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>)> {
+        if self.inner.parts.is_empty() {
+            return vec![mesh_arrays(py, &self.inner.mesh)];
+        }
+        self.inner.parts.iter().map(|m| mesh_arrays(py, m)).collect()
     }
     /// Contact points (object frame, m) of the two finger pads at `pose` `[x, y, z, qw, qx, qy, qz]`
     /// (m, unit quaternion).
@@ -158,4 +166,9 @@ impl Scene3D {
             dynamics::simulate_spatial(py, &self.inner, PushArgs { pose, pusher, twist, duration, dt })
         })
     }
+}
+
+/// A mesh's vertices and triangles as numpy arrays.
+fn mesh_arrays<'py>(py: Python<'py>, m: &regrasp::scene::spatial::ConvexMesh) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>) {
+    (rows_array(py, m.vertices.iter().map(|&v| v.into()).collect()), rows_array(py, m.triangles.iter().map(|t| t.map(|i| i as u32)).collect()))
 }

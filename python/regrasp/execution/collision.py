@@ -111,11 +111,14 @@ def solid(scene) -> Solid:
         c, s, z = r * np.cos(a), r * np.sin(a), np.zeros_like(a)
         pts = np.vstack([np.c_[c, s, z], np.c_[c, z, s], np.c_[z, c, s]])
         return Solid(pts, [], float(r), float(r))
-    v, t = scene.mesh()
-    v, t = np.asarray(v, float), np.asarray(t, int)
-    edges = sorted({tuple(sorted((int(a), int(b)))) for tri in t for a, b in zip(tri, np.roll(tri, -1))})
-    pts = np.vstack([v] + [_along(v[a], v[b], SPACING) for a, b in edges])
-    return Solid(pts, [_planes(v, t)], 0.0, float(np.max(np.linalg.norm(pts, axis=1))))
+    pts, pieces = [], []
+    for v, t in scene.parts():  # a non-convex object: one convex piece per part
+        v, t = np.asarray(v, float), np.asarray(t, int)
+        edges = sorted({tuple(sorted((int(a), int(b)))) for tri in t for a, b in zip(tri, np.roll(tri, -1))})
+        pts += [v] + [_along(v[a], v[b], SPACING) for a, b in edges]
+        pieces.append(_planes(v, t))
+    pts = np.vstack(pts)
+    return Solid(pts, pieces, 0.0, float(np.max(np.linalg.norm(pts, axis=1))))
 
 
 def cores(shapes: list[Shape]) -> list:

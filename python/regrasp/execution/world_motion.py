@@ -242,7 +242,7 @@ def edge_points(scene) -> np.ndarray:
         v = object_points(scene)
         edges = [(v[i], v[(i + 1) % len(v)]) for i in range(len(v))]
     else:
-        v, t = scene.mesh()
+        v, t = scene.surface()  # a non-convex object: its parts' edges
         v, t = np.asarray(v, float), np.asarray(t, int)
         edges = {tuple(sorted((int(a), int(b)))) for tri in t for a, b in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0]))}
         edges = [(v[a], v[b]) for a, b in sorted(edges)]

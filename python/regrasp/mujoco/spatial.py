@@ -80,8 +80,9 @@ def add_feature_geoms(body, scene, name: str, friction: float):
 
 
 def add_object3d(spec, scene, s0, mesh, mass_scale: float):
-    """The object at pose ``s0`` on a free joint: a sphere or the scene's convex ``mesh``
-    (vertices, triangles)."""
+    """The object at pose ``s0`` on a free joint: a sphere, the scene's convex ``mesh``
+    (vertices, triangles) or, for a non-convex object, one mesh geom per convex part (MuJoCo
+    collides each as its convex hull: exact for a convex part); the inertia is the scene's."""
     m = scene.mass * mass_scale
     I = np.asarray(scene.inertia, float) * mass_scale
     body = spec.worldbody.add_body(name="object", pos=s0[:3], quat=s0[3:])
@@ -91,6 +92,12 @@ def add_object3d(spec, scene, s0, mesh, mass_scale: float):
     kw = dict(bits=OBJECT_BITS, friction=[0.0], condim=4)
     if scene._core.sphere:
         return add_geom(body, "sphere", [scene._core.sphere], **kw)
+    parts = scene.parts()
+    if len(parts) > 1:
+        for k, (v, t) in enumerate(parts):
+            spec.add_mesh(name=f"obj_{k}", uservert=np.ravel(v).tolist(), userface=np.ravel(t).tolist())
+            add_geom(body, "mesh", [], meshname=f"obj_{k}", **kw)
+        return None
     v, t = mesh
     spec.add_mesh(name="obj", uservert=np.ravel(v).tolist(), userface=np.ravel(t).tolist())
     return add_geom(body, "mesh", [], meshname="obj", **kw)

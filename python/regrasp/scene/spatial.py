@@ -71,8 +71,24 @@ class Scene3D:
 
     def mesh(self):
         """The object's mesh: vertices (n, 3) in the object frame [m] and triangles (m, 3) (vertex
-        indices, uint32)."""
+        indices, uint32); for a non-convex object (an OBJ of convex parts) their convex hull, where
+        planes and pads touch it."""
         return self._core.mesh()
+
+    def parts(self) -> list:
+        """The object's convex parts (their union is the object), each its vertices (n, 3) [m] and
+        triangles (m, 3): ``[mesh()]`` for a convex object."""
+        return self._core.parts()
+
+    def surface(self):
+        """The object's surface to draw: the parts' vertices stacked and their triangles renumbered
+        (``mesh()`` for a convex object)."""
+        parts = self.parts()
+        if len(parts) == 1:
+            return parts[0]
+        offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
+        return (np.vstack([np.asarray(v, float) for v, _ in parts]),
+                np.vstack([np.asarray(t, np.int64) + o for (_, t), o in zip(parts, offsets)]).astype(np.uint32))
 
     def pad_contacts(self, pose) -> list:
         """Contact points of the two finger pads at ``pose`` ``[x, y, z, qw, qx, qy, qz]`` (m, quaternion),
@@ -158,7 +174,11 @@ def _check_mesh_file(text: str, base) -> None:
     if not isinstance(mesh, str) or not mesh.strip():
         return
     folder = Path(base or ".").absolute()
-    if not (folder / mesh).is_file():
+    try:
+        found = (folder / mesh).is_file()
+    except (OSError, ValueError):  # e.g. a name too long for the file system: the core says why
+        return
+    if not found:
         raise SceneError(f"scene field `object.mesh`: cannot read {mesh}: no such file (`object.mesh` is relative "
                          f"to the scene file's folder, {folder}; `regrasp examples NAME --copy DIR` copies a "
                          f"bundled scene with its meshes)", "object.mesh")

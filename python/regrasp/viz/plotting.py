@@ -466,7 +466,7 @@ def plot_control(scene, res, path, extra=None) -> Path:
 def _plan3d(scene, plan):
     """The prelude of the 3-D figures: the object's mesh (vertices [m] in the object frame,
     triangles), the plan checked against ``scene`` and its poses (m, unit quaternion) as an array."""
-    v, t = scene.mesh()
+    v, t = scene.surface()
     plan = as_plan(plan, scene)
     return np.asarray(v, float), np.asarray(t, int), plan, np.asarray(plan.poses, float)
 

@@ -206,7 +206,7 @@ def spatial_description(scene, plan_poses, plan_pushers, marks) -> dict:
     poses [x, y, z, qw, qx, qy, qz] (m, unit quaternion) in the gripper frame, ``plan_pushers``
     their pusher names."""
     core = scene._core
-    v, t = scene.mesh()
+    v, t = scene.surface()
     v = np.asarray(v, float)
     size = float(np.linalg.norm(v, axis=1).max())
     start, goal, _ = scene.task

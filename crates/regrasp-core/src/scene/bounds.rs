@@ -76,6 +76,8 @@ pub const MAX_OUTLINE_VERTICES: usize = 10_000;
 /// Most vertices and triangles of a 3-D mesh (its convexity test is vertices × triangles).
 pub const MAX_MESH_VERTICES: usize = 5_000;
 pub const MAX_MESH_TRIANGLES: usize = 10_000;
+/// The most convex parts of a non-convex 3-D object.
+pub const MAX_MESH_PARTS: usize = 64;
 /// Most points of one 3-D pusher.
 pub const MAX_PUSHER_POINTS: usize = 1_000;
 /// Most pushers in a scene.

@@ -160,6 +160,15 @@ impl ConvexMesh {
             let n = n.normalize();
             planes.push((n, n.dot(&a)));
         }
+        // closed and consistently oriented: each directed edge once, and its reverse once
+        let mut edges: Vec<(usize, usize)> = triangles.iter().flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
+        edges.sort_unstable();
+        if let Some(w) = edges.windows(2).find(|w| w[0] == w[1]) {
+            return Err(format!("the edge between vertices {} and {} is used twice in the same direction (triangles not consistently oriented, or more than two at an edge)", w[0].0 + 1, w[0].1 + 1));
+        }
+        if let Some(&(a, b)) = edges.iter().find(|&&(a, b)| edges.binary_search(&(b, a)).is_err()) {
+            return Err(format!("the mesh is not closed: the edge between vertices {} and {} borders one triangle only", a + 1, b + 1));
+        }
         let m = Self { vertices, triangles, planes };
         let vol = m.mass_properties().0;
         if !(vol > 0.0 && vol.is_finite()) {
@@ -173,39 +182,51 @@ impl ConvexMesh {
         Ok(m)
     }
 
-    /// Reads a Wavefront OBJ file (`v` and `f` lines; polygons are fanned into triangles).
+    /// Reads a Wavefront OBJ file (`v` and `f` lines; polygons are fanned into triangles) of one
+    /// convex mesh.
     pub fn from_obj(text: &str) -> std::result::Result<Self, String> {
-        let mut v = Vec::new();
-        let mut t = Vec::new();
-        for (ln, line) in text.lines().enumerate() {
-            let mut it = line.split_whitespace();
-            match it.next() {
-                Some("v") => {
-                    let c: Vec<f64> = it.take(3).map(|x| x.parse::<f64>()).collect::<std::result::Result<_, _>>()
-                        .map_err(|e| format!("line {}: {e}", ln + 1))?;
-                    if c.len() != 3 {
-                        return Err(format!("line {}: a vertex needs 3 coordinates", ln + 1));
-                    }
-                    v.push(V3::new(c[0], c[1], c[2]));
+        let (v, parts) = read_obj(text)?;
+        Self::new(v, parts.into_iter().flat_map(|(_, t)| t).collect())
+    }
+
+    /// The convex parts of a Wavefront OBJ file: each object or group (`o`, `g` lines) with
+    /// faces is one closed convex mesh (one part when there are no such lines).
+    pub fn parts_from_obj(text: &str) -> std::result::Result<Vec<Self>, String> {
+        let (v, parts) = read_obj(text)?;
+        let many = parts.len() > 1;
+        parts
+            .into_iter()
+            .enumerate()
+            .map(|(k, (name, t))| {
+                // the part's own vertices, renumbered
+                let mut used: Vec<usize> = t.iter().flatten().copied().collect();
+                used.sort_unstable();
+                used.dedup();
+                if let Some(&i) = used.iter().find(|&&i| i >= v.len()) {
+                    return Err(format!("part {k} ({name}): a face refers to vertex {} of {}", i + 1, v.len()));
                 }
-                Some("f") => {
-                    let idx: Vec<usize> = it
-                        .map(|x| x.split('/').next().unwrap_or("").parse::<isize>())
-                        .collect::<std::result::Result<Vec<_>, _>>()
-                        .map_err(|e| format!("line {}: {e}", ln + 1))?
-                        .into_iter()
-                        .map(|i| if i < 0 { (v.len() as isize + i) as usize } else { (i - 1) as usize })
-                        .collect();
-                    if idx.len() < 3 {
-                        return Err(format!("line {}: a face needs 3 vertices", ln + 1));
-                    }
-                    for k in 1..idx.len() - 1 {
-                        t.push([idx[0], idx[k], idx[k + 1]]);
-                    }
-                }
-                _ => {}
-            }
-        }
+                let at = |i: usize| used.binary_search(&i).unwrap_or(0);
+                let tri = t.iter().map(|f| [at(f[0]), at(f[1]), at(f[2])]).collect();
+                Self::new(used.iter().map(|&i| v[i]).collect(), tri).map_err(|e| if many { format!("part {k} ({name}): {e}") } else { e })
+            })
+            .collect()
+    }
+
+    /// The convex hull of `points` (parry's quickhull), triangles outward.
+    pub fn hull(points: &[V3]) -> std::result::Result<Self, String> {
+        use parry3d_f64::math::Vector;
+        let pts: Vec<Vector> = points.iter().map(|p| Vector::new(p.x, p.y, p.z)).collect();
+        let (v, t) = parry3d_f64::transformation::try_convex_hull(&pts).map_err(|e| format!("no convex hull: {e:?}"))?;
+        let v: Vec<V3> = v.iter().map(|p| V3::new(p.x, p.y, p.z)).collect();
+        let c = v.iter().fold(V3::zeros(), |a, p| a + p) / v.len().max(1) as f64;
+        // each triangle turned to face away from the hull's interior (its vertices' mean)
+        let t = t
+            .iter()
+            .map(|f| {
+                let [a, b, d] = [f[0] as usize, f[1] as usize, f[2] as usize];
+                if (v[b] - v[a]).cross(&(v[d] - v[a])).dot(&(v[a] - c)) < 0.0 { [a, d, b] } else { [a, b, d] }
+            })
+            .collect();
         Self::new(v, t)
     }
 
@@ -253,8 +274,12 @@ pub struct Pusher3 {
 #[derive(Clone, Debug)]
 pub struct Scene3 {
     pub name: String,
-    /// The object's surface: exact for a box or a mesh, a drawing (an icosphere) for a sphere.
+    /// The object's surface: exact for a box or a convex mesh, a drawing (an icosphere) for a
+    /// sphere; for an object of several convex parts their convex hull (where a plane or a pad
+    /// touches the object).
     pub mesh: ConvexMesh,
+    /// A non-convex object's convex parts (their union is the object); empty for a convex one.
+    pub parts: Vec<ConvexMesh>,
     /// A sphere's radius (centred on the object frame's origin): its exact surface.
     pub sphere: Option<f64>,
     pub mass: f64,
@@ -276,9 +301,11 @@ pub struct Scene3 {
 }
 
 /// Signed distance to the object's surface: the sphere's exactly, else the mesh's.
-pub(crate) fn surface_distance(mesh: &ConvexMesh, sphere: Option<f64>, p: &V3) -> f64 {
+pub(crate) fn surface_distance(mesh: &ConvexMesh, parts: &[ConvexMesh], sphere: Option<f64>, p: &V3) -> f64 {
     match sphere {
         Some(r) => p.norm() - r,
+        // the union of the parts: exact outside, a bound inside
+        None if !parts.is_empty() => parts.iter().map(|m| m.signed_distance(p)).fold(f64::INFINITY, f64::min),
         None => mesh.signed_distance(p),
     }
 }
@@ -291,7 +318,7 @@ impl Scene3 {
 
     /// Signed distance of object-frame point `p` to the object's surface (positive outside).
     pub fn signed_distance(&self, p: &V3) -> f64 {
-        surface_distance(&self.mesh, self.sphere, p)
+        surface_distance(&self.mesh, &self.parts, self.sphere, p)
     }
 
     /// The object's points lowest along `n` (object frame): where a plane with normal `n`
@@ -381,7 +408,7 @@ impl Scene3 {
                     let pg = nalgebra::Point3::new(rho * a.cos(), 0.0, rho * a.sin());
                     let po = inv * pg;
                     let on_face = po.coords + dir * (top - po.coords.dot(&dir));
-                    if self.mesh.signed_distance(&on_face) <= 1e-6 * size {
+                    if self.signed_distance(&on_face) <= 1e-6 * size {
                         out[side].push(on_face);
                     }
                 }
@@ -391,4 +418,48 @@ impl Scene3 {
         }
         out
     }
+}
+
+/// The vertices of an OBJ text and its faces (fanned into triangles, 0-based vertex indices)
+/// grouped by the `o`/`g` lines before them, with the groups' names; groups without faces are
+/// dropped.
+fn read_obj(text: &str) -> std::result::Result<(Vec<V3>, Vec<(String, Vec<[usize; 3]>)>), String> {
+    let mut v = Vec::new();
+    let mut parts: Vec<(String, Vec<[usize; 3]>)> = vec![("unnamed".into(), Vec::new())];
+    for (ln, line) in text.lines().enumerate() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f64> = it.take(3).map(|x| x.parse::<f64>()).collect::<std::result::Result<_, _>>()
+                    .map_err(|e| format!("line {}: {e}", ln + 1))?;
+                if c.len() != 3 {
+                    return Err(format!("line {}: a vertex needs 3 coordinates", ln + 1));
+                }
+                v.push(V3::new(c[0], c[1], c[2]));
+            }
+            Some(kw @ ("o" | "g")) => {
+                let name = it.collect::<Vec<_>>().join(" ");
+                parts.push((format!("`{kw} {name}`"), Vec::new()));
+            }
+            Some("f") => {
+                let idx: Vec<usize> = it
+                    .map(|x| x.split('/').next().unwrap_or("").parse::<isize>())
+                    .collect::<std::result::Result<Vec<_>, _>>()
+                    .map_err(|e| format!("line {}: {e}", ln + 1))?
+                    .into_iter()
+                    .map(|i| if i < 0 { (v.len() as isize + i) as usize } else { (i - 1) as usize })
+                    .collect();
+                if idx.len() < 3 {
+                    return Err(format!("line {}: a face needs 3 vertices", ln + 1));
+                }
+                let t = &mut parts.last_mut().expect("one group at least").1;
+                for k in 1..idx.len() - 1 {
+                    t.push([idx[0], idx[k], idx[k + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    parts.retain(|(_, t)| !t.is_empty());
+    Ok((v, parts))
 }

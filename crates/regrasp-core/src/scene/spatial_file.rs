@@ -133,16 +133,17 @@ impl Scene3 {
         }
         let name = name("name", raw.name)?;
         let obj = req("object", raw.object)?;
-        let (mesh, sphere) = shape(&obj, base)?;
-        let (mass, com, inertia) = mass_properties(&obj, &mesh, sphere)?;
+        let solid = shape(&obj, base)?;
+        let (mass, com, inertia) = mass_properties(&obj, &solid)?;
         let gr = req("grasp", raw.grasp)?;
         let (start, goal, tolerance) = task(req("task", raw.task)?)?;
         let mut notes = Vec::new();
         let s = Scene3 {
             name,
-            pushers: pushers(req("pushers", raw.pushers)?, &mesh, sphere, &mut notes)?,
-            mesh,
-            sphere,
+            pushers: pushers(req("pushers", raw.pushers)?, &solid, &mut notes)?,
+            mesh: solid.mesh,
+            parts: solid.parts,
+            sphere: solid.sphere,
             mass,
             com,
             inertia,
@@ -170,9 +171,24 @@ impl Scene3 {
     }
 }
 
-/// The object's surface: a box, a convex OBJ mesh (relative to `base`) or a sphere (with its
-/// radius; its mesh an icosphere for drawing and contacts); its size within [`bounds::SIZE`].
-fn shape(obj: &RawObject, base: Option<&Path>) -> Result<(ConvexMesh, Option<f64>)> {
+/// The object's solid while the scene is read: its mesh (a non-convex object's convex hull),
+/// its convex parts (empty for a convex object) and a sphere's radius.
+struct Solid {
+    mesh: ConvexMesh,
+    parts: Vec<ConvexMesh>,
+    sphere: Option<f64>,
+}
+
+impl Solid {
+    fn distance(&self, p: &V3) -> f64 {
+        surface_distance(&self.mesh, &self.parts, self.sphere, p)
+    }
+}
+
+/// The object's surface: a box, an OBJ mesh (relative to `base`: one convex mesh, or the convex
+/// parts of a non-convex object, [`parts`]) or a sphere (with its radius; its mesh an
+/// icosphere for drawing and contacts); its size within [`bounds::SIZE`].
+fn shape(obj: &RawObject, base: Option<&Path>) -> Result<Solid> {
     let kind = match obj.shape.as_deref() {
         Some(k @ ("box" | "mesh" | "sphere")) => k,
         Some(other) => return Err(Error::scene("object.shape", format!("must be \"box\", \"mesh\" or \"sphere\" (got \"{other}\")"))),
@@ -192,14 +208,14 @@ fn shape(obj: &RawObject, base: Option<&Path>) -> Result<(ConvexMesh, Option<f64
             let s = vec3("object.size", req("object.size", obj.size)?)?;
             bounds::SIZE.check_each("object.size", [s.x, s.y, s.z])?;
             let m = ConvexMesh::try_cuboid(&s).map_err(|e| Error::scene("object.size", e))?;
-            Ok((m, None))
+            Ok(Solid { mesh: m, parts: vec![], sphere: None })
         }
         "mesh" => {
             let file = req("object.mesh", obj.mesh.clone())?;
             let path = base.map(|b| b.join(&file)).unwrap_or_else(|| file.clone().into());
             let text = std::fs::read_to_string(&path)
                 .map_err(|e| Error::scene("object.mesh", format!("cannot read {}: {e}", path.display())))?;
-            let m = ConvexMesh::from_obj(&text).map_err(|e| Error::scene("object.mesh", e))?;
+            let (m, parts) = parts(&text)?;
             let size = m.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
             if bounds::SIZE.check("object.mesh", size).is_err() {
                 let b = bounds::SIZE;
@@ -208,26 +224,60 @@ fn shape(obj: &RawObject, base: Option<&Path>) -> Result<(ConvexMesh, Option<f64
                     format!("its size (largest distance of a vertex from the origin) must be in [{:e}, {:e}] m (got {size:e})", b.lo, b.hi),
                 ));
             }
-            Ok((m, None))
+            Ok(Solid { mesh: m, parts, sphere: None })
         }
         _ => {
             let r = bounds::SIZE.check("object.radius", req("object.radius", obj.radius)?)?;
             let m = ConvexMesh::try_icosphere(r, 2).map_err(|e| Error::scene("object.radius", e))?;
-            Ok((m, Some(r)))
+            Ok(Solid { mesh: m, parts: vec![], sphere: Some(r) })
         }
     }
+}
+
+/// An OBJ file's object: one convex mesh (no parts), or a non-convex object given as convex
+/// parts (`o`/`g` groups, at most [`bounds::MAX_MESH_PARTS`]) whose interiors do not overlap,
+/// with their convex hull.
+fn parts(text: &str) -> Result<(ConvexMesh, Vec<ConvexMesh>)> {
+    let mut parts = ConvexMesh::parts_from_obj(text).map_err(|e| {
+        let hint = if e.contains("not convex") {
+            "; a non-convex object is given as convex parts, one `o` group each (e.g. from a convex decomposition)"
+        } else {
+            ""
+        };
+        Error::scene("object.mesh", format!("{e}{hint}"))
+    })?;
+    bounds::count("object.mesh", parts.len(), bounds::MAX_MESH_PARTS, "convex parts (`o` groups)")?;
+    if parts.len() == 1 {
+        return Ok((parts.remove(0), vec![]));
+    }
+    let all: Vec<V3> = parts.iter().flat_map(|m| m.vertices.iter().copied()).collect();
+    let size = all.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    // overlapping interiors would count their volume twice: no part's vertex, face centre or
+    // centroid lies inside another part
+    for (i, a) in parts.iter().enumerate() {
+        let probes = a.vertices.iter().copied().chain(a.triangles.iter().map(|t| (a.vertices[t[0]] + a.vertices[t[1]] + a.vertices[t[2]]) / 3.0));
+        let probes: Vec<V3> = probes.chain(std::iter::once(a.mass_properties().1)).collect();
+        for (j, b) in parts.iter().enumerate().filter(|(j, _)| *j != i) {
+            if probes.iter().any(|p| b.signed_distance(p) < -1e-6 * size) {
+                return Err(Error::scene("object.mesh", format!("convex parts {i} and {j} overlap: the parts of a non-convex object may touch, not overlap")));
+            }
+        }
+    }
+    let hull = ConvexMesh::hull(&all).map_err(|e| Error::scene("object.mesh", format!("the parts' convex hull: {e}")))?;
+    Ok((hull, parts))
 }
 
 /// Mass [kg], centre of mass (default: the volume centroid; inside the object) and inertia about
 /// it [kg m²] of a uniform-density object (a moved centre of mass shifts the inertia by the
 /// parallel-axis rule).
-fn mass_properties(obj: &RawObject, mesh: &ConvexMesh, sphere: Option<f64>) -> Result<(f64, V3, Matrix3<f64>)> {
+fn mass_properties(obj: &RawObject, solid: &Solid) -> Result<(f64, V3, Matrix3<f64>)> {
     let mass = bounds::MASS.check("object.mass", req("object.mass", obj.mass)?)?;
-    let (centroid, inertia_unit) = match sphere {
+    let (centroid, inertia_unit) = match solid.sphere {
         // a solid sphere: I = (2/5) r² per unit mass
         Some(r) => (V3::zeros(), Matrix3::identity() * 0.4 * r * r),
+        None if !solid.parts.is_empty() => compound_mass_properties(&solid.parts),
         None => {
-            let (_, c, i) = mesh.mass_properties();
+            let (_, c, i) = solid.mesh.mass_properties();
             (c, i)
         }
     };
@@ -235,12 +285,25 @@ fn mass_properties(obj: &RawObject, mesh: &ConvexMesh, sphere: Option<f64>) -> R
         Some(c) => point3("object.com", c)?,
         None => centroid,
     };
-    if surface_distance(mesh, sphere, &com) > 0.0 {
+    if solid.distance(&com) > 0.0 {
         return Err(Error::scene("object.com", "must lie inside the object"));
     }
     let d = com - centroid;
     let inertia = inertia_unit * mass - (Matrix3::identity() * d.norm_squared() - d * d.transpose()) * mass;
     Ok((mass, com, inertia))
+}
+
+/// Centroid and inertia about it per unit mass of the union of `parts` (uniform density): the
+/// volumes add, each part's inertia moved to the common centroid (parallel axes).
+fn compound_mass_properties(parts: &[ConvexMesh]) -> (V3, Matrix3<f64>) {
+    let props: Vec<(f64, V3, Matrix3<f64>)> = parts.iter().map(|m| m.mass_properties()).collect();
+    let vol: f64 = props.iter().map(|p| p.0).sum();
+    let c = props.iter().fold(V3::zeros(), |a, p| a + p.1 * p.0) / vol;
+    let i = props.iter().fold(Matrix3::zeros(), |a, (v, ci, ii)| {
+        let d = ci - c;
+        a + (ii + Matrix3::identity() * d.norm_squared() - d * d.transpose()) * *v
+    });
+    (c, i / vol)
 }
 
 /// The gravity vector [m/s²] in the gripper frame (default `[0, 0, −9.81]`).
@@ -256,13 +319,13 @@ fn gravity(gv: Option<RawGravity>) -> Result<V3> {
 
 /// The pushers (at least one, unique names): planes, or point sets on the object's surface
 /// with an inward normal.
-fn pushers(raw: Vec<RawPusher>, mesh: &ConvexMesh, sphere: Option<f64>, notes: &mut Vec<String>) -> Result<Vec<Pusher3>> {
+fn pushers(raw: Vec<RawPusher>, solid: &Solid, notes: &mut Vec<String>) -> Result<Vec<Pusher3>> {
     bounds::count("pushers", raw.len(), bounds::MAX_PUSHERS, "entries")?;
-    let size = mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let size = solid.mesh.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
     let mut out: Vec<Pusher3> = Vec::new();
     for (i, p) in raw.into_iter().enumerate() {
         let f = format!("pushers[{i}]");
-        let pusher = self::pusher(&f, p, mesh, sphere, size, notes)?;
+        let pusher = self::pusher(&f, p, solid, size, notes)?;
         if out.iter().any(|q| q.name == pusher.name) {
             return Err(Error::scene(format!("{f}.name"), format!("`{}` is used twice", pusher.name)));
         }
@@ -275,7 +338,7 @@ fn pushers(raw: Vec<RawPusher>, mesh: &ConvexMesh, sphere: Option<f64>, notes: &
 }
 
 /// One pusher (`f` its field path).
-fn pusher(f: &str, p: RawPusher, mesh: &ConvexMesh, sphere: Option<f64>, size: f64, notes: &mut Vec<String>) -> Result<Pusher3> {
+fn pusher(f: &str, p: RawPusher, solid: &Solid, size: f64, notes: &mut Vec<String>) -> Result<Pusher3> {
     let name = self::name(&format!("{f}.name"), p.name)?;
     let friction = bounds::PUSHER_FRICTION.check(&format!("{f}.friction"), req(&format!("{f}.friction"), p.friction)?)?;
     let normal = direction3(&format!("{f}.normal"), req(&format!("{f}.normal"), p.normal)?)?;
@@ -293,11 +356,11 @@ fn pusher(f: &str, p: RawPusher, mesh: &ConvexMesh, sphere: Option<f64>, size: f
     let mut points: Vec<V3> = Vec::new();
     for (k, q) in pts.iter().enumerate() {
         let fk = format!("{f}.points[{k}]");
-        let q = on_surface(&fk, point3(&fk, *q)?, mesh, sphere, notes)?;
+        let q = on_surface(&fk, point3(&fk, *q)?, solid, notes)?;
         if let Some(j) = points.iter().position(|p| (p - q).norm() <= 1e-6 * size) {
             return Err(Error::scene(fk, format!("coincides with {f}.points[{j}]: a pusher's points must be distinct")));
         }
-        if surface_distance(mesh, sphere, &(q + normal * 1e-3 * size)) > 0.0 {
+        if solid.distance(&(q + normal * 1e-3 * size)) > 0.0 {
             return Err(Error::scene(format!("{f}.normal"), "must point into the object"));
         }
         points.push(q);
@@ -307,8 +370,8 @@ fn pusher(f: &str, p: RawPusher, mesh: &ConvexMesh, sphere: Option<f64>, size: f
 
 /// A measured pusher point taken onto the object's surface: within [`bounds::SNAP_DISTANCE`] it
 /// is moved onto it (a note says so when it moves more than 1 nm); farther is an error.
-fn on_surface(field: &str, q: V3, mesh: &ConvexMesh, sphere: Option<f64>, notes: &mut Vec<String>) -> Result<V3> {
-    let dist = surface_distance(mesh, sphere, &q);
+fn on_surface(field: &str, q: V3, solid: &Solid, notes: &mut Vec<String>) -> Result<V3> {
+    let dist = solid.distance(&q);
     if dist.abs() > bounds::SNAP_DISTANCE {
         return Err(Error::scene(
             field,
@@ -323,9 +386,14 @@ fn on_surface(field: &str, q: V3, mesh: &ConvexMesh, sphere: Option<f64>, notes:
     if dist.abs() <= 1e-9 {
         return Ok(q);
     }
-    let snapped = match sphere {
+    let snapped = match solid.sphere {
         Some(r) if q.norm() > 0.0 => q * (r / q.norm()),
-        _ => snap_to_mesh(mesh, q),
+        // onto the part whose surface is nearest
+        _ if !solid.parts.is_empty() => {
+            let near = solid.parts.iter().min_by(|a, b| a.signed_distance(&q).abs().total_cmp(&b.signed_distance(&q).abs()));
+            snap_to_mesh(near.expect("parts"), q)
+        }
+        _ => snap_to_mesh(&solid.mesh, q),
     };
     let moved = (snapped - q).norm();
     notes.push(format!("{field} moved {:.1} µm onto the object's surface", moved * 1e6));
