@@ -25,7 +25,8 @@ if __name__ == "__main__":
     # 3-D plans: GIFs (seed 0)
     from regrasp.viz.plotting import animate_plan3d
 
-    for name, fps in (("pivot-3d", 6), ("pivot-single-3d", 6), ("ball-roll-3d", 4), ("pivot-90-3d", 4), ("offset-pivot-3d", 6)):
+    for name, fps in (("pivot-3d", 6), ("pivot-single-3d", 6), ("ball-roll-3d", 4), ("pivot-90-3d", 4), ("offset-pivot-3d", 6),
+                      ("bracket-pivot-3d", 6)):
         s3 = regrasp.Scene3D.load(ROOT / "examples" / f"{name}.toml")
         animate_plan3d(s3, s3.plan(seed=0), OUT / f"plan-{name}.gif", frames_per_step=fps)
     print("wrote", *sorted(p.name for p in OUT.glob("*.png")), *sorted(p.name for p in OUT.glob("*.gif")))

@@ -369,3 +369,11 @@ def test_a_top_push_slides_under_the_ledge_lengthwise_between_the_fingers(tmp_pa
     assert ledge.pose[2] - top == pytest.approx(SLIDE_GAP, abs=1e-6)
     r = execute_arm(scene, plan, m, trajectory=am.trajectory)
     assert r.success, r.goal_error
+
+
+def test_the_arm_executes_the_non_convex_bracket():
+    """The L-bracket (two convex parts, issue 18) run by the arm in its default workcell: MuJoCo
+    collides its parts with the pads, the plate and the ground."""
+    scene, plan, motion, robot, tcp, arm = case("bracket-pivot-3d")
+    r = execute_arm(scene, plan, motion, trajectory=arm)
+    assert r.success, r.goal_error

@@ -28,7 +28,7 @@ fn boxed(lo: [f64; 3], hi: [f64; 3]) -> (f64, V3, Matrix3<f64>) {
 fn the_brackets_mass_properties_are_the_two_boxes() {
     let s = bracket();
     assert_eq!(s.parts.len(), 2);
-    let (up, foot) = (boxed([-0.012, -0.006, -0.02], [0.012, 0.006, 0.045]), boxed([-0.012, -0.006, -0.04], [0.04, 0.006, -0.02]));
+    let (up, foot) = (boxed([-0.012, -0.006, -0.02], [0.012, 0.006, 0.04]), boxed([-0.012, -0.006, -0.04], [0.04, 0.006, -0.02]));
     let vol = up.0 + foot.0;
     let c = (up.1 * up.0 + foot.1 * foot.0) / vol;
     let mut i = Matrix3::zeros();
@@ -38,7 +38,7 @@ fn the_brackets_mass_properties_are_the_two_boxes() {
     }
     let i = i / vol * s.mass;
     assert!((s.com - c).norm() < 1e-12, "{:?} vs {:?}", s.com, c);
-    assert!((s.com - V3::new(0.0056, 0.0, -0.0045)).norm() < 1e-9);
+    assert!((s.com - V3::new(0.014 * 12.48 / 29.76, 0.0, (0.01 * 17.28 - 0.03 * 12.48) / 29.76)).norm() < 1e-9);
     assert!((s.inertia - i).norm() < 1e-12 * s.mass, "{} vs {}", s.inertia, i);
     // the hull is not the object: its centroid lies elsewhere
     let (hv, hc, _) = s.mesh.mass_properties();
@@ -105,7 +105,7 @@ fn box_obj(name: &str, lo: [f64; 3], hi: [f64; 3], first: usize) -> String {
 
 #[test]
 fn bad_parts_are_errors_naming_the_field() {
-    let up = box_obj("upright", [-0.012, -0.006, -0.02], [0.012, 0.006, 0.045], 1);
+    let up = box_obj("upright", [-0.012, -0.006, -0.02], [0.012, 0.006, 0.04], 1);
     let foot = |top: f64| box_obj("foot", [-0.012, -0.006, -0.04], [0.04, 0.006, top], 9);
     // the box helper writes the bundled bracket's two parts
     let same = with_obj(&(up.clone() + &foot(-0.02)), "same").unwrap();
@@ -138,10 +138,10 @@ fn the_hull_of_points_is_convex_and_holds_them_all() {
     let h = ConvexMesh::hull(&all).unwrap();
     assert!(all.iter().all(|p| h.signed_distance(p) <= 1e-12));
     let (v, _, _) = h.mass_properties();
-    // the L's outline (x–z) hull: the L (2,600 mm²) and the notch's triangle under the hull's
-    // slanted edge (28 mm × 65 mm), 12 mm thick
-    let l_area = 24.0 * 65.0 + 52.0 * 20.0;
-    let tri = 0.5 * 28.0 * 65.0;
+    // the L's outline (x–z) hull: the L (2,480 mm²) and the notch's triangle under the hull's
+    // slanted edge (28 mm × 60 mm), 12 mm thick
+    let l_area = 24.0 * 60.0 + 52.0 * 20.0;
+    let tri = 0.5 * 28.0 * 60.0;
     assert!((v - (l_area + tri) * 12.0 * 1e-9).abs() < 1e-15, "{v}");
 }
 
