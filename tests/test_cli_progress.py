@@ -91,12 +91,14 @@ def test_no_bar_when_stderr_is_not_a_terminal():
 
 
 def test_a_long_plan_shows_the_time_against_its_limit(tmp_path):
-    # a scene that can only push down while the goal is up: the planner runs for its time limit
+    # a scene that can only push down while the goal is up and turned 2.8 rad: not decided
+    # unreachable (over such turns gravity pulls every way in the object's frame), not found
+    # either: the planner runs for its time limit
     parts = BLOCK.read_text().split("[[pushers]]")
     top = [p for p in parts[1:] if 'name = "top"' in p][0]
     scene = tmp_path / "top-only.toml"
     scene.write_text(parts[0] + "[[pushers]]" + top)
-    status, out, err = run_tty("plan", scene, "--time-limit", "1.5", "--json", delay=0.3)
+    status, out, err = run_tty("plan", scene, "--goal", "0,0.03,2.8", "--time-limit", "1.5", "--json", delay=0.3)
     assert status == 1, err
     assert has_bar(err) and "planning block-low-friction" in err and "/1.5 s" in err, err
     assert not any(mark in out for mark in BAR)
