@@ -34,9 +34,10 @@ LONG = {
     "3-d plan": "s3.plan(None, None, {'time_limit': 600, 'max_nodes': 10**8, 'max_iterations': 10**12, 'cost_threshold': -1.0, 'refine': float('inf')})",
     "planar simulate_push": "planar.simulate_push([0, 0, 0], 'left', [1e-9, 0, 0], 1e5, 0.1)",
     "push_outcomes": "planar.push_outcomes(np.zeros((10**6, 3)), 'left', np.tile([0.01, 0, 0], (10**6, 1)))",
-    # slow single solves (about 1 s each on the incline's footprint): stopped inside the solver
+    # single solves on the incline's footprint, many points (about 1 s each before the block-arrow
+    # Newton step, 0.5 ms now): stopped inside a solve or between two
     "slow push_outcomes": "incline = _core.Scene.from_toml((E / 'block-on-incline.toml').read_text()); "
-                          "incline.push_outcomes(np.zeros((400, 3)), 'finger', np.tile([0.004, 0.006, -0.1], (400, 1)))",
+                          "incline.push_outcomes(np.zeros((10**6, 3)), 'finger', np.tile([0.004, 0.006, -0.1], (10**6, 1)))",
     "validate_path": "planar.validate_path([[0, 0, 0], [1e-6, 0, 0]] * 20000, [None] + ['left'] * 39999, 10000)",
 }
 

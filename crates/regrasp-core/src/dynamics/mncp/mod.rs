@@ -22,11 +22,12 @@
 //! [`residuals`] checks any candidate solution against every constraint in its original form.
 //!
 //! Files: this one holds the problem and its [`residuals`]; `newton` the semismooth Newton
-//! solver, `forward` the forward solve's attempts, `inverse` the cone program.
+//! solver, `arrow` its linear-time step, `forward` the forward solve's attempts, `inverse` the cone program.
 
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
 
+mod arrow;
 mod forward;
 mod inverse;
 mod newton;

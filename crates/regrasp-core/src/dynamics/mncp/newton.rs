@@ -2,6 +2,7 @@
 //! the Alart–Curnier projection equations of eqs 3.1–3.3 and 3.16 (exact, or smoothed by `ε`),
 //! their generalized Jacobian, and a damped Newton method with a backtracking line search.
 
+use super::arrow::Arrow;
 use super::{normal_force, FrictionLaw, NormalLaw, Problem, Solution};
 use nalgebra::{DMatrix, DVector, DVectorView};
 
@@ -28,6 +29,15 @@ impl Layout {
             k += c.tangent_dim();
         }
         Self { n: k, normal, tangent }
+    }
+
+    /// Each contact's first unknown and its number of unknowns (normal force, then friction).
+    fn blocks(&self, p: &Problem) -> Vec<(usize, usize)> {
+        p.contacts
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (self.normal[i].unwrap_or(self.tangent[i]), self.normal[i].is_some() as usize + c.tangent_dim()))
+            .collect()
     }
 }
 
@@ -84,6 +94,14 @@ fn metric_inv(law: &FrictionLaw) -> Option<DMatrix<f64>> {
     }
 }
 
+/// Iterations over which a Newton solve must shrink |F| to [`STALL_SHRINK`] of it or give up
+/// (stalled: the forward solve's next attempt starts elsewhere).
+const STALL: usize = 4;
+/// The share of |F| left after [`STALL`] iterations above which a solve has stalled.
+const STALL_SHRINK: f64 = 0.5;
+/// Step halvings of the line search before a Newton step is given up (the attempt then ends).
+const HALVINGS: usize = 30;
+
 /// Per-contact data fixed during a solve.
 struct Pre {
     /// `J_tᵀ` (d × k).
@@ -95,11 +113,11 @@ struct Pre {
     bn: f64,
 }
 
-/// What one evaluation of the equations writes: the residual and, when asked, its Jacobian (rows
-/// scaled by `sf = 1/force_scale`), at smoothing `e`.
+/// What one evaluation of the equations writes: the residual and, when asked, its Jacobian in
+/// block-arrow form (rows scaled by `sf = 1/force_scale`), at smoothing `e`.
 struct Eval {
     f: DVector<f64>,
-    j: Option<DMatrix<f64>>,
+    j: Option<Arrow>,
     sf: f64,
     e: f64,
 }
@@ -181,19 +199,18 @@ impl<'a> Newton<'a> {
     /// Residual F(x) (smoothed by `e`, in units of `force_scale`; exact for `e = 0`) and, when
     /// asked, its (generalized) Jacobian: the Newton–Euler rows (eq 3.13), then per contact its
     /// normal row (eq 3.16) and friction rows (eqs 3.1–3.3).
-    fn eval(&self, x: &DVector<f64>, jac: bool, e: f64) -> (DVector<f64>, Option<DMatrix<f64>>) {
+    fn eval(&self, x: &DVector<f64>, jac: bool, e: f64) -> (DVector<f64>, Option<Arrow>) {
         let p = self.p;
         let d = p.dim;
         let n = self.lay.n;
         let v = x.rows(0, d);
-        let j = if jac { Some(DMatrix::zeros(n, n)) } else { None };
+        let j = if jac { Some(Arrow::zeros(d, &self.lay.blocks(p))) } else { None };
         let mut out = Eval { f: DVector::zeros(n), j, sf: 1.0 / p.force_scale, e };
         // Newton–Euler (scaled by 1/force_scale)
         let mut ne = &p.wrench - &p.mass * v;
         if let Some(j) = out.j.as_mut() {
-            let mut blk = j.view_mut((0, 0), (d, d));
-            blk.copy_from(&p.mass);
-            blk *= -out.sf;
+            j.a.copy_from(&p.mass);
+            j.a *= -out.sf;
         }
         for (i, c) in p.contacts.iter().enumerate() {
             let f_n = match self.lay.normal[i] {
@@ -219,14 +236,16 @@ impl<'a> Newton<'a> {
         ne.axpy(f_n, &c.jn, 1.0);
         ne.gemv(1.0, &pre.jt_t, &ft, 1.0);
         if let Some(j) = out.j.as_mut() {
-            if let Some(k) = self.lay.normal[i] {
-                let mut col = j.view_mut((0, k), (d, 1));
-                col.copy_from(&c.jn);
-                col *= out.sf;
+            let b = &mut j.blocks[i].b;
+            let off = self.lay.normal[i].is_some() as usize;
+            for row in 0..d {
+                if off == 1 {
+                    b[(row, 0)] = c.jn[row] * out.sf;
+                }
+                for a in 0..c.tangent_dim() {
+                    b[(row, off + a)] = pre.jt_t[(row, a)] * out.sf;
+                }
             }
-            let mut blk = j.view_mut((0, self.lay.tangent[i]), (d, c.tangent_dim()));
-            blk.copy_from(&pre.jt_t);
-            blk *= out.sf;
         }
     }
 
@@ -238,9 +257,10 @@ impl<'a> Newton<'a> {
         let (m, _, dm) = smax(0.0, z, out.e * self.p.force_scale);
         out.f[k] = (f_n - m) * out.sf;
         if let Some(j) = out.j.as_mut() {
-            j[(k, k)] = (1.0 - dm) * out.sf;
+            let blk = &mut j.blocks[i];
+            blk.d[(0, 0)] = (1.0 - dm) * out.sf;
             for col in 0..self.p.dim {
-                j[(k, col)] = c.jn[col] * dm * self.rho_n * out.sf;
+                blk.c[(0, col)] = c.jn[col] * dm * self.rho_n * out.sf;
             }
         }
     }
@@ -249,6 +269,11 @@ impl<'a> Newton<'a> {
     fn friction_rows(&self, i: usize, f_n: f64, ft: DVectorView<'_, f64>, v: DVectorView<'_, f64>, out: &mut Eval) {
         let (c, pre) = (&self.p.contacts[i], &self.pre[i]);
         let (d, kt, t0) = (self.p.dim, c.tangent_dim(), self.lay.tangent[i]);
+        if let FrictionLaw::Coulomb(mu) = c.friction {
+            if kt <= 3 {
+                return self.coulomb_rows(i, mu, f_n, ft, v, out);
+            }
+        }
         let (e, sf) = (out.e, out.sf);
         let y = ft - (&pre.gjt * v + &pre.gbt);
         let (r, dr_dfn) = match &c.friction {
@@ -268,16 +293,60 @@ impl<'a> Newton<'a> {
         fr *= sf;
         if let Some(j) = out.j.as_mut() {
             // dF/df_t = I − dP; dF/dV = dP ρ G⁻¹ J_t; dF/df_n = −dP/dr · dr/df_n
-            let mut blk = j.view_mut((t0, t0), (kt, kt));
-            blk.copy_from(&(DMatrix::identity(kt, kt) - &dp));
-            blk *= sf;
-            let mut blk = j.view_mut((t0, 0), (kt, d));
-            blk.copy_from(&(&dp * &pre.gjt));
-            blk *= sf;
-            if let Some(k) = self.lay.normal[i] {
-                let mut col = j.view_mut((t0, k), (kt, 1));
-                col.copy_from(&dpr);
-                col *= -dr_dfn * sf;
+            let blk = &mut j.blocks[i];
+            let off = self.lay.normal[i].is_some() as usize;
+            blk.d.view_mut((off, off), (kt, kt)).copy_from(&((DMatrix::identity(kt, kt) - &dp) * sf));
+            blk.c.view_mut((off, 0), (kt, d)).copy_from(&(&dp * &pre.gjt * sf));
+            if off == 1 {
+                blk.d.view_mut((off, 0), (kt, 1)).copy_from(&(&dpr * (-dr_dfn * sf)));
+            }
+        }
+    }
+
+    /// [`Self::friction_rows`] of a Coulomb contact (k ≤ 3 tangent directions) on the stack: the
+    /// same projection as [`project`]'s, written without temporaries (the solve's inner loop).
+    fn coulomb_rows(&self, i: usize, mu: f64, f_n: f64, ft: DVectorView<'_, f64>, v: DVectorView<'_, f64>, out: &mut Eval) {
+        let (c, pre) = (&self.p.contacts[i], &self.pre[i]);
+        let (d, kt, t0) = (self.p.dim, c.tangent_dim(), self.lay.tangent[i]);
+        let (pe, sf) = (out.e * self.p.force_scale, out.sf);
+        let mut y = [0.0; 3];
+        for a in 0..kt {
+            let g = pre.gbt[a] + (0..d).map(|b| pre.gjt[(a, b)] * v[b]).sum::<f64>();
+            y[a] = ft[a] - g;
+        }
+        let (m0, _, dm0) = smax(0.0, f_n, pe);
+        let (r, dr_dfn) = (mu * m0, mu * dm0);
+        let ny = y[..kt].iter().map(|x| x * x).sum::<f64>().sqrt();
+        let (m, dm_dr, dm_dy) = smax(r, ny, pe);
+        let (mut p, mut dp, mut dpr) = ([0.0; 3], [[0.0; 3]; 3], [0.0; 3]);
+        if m > 0.0 {
+            for a in 0..kt {
+                p[a] = y[a] * r / m;
+                dpr[a] = y[a] / m - y[a] * r * dm_dr / (m * m);
+                for b in 0..kt {
+                    dp[a][b] = if a == b { r / m } else { 0.0 };
+                    if ny > 0.0 {
+                        dp[a][b] -= y[a] * y[b] / ny * r * dm_dy / (m * m);
+                    }
+                }
+            }
+        }
+        for a in 0..kt {
+            out.f[t0 + a] = (ft[a] - p[a]) * sf;
+        }
+        if let Some(j) = out.j.as_mut() {
+            let blk = &mut j.blocks[i];
+            let off = self.lay.normal[i].is_some() as usize;
+            for a in 0..kt {
+                for b in 0..kt {
+                    blk.d[(off + a, off + b)] = (if a == b { 1.0 } else { 0.0 } - dp[a][b]) * sf;
+                }
+                for col in 0..d {
+                    blk.c[(off + a, col)] = (0..kt).map(|b| dp[a][b] * pre.gjt[(b, col)]).sum::<f64>() * sf;
+                }
+                if off == 1 {
+                    blk.d[(off + a, 0)] = dpr[a] * (-dr_dfn * sf);
+                }
             }
         }
     }
@@ -288,30 +357,27 @@ impl<'a> Newton<'a> {
         let (mut fx, _) = self.eval(&x, false, e);
         let mut phi = 0.5 * fx.norm_squared();
         let mut it = 0;
+        let mut recent = std::collections::VecDeque::from([fx.amax()]);
         // an interrupt ends the iterations; it stays raised for the caller's next check
         while it < max_it && fx.amax() > tol && crate::interrupt::check().is_ok() {
+            // stalled: |F| not halved over the last STALL iterations (the caller's next
+            // attempt starts elsewhere)
+            if recent.len() > STALL && fx.amax() > STALL_SHRINK * recent[0] {
+                break;
+            }
             it += 1;
             if std::env::var("MNCP_TRACE").is_ok() {
                 eprintln!("it {it}: |F| = {:.3e}  v = {:?}", fx.amax(), x.rows(0, self.p.dim).as_slice());
             }
             let (_, jac) = self.eval(&x, true, e);
             let jac = jac.expect("jacobian requested");
-            let step = match jac.clone().lu().solve(&(-&fx)) {
-                Some(dx) if dx.iter().all(|z| z.is_finite()) => dx,
-                _ => {
-                    // singular generalized Jacobian: a regularized (Levenberg–Marquardt) step
-                    let jt = jac.transpose();
-                    let m = &jt * &jac + DMatrix::identity(self.lay.n, self.lay.n) * 1e-10;
-                    match m.lu().solve(&(-(jt * &fx))) {
-                        Some(dx) => dx,
-                        None => break,
-                    }
-                }
-            };
+            // the block-arrow step: exact where the Jacobian is invertible, least squares where a
+            // sticking contact makes it singular ([`super::arrow`])
+            let Some(step) = jac.solve(&(-&fx), 1.0 / self.p.force_scale) else { break };
             // backtracking line search on ½|F|²
             let mut t = 1.0;
             let mut accepted = false;
-            for _ in 0..30 {
+            for _ in 0..HALVINGS {
                 if crate::interrupt::check().is_err() {
                     break;
                 }
@@ -329,6 +395,10 @@ impl<'a> Newton<'a> {
             }
             if !accepted {
                 break;
+            }
+            recent.push_back(fx.amax());
+            if recent.len() > STALL + 1 {
+                recent.pop_front();
             }
         }
         (x, fx.amax(), it)
@@ -349,7 +419,7 @@ mod tests {
             let mut x = DVector::from_fn(nw.lay.n, |i, _| ((i as f64) * 1.7).sin());
             x.rows_mut(0, 3).copy_from(&DVector::from_row_slice(&[0.007, -0.003, 0.2]));
             let (f0, j) = nw.eval(&x, true, e);
-            let j = j.unwrap();
+            let j = j.unwrap().dense();
             for k in 0..nw.lay.n {
                 let eps = 1e-7 * (1.0 + x[k].abs());
                 let mut xp = x.clone();
