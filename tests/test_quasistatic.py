@@ -93,6 +93,18 @@ def test_fast_and_reference_solvers_agree(u):
     assert np.allclose(fast["twist"], ref.twist, atol=1e-6 * 0.01 + 1e-7)
 
 
+def test_at_512_finger_points_the_fast_solver_agrees_with_ipopt():
+    """Issue 17: the linear-time Newton step (dynamics/mncp/arrow.rs) on two pads of 256 points
+    each, a sliding push, against IPOPT on the thesis' NLP."""
+    u = [0.002, 0.01, 0.0]
+    sc = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
+    p = sc._core.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, 256, False)
+    fast = p.solve_forward(u)
+    ref = mncp_reference.solve(p, pusher_twist=u)
+    assert ref.max_residual < 1e-6 and fast["max_residual"] < 1e-6
+    assert np.allclose(fast["twist"], ref.twist, atol=1e-6 * 0.01 + 1e-7), (fast["twist"], ref.twist)
+
+
 def test_inverse_then_forward_round_trip_and_reference_inverse():
     _, p = bench_problem()
     v = [0.01, 0.001, 0.05]

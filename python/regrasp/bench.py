@@ -61,6 +61,7 @@ def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, sc
         ("single cone", lambda: _single_cone(scene, pusher, params, poses[0], reps)),
         ("projection", lambda: _projection(scene, pusher, poses, twists, reps)),
         ("MNCP solver", lambda: _unless_missing("the MNCP solver against IPOPT", lambda: run_mncp(reps=reps))),
+        ("MNCP scaling", lambda: _unless_missing("the MNCP solver's scaling against IPOPT", run_mncp_scaling)),
         ("planner", run_planner),
         ("hard plans", run_hard_plans),
         ("MuJoCo", lambda: _unless_missing("MuJoCo's speed", run_mujoco)),
@@ -506,6 +507,46 @@ def run_mncp(reps: int = 11, ref_reps: int = 3) -> dict:
             "residual_reference": ref.max_residual,
         }
     return out
+
+
+#: Finger contact points (both fingers together) of :func:`run_mncp_scaling`.
+SCALING_POINTS = (8, 32, 128, 512, 1024)
+
+#: The pusher twists of :func:`run_mncp_scaling` (the block's left line pusher): a push that
+#: sticks, one that slides, one that separates.
+SCALING_PUSHES = (("stick", [0.01, 0.0, 0.0]), ("slide", [0.002, 0.01, 0.0]), ("separate", [-0.01, 0.0, 0.2]))
+
+
+def run_mncp_scaling(points=SCALING_POINTS, reps: int = 5) -> dict:
+    """The forward complementarity solve as the finger pads get more contact points (the block of
+    ``block-low-friction`` in two pads of ``points / 2`` points each, pushed by its left line
+    pusher): the median time of a push that sticks, slides and separates, against IPOPT's own
+    solve time (casadi's model build excluded) on the sliding one, in the same run; each row also
+    gives the largest twist difference between the two. The entry's time is the sliding solve at
+    512 points (or the largest size given)."""
+    from .reference import mncp as mncp_reference
+
+    scene = Scene.load(bundled.path("block-low-friction"))
+    rows = []
+    for n in points:
+        p = scene._core.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, max(1, n // 2), False)
+        row = {"points": int(n)}
+        for name, u in SCALING_PUSHES:
+            m = max(1, 200 // n)
+            row[f"{name}_s"] = _median_time(lambda: [p.solve_forward(u) for _ in range(m)], reps) / m
+        u = dict(SCALING_PUSHES)["slide"]
+        ref = mncp_reference.solve(p, pusher_twist=u)
+        row["ipopt_s"] = float(ref.solve_time_s)
+        row["ratio_ipopt"] = row["ipopt_s"] / row["slide_s"]
+        row["max_abs_twist_diff"] = float(np.abs(p.solve_forward(u)["twist"] - ref.twist).max())
+        rows.append(row)
+    at = next((r for r in rows if r["points"] == 512), rows[-1])
+    return {"mncp_scaling": {
+        "median_s": at["slide_s"], "baseline_median_s": at["ipopt_s"], "ratio": at["ratio_ipopt"],
+        "baseline": f"IPOPT (casadi) on the sliding push at {at['points']} finger points; rows: "
+                    + ", ".join(f"{r['points']}: {r['slide_s'] * 1e3:.3g} ms vs {r['ipopt_s'] * 1e3:.3g} ms" for r in rows),
+        "rows": rows,
+    }}
 
 
 def run_grasp_graph(trials: int = 3, name: str = "prism", workers: int = 1) -> dict:
