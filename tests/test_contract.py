@@ -265,6 +265,9 @@ def written_plans(tmp_path_factory):
     top = [p for p in parts[1:] if 'name = "top"' in p][0]
     (d / "top-only.toml").write_text(parts[0] + "[[pushers]]" + top)  # can only push down; the goal is up
     (d / "weak.toml").write_text(text.replace("force = 20.0", "force = 4.0"))  # holds the task, not a pad far off
+    # the 3-D block at 2 N: it holds at the start, not 18 mm off its centre of mass
+    weak3 = (EXAMPLES / "block-3d.toml").read_text().replace("force = 20.0", "force = 2.0")
+    (d / "weak-3d.toml").write_text(re.sub(r"(?m)^goal = .*$", "goal = [0.018, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]", weak3))
     runs = cli_many([
         ["plan", EXAMPLES / "t-shape.toml", "--out", d / "planar.json", "--time-limit", "5"],
         ["plan", EXAMPLES / "offset-3d.toml", "--out", d / "3d.json", "--time-limit", "5"],
@@ -273,6 +276,7 @@ def written_plans(tmp_path_factory):
         ["plan", ROOT / "benches" / "scenes" / "neck-unreachable.toml", "--out", d / "unreachable.json"],
         ["plan", d / "weak.toml", "--goal", "0.0175,0,0", "--out", d / "cannot-hold.json"],
         ["plan", d / "top-only.toml", "--out", d / "one-way.json"],
+        ["plan", d / "weak-3d.toml", "--out", d / "cannot-hold-3d.json"],
     ])
     return d, runs
 
@@ -446,3 +450,12 @@ def test_a_goal_no_push_can_move_towards_is_unreachable_and_exits_1(written_plan
     plan = _not_found(written_plans, 6, "one-way.json", "no plan found: unreachable: no push can move the pad's centre")
     assert plan["stop_reason"] == "unreachable" and "the planner's range" in plan["reason"]
     assert plan["planning_time_s"] < 1.0 and len(plan["path"]) == 1
+
+
+def test_a_3d_goal_the_pads_cannot_hold_is_unreachable_and_exits_1(written_plans):
+    d, runs = written_plans
+    assert runs[7].returncode == 1 and "no plan found: unreachable: the grasp cannot hold" in runs[7].stderr, runs[7].stderr
+    plan = _strict_json((d / "cannot-hold-3d.json").read_text())
+    check_plan(plan, "3-D plan key")
+    assert plan["stop_reason"] == "unreachable" and "within the goal's tolerance" in plan["reason"]
+    assert plan["planning_time_s"] < 1.0 and len(plan["path"]) == 1 and plan["found"] is False

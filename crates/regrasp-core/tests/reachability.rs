@@ -318,3 +318,58 @@ fn the_bundled_one_way_scene_is_unreachable_and_its_full_example_is_not() {
     let (start, goal, tol) = (s.task.unwrap().start, s.task.unwrap().goal, s.task.unwrap().tolerance);
     assert_eq!(one_way(&three, &start, &goal, &tol, [-0.5, 0.5]), None);
 }
+
+/// The 3-D block held by a weak grip (`force` N per finger).
+fn weak_block3(force: f64) -> regrasp::scene::spatial::Scene3 {
+    let text = include_str!("../../../python/regrasp/examples/block-3d.toml").replace("force = 20.0", &format!("force = {force}"));
+    regrasp::scene::spatial::Scene3::from_toml_str(&text, None).unwrap()
+}
+
+#[test]
+fn a_3d_goal_the_pads_cannot_hold_is_unreachable_at_once() {
+    use nalgebra::{Isometry3, UnitQuaternion, Vector3};
+    use regrasp::planning::reachability::{cannot_hold3, hold_ratio3};
+    use regrasp::planning::spatial::{plan3, SpatialSettings};
+    let s = weak_block3(2.0);
+    // independent: with the centre of mass on the pads' axis the weight is a pure force, carried
+    // by both pads' discs at once, m g / (2 μ N)
+    let pure = s.mass * 9.81 / (2.0 * 0.6 * 2.0);
+    let start = hold_ratio3(&s, &Isometry3::identity()).unwrap();
+    assert!((start - pure).abs() < 2e-3 * pure, "{start} vs {pure}");
+    // 18 mm off the centre of mass the weight's moment is too much for 2 N
+    let goal = Isometry3::translation(0.018, 0.0, 0.0);
+    let t0 = Instant::now();
+    let r = plan3(&s, None, Some(goal), &SpatialSettings::default()).unwrap().plan;
+    assert!(t0.elapsed().as_secs_f64() < 1.0);
+    assert!(!r.found && r.stop_reason == StopReason::Unreachable && r.path.len() == 1, "{:?}", r.stop_reason);
+    assert!(r.reason.unwrap().contains("cannot hold"));
+    // brute force: no pose of a finer grid of the tolerance region holds (5³ translations, the
+    // rotation turned about 6 axes by 0.5 and 1 times the angle)
+    let tol = s.tolerance;
+    let mut turns = vec![UnitQuaternion::identity()];
+    for axis in [Vector3::x(), Vector3::y(), Vector3::z(), Vector3::new(1.0, 1.0, 0.0), Vector3::new(0.0, 1.0, 1.0), Vector3::new(1.0, 0.0, 1.0)] {
+        for k in [-1.0, -0.5, 0.5, 1.0] {
+            turns.push(UnitQuaternion::from_scaled_axis(axis.normalize() * (k * tol[3])));
+        }
+    }
+    for turn in &turns {
+        for c in 0..125 {
+            let d = Vector3::new((c % 5) as f64 / 2.0 - 1.0, ((c / 5) % 5) as f64 / 2.0 - 1.0, (c / 25) as f64 / 2.0 - 1.0);
+            let at = Isometry3::from_parts((goal.translation.vector + d.component_mul(&Vector3::new(tol[0], tol[1], tol[2]))).into(), *turn * goal.rotation);
+            assert!(hold_ratio3(&s, &at).is_none_or(|h| h >= 1.0), "{at:?} holds");
+        }
+    }
+    // a goal that holds is left to the search, and the strong grip holds the same goal
+    assert_eq!(cannot_hold3(&s, &Isometry3::identity(), &Isometry3::translation(0.0, 0.0, 0.01), &tol), None);
+    let strong = weak_block3(20.0);
+    assert_eq!(cannot_hold3(&strong, &Isometry3::identity(), &goal, &tol), None);
+    // a start that cannot hold either: not the certificate's question
+    assert_eq!(cannot_hold3(&weak_block3(1.0), &Isometry3::identity(), &goal, &tol), None);
+    // near the limit: where the ratio crosses 1 along x, a goal 0.5 mm beyond it (its box reaches
+    // back over the limit: some pose there holds) is left to the search; 3 mm beyond is refused
+    let x1 = (0..400).map(|i| i as f64 * 5e-5).find(|&x| hold_ratio3(&s, &Isometry3::translation(x, 0.0, 0.0)).unwrap() >= 1.0).unwrap();
+    let near = Isometry3::translation(x1 + 5e-4, 0.0, 0.0);
+    assert!(hold_ratio3(&s, &near).unwrap() > 1.0 && hold_ratio3(&s, &Isometry3::translation(x1 - 5e-4, 0.0, 0.0)).unwrap() < 1.0);
+    assert_eq!(cannot_hold3(&s, &Isometry3::identity(), &near, &tol), None);
+    assert!(cannot_hold3(&s, &Isometry3::identity(), &Isometry3::translation(x1 + 3e-3, 0.0, 0.0), &tol).is_some());
+}

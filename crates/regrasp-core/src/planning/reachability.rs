@@ -22,6 +22,8 @@
 use crate::mechanics::geometry::Vec2;
 use crate::scene::planar::Support;
 use crate::scene::Scene;
+use crate::scene::spatial::Scene3;
+use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 use geo::algorithm::buffer::{BufferStyle, LineJoin};
 use geo::{Buffer, Contains, Distance, Euclidean, LineString, MultiPolygon, Point, Polygon, Simplify, Validation};
 
@@ -226,4 +228,144 @@ pub fn one_way(scene: &Scene, start: &[f64; 3], goal: &[f64; 3], tol: &[f64; 3],
 /// Whether gravity pulls in the object's plane (it then depends on the turn).
 fn gravity_in_plane(scene: &Scene) -> bool {
     scene.mass * scene.g_plane() > 0.0 && scene.gravity_dir.norm() > 0.0
+}
+
+/// 3-D: how much of the pads' friction the object's weight needs at `pose` (gripper frame): the
+/// least factor `s` on the pads' Coulomb coefficients at which friction forces inside every pad
+/// point's disc (radius `s μ N`) hold the object at rest against gravity and the pads' normal
+/// forces (eq 3.13 at a zero twist) — one second-order cone program (clarabel) minimizing `s`;
+/// < 1: the grasp holds. None when the pads do not both touch there (or a pad is not a point
+/// set); infinity when no friction would hold it (e.g. gravity along the grasp axis).
+pub fn hold_ratio3(scene: &Scene3, pose: &Isometry3<f64>) -> Option<f64> {
+    use crate::dynamics::mncp::{FrictionLaw, NormalLaw};
+    use clarabel::algebra::CscMatrix;
+    use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+    if !crate::planning::spatial::pads_on(scene, pose) {
+        return None;
+    }
+    let p = crate::dynamics::spatial::problem(scene, pose, None, 1.0, 0.01).ok()?;
+    let (d, fs) = (p.dim, p.force_scale);
+    let mut laws = Vec::with_capacity(p.contacts.len());
+    for c in &p.contacts {
+        match (&c.normal, &c.friction) {
+            (NormalLaw::Fixed(n), FrictionLaw::Coulomb(mu)) => laws.push((*n, *mu)),
+            _ => return None,
+        }
+    }
+    let nf: usize = p.contacts.iter().map(|c| c.tangent_dim()).sum();
+    let n = nf + 1; // the friction forces (in units of the force scale), then s
+    // balance: Σ J_tᵀ f = −(w + Σ J_n N)
+    let mut rhs = -&p.wrench;
+    for (c, (nn, _)) in p.contacts.iter().zip(&laws) {
+        rhs -= &c.jn * *nn;
+    }
+    let rows = d + nf + p.contacts.len();
+    let mut a = vec![vec![0.0; n]; rows];
+    let mut b = vec![0.0; rows];
+    let mut cones = vec![SupportedConeT::ZeroConeT(d)];
+    let mut col = 0;
+    let mut row = d;
+    for (c, (nn, mu)) in p.contacts.iter().zip(&laws) {
+        let k = c.tangent_dim();
+        for i in 0..d {
+            for j in 0..k {
+                a[i][col + j] = c.jt[(j, i)];
+            }
+        }
+        // (μ N s, f) in the second-order cone: z = b − A x
+        a[row][nf] = -mu * nn / fs;
+        for j in 0..k {
+            a[row + 1 + j][col + j] = -1.0;
+        }
+        cones.push(SupportedConeT::SecondOrderConeT(k + 1));
+        row += k + 1;
+        col += k;
+    }
+    for i in 0..d {
+        b[i] = rhs[i] / fs;
+    }
+    let mut q = vec![0.0; n];
+    q[nf] = 1.0;
+    let pm = CscMatrix::zeros((n, n));
+    let cfg = DefaultSettings { verbose: false, tol_gap_abs: 1e-10, tol_gap_rel: 1e-10, tol_feas: 1e-10, ..DefaultSettings::default() };
+    let mut solver = DefaultSolver::new(&pm, &q, &CscMatrix::from(&a), &b, &cones, cfg).ok()?;
+    solver.solve();
+    match solver.solution.status {
+        SolverStatus::Solved | SolverStatus::AlmostSolved => {
+            let s = solver.solution.x[nf];
+            s.is_finite().then_some(s.max(0.0))
+        }
+        SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => Some(f64::INFINITY),
+        _ => None,
+    }
+}
+
+/// 3-D: why the object cannot end within the goal's tolerance `tol` (`[x, y, z]` m, angle rad) of
+/// `goal`: the pads hold it nowhere there. Decided only when the goal itself cannot hold and the
+/// start can (otherwise the model's holding is not the question). The hold ratio
+/// ([`hold_ratio3`]) is evaluated on a grid of the tolerance region: the goal's translation
+/// ±`tol` along each axis (3³) at its rotation turned about the grasp axis by 0 and ±`tol[3]`,
+/// and about the two others by ±`tol[3]` and ±`tol[3]`/2 (a turn out of the pads' plane makes the
+/// pads touch an edge or a corner instead of a face: another contact, another family of poses).
+/// In each family (the same pad contacts) the ratio must exceed 1 by the family's largest change
+/// between neighbouring grid poses; the answer errs towards "reachable" (checked against a finer grid in
+/// the tests); None when some pose may hold.
+pub fn cannot_hold3(scene: &Scene3, start: &Isometry3<f64>, goal: &Isometry3<f64>, tol: &[f64; 4]) -> Option<String> {
+    // the usual case at the cost of one cone program: the goal holds
+    if hold_ratio3(scene, goal)? < 1.0 || !(hold_ratio3(scene, start)? < 1.0) {
+        return None;
+    }
+    let a = tol[3];
+    let turn = |k: usize, x: f64| UnitQuaternion::from_scaled_axis(Vector3::ith(k, x));
+    let turns = [
+        turn(1, 0.0), turn(1, -a), turn(1, a),
+        turn(0, -a), turn(0, -0.5 * a), turn(0, 0.5 * a), turn(0, a),
+        turn(2, -a), turn(2, -0.5 * a), turn(2, 0.5 * a), turn(2, a),
+    ];
+    // neighbouring turns: about the grasp axis, and along each tilt
+    let near = [(0, 1), (0, 2), (3, 4), (5, 6), (7, 8), (9, 10), (0, 4), (0, 5), (0, 8), (0, 9)];
+    let mut grid = vec![(f64::INFINITY, [0usize; 2]); 27 * turns.len()];
+    for (t, q) in turns.iter().enumerate() {
+        for c in 0..27 {
+            let shift = Vector3::new((c % 3) as f64 - 1.0, ((c / 3) % 3) as f64 - 1.0, (c / 9) as f64 - 1.0);
+            let at = Isometry3::from_parts(
+                (goal.translation.vector + shift.component_mul(&Vector3::new(tol[0], tol[1], tol[2]))).into(),
+                q * goal.rotation,
+            );
+            let pads = scene.pad_contacts(&at);
+            // a pose where the pads do not both touch is no goal: it holds nothing
+            grid[t * 27 + c] = (hold_ratio3(scene, &at).unwrap_or(f64::INFINITY), [pads[0].len(), pads[1].len()]);
+        }
+    }
+    // per family (the same pad contacts): its lowest ratio and largest change between neighbours
+    let mut families: Vec<([usize; 2], f64, f64)> = Vec::new();
+    for g in grid.iter().filter(|g| g.0.is_finite()) {
+        match families.iter_mut().find(|f| f.0 == g.1) {
+            Some(f) => f.1 = f.1.min(g.0),
+            None => families.push((g.1, g.0, 0.0)),
+        }
+    }
+    let mut pair = |a: (f64, [usize; 2]), b: (f64, [usize; 2])| {
+        if a.0.is_finite() && b.0.is_finite() && a.1 == b.1 {
+            if let Some(f) = families.iter_mut().find(|f| f.0 == a.1) {
+                f.2 = f.2.max((a.0 - b.0).abs());
+            }
+        }
+    };
+    for t in 0..turns.len() {
+        for c in 0..27 {
+            let (x, y, z) = (c % 3, (c / 3) % 3, c / 9);
+            let here = grid[t * 27 + c];
+            if x < 2 { pair(here, grid[t * 27 + c + 1]) }
+            if y < 2 { pair(here, grid[t * 27 + c + 3]) }
+            if z < 2 { pair(here, grid[t * 27 + c + 9]) }
+        }
+    }
+    for (t, u) in near {
+        for c in 0..27 {
+            pair(grid[t * 27 + c], grid[u * 27 + c]);
+        }
+    }
+    let low = families.iter().map(|f| f.1).fold(f64::INFINITY, f64::min);
+    (!families.is_empty() && families.iter().all(|f| f.1 >= 1.0 + f.2)).then(|| hold_reason(low))
 }

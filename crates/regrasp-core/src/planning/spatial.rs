@@ -376,10 +376,32 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
         }
     }
     settings.search.check()?;
+    let t0 = std::time::Instant::now();
+    if let Some(reason) = crate::planning::reachability::cannot_hold3(scene, &start, &goal, &scene.tolerance) {
+        let plan = trrt::Plan {
+            found: false,
+            stop_reason: trrt::StopReason::Unreachable,
+            path: vec![(start, None, [0.0; 6])],
+            nodes: 1,
+            iterations: 0,
+            planning_time_s: t0.elapsed().as_secs_f64(),
+            switch_overs: 0,
+            cost: 0.0,
+            goal_distance: distance(scene.length, &start, &goal),
+            reason: Some(reason),
+            first: None,
+        };
+        return Ok(SpatialPlan { plan, solves: 0 });
+    }
     let step = settings.search.step.unwrap_or(0.2 * scene.length);
     let core = SpaceCore { search: settings.search.clone(), length: scene.length, step, pushers: scene.pushers.len(), goal };
     let space = SpatialSpace { core, scene, s: settings, solves: AtomicUsize::new(0) };
-    let plan = trrt::plan(&space, start)?;
+    let before = t0.elapsed().as_secs_f64(); // the certificate counts as planning time
+    let mut plan = trrt::plan(&space, start)?;
+    plan.planning_time_s += before;
+    if let Some(f) = plan.first.as_mut() {
+        f.planning_time_s += before;
+    }
     Ok(SpatialPlan { plan, solves: space.solves.load(Ordering::Relaxed) })
 }
 
