@@ -1,4 +1,5 @@
-//! Infeasibility certificates: planar regrasps decided unreachable before any search.
+//! Infeasibility certificates: regrasps decided unreachable before any search (planar; in 3-D,
+//! a goal the pads cannot hold, [`cannot_hold3`]).
 //!
 //! Wherever the grasp is, the whole finger pad lies on the object, so the pad's centre (object
 //! frame) stays in the outline eroded by the radius r of the largest disc inside the pad — for
