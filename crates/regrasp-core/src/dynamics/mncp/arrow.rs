@@ -9,9 +9,10 @@
 //! and its forces are multipliers seen only through the wrench `B_i dz_i`. Per contact, the SVD
 //! of `D_i` splits its directions into eliminated and constraint ones. What remains is at most
 //! `2d` unknowns — the twist and the multipliers' wrench, in the range of their columns — in `d`
-//! balance rows and one row per constraint direction, solved in least squares (SVD): the exact
-//! Newton step when the Jacobian is invertible, the least-squares step of least norm (forces
-//! statically indeterminate, constraints inconsistent) otherwise. Cost O(n d²), where the dense
+//! balance rows and one row per constraint direction, solved in least squares (its normal
+//! equations, pseudo-inverted by an SVD of at most 2d × 2d, with two steps of refinement): the
+//! exact Newton step when the Jacobian is invertible, a least-squares step with the multipliers of
+//! least norm (forces statically indeterminate, constraints inconsistent) otherwise. Cost O(n d²), where the dense
 //! LU it replaces took O((d + Σ k_i)³).
 
 use nalgebra::{DMatrix, DVector};
@@ -180,7 +181,8 @@ struct Local {
     ci: [[f64; 6]; 3],
 }
 
-/// [`split`] on the stack: a scalar, a 2 × 2 in closed form ([`svd2`]), a 3 × 3 by [`split`].
+/// [`split`] on the stack: a scalar, a 2 × 2 in closed form ([`svd2`]), a 3 × 3 by [`split`]
+/// ([`super::Problem`]'s check keeps contacts to at most 3 unknowns).
 #[allow(clippy::type_complexity)]
 fn split_small(d: &DMatrix<f64>, tau: f64) -> Option<([[f64; 3]; 3], [f64; 3], [[f64; 3]; 3])> {
     let (mut u, mut sv, mut w) = ([[0.0; 3]; 3], [0.0; 3], [[0.0; 3]; 3]);
@@ -240,13 +242,6 @@ fn svd2(a: f64, b: f64, c: f64, d: f64) -> ([[f64; 2]; 2], [f64; 2], [[f64; 2]; 
 /// Gram–Schmidt.
 fn split(d: &DMatrix<f64>, tau: f64) -> Option<(DMatrix<f64>, DVector<f64>, DMatrix<f64>)> {
     let k = d.nrows();
-    if k == 1 {
-        // a scalar: |d| and its sign
-        let x = d[(0, 0)];
-        let s = if x.abs() > tau { x.abs() } else { 0.0 };
-        let sign = if x < 0.0 { -1.0 } else { 1.0 };
-        return x.is_finite().then(|| (DMatrix::identity(1, 1), DVector::from_element(1, s), DMatrix::from_element(1, 1, sign)));
-    }
     let scale = d.amax().max(tau);
     let check = |u: &DMatrix<f64>, sv: &DVector<f64>, w: &DMatrix<f64>| {
         let id = DMatrix::<f64>::identity(k, k);

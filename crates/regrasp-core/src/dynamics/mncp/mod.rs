@@ -212,12 +212,19 @@ impl Default for Settings {
 impl Problem {
     fn check(&self) -> Result<()> {
         let d = self.dim;
+        if d != 3 && d != 6 {
+            return Err(Error::arg("problem", format!("the twist has 3 (planar) or 6 (spatial) components, not {d}")));
+        }
         if self.mass.nrows() != d || self.mass.ncols() != d || self.wrench.len() != d {
             return Err(Error::arg("problem", "mass matrix / wrench do not match the twist dimension"));
         }
         for c in &self.contacts {
             if c.jn.len() != d || c.jt.ncols() != d || c.jn_other.len() != d || c.jt_other.ncols() != d {
                 return Err(Error::arg("problem", format!("contact {} has rows of the wrong size", c.label)));
+            }
+            // the forward solve's block step works on contacts of at most 3 unknowns
+            if c.tangent_dim() + (c.normal == NormalLaw::Unilateral) as usize > 3 {
+                return Err(Error::arg("problem", format!("contact {} has more than 3 force components", c.label)));
             }
             if c.jt_other.nrows() != c.jt.nrows() {
                 return Err(Error::arg("problem", format!("contact {} tangent rows differ", c.label)));

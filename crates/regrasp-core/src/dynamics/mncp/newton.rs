@@ -51,38 +51,19 @@ fn smax(a: f64, b: f64, e: f64) -> (f64, f64, f64) {
     (0.5 * (a + b + s), 0.5 * (1.0 + (a - b) / s), 0.5 * (1.0 - (a - b) / s))
 }
 
-/// Projection of `y` on the friction set, smoothed by `e`, and its derivatives
-/// `(P, dP/dy, dP/dr)`: `P = y r / smax(r, |y|)` for a Coulomb disc of radius `r`,
-/// `P = y / smax(1, √(yᵀAy))` for an ellipsoid (its projection in the metric `A`).
-fn project(law: &FrictionLaw, y: &DVector<f64>, r: f64, e: f64) -> (DVector<f64>, DMatrix<f64>, DVector<f64>) {
+/// Projection of `y` on an ellipsoid `yᵀAy ≤ 1` in the metric `A`, smoothed by `e`, and its
+/// derivative: `P = y / smax(1, √(yᵀAy))` (a Coulomb disc's is [`Newton::coulomb_rows`]').
+fn project_ellipsoid(a: &DMatrix<f64>, y: &DVector<f64>, e: f64) -> (DVector<f64>, DMatrix<f64>) {
     let k = y.len();
-    match law {
-        FrictionLaw::Coulomb(_) => {
-            let ny = y.norm();
-            let (m, dm_dr, dm_dy) = smax(r, ny, e);
-            if m <= 0.0 {
-                return (DVector::zeros(k), DMatrix::zeros(k, k), DVector::zeros(k));
-            }
-            let p = y * (r / m);
-            let mut dp = DMatrix::identity(k, k) * (r / m);
-            if ny > 0.0 {
-                dp -= (y * (y / ny).transpose()) * (r * dm_dy / (m * m));
-            }
-            let dpr = y / m - y * (r * dm_dr / (m * m));
-            (p, dp, dpr)
-        }
-        FrictionLaw::Ellipsoid(a) => {
-            let ay = a * y;
-            let q = y.dot(&ay).sqrt();
-            let (m, _, dm_dq) = smax(1.0, q, e);
-            let p = y / m;
-            let mut dp = DMatrix::identity(k, k) / m;
-            if q > 0.0 {
-                dp -= (y * (&ay / q).transpose()) * (dm_dq / (m * m));
-            }
-            (p, dp, DVector::zeros(k))
-        }
+    let ay = a * y;
+    let q = y.dot(&ay).sqrt();
+    let (m, _, dm_dq) = smax(1.0, q, e);
+    let p = y / m;
+    let mut dp = DMatrix::identity(k, k) / m;
+    if q > 0.0 {
+        dp -= (y * (&ay / q).transpose()) * (dm_dq / (m * m));
     }
+    (p, dp)
 }
 
 /// The metric used for the friction projection of a contact: `ρ G⁻¹ u` with `G⁻¹ = I` for
@@ -265,46 +246,34 @@ impl<'a> Newton<'a> {
         }
     }
 
-    /// Friction rows of contact `i` (eqs 3.1–3.3 in projection form): `F = f_t − P(f_t − ρ G⁻¹ u_t)`.
+    /// Friction rows of contact `i` (eqs 3.1–3.3 in projection form): `F = f_t − P(f_t − ρ G⁻¹ u_t)`;
+    /// a Coulomb disc's in [`Self::coulomb_rows`], an ellipsoid's (a fixed normal force: no
+    /// `dF/df_n`) here.
     fn friction_rows(&self, i: usize, f_n: f64, ft: DVectorView<'_, f64>, v: DVectorView<'_, f64>, out: &mut Eval) {
         let (c, pre) = (&self.p.contacts[i], &self.pre[i]);
         let (d, kt, t0) = (self.p.dim, c.tangent_dim(), self.lay.tangent[i]);
-        if let FrictionLaw::Coulomb(mu) = c.friction {
-            if kt <= 3 {
-                return self.coulomb_rows(i, mu, f_n, ft, v, out);
-            }
-        }
-        let (e, sf) = (out.e, out.sf);
+        let a = match &c.friction {
+            FrictionLaw::Coulomb(mu) => return self.coulomb_rows(i, *mu, f_n, ft, v, out),
+            FrictionLaw::Ellipsoid(a) => a,
+        };
+        let sf = out.sf;
         let y = ft - (&pre.gjt * v + &pre.gbt);
-        let (r, dr_dfn) = match &c.friction {
-            FrictionLaw::Coulomb(mu) => {
-                let (m, _, dm) = smax(0.0, f_n, e * self.p.force_scale);
-                (mu * m, mu * dm)
-            }
-            FrictionLaw::Ellipsoid(_) => (1.0, 0.0),
-        };
-        let pe = match &c.friction {
-            FrictionLaw::Coulomb(_) => e * self.p.force_scale,
-            FrictionLaw::Ellipsoid(_) => e,
-        };
-        let (proj, dp, dpr) = project(&c.friction, &y, r, pe);
+        let (proj, dp) = project_ellipsoid(a, &y, out.e);
         let mut fr = out.f.rows_mut(t0, kt);
         fr.copy_from(&(ft - proj));
         fr *= sf;
         if let Some(j) = out.j.as_mut() {
-            // dF/df_t = I − dP; dF/dV = dP ρ G⁻¹ J_t; dF/df_n = −dP/dr · dr/df_n
+            // dF/df_t = I − dP; dF/dV = dP ρ G⁻¹ J_t
             let blk = &mut j.blocks[i];
             let off = self.lay.normal[i].is_some() as usize;
             blk.d.view_mut((off, off), (kt, kt)).copy_from(&((DMatrix::identity(kt, kt) - &dp) * sf));
             blk.c.view_mut((off, 0), (kt, d)).copy_from(&(&dp * &pre.gjt * sf));
-            if off == 1 {
-                blk.d.view_mut((off, 0), (kt, 1)).copy_from(&(&dpr * (-dr_dfn * sf)));
-            }
         }
     }
 
-    /// [`Self::friction_rows`] of a Coulomb contact (k ≤ 3 tangent directions) on the stack: the
-    /// same projection as [`project`]'s, written without temporaries (the solve's inner loop).
+    /// [`Self::friction_rows`] of a Coulomb contact (at most 3 tangent directions, [`Problem`]'s
+    /// check) on the stack: `P = y r / smax(r, |y|)` with `r = μ f_n`, and its derivatives
+    /// `dP/dy`, `dP/dr` (the solve's inner loop, without temporaries).
     fn coulomb_rows(&self, i: usize, mu: f64, f_n: f64, ft: DVectorView<'_, f64>, v: DVectorView<'_, f64>, out: &mut Eval) {
         let (c, pre) = (&self.p.contacts[i], &self.pre[i]);
         let (d, kt, t0) = (self.p.dim, c.tangent_dim(), self.lay.tangent[i]);
