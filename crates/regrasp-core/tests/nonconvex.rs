@@ -157,3 +157,31 @@ fn the_bracket_is_planned_and_every_step_checks() {
         assert!(validate_path3(&s, &path, Some(&twists)).unwrap().iter().all(|b| *b));
     }
 }
+
+#[test]
+fn parts_are_bounded_together() {
+    // 40 copies of a 200-vertex prism side by side: 8,000 vertices in all, each part within a
+    // mesh's bounds; refused, naming the field, before any overlap test
+    let mut obj = String::new();
+    let mut first = 1;
+    for p in 0..40 {
+        obj += &format!("o p{p}\n");
+        let x0 = -0.02 + 0.001 * p as f64;
+        for y in [-0.006, 0.006] {
+            for k in 0..100 {
+                let a = std::f64::consts::TAU * k as f64 / 100.0;
+                obj += &format!("v {} {} {}\n", x0 + 0.0004 * (1.0 + a.cos()), y, 0.01 * a.sin());
+            }
+        }
+        // the two caps fanned, the sides as quads, outward
+        obj += &format!("f {}\n", (0..100).map(|k| (first + k).to_string()).collect::<Vec<_>>().join(" "));
+        obj += &format!("f {}\n", (0..100).rev().map(|k| (first + 100 + k).to_string()).collect::<Vec<_>>().join(" "));
+        for k in 0..100 {
+            let (a, b) = (first + k, first + (k + 1) % 100);
+            obj += &format!("f {a} {} {} {b}\n", a + 100, b + 100);
+        }
+        first += 200;
+    }
+    let m = mesh_error(with_obj(&obj, "many"));
+    assert!(m.contains("vertices in all its parts"), "{m}");
+}

@@ -251,13 +251,19 @@ fn parts(text: &str) -> Result<(ConvexMesh, Vec<ConvexMesh>)> {
         return Ok((parts.remove(0), vec![]));
     }
     let all: Vec<V3> = parts.iter().flat_map(|m| m.vertices.iter().copied()).collect();
+    let triangles: usize = parts.iter().map(|m| m.triangles.len()).sum();
+    // the parts together within one mesh's bounds (this also bounds the overlap test's work)
+    bounds::count("object.mesh", all.len(), bounds::MAX_MESH_VERTICES, "vertices in all its parts")?;
+    bounds::count("object.mesh", triangles, bounds::MAX_MESH_TRIANGLES, "triangles in all its parts")?;
     let size = all.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let boxes: Vec<(V3, V3)> = parts.iter().map(|m| m.vertices.iter().fold((m.vertices[0], m.vertices[0]), |(l, h), v| (l.inf(v), h.sup(v)))).collect();
     // overlapping interiors would count their volume twice: no part's vertex, face centre or
-    // centroid lies inside another part
+    // centroid lies inside another part (only parts whose bounding boxes meet are compared)
     for (i, a) in parts.iter().enumerate() {
         let probes = a.vertices.iter().copied().chain(a.triangles.iter().map(|t| (a.vertices[t[0]] + a.vertices[t[1]] + a.vertices[t[2]]) / 3.0));
         let probes: Vec<V3> = probes.chain(std::iter::once(a.mass_properties().1)).collect();
-        for (j, b) in parts.iter().enumerate().filter(|(j, _)| *j != i) {
+        let meet = |j: usize| (0..3).all(|k| boxes[i].0[k] < boxes[j].1[k] && boxes[j].0[k] < boxes[i].1[k]);
+        for (j, b) in parts.iter().enumerate().filter(|(j, _)| *j != i && meet(*j)) {
             if probes.iter().any(|p| b.signed_distance(p) < -1e-6 * size) {
                 return Err(Error::scene("object.mesh", format!("convex parts {i} and {j} overlap: the parts of a non-convex object may touch, not overlap")));
             }
