@@ -7,7 +7,9 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use common::*;
 use proptest::prelude::*;
+use regrasp::mechanics::exact_surface::Region;
 use regrasp::mechanics::geometry::{perp, rot, Vec2, Vec3};
+use regrasp::mechanics::limit_surface::Pressure;
 use regrasp::scene::planar_file::{RawGravity, RawScene};
 use regrasp::Scene;
 
@@ -21,6 +23,12 @@ fn twist_from_angles(a: f64, b: f64, l: f64) -> Vec3 {
 /// and the pad's limit surface (eq 3.10), then an LP asks for contact forces at the pusher
 /// points, inside their Coulomb cones, that balance it with gravity. Returns feasibility.
 fn brute_force_sticks(raw: &RawScene, q: &[f64; 3], v: &Vec3) -> bool {
+    brute_force_sticks_on(raw, q, v, false)
+}
+
+/// [`brute_force_sticks`] with the pad's load on the ellipsoid (`k = 0.6 r`) or, when `exact`,
+/// integrated over the uniform disc directly ([`Region::wrench`], eq 3.5).
+fn brute_force_sticks_on(raw: &RawScene, q: &[f64; 3], v: &Vec3, exact: bool) -> bool {
     let obj = raw.object.as_ref().unwrap();
     let grasp = raw.grasp.as_ref().unwrap();
     let grav = raw.gravity.clone().unwrap_or(RawGravity { direction: None, g: None });
@@ -35,8 +43,13 @@ fn brute_force_sticks(raw: &RawScene, q: &[f64; 3], v: &Vec3) -> bool {
     let vel = r * vel_obj;
     // eq 3.10 with A = diag(1, 1, 1/k²)/s²: w = s [vx, vz, k² ω]/√(vx² + vz² + k² ω²)
     let den = (vel.x * vel.x + vel.y * vel.y + k * k * v.z * v.z).sqrt();
-    let f_pad = r.transpose() * Vec2::new(vel.x, vel.y) * (s / den);
-    let tau_pad = s * k * k * v.z / den;
+    let (f_pad, tau_pad) = if exact {
+        let disc = Region::Disc { radius: grasp.pad_radius.unwrap(), pressure: Pressure::Uniform };
+        let w = disc.wrench(&Vec3::new(vel.x, vel.y, v.z)) * s;
+        (r.transpose() * Vec2::new(w.x, w.y), w.z)
+    } else {
+        (r.transpose() * Vec2::new(vel.x, vel.y) * (s / den), s * k * k * v.z / den)
+    };
     // required pusher wrench about the object origin = support load − gravity
     let d = grav.direction.unwrap_or([0.0, -1.0]);
     let g = grav.g.unwrap_or(9.81);
@@ -60,27 +73,43 @@ fn brute_force_sticks(raw: &RawScene, q: &[f64; 3], v: &Vec3) -> bool {
             cols.push(vec![dir.x, dir.y, pv.x * dir.y - pv.y * dir.x]);
         }
     }
-    // rows: 3 equalities, then 3 inequalities per point written as -G f + s = 0, s ≥ 0
-    let mut dense = vec![vec![0.0; m]; 3 + 3 * pts.len()];
+    // rows: 3 equalities (on the integrated surface: within 1e-4 of the load, the table's
+    // error, as 6 inequalities), then 3 inequalities per point written as -G f + s = 0, s ≥ 0
+    let eq = if exact { 6 } else { 3 };
+    let mut dense = vec![vec![0.0; m]; eq + 3 * pts.len()];
     for j in 0..m {
         for i in 0..3 {
             dense[i][j] = cols[j][i];
+            if exact {
+                dense[3 + i][j] = -cols[j][i];
+            }
         }
     }
     for i in 0..pts.len() {
         let (jn, jt) = (2 * i, 2 * i + 1);
-        dense[3 + 3 * i][jn] = -1.0;
-        dense[4 + 3 * i][jn] = -mu;
-        dense[4 + 3 * i][jt] = -1.0;
-        dense[5 + 3 * i][jn] = -mu;
-        dense[5 + 3 * i][jt] = 1.0;
+        dense[eq + 3 * i][jn] = -1.0;
+        dense[eq + 1 + 3 * i][jn] = -mu;
+        dense[eq + 1 + 3 * i][jt] = -1.0;
+        dense[eq + 2 + 3 * i][jn] = -mu;
+        dense[eq + 2 + 3 * i][jt] = 1.0;
     }
     let a = CscMatrix::from(&dense);
-    let mut b = vec![0.0; 3 + 3 * pts.len()];
+    let mut b = vec![0.0; eq + 3 * pts.len()];
     b[..3].copy_from_slice(&[req.x, req.y, req.z]);
+    if exact {
+        let l = obj.outline.as_ref().map_or(0.05, |o| o.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max));
+        let tol = 1e-4 * (req.x.hypot(req.y) + req.z.abs() / l);
+        b[..3].iter_mut().for_each(|x| *x += tol);
+        b[3..6].copy_from_slice(&[-req.x + tol, -req.y + tol, -req.z + tol * l]);
+        b[2] += tol * (l - 1.0);
+    }
     let pmat = CscMatrix::zeros((m, m));
     let qv = vec![0.0; m];
-    let cones = [SupportedConeT::ZeroConeT(3), SupportedConeT::NonnegativeConeT(3 * pts.len())];
+    let cones = if exact {
+        vec![SupportedConeT::NonnegativeConeT(6 + 3 * pts.len())]
+    } else {
+        vec![SupportedConeT::ZeroConeT(3), SupportedConeT::NonnegativeConeT(3 * pts.len())]
+    };
     let settings = DefaultSettings { verbose: false, ..DefaultSettings::default() };
     let mut solver = DefaultSolver::new(&pmat, &qv, &a, &b, &cones, settings).unwrap();
     solver.solve();
@@ -96,10 +125,10 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 200, .. ProptestConfig::default() })]
 
     /// Every generator's pusher wrench lies on an edge of the pusher's friction cone, and the
-    /// support wrench is on the limit surface, balancing pusher and gravity.
+    /// support wrench is on the (ellipsoidal) limit surface, balancing pusher and gravity.
     #[test]
     fn generators_balance_forces(b in block_case()) {
-        let Some(scene) = scene(&b) else { return Ok(()) };
+        let Some(scene) = scene_ellipsoid(&b) else { return Ok(()) };
         let push = scene.push(&b.pose, 0).unwrap();
         let gens = push.generators().unwrap();
         let spec = push.spec().clone();
@@ -189,11 +218,43 @@ proptest! {
         }
     }
 
-    /// Without gravity the exact cone is the polyhedral cone.
+    /// On the true limit surface too, every generator's pusher wrench lies on an edge of the
+    /// pusher's friction cone and balances gravity with the support's load, and that load is the
+    /// pad's friction integrated directly (not from the table) within the table's error.
+    #[test]
+    fn generators_balance_forces_on_the_true_surface(b in block_case()) {
+        let Some(scene) = scene(&b) else { return Ok(()) };
+        let push = scene.push(&b.pose, 0).unwrap();
+        let gens = push.generators().unwrap();
+        let spec = push.spec().clone();
+        let exact = spec.exact.clone().expect("the true surface is the default");
+        let js = spec.support_jacobian;
+        let l = exact.length();
+        for (g, e) in gens.iter().zip(push.pusher_edges()) {
+            let c = push.classify(g).unwrap();
+            prop_assert!(c.margin.abs() < 1e-7, "margin {}", c.margin);
+            let ang = angle(&c.pusher_wrench, &e.wrench);
+            prop_assert!(ang < 1e-6 || c.pusher_wrench.norm() < 1e-9 * spec.friction_scale, "edge angle {ang}");
+            let direct = js.transpose() * exact.wrench_direct(&(js * g)) * spec.friction_scale;
+            let d = js.try_inverse().unwrap().transpose() * (c.support_wrench - direct);
+            let scaled = Vec3::new(d.x, d.y, d.z / l).norm() / spec.friction_scale;
+            prop_assert!(scaled < 5e-4, "load off the integrated surface by {scaled}");
+            prop_assert!((c.support_wrench - c.pusher_wrench - spec.gravity).norm() < 1e-9 * spec.friction_scale);
+        }
+    }
+
+    /// Without gravity the exact cone on the ellipsoid is the polyhedral cone (on the true
+    /// surface the rays are still those of the gravity-free cone).
     #[test]
     fn zero_gravity_cone_is_polyhedral(mut b in block_case(), a1 in -3.2f64..3.2, a2 in -1.5f64..1.5) {
         b.g = 0.0;
-        let Some(scene) = scene(&b) else { return Ok(()) };
+        if let Some(scene) = scene(&b) {
+            let push = scene.push(&b.pose, 0).unwrap();
+            for (g, gf) in push.generators().unwrap().iter().zip(push.gravity_free_generators()) {
+                prop_assert!(angle(g, &gf) < 1e-9);
+            }
+        }
+        let Some(scene) = scene_ellipsoid(&b) else { return Ok(()) };
         let push = scene.push(&b.pose, 0).unwrap();
         for (g, gf) in push.generators().unwrap().iter().zip(push.gravity_free_generators()) {
             prop_assert!(angle(g, &gf) < 1e-9);
@@ -357,6 +418,17 @@ fn cannot_hold_is_an_error_not_a_nan() {
 /// both outcomes well represented.
 #[test]
 fn exact_test_matches_brute_force_lp() {
+    exact_test_matches_lp(false);
+}
+
+/// The same on the true limit surface, against the pad's friction integrated directly; twists
+/// whose margin is within the table's error (1e-3) are left out.
+#[test]
+fn exact_test_on_the_true_surface_matches_brute_force_lp() {
+    exact_test_matches_lp(true);
+}
+
+fn exact_test_matches_lp(exact: bool) {
     use proptest::strategy::ValueTree;
     use proptest::test_runner::TestRunner;
     let mut runner = TestRunner::deterministic();
@@ -365,7 +437,7 @@ fn exact_test_matches_brute_force_lp() {
     let mut inside = [0usize; 2];
     for _ in 0..3000 {
         let (b, a1, a2, w, near) = strat.new_tree(&mut runner).unwrap().current();
-        let raw = raw_scene(&b);
+        let raw = if exact { raw_scene(&b) } else { raw_scene_ellipsoid(&b) };
         let Ok(scene) = Scene::from_raw(raw.clone()) else { continue };
         let push = scene.push(&b.pose, 0).unwrap();
         let mut v = twist_from_angles(a1, a2, scene.length);
@@ -386,12 +458,12 @@ fn exact_test_matches_brute_force_lp() {
             }
         }
         let c = push.classify(&v).unwrap();
-        if c.margin.abs() < 1e-6 {
+        if c.margin.abs() < if exact { 1e-3 } else { 1e-6 } {
             continue;
         }
         checked[kind] += 1;
         inside[kind] += c.feasible as usize;
-        if c.feasible != brute_force_sticks(&raw, &b.pose, &v) {
+        if c.feasible != brute_force_sticks_on(&raw, &b.pose, &v, exact) {
             disagree.push((b, v, c.margin));
         }
     }
@@ -477,3 +549,4 @@ fn absurd_grip_forces_are_errors() {
     let e = Scene::from_toml_str(&text).unwrap_err();
     assert!(e.to_string().contains("grasp.force"), "{e}");
 }
+

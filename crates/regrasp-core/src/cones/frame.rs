@@ -3,9 +3,11 @@
 //! (nominal, robust, fixtureless; §5.1, CASE 2018).
 //!
 //! Exact test: for a twist `v`, `v_s = J_s v`, `ŵ = A⁻¹v_s/√(v_sᵀA⁻¹v_s)` (eq 3.10); the
-//! required pusher wrench is `w_p = J_sᵀŵ − w_g`; `v` is feasible iff `w_p ∈ W_p`.
+//! required pusher wrench is `w_p = J_sᵀŵ − w_g`; `v` is feasible iff `w_p ∈ W_p`. With the exact
+//! limit surface ([`ExactSurface`]) `ŵ = μN W(v_s)` and the rays solve `H(λu + u_g) = 1` on it.
 
 use crate::error::{Error, Result};
+use crate::mechanics::exact_surface::ExactSurface;
 use crate::mechanics::friction_cone::{ContactLimit, EdgeWrench, PolyhedralCone, PusherContact};
 use crate::mechanics::geometry::{Mat3, Vec3};
 use crate::mechanics::metric::Metric;
@@ -44,7 +46,7 @@ impl PusherModel {
 }
 
 /// Pose-dependent quantities of a push: limit surface, support Jacobian, gravity.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct SupportFrame {
     /// `A` (eq 3.7), support frame.
     pub a: Mat3,
@@ -56,8 +58,11 @@ pub struct SupportFrame {
     pub gravity: Vec3,
     /// `J_s⁻ᵀ w_g`.
     pub ug: Vec3,
-    /// `√(u_gᵀ A u_g)`: < 1 when the support holds the object against gravity.
+    /// `√(u_gᵀ A u_g)` (exact surface: `H(u_g/μN)`): < 1 when the support holds the object
+    /// against gravity.
     pub hold_ratio: f64,
+    /// The exact limit surface (μN = 1) and `μN`, when the support uses it instead of `A`.
+    pub exact: Option<(ExactSurface, f64)>,
     /// Which cone the exact test answers for (nominal, robust, fixtureless; [`crate::cones::robust`]).
     pub mode: ConeMode,
 }
@@ -66,36 +71,65 @@ impl SupportFrame {
     pub fn new(a: Mat3, a_inv: Mat3, js: Mat3, js_inv: Mat3, gravity: Vec3) -> Self {
         let ug = js_inv.tr_mul(&gravity);
         let hold_ratio = ug.dot(&(a * ug)).sqrt();
-        Self { a, a_inv, js, js_inv, gravity, ug, hold_ratio, mode: ConeMode::Nominal }
+        Self { a, a_inv, js, js_inv, gravity, ug, hold_ratio, mode: ConeMode::Nominal, exact: None }
+    }
+
+    /// The same frame on the exact limit surface `surface` (μN = 1) at `μN = scale` [N].
+    pub fn with_exact(mut self, surface: &ExactSurface, scale: f64) -> Self {
+        self.hold_ratio = surface.gauge(&(self.ug / scale));
+        self.exact = Some((surface.clone(), scale));
+        self
     }
 
     /// The motion-cone ray (unit twist in `metric`) of pusher wrench direction `p`;
     /// `None` if the support cannot hold the object (no positive root).
     #[inline]
     pub fn ray(&self, p: &Vec3, metric: &Metric) -> Option<Vec3> {
+        self.ray_with::<true>(p, metric)
+    }
+
+    /// [`Self::ray`] to about 1e-5 on the exact surface (the inverse table's twist, not polished
+    /// on the forward one), for searches whose result is polished by [`Self::ray`].
+    #[inline]
+    pub fn ray_guess(&self, p: &Vec3, metric: &Metric) -> Option<Vec3> {
+        self.ray_with::<false>(p, metric)
+    }
+
+    #[inline]
+    fn ray_with<const POLISH: bool>(&self, p: &Vec3, metric: &Metric) -> Option<Vec3> {
         let scale = p.amax();
         if !(scale > 0.0) || !scale.is_finite() {
             return None;
         }
         let u = self.js_inv.tr_mul(&(p / scale));
+        // λ: (λu + u_g)ᵀ A (λu + u_g) = 1 on the ellipsoid
         let au = self.a * u;
         let qa = u.dot(&au);
         let qb = 2.0 * self.ug.dot(&au);
-        let qc = self.hold_ratio * self.hold_ratio - 1.0;
-        if !(qc < 0.0) || !(qa > 0.0) {
-            return None;
+        let qc = self.ug.dot(&(self.a * self.ug)) - 1.0;
+        let lambda = if !(qc < 0.0) || !(qa > 0.0) {
+            None
+        } else {
+            let disc = (qb * qb - 4.0 * qa * qc).sqrt();
+            // positive root, in the cancellation-free form
+            Some(if qb >= 0.0 { 2.0 * qc / (-qb - disc) } else { (-qb + disc) / (2.0 * qa) })
+        };
+        if let Some((surface, s)) = &self.exact {
+            // the ellipsoid's root is a first guess on the exact surface
+            let v = self.js_inv * surface.ray_from::<POLISH>(&u, &(self.ug / *s), self.hold_ratio, lambda.map(|l| l / s))?;
+            return Some(v / metric.twist_norm(&v));
         }
-        let disc = (qb * qb - 4.0 * qa * qc).sqrt();
-        // positive root, in the cancellation-free form
-        let lambda = if qb >= 0.0 { 2.0 * qc / (-qb - disc) } else { (-qb + disc) / (2.0 * qa) };
-        let v = self.js_inv * (au * lambda + self.a * self.ug);
+        let v = self.js_inv * (au * lambda? + self.a * self.ug);
         Some(v / metric.twist_norm(&v))
     }
 
-    /// Ray of the gravity-free cone for pusher wrench `p`: `J_s⁻¹ A J_s⁻ᵀ p`, unit.
+    /// Ray of the gravity-free cone for pusher wrench `p`: `J_s⁻¹ A J_s⁻ᵀ p` (exact surface: the
+    /// sliding twist whose load is along `J_s⁻ᵀ p`), unit.
     #[inline]
     pub fn gravity_free_ray(&self, p: &Vec3, metric: &Metric) -> Vec3 {
-        let v = self.js_inv * (self.a * self.js_inv.tr_mul(&(p / p.amax())));
+        let u = self.js_inv.tr_mul(&(p / p.amax()));
+        let exact = self.exact.as_ref().and_then(|(surface, _)| surface.twist_for(&u));
+        let v = self.js_inv * exact.unwrap_or_else(|| self.a * u);
         v / metric.twist_norm(&v)
     }
 
@@ -104,6 +138,9 @@ impl SupportFrame {
     pub fn support_load(&self, v: &Vec3) -> Vec3 {
         // only the direction matters: normalize first so that huge or tiny twists are safe
         let vs = self.js * (v / v.amax());
+        if let Some((surface, s)) = &self.exact {
+            return self.js.tr_mul(&(surface.wrench(&vs) * *s));
+        }
         let w = self.a_inv * vs;
         self.js.tr_mul(&(w / vs.dot(&w).sqrt()))
     }

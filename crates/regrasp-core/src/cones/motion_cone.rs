@@ -21,6 +21,7 @@
 //! the object frame) and a [`SupportFrame`] (everything that depends on the pose).
 
 use crate::error::{Error, Result};
+use crate::mechanics::exact_surface::ExactSurface;
 use crate::mechanics::friction_cone::{ConeShape, EdgeWrench, PolyhedralCone, PusherContact};
 use crate::mechanics::geometry::{perp, Mat3, Vec2, Vec3};
 use crate::mechanics::limit_surface::LimitSurface;
@@ -31,8 +32,10 @@ pub use crate::cones::projection::{project_exact, project_onto_generators, proje
 /// Everything that defines one push at one pose.
 #[derive(Clone, Debug)]
 pub struct PushSpec {
-    /// Unit limit surface of the support, in the support frame.
+    /// Unit ellipsoidal limit surface of the support, in the support frame.
     pub limit_surface: LimitSurface,
+    /// The exact limit surface (μN = 1) the cones use instead, when the scene selects it.
+    pub exact: Option<ExactSurface>,
     /// `μ_s N` of the support [N]: the limit surface is `wᵀ (B / s²) w = 1`.
     pub friction_scale: f64,
     /// `J_s`: object twist (object frame) → support twist (support frame).
@@ -100,6 +103,9 @@ impl PlanarPush {
             spec.gravity,
         );
         frame.mode = spec.mode;
+        if let Some(e) = &spec.exact {
+            frame = frame.with_exact(e, spec.friction_scale);
+        }
         Ok(Self { spec, frame, model })
     }
 
@@ -215,10 +221,7 @@ impl PlanarPush {
     /// `None` when no rotation rate balances the moments.
     pub fn point_pusher_twist(&self, u: &Vec2, s: f64) -> Option<Vec3> {
         let r = *self.spec.pusher.points.first()?;
-        let (binv, js) = (self.spec.limit_surface.b_inv, self.spec.support_jacobian);
-        crate::cones::point_pusher::contact_twist(&r, u, self.spec.metric.length, |v| {
-            js.tr_mul(&LimitSurface::wrench_for_twist(&binv, &(js * v))) * s - self.spec.gravity
-        })
+        crate::cones::point_pusher::contact_twist(&r, u, self.spec.metric.length, |v| self.unit_load(v) * s - self.spec.gravity)
     }
 
     /// The same push with another friction scale (another grip force).
@@ -243,16 +246,16 @@ impl PlanarPush {
             .spec
             .grip_per_scale
             .ok_or_else(|| Error::arg("scene", "grip force is defined only for a grasp (not an object on a surface)"))?;
-        // u_gᵀ A u_g = u_gᵀ B u_g / s² < 1  ⇔  s > √(u_gᵀ B u_g)
-        let s_hold = self.frame.ug.dot(&(self.spec.limit_surface.b * self.frame.ug)).sqrt();
+        // the hold ratio is degree −1 in s: it stays below 1 for s > s_hold
+        let s_hold = self.frame.hold_ratio * self.spec.friction_scale;
         let v = v / v.amax();
         let range = if self.spec.pusher.is_line() { self.line_scale_range(&v, s_hold) } else { self.point_scale_range(&v, s_hold) };
         Ok(range.map(|(lo, hi)| GripForceRange { min: lo * per, max: hi * per }))
     }
 
+    /// The support's load for twist `v` at unit friction scale (the load is linear in it).
     fn unit_load(&self, v: &Vec3) -> Vec3 {
-        let js = self.spec.support_jacobian;
-        js.tr_mul(&LimitSurface::wrench_for_twist(&self.spec.limit_surface.b_inv, &(js * v)))
+        self.frame.support_load(v) / self.spec.friction_scale
     }
 
     /// Line pusher: `w(s) = s a₀ − w_g` must lie in `W_p`, linear in `s` (facet inequalities; for

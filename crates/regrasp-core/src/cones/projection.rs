@@ -1,5 +1,5 @@
 //! Projections onto motion cones: the closest feasible twist to a desired one, on the exact
-//! cone (the image of the boundary of the pusher's cone searched by grid and golden section) or
+//! cone (the image of the boundary of the pusher's cone searched by grid and Brent's method) or
 //! on a polyhedral cone spanned by generators (non-negative least squares).
 
 use crate::cones::frame::{ConeMode, PusherModel, SupportFrame};
@@ -91,8 +91,9 @@ fn centre(frame: &SupportFrame, model: &PusherModel, gens: &[Vec3], margin_min: 
 }
 
 /// A sample of the exact cone's boundary: (parameter along the fan, cosine to the desired
-/// direction, unit ray in the metric, ray).
-type Sample = (f64, f64, Vec3, Vec3);
+/// direction, unit ray in the metric, ray, pusher wrench); the fans' rays from
+/// [`SupportFrame::ray_guess`], Brent's search's exact.
+type Sample = (f64, f64, Vec3, Vec3, Vec3);
 
 /// The rays of the exact cone's boundary fans compared with one desired direction.
 struct BoundaryRays<'a> {
@@ -108,13 +109,20 @@ impl BoundaryRays<'_> {
 
     /// The boundary ray of pusher wrench direction `p` (`t`: its parameter on the fan).
     fn sample(&self, p: &Vec3, t: f64) -> Sample {
+        self.sample_with::<false>(p, t)
+    }
+
+    /// [`Self::sample`], its ray exact (`POLISH`) or a guess ([`SupportFrame::ray_guess`]).
+    fn sample_with<const POLISH: bool>(&self, p: &Vec3, t: f64) -> Sample {
         let m = &self.model.metric;
-        match self.frame.ray(&m.wrench_inv(p), m) {
+        let w = m.wrench_inv(p);
+        let ray = if POLISH { self.frame.ray(&w, m) } else { self.frame.ray_guess(&w, m) };
+        match ray {
             Some(v) => {
                 let s = m.twist(&v);
-                (t, s.dot(&self.ds), s, v)
+                (t, s.dot(&self.ds), s, v, w)
             }
-            None => (t, f64::NEG_INFINITY, Vec3::zeros(), Vec3::zeros()),
+            None => (t, f64::NEG_INFINITY, Vec3::zeros(), Vec3::zeros(), w),
         }
     }
 
@@ -138,37 +146,79 @@ impl BoundaryRays<'_> {
         pts
     }
 
-    /// Golden-section search for the largest cosine on the fan `ea`–`eb` within `[lo, hi]`;
-    /// returns the two last samples.
-    fn golden(&self, ea: Vec3, eb: Vec3, mut lo: f64, mut hi: f64) -> [Sample; 2] {
+    /// Brent's search (parabolic steps, golden sections where they fail; Brent 1973, ch. 5) for
+    /// the largest cosine on the fan `ea`–`eb` within `[lo, hi]`, from the sample `start`
+    /// inside; returns the best sample (its ray exact).
+    fn brent(&self, ea: Vec3, eb: Vec3, mut lo: f64, mut hi: f64, start: Sample) -> Sample {
+        const C: f64 = 0.381_966_011_250_105; // (3 − √5)/2
         let at = |t: f64| ea * (1.0 - t) + eb * t;
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-        let (mut f1, mut f2) = (self.sample(&at(x1), x1), self.sample(&at(x2), x2));
-        let stop = 1e-7 * (hi - lo);
-        while hi - lo > stop {
-            if f1.1 >= f2.1 {
-                hi = x2;
-                x2 = x1;
-                f2 = f1;
-                x1 = hi - g * (hi - lo);
-                f1 = self.sample(&at(x1), x1);
+        // the search on exact rays
+        let start = self.sample_with::<true>(&at(start.0), start.0);
+        let tol = 1e-8 * (hi - lo);
+        // minimize −cos
+        let (mut x, mut w, mut v) = (start, start, start);
+        let (mut d, mut e): (f64, f64) = (0.0, 0.0);
+        for _ in 0..100 {
+            let xm = 0.5 * (lo + hi);
+            if (x.0 - xm).abs() <= 2.0 * tol - 0.5 * (hi - lo) {
+                break;
+            }
+            let (fx, fw, fv) = (-x.1, -w.1, -v.1);
+            let mut golden = true;
+            if e.abs() > tol && fx.is_finite() && fw.is_finite() && fv.is_finite() {
+                let r = (x.0 - w.0) * (fx - fv);
+                let mut q = (x.0 - v.0) * (fx - fw);
+                let mut p = (x.0 - v.0) * q - (x.0 - w.0) * r;
+                q = 2.0 * (q - r);
+                if q > 0.0 {
+                    p = -p;
+                }
+                q = q.abs();
+                let e_old = e;
+                if p.abs() < (0.5 * q * e_old).abs() && p > q * (lo - x.0) && p < q * (hi - x.0) {
+                    e = d;
+                    d = p / q;
+                    let u = x.0 + d;
+                    if u - lo < 2.0 * tol || hi - u < 2.0 * tol {
+                        d = tol.copysign(xm - x.0);
+                    }
+                    golden = false;
+                }
+            }
+            if golden {
+                e = if x.0 >= xm { lo - x.0 } else { hi - x.0 };
+                d = C * e;
+            }
+            let u = if d.abs() >= tol { x.0 + d } else { x.0 + tol.copysign(d) };
+            let fu = self.sample_with::<true>(&at(u), u);
+            if fu.1 >= x.1 {
+                if u >= x.0 {
+                    lo = x.0;
+                } else {
+                    hi = x.0;
+                }
+                (v, w, x) = (w, x, fu);
             } else {
-                lo = x1;
-                x1 = x2;
-                f1 = f2;
-                x2 = lo + g * (hi - lo);
-                f2 = self.sample(&at(x2), x2);
+                if u < x.0 {
+                    lo = u;
+                } else {
+                    hi = u;
+                }
+                if fu.1 >= w.1 || w.0 == x.0 {
+                    (v, w) = (w, fu);
+                } else if fu.1 >= v.1 || v.0 == x.0 || v.0 == w.0 {
+                    v = fu;
+                }
             }
         }
-        [f1, f2]
+        x
     }
 }
 
 /// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images of
 /// the boundary fans of `W_p`). Each fan is sampled until consecutive rays are less than 4°
 /// apart (the boundary can turn quickly where gravity matters most), then every local maximum
-/// near the best is refined by golden-section search. Returns the cosine and the unit ray.
+/// near the best is refined by Brent's search. Returns the cosine and the unit ray.
 fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> (f64, Vec3) {
     let rays = BoundaryRays { frame, model, ds: model.metric.twist(d).normalize() };
     let segments = model.cone.boundary_segments();
@@ -181,7 +231,7 @@ fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> 
     // between samples at most MAX_STEP apart the cosine can rise by about MAX_STEP²/2 above
     // the better sample: refine every local maximum within that of the best one
     let slack = BoundaryRays::MAX_STEP * BoundaryRays::MAX_STEP;
-    let mut best = (f64::NEG_INFINITY, Vec3::zeros());
+    let mut best = (f64::NEG_INFINITY, None);
     for (seg, pts) in sampled.iter().enumerate() {
         let (ea, eb) = edges(segments[seg]);
         for k in 0..pts.len() {
@@ -190,20 +240,24 @@ fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> 
                 continue;
             }
             if pts[k].1 > best.0 {
-                best = (pts[k].1, pts[k].3);
+                best = (pts[k].1, Some(pts[k].4));
             }
             if pts.len() < 2 {
                 continue;
             }
             let (lo, hi) = (pts[k.saturating_sub(1)].0, pts[(k + 1).min(pts.len() - 1)].0);
-            for f in rays.golden(ea, eb, lo, hi) {
-                if f.1 > best.0 {
-                    best = (f.1, f.3);
-                }
+            let f = rays.brent(ea, eb, lo, hi, pts[k]);
+            if f.1 > best.0 {
+                best = (f.1, Some(f.4));
             }
         }
     }
-    best
+    // the best sample's ray, exact
+    let m = &model.metric;
+    match best.1.and_then(|w| frame.ray(&w, m)) {
+        Some(v) => (m.twist(&v).dot(&rays.ds), v),
+        None => (f64::NEG_INFINITY, Vec3::zeros()),
+    }
 }
 
 /// Euclidean projection of `d` onto the cone generated by `gens` (non-negative least squares,

@@ -139,16 +139,19 @@ pub(crate) fn pad_region(scene: &Scene, r: f64, join: LineJoin<f64>) -> Option<M
 ///
 /// On the grasp's ellipsoidal limit surface (eq 3.7), the object's velocity at the pad's centre
 /// is `B_ff` times the force on it (pushers' plus gravity's; `B` has no force–moment coupling for
-/// the disc and rectangle pads), so the pad's centre moves along `−B_ff (f_p + f_g)`: within the
+/// the disc and rectangle pads; on a disc's exact surface the two are parallel), so the pad's centre moves along `−B_ff (f_p + f_g)`: within the
 /// cone of the pushers' Coulomb edges `−f` and of gravity's directions `−Rᵀ(θ) d` over the turn,
 /// each widened by the angle `B_ff`'s anisotropy can bend a vector. When that cone is pointed
 /// (narrower than π), the directions at least 90° from all of it are blocked.
 pub fn blocked(scene: &Scene, turn: [f64; 2]) -> Option<(f64, f64)> {
     let Support::Grasp(g) = &scene.support else { return None };
     let b = &g.limit_surface.b;
-    let beta = 0.5 * (b[(0, 0)] + b[(1, 1)]);
-    let coupling = b[(0, 2)].abs() + b[(1, 2)].abs();
-    let aniso = (0.5 * (b[(0, 0)] - b[(1, 1)])).hypot(b[(0, 1)]);
+    let (beta, coupling, aniso) = match &g.exact {
+        // an axisymmetric pad's force is along its centre's velocity (mirror symmetry)
+        Some(e) if e.region().axisymmetric() => (1.0, 0.0, 0.0),
+        Some(_) => return None,
+        None => (0.5 * (b[(0, 0)] + b[(1, 1)]), b[(0, 2)].abs() + b[(1, 2)].abs(), (0.5 * (b[(0, 0)] - b[(1, 1)])).hypot(b[(0, 1)])),
+    };
     if !(beta > 0.0) || coupling > 1e-9 * beta || aniso >= 0.5 * beta || !turn.iter().all(|t| t.is_finite()) {
         return None;
     }

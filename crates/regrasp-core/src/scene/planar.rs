@@ -8,7 +8,8 @@ use crate::error::{Error, Result};
 use crate::mechanics::friction_cone::PusherContact;
 use crate::mechanics::geometry::{rot, shift_jacobian, Mat3, Polygon, Vec2, Vec3};
 use crate::mechanics::gravity::gravity_wrench;
-use crate::mechanics::limit_surface::{LimitSurface, Pressure};
+use crate::mechanics::exact_surface::{ExactSurface, Region};
+use crate::mechanics::limit_surface::{LimitSurface, Pressure, SurfaceModel};
 use crate::mechanics::metric::Metric;
 use crate::cones::motion_cone::{PlanarPush, PushSpec, PusherModel, SupportFrame};
 use crate::cones::robust::{ConeMode, Uncertainty};
@@ -28,16 +29,21 @@ pub struct Grasp {
     pub friction: f64,
     pub pad: PadShape,
     pub pressure: Pressure,
-    /// Unit limit surface of one pad, gripper axes (both pads act as one with normal force 2N).
+    /// Unit ellipsoidal limit surface of one pad, gripper axes (both pads act as one with
+    /// normal force 2N).
     pub limit_surface: LimitSurface,
+    /// The pad's exact limit surface, when the scene uses it.
+    pub exact: Option<ExactSurface>,
 }
 
 #[derive(Clone, Debug)]
 pub struct Surface {
     pub friction: f64,
     pub incline: f64,
-    /// Unit limit surface of the footprint (uniform pressure), object axes, about `cop`.
+    /// Unit ellipsoidal limit surface of the footprint (uniform pressure), object axes, about `cop`.
     pub limit_surface: LimitSurface,
+    /// The footprint's exact limit surface, when the scene uses it.
+    pub exact: Option<ExactSurface>,
     /// Centre of pressure, object frame (the area centroid).
     pub cop: Vec2,
 }
@@ -85,7 +91,95 @@ pub struct Scene {
     /// What the loader changed, e.g. a measured pusher point moved onto the outline.
     pub notes: Vec<String>,
 }
+/// Most vertices of a footprint's exact limit surface (its tables cost time in proportion).
+pub const MAX_FOOTPRINT_VERTICES: usize = 64;
+
+/// The footprint about `cop` for its exact limit surface: the outline, simplified
+/// (Ramer–Douglas–Peucker, the tolerance doubled until at most [`MAX_FOOTPRINT_VERTICES`]
+/// remain) when it has more vertices, with a note saying so.
+fn footprint(outline: &Polygon, cop: &Vec2) -> (Vec<Vec2>, Option<String>) {
+    use geo::Simplify;
+    let pts: Vec<Vec2> = outline.vertices().iter().map(|v| v - cop).collect();
+    if pts.len() <= MAX_FOOTPRINT_VERTICES {
+        return (pts, None);
+    }
+    let ring: geo::LineString<f64> = pts.iter().chain(std::iter::once(&pts[0])).map(|p| geo::coord! { x: p.x, y: p.y }).collect();
+    let mut eps = 1e-4 * outline.bbox_diagonal();
+    loop {
+        let simple = ring.simplify(eps);
+        let n = simple.0.len().saturating_sub(1);
+        if n <= MAX_FOOTPRINT_VERTICES && n >= 3 {
+            let v = simple.0[..n].iter().map(|c| Vec2::new(c.x, c.y)).collect();
+            let note = format!(
+                "the footprint's exact limit surface uses the outline simplified to {n} of its {} vertices (within {:.3} mm)",
+                pts.len(),
+                eps * 1e3
+            );
+            return (v, Some(note));
+        }
+        if n < 3 {
+            // (a tolerance that removes nearly everything at once) every k-th vertex instead
+            let k = pts.len().div_ceil(MAX_FOOTPRINT_VERTICES);
+            let v: Vec<Vec2> = pts.iter().step_by(k).copied().collect();
+            let note = format!("the footprint's exact limit surface uses every {k}-th of the outline's {} vertices", pts.len());
+            return (v, Some(note));
+        }
+        eps *= 2.0;
+    }
+}
+
+impl Grasp {
+    /// The pad's region and pressure (pad frame, centred).
+    pub fn region(&self) -> Region {
+        match self.pad {
+            PadShape::Circle { radius } => Region::Disc { radius, pressure: self.pressure },
+            PadShape::Rectangle { width, height } => {
+                let (w, h) = (width / 2.0, height / 2.0);
+                Region::Polygon { vertices: vec![Vec2::new(-w, -h), Vec2::new(w, -h), Vec2::new(w, h), Vec2::new(-w, h)] }
+            }
+        }
+    }
+}
+
 impl Scene {
+    /// The limit surface the motion cones use.
+    pub fn surface_model(&self) -> SurfaceModel {
+        let exact = match &self.support {
+            Support::Grasp(g) => g.exact.is_some(),
+            Support::Surface(s) => s.exact.is_some(),
+        };
+        if exact {
+            SurfaceModel::True
+        } else {
+            SurfaceModel::Ellipsoid
+        }
+    }
+
+    /// A copy whose motion cones use limit surface `model` (the exact one built or shared).
+    pub fn with_surface_model(&self, model: SurfaceModel) -> Scene {
+        let mut s = self.clone();
+        let outline = &self.outline;
+        match &mut s.support {
+            Support::Grasp(g) => g.exact = (model == SurfaceModel::True).then(|| ExactSurface::new(&g.region())),
+            Support::Surface(sf) => {
+                sf.exact = None;
+                if model == SurfaceModel::True {
+                    let (vertices, note) = footprint(outline, &sf.cop);
+                    sf.exact = Some(ExactSurface::new(&Region::Polygon { vertices }));
+                    s.notes.extend(note);
+                }
+            }
+        }
+        s
+    }
+
+    fn exact_surface(&self) -> Option<&ExactSurface> {
+        match &self.support {
+            Support::Grasp(g) => g.exact.as_ref(),
+            Support::Surface(s) => s.exact.as_ref(),
+        }
+    }
+
     /// What the loader changed in the file's values (pusher points snapped onto the outline).
     pub fn notes(&self) -> &[String] {
         &self.notes
@@ -253,7 +347,10 @@ impl Scene {
         let k = 1.0 / (s * s);
         let mut f = SupportFrame::new(ls.b * k, ls.b_inv * (s * s), js, js_inv, wg);
         f.mode = self.mode;
-        f
+        match self.exact_surface() {
+            Some(e) => f.with_exact(e, s),
+            None => f,
+        }
     }
 
     /// Checks a pose and returns its frame; the error says what is wrong.
@@ -272,6 +369,7 @@ impl Scene {
         let p = self.pushers.get(pusher).ok_or_else(|| Error::arg("pusher", format!("index {pusher} out of range")))?;
         Ok(PushSpec {
             limit_surface: self.limit_surface(),
+            exact: self.exact_surface().cloned(),
             friction_scale: self.friction_scale(),
             support_jacobian: self.support_jacobian(q),
             pusher: p.contact.clone(),

@@ -7,7 +7,7 @@ use crate::cones::robust::{ConeMode, Uncertainty};
 use crate::error::{Error, Result};
 use crate::mechanics::friction_cone::PusherContact;
 use crate::mechanics::geometry::{cross2, perp, point_segment_distance, Polygon, Vec2};
-use crate::mechanics::limit_surface::{LimitSurface, Pressure, PressureDistribution};
+use crate::mechanics::limit_surface::{LimitSurface, Pressure, PressureDistribution, SurfaceModel};
 use crate::mechanics::metric::Metric;
 use crate::scene::{bounds, exact};
 use crate::scene::planar::{Grasp, PadShape, Pusher, Scene, Support, Surface, Task};
@@ -65,6 +65,9 @@ pub struct RawGrasp {
     pub pad_size: Option<[f64; 2]>,
     /// `"uniform"` (default) or `"hertzian"` (circular pads only).
     pub pressure: Option<String>,
+    /// `"true"` or `"ellipsoid"`: the limit surface the motion cones use (default
+    /// [`SurfaceModel::default`]).
+    pub limit_surface: Option<String>,
 }
 
 #[derive(Deserialize, Serialize, Default, Debug, Clone)]
@@ -73,6 +76,8 @@ pub struct RawSurface {
     pub friction: Option<f64>,
     /// Inclination of the surface [rad], 0 = horizontal.
     pub incline: Option<f64>,
+    /// `"true"` or `"ellipsoid"`, as for the grasp.
+    pub limit_surface: Option<String>,
 }
 
 #[derive(Deserialize, Serialize, Default, Debug, Clone)]
@@ -250,6 +255,14 @@ impl Scene {
             mode: ConeMode::Nominal,
             notes,
         };
+        let model = match (&raw.grasp, &raw.surface) {
+            (Some(gr), _) => Self::read_surface_model("grasp.limit_surface", gr.limit_surface.as_deref())?,
+            (_, Some(sf)) => Self::read_surface_model("surface.limit_surface", sf.limit_surface.as_deref())?,
+            _ => SurfaceModel::default(),
+        };
+        if model != SurfaceModel::Ellipsoid {
+            scene = scene.with_surface_model(model);
+        }
         scene.task = Self::task(raw.task.as_ref(), &scene)?;
         if let Support::Surface(_) = scene.support {
             // the support frame sits under the centre of mass: holding depends on the heading only
@@ -307,6 +320,15 @@ impl Scene {
         Ok((d, g))
     }
 
+    /// The `limit_surface` key of the support's table (default [`SurfaceModel::default`]).
+    fn read_surface_model(field: &str, raw: Option<&str>) -> Result<SurfaceModel> {
+        match raw {
+            None => Ok(SurfaceModel::default()),
+            Some(s) => SurfaceModel::parse(s)
+                .ok_or_else(|| Error::scene(field, format!("must be \"true\" or \"ellipsoid\" (got {s:?})"))),
+        }
+    }
+
     /// A surface the object lies on (incline below π/2; uniform pressure over the outline, so
     /// the centre of mass must be the centroid); its limit surface fitted to the footprint.
     fn surface(sf: &RawSurface, outline: &Polygon, com: &Vec2) -> Result<Surface> {
@@ -326,7 +348,7 @@ impl Scene {
             ));
         }
         let (ls, _) = LimitSurface::fit(&PressureDistribution::polygon(outline, &centroid, 80));
-        Ok(Surface { friction, incline, limit_surface: ls, cop: centroid })
+        Ok(Surface { friction, incline, limit_surface: ls, cop: centroid, exact: None })
     }
 
     /// The pushers (at least one, unique names), their cones in the scene's metric.
@@ -426,7 +448,7 @@ impl Scene {
                 return Err(Error::scene("grasp.pressure", "\"hertzian\" is defined for circular pads only"))
             }
         };
-        Ok(Grasp { force, friction, pad, pressure, limit_surface })
+        Ok(Grasp { force, friction, pad, pressure, limit_surface, exact: None })
     }
 
     fn pusher(field: &str, p: &RawPusher, outline: &Polygon, size: f64, notes: &mut Vec<String>) -> Result<Pusher> {

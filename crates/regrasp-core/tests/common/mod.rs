@@ -97,6 +97,15 @@ pub fn star(radii: &[f64]) -> Vec<[f64; 2]> {
     }).collect()
 }
 
+/// [`raw_scene`] on the ellipsoidal limit surface (eq 3.7, `k = 0.6 r`).
+pub fn raw_scene_ellipsoid(b: &BlockCase) -> RawScene {
+    let mut raw = raw_scene(b);
+    if let Some(g) = raw.grasp.as_mut() {
+        g.limit_surface = Some("ellipsoid".into());
+    }
+    raw
+}
+
 pub fn raw_scene(b: &BlockCase) -> RawScene {
     let (hw, hh) = (b.w / 2.0, b.h / 2.0);
     let outline = vec![[-hw, -hh], [hw, -hh], [hw, hh], [-hw, hh]];
@@ -139,6 +148,11 @@ pub fn raw_scene(b: &BlockCase) -> RawScene {
 }
 
 /// The scene, or None when the random grasp cannot hold the object (rejected at load).
+/// [`scene`] on the ellipsoidal limit surface.
+pub fn scene_ellipsoid(b: &BlockCase) -> Option<Scene> {
+    Scene::from_raw(raw_scene_ellipsoid(b)).ok()
+}
+
 pub fn scene(b: &BlockCase) -> Option<Scene> {
     Scene::from_raw(raw_scene(b)).ok()
 }
