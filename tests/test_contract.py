@@ -264,7 +264,7 @@ def written_plans(tmp_path_factory):
     parts = text.split("[[pushers]]")
     top = [p for p in parts[1:] if 'name = "top"' in p][0]
     (d / "top-only.toml").write_text(parts[0] + "[[pushers]]" + top)  # can only push down; the goal is up
-    (d / "weak.toml").write_text(text.replace("force = 20.0", "force = 4.0"))  # holds the task, not a pad far off
+    (d / "weak.toml").write_text(text.replace("force = 20.0", "force = 3.6"))  # holds the task, not a pad far off
     # the 3-D block at 2 N: it holds at the start, not 18 mm off its centre of mass
     weak3 = (EXAMPLES / "block-3d.toml").read_text().replace("force = 20.0", "force = 2.0")
     (d / "weak-3d.toml").write_text(re.sub(r"(?m)^goal = .*$", "goal = [0.018, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]", weak3))

@@ -115,8 +115,8 @@ def test_point_pushers_only_plans_replay_in_the_simulator():
     """Issue 18, item 1: a scene whose pushers are all points is planned (steps in contact-point
     velocity, each the object's flow under the pusher's motion); every plan passes the exact test
     along its flows, and the quasi-static simulator (an independent solver, same ellipsoidal pad
-    model) driving the pushers as planned ends within the task's tolerance."""
-    sc = regrasp.Scene.load(ROOT / "benches" / "scenes" / "point-pushers.toml")
+    model: the scene on the ellipsoid) driving the pushers as planned ends within the task's tolerance."""
+    sc = regrasp.Scene.load(ROOT / "benches" / "scenes" / "point-pushers.toml").with_limit_surface("ellipsoid")
     t = sc.task
     for seed in range(3):
         p = regrasp.plan(sc, seed=seed, time_limit=10.0)
@@ -125,6 +125,21 @@ def test_point_pushers_only_plans_replay_in_the_simulator():
         r = replay_plan(sc, p, support="limit_surface")
         assert r.success, (seed, r.goal_error)
         assert r.max_pusher_slip < 1e-9
+
+
+def test_point_pushers_plans_on_the_true_surface_replay_on_fine_point_set_pads():
+    """The same on the exact limit surface (the default), replayed with pads of 8 rings of points
+    (216 a pad, whose limit surface is close to the exact one): the simulator ends within the
+    task's tolerance."""
+    sc = regrasp.Scene.load(ROOT / "benches" / "scenes" / "point-pushers.toml")
+    assert sc.limit_surface == "true"
+    t = sc.task
+    for seed in range(3):
+        p = regrasp.plan(sc, seed=seed, time_limit=10.0)
+        assert p.found and p.valid, (seed, p.stop_reason)
+        assert np.all(np.abs(p.poses[-1] - t.goal) <= t.tolerance)
+        r = replay_plan(sc, p, support="points", rings=8)
+        assert r.success, (seed, r.goal_error)
 
 
 def test_a_point_pushers_step_that_does_not_land_is_invalid():

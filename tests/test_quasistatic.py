@@ -172,11 +172,17 @@ def test_validate_json_and_agreement():
     assert {"pushes", "agreement_quasistatic", "confusion_quasistatic"} <= set(out)
     assert out["pushes"] == 120 and sum(out["confusion_quasistatic"].values()) == out["solved"]
     assert out["agreement_quasistatic"] > 0.85
-    # with the motion cones' own limit surface as the pads, prediction and simulation coincide
+    assert out["limit_surface"] == "true" and out["rings"] == 3
+    # with the motion cones' own limit surface as the pads (the ellipsoid), prediction and
+    # simulation coincide
     from regrasp.sim.validation import validate
 
-    ls = validate(regrasp.Scene.load(EXAMPLES / "block-high-friction.toml"), 90, 1, support="limit_surface")
-    assert ls["agreement_quasistatic"] > 0.99
+    scene = regrasp.Scene.load(EXAMPLES / "block-high-friction.toml")
+    ls = validate(scene.with_limit_surface("ellipsoid"), 90, 1, support="limit_surface")
+    assert ls["agreement_quasistatic"] > 0.99 and ls["limit_surface"] == "ellipsoid"
+    # the exact surface against point-set pads fine enough to share it (8 rings, 216 points)
+    fine = validate(scene, 300, 2, rings=8)
+    assert fine["rings"] == 8 and fine["agreement_quasistatic"] >= 0.99, fine["confusion_quasistatic"]
 
 
 def test_push_cli_plot(tmp_path):

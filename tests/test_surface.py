@@ -26,7 +26,7 @@ def test_horizontal_plane_cone_is_exactly_polyhedral():
 
 def test_horizontal_cone_matches_the_ellipsoidal_closed_form():
     # support at the COM, J_s = I: a pusher force f at r moves the object along A [f, r x f]
-    sc = incline_scene(0.0)
+    sc = incline_scene(0.0).with_limit_surface("ellipsoid")
     c = sc.motion_cone([0, 0, 0], "paddle")
     A, Js, wg = c._core.support_matrices
     assert np.allclose(Js, np.eye(3)) and np.allclose(wg, 0)

@@ -23,6 +23,7 @@ __all__ = [
     "planner_defaults",
     "mpc_defaults",
     "quasistatic_defaults",
+    "limit_surface_default",
     "se3_log",
     "se3_integrate",
     "se3_compose",
@@ -102,6 +103,11 @@ class Scene:
         (< 1 holds)."""
     def with_grip_force(self, force: float) -> Scene:
         """The same scene with grip force `force` [N] per finger (grasp scenes)."""
+    def with_limit_surface(self, model: str) -> Scene:
+        """A copy whose motion cones use limit surface `model`, "true" or "ellipsoid"."""
+    @property
+    def limit_surface(self) -> str:
+        """The limit surface the motion cones use: "true" or "ellipsoid"."""
     def motion_cone(self, pose: ArrayLike, pusher: str, check_hold: bool | None = None) -> MotionCone:
         """The motion cone of pusher `pusher` at `pose` `[x, z, theta]` (m, m, rad) (raises GraspError if the grasp cannot
         hold, unless `check_hold` is False)."""
@@ -412,6 +418,9 @@ def mpc_defaults() -> dict[str, Any]:
     """The MPC's default settings (`regrasp::control::mpc::MpcSettings::default()`): the keywords
     `_core.Mpc` takes, `replan_time_limit` and `seed` being those of its re-planning."""
 
+def limit_surface_default() -> str:
+    """The limit surface a scene's motion cones use when its file does not say
+(`regrasp::mechanics::limit_surface::SurfaceModel::default()`): "true" or "ellipsoid"."""
 def quasistatic_defaults() -> dict[str, Any]:
     """The quasi-static model's default options (`regrasp::dynamics::planar::Options::default()`):
     the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`."""

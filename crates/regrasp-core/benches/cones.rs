@@ -1,6 +1,7 @@
 //! Criterion benchmarks of the motion-cone hot paths: building one cone through the public API,
 //! the fast frame + rays path of the batch API, the exact membership test, the projection, and
-//! the batch generator computation over many poses.
+//! the batch generator computation over many poses; on the scenes' default (exact) limit surface,
+//! and the frame, exact test and projection also on the ellipsoid (`*_ellipsoid`).
 //!
 //! Run with `cargo bench -p regrasp-core --bench cones`.
 
@@ -11,6 +12,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion};
 use regrasp::cones::batch::{generators_into, Status};
 use regrasp::mechanics::geometry::Vec3;
+use regrasp::mechanics::limit_surface::SurfaceModel;
 use regrasp::Scene;
 
 const POSE: [f64; 3] = [0.003, 0.004, 0.1];
@@ -86,6 +88,19 @@ fn bench_cone(c: &mut Criterion) {
     });
 
     let model = &scene.pushers[i].model;
+    let ellipsoid = scene.with_surface_model(SurfaceModel::Ellipsoid);
+    g.bench_function("frame+rays_ellipsoid", |b| {
+        b.iter(|| {
+            let frame = ellipsoid.frame(black_box(&POSE));
+            let mut acc = Vec3::zeros();
+            for e in &model.edges {
+                if let Some(v) = frame.ray(&e.wrench, &ellipsoid.metric()) {
+                    acc += v;
+                }
+            }
+            black_box(acc)
+        })
+    });
     g.bench_function("frame+rays", |b| {
         b.iter(|| {
             let frame = scene.frame(black_box(&POSE));
@@ -108,12 +123,24 @@ fn bench_membership(c: &mut Criterion) {
     let frame = scene.frame(&POSE);
     let push = scene.push(&POSE, i).unwrap();
 
+    // the same test on the ellipsoidal limit surface (the scenes' default is the exact one)
+    let ellipsoid = scene.with_surface_model(SurfaceModel::Ellipsoid);
+    let frame_e = ellipsoid.frame(&POSE);
+
     let mut g = c.benchmark_group("membership");
     g.measurement_time(Duration::from_secs(3)).warm_up_time(Duration::from_secs(1));
+    // two exact tests per iteration (one twist inside, one outside)
     g.bench_function("exact", |b| {
         b.iter(|| {
             let a = frame.classify(model, black_box(&inside));
             let o = frame.classify(model, black_box(&outside));
+            black_box((a, o))
+        })
+    });
+    g.bench_function("exact_ellipsoid", |b| {
+        b.iter(|| {
+            let a = frame_e.classify(model, black_box(&inside));
+            let o = frame_e.classify(model, black_box(&outside));
             black_box((a, o))
         })
     });
@@ -126,9 +153,11 @@ fn bench_membership(c: &mut Criterion) {
     });
     g.finish();
 
+    let push_e = ellipsoid.push(&POSE, i).unwrap();
     let mut g = c.benchmark_group("project");
     g.measurement_time(Duration::from_secs(3)).warm_up_time(Duration::from_secs(1));
     g.bench_function("exact", |b| b.iter(|| black_box(push.project(black_box(&outside)).unwrap())));
+    g.bench_function("exact_ellipsoid", |b| b.iter(|| black_box(push_e.project(black_box(&outside)).unwrap())));
     g.finish();
 }
 

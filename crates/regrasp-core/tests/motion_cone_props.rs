@@ -22,12 +22,8 @@ fn twist_from_angles(a: f64, b: f64, l: f64) -> Vec3 {
 /// Independent force balance: the load wrench of the finger pads is recomputed from the pose
 /// and the pad's limit surface (eq 3.10), then an LP asks for contact forces at the pusher
 /// points, inside their Coulomb cones, that balance it with gravity. Returns feasibility.
-fn brute_force_sticks(raw: &RawScene, q: &[f64; 3], v: &Vec3) -> bool {
-    brute_force_sticks_on(raw, q, v, false)
-}
-
-/// [`brute_force_sticks`] with the pad's load on the ellipsoid (`k = 0.6 r`) or, when `exact`,
-/// integrated over the uniform disc directly ([`Region::wrench`], eq 3.5).
+/// The pad's load is on the ellipsoid (`k = 0.6 r`) or, when `exact`, integrated over the
+/// uniform disc directly ([`Region::wrench`], eq 3.5).
 fn brute_force_sticks_on(raw: &RawScene, q: &[f64; 3], v: &Vec3, exact: bool) -> bool {
     let obj = raw.object.as_ref().unwrap();
     let grasp = raw.grasp.as_ref().unwrap();
@@ -549,4 +545,5 @@ fn absurd_grip_forces_are_errors() {
     let e = Scene::from_toml_str(&text).unwrap_err();
     assert!(e.to_string().contains("grasp.force"), "{e}");
 }
+
 

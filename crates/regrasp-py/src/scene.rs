@@ -11,6 +11,7 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use regrasp::cones::robust::ConeMode;
+use regrasp::mechanics::limit_surface::SurfaceModel;
 use regrasp::scene::perturb;
 use regrasp::scene::planar::{PadShape, Support};
 use std::collections::HashMap;
@@ -148,6 +149,22 @@ impl Scene {
             }
             Ok(Self { inner: self.inner.try_with_grip_force(force).map_err(to_py)? })
         })
+    }
+
+    /// A copy whose motion cones use limit surface `model`, "true" or "ellipsoid".
+    fn with_limit_surface(&self, model: &Arg<'_>) -> PyResult<Self> {
+        guard(move || {
+            let name = arg::<String>("limit_surface", model)?;
+            let m = SurfaceModel::parse(&name)
+                .ok_or_else(|| arg_err("limit_surface", format!("must be \"true\" or \"ellipsoid\" (got {name:?})")))?;
+            Ok(Self { inner: self.inner.with_surface_model(m) })
+        })
+    }
+
+    /// The limit surface the motion cones use: "true" or "ellipsoid".
+    #[getter]
+    fn limit_surface(&self) -> &'static str {
+        self.inner.surface_model().label()
     }
 
     /// The motion cone of pusher `pusher` at `pose` `[x, z, theta]` (m, m, rad) (raises GraspError if the grasp cannot

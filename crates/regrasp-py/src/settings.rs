@@ -154,6 +154,13 @@ pub fn quasistatic_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     })
 }
 
+/// The limit surface a scene's motion cones use when its file does not say
+/// (`regrasp::mechanics::limit_surface::SurfaceModel::default()`): "true" or "ellipsoid".
+#[pyfunction]
+pub fn limit_surface_default() -> &'static str {
+    regrasp::mechanics::limit_surface::SurfaceModel::default().label()
+}
+
 /// Most rings and points a pad's support model may take (each point is a contact of the problem).
 const MAX_RINGS: usize = 64;
 const MAX_POINTS: usize = 1024;

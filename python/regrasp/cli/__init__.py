@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import errors, progress
+from .. import _core, errors, progress
 from ..errors import ArgumentError, MissingExtraError, RegraspError, SceneError
 from ..extras import need
 from ..files import check_writable, refuse_overwrite_input
@@ -210,10 +210,24 @@ def load(path, a=None, arg: str = "scene"):
         if e.field != "path":
             raise
         raise unreadable(path, e, arg) from e
+    model = getattr(a, "limit_surface", None)
+    if model is not None:
+        if scene.dimension == 3:
+            raise ArgumentError("invalid `--limit-surface`: it selects a planar scene's limit surface; "
+                                f"{path} is a 3-D scene", "--limit-surface")
+        scene = scene.with_limit_surface(model)
     if getattr(a, "verbose", False):
         for note in getattr(scene, "notes", None) or []:
             progress.note(f"regrasp: {path}: {note}")
     return scene
+
+
+def add_limit_surface(p) -> None:
+    """``--limit-surface``: the limit surface of a planar scene's motion cones."""
+    p.add_argument("--limit-surface", choices=["true", "ellipsoid"],
+                   help="the motion cones' limit surface: the exact one of the pad's or footprint's pressure, or "
+                   "the ellipsoid of eq 3.7 (default: the scene's `limit_surface`, else "
+                   f"{_core.limit_surface_default()})")
 
 
 def unreadable(path, e: ArgumentError, arg: str = "scene") -> ArgumentError:

@@ -9,7 +9,7 @@ import numpy as np
 from ..errors import ArgumentError, GraspError
 from ..scene.planar import Scene
 from .. import progress
-from . import (CANNOT, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, pusher_help, add_command, add_verbose, api_default,
+from . import (CANNOT, FIGURE_SUFFIXES, MAX_FORCE, MAX_SAMPLES, OK, pusher_help, add_command, add_limit_surface, add_verbose, api_default,
                check_count, check_outputs, check_pusher, floats, load_planar, seed_arg)
 
 
@@ -53,13 +53,14 @@ def cone_report(scene: Scene, pose, pusher: str, twist=None) -> dict:
         "hold_ratio": cone.hold_ratio,
         "pusher_kind": "line" if cone.is_line_pusher else "point",
         "twist_metric_length": scene.length,
+        "limit_surface": scene.limit_surface,
     }
 
 
 def _print_cone(scene: Scene, rep: dict, plot) -> None:
     print(f"motion cone of pusher '{rep['pusher']}' in scene '{scene.name}' at pose {rep['pose']}")
-    print(f"  ({rep['pusher_kind']} pusher; twists [vx, vz, omega] in the object frame, unit in diag(1,1,L^2), "
-          f"L = {scene.length:.4f} m)")
+    print(f"  ({rep['pusher_kind']} pusher on the {rep['limit_surface']} limit surface; twists [vx, vz, omega] in the "
+          f"object frame, unit in diag(1,1,L^2), L = {scene.length:.4f} m)")
     print("  generators (polyhedral approximation):")
     for g in rep["generators"]:
         print("    [{:+.5f}, {:+.5f}, {:+.4f}]".format(*g))
@@ -134,6 +135,7 @@ def add_parsers(sub) -> None:
                    "gravity-free twist)")
     c.add_argument("--json", action="store_true", help="print the report as JSON")
     c.add_argument("--plot", metavar="PNG", help="draw the cone in wrench and twist space")
+    add_limit_surface(c)
     add_verbose(c)
 
     e = add_command(sub, "approx-error", "polyhedral approximation vs exact cone, per scene and grip force",

@@ -11,7 +11,7 @@ from ..errors import ArgumentError
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, pusher_help, VIDEO_SUFFIXES,
-               add_command, add_scale_options, api_default, add_verbose, check_count, check_number, check_outputs, check_positive,
+               add_command, add_limit_surface, add_scale_options, api_default, add_verbose, check_count, check_number, check_outputs, check_positive,
                check_pusher, execute3d, floats, given, load, load_planar, plural, refuse_flags, runs, rounded, scales, seed_arg, error3d)
 
 
@@ -25,10 +25,12 @@ def cmd_validate(a) -> int:
         refuse_flags(a, ("workers", "ray"), "without the MuJoCo engine", "only MuJoCo pushes run in processes "
                      "(add --engines mujoco)")
     if "quasistatic" not in engines:
-        refuse_flags(a, ("support",), "without the quasi-static engine", "it is the quasi-static simulator's pad model")
+        refuse_flags(a, ("support", "rings"), "without the quasi-static engine", "it is the quasi-static simulator's pad model")
+    if a.rings is not None and a.support == "limit_surface":
+        refuse_flags(a, ("rings",), "with --support limit_surface", "rings are the point-set pads' (--support points)")
     scene = load_planar(a.scene, "validate", a)
     res = validate(scene, a.pushes, a.seed, engines=engines, workers=a.workers, ray_address=a.ray, progress=True,
-                   support=a.support)
+                   support=a.support, rings=a.rings)
     print(json.dumps(res) if a.json else format_validation(res))
     return OK
 
@@ -200,9 +202,12 @@ def add_parsers(sub) -> None:
     v.add_argument("--workers", type=int, help=f"local processes for MuJoCo, 1 to {MAX_WORKERS} (default: all cores)")
     v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
     v.add_argument("--support", choices=["points", "limit_surface"],
-                   help="quasi-static pads as point sets or as the motion cones' limit surface "
+                   help="quasi-static pads as point sets or as one patch on the ellipsoidal limit surface (eq 3.7) "
                    f"(default: {_core.quasistatic_defaults()['support']})")
+    v.add_argument("--rings", type=int, help="quasi-static point-set pads: rings of points per circular pad, 1 to 64 "
+                   f"(6, 12, 18... points; default: {_core.quasistatic_defaults()['rings']})")
     v.add_argument("--json", action="store_true", help="print the result as JSON")
+    add_limit_surface(v)
     add_verbose(v)
 
     s = add_command(sub, "simulate", "replay a plan in a simulator (planar or 3-D)",

@@ -9,7 +9,7 @@ from ..errors import ArgumentError
 from ..files import Outputs
 from .. import progress
 from ..planning.plan import POSE_SIZE, Plan, plan, planner_defaults
-from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_command, add_verbose, check_number, check_outputs,
+from . import (ANIMATION_SUFFIXES, CANNOT, FIGURE_SUFFIXES, OK, add_command, add_limit_surface, add_verbose, check_number, check_outputs,
                floats, load, mode_scene, planner_default, plural, pusher_runs, refuse_flags, seed_arg)
 
 #: the output options of `regrasp plan` and the file-name suffixes they take (None: any)
@@ -163,4 +163,5 @@ def add_parsers(sub) -> None:
     pl.add_argument("--fixtureless", action="store_true", help="planar only: plan only with fixtureless-fixturing "
                     "pushes (invariant to mass, grip force, finger friction)")
     pl.add_argument("--html", metavar="HTML", help="an interactive view of the plan in the browser (self-contained page)")
+    add_limit_surface(pl)
     add_verbose(pl)

@@ -32,10 +32,13 @@ class RefParams:
 
     @classmethod
     def from_scene(cls, scene: Scene, pusher: str) -> "RefParams":
-        """The parameters of ``pusher`` in a grasp ``scene`` with circular pads (ValueError
-        otherwise)."""
+        """The parameters of ``pusher`` in a grasp ``scene`` with circular pads on the
+        ellipsoidal limit surface, the model this reference implements (ValueError otherwise)."""
         if scene.kind != "grasp" or scene.pad is None or scene.pad[0] != "circle":
             raise ValueError("the numpy reference handles grasps with circular pads only")
+        if scene.limit_surface != "ellipsoid":
+            raise ValueError("the numpy reference is the ellipsoidal limit surface's (eq 3.7): take "
+                             "scene.with_limit_surface('ellipsoid')")
         p = scene.pusher(pusher)
         gdir, g = scene.gravity
         mu_s = scene._core.friction_scale / (2 * scene.grip_force)

@@ -496,6 +496,17 @@ class Scene:
         force = _number(force, "force")
         return self._view(self._core.with_grip_force(force), "with_grip_force", force=force)
 
+    def with_limit_surface(self, model: str) -> "Scene":
+        """A copy whose motion cones use limit surface ``model``: ``"true"`` (the exact surface of
+        the pad's or footprint's pressure) or ``"ellipsoid"`` (eq 3.7, the thesis' model)."""
+        model = _name(model, "limit_surface")
+        if model == self.limit_surface:
+            return self
+        return self._view(self._core.with_limit_surface(model), "with_limit_surface", model=model)
+
+    limit_surface = core_property("limit_surface", 'The limit surface the motion cones use: "true" (exact) or '
+                                                   '"ellipsoid" (eq 3.7).')
+
     def _view(self, core, op: str, **kw) -> "Scene":
         """A view of this scene (a new core) that remembers how it was taken, so it pickles."""
         s = Scene(core, self.path, self.source)

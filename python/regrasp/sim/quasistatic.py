@@ -27,7 +27,7 @@ DT = 0.05
 def support_kwargs(support: str | None = None, rings: int | None = None, points: int | None = None,
                    merge_fingers: bool | None = None) -> dict:
     """The finger support model (defaults: the core's): ``support`` "points" (pads as rings of
-    contact points) or "limit_surface" (each pad one ellipsoidal patch); ``rings`` in [1, 64] and
+    contact points) or "limit_surface" (each pad one patch on the ellipsoidal limit surface, eq 3.7); ``rings`` in [1, 64] and
     ``points`` in [0, 4096] (bounds against runaway model sizes)."""
     given = dict(support=support, rings=rings, points=points, merge_fingers=merge_fingers)
     kw = {k: DEFAULTS[k] if v is None else v for k, v in given.items()}

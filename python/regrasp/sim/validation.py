@@ -243,13 +243,15 @@ def _table(pred, sim, ok, mask) -> dict:
 
 
 def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasistatic",), support: str | None = None,
-             workers: int | None = None, ray_address=None, progress: bool = False) -> dict:
-    """Agreement of the exact motion-cone prediction with each engine (see the module notes);
-    ``support`` the quasi-static pad model, "points" or "limit_surface" (default: the core's)."""
+             workers: int | None = None, ray_address=None, progress: bool = False, rings: int | None = None) -> dict:
+    """Agreement of the exact motion-cone prediction (on the scene's limit surface,
+    ``scene.limit_surface``) with each engine (see the module notes); ``support`` the quasi-static
+    pad model, "points" or "limit_surface" (default: the core's), ``rings`` the point-set pads'
+    rings (default: the core's)."""
     pushes, seed = _count(pushes, "pushes", 1, MAX_PUSHES), check_seed(seed)
     if isinstance(engines, str) or not isinstance(engines, (list, tuple)) or not engines:
         raise ArgumentError(f"invalid `engines`: a list of engine names (got {engines!r:.60})", "engines")
-    support = support_kwargs(support)
+    support = support_kwargs(support, rings=rings)
     if workers is not None:
         workers = _count(workers, "workers", 1, 4096)
     for e in engines:
@@ -266,11 +268,13 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
     rows = samples(scene, pushes, seed, progress)
     pred = np.array([r[4] for r in rows])
     kind = np.array([r[1] for r in rows])
-    out = {"scene": scene.name, "pushes": pushes, "seed": seed}
+    out = {"scene": scene.name, "pushes": pushes, "seed": seed, "limit_surface": scene.limit_surface}
     for engine in engines:
         if engine == "quasistatic":
             sim, ok = _run_quasistatic(scene, rows, support, progress)
             out["support_model"] = support["support"]
+            if support["support"] == "points":
+                out["rings"] = support["rings"]
         else:
             res = _run_mujoco(scene, rows, workers, ray_address, progress)
             ok = ~np.isnan(res)
@@ -293,7 +297,7 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
 def format_validation(res: dict) -> str:
     """The validation results of :func:`validate` as text: per engine, the agreement of the
     motion-cone prediction with the simulator."""
-    lines = [f"{res['scene']}: {res['pushes']} random pushes"]
+    lines = [f"{res['scene']}: {res['pushes']} random pushes, motion cones on the {res['limit_surface']} limit surface"]
     for engine in ENGINES:
         if f"agreement_{engine}" not in res:
             continue

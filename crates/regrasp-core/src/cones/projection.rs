@@ -245,7 +245,8 @@ fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> 
             if pts.len() < 2 {
                 continue;
             }
-            let (lo, hi) = (pts[k.saturating_sub(1)].0, pts[(k + 1).min(pts.len() - 1)].0);
+            // two samples either side: a guessed ray's error may shift the peak by one
+            let (lo, hi) = (pts[k.saturating_sub(2)].0, pts[(k + 2).min(pts.len() - 1)].0);
             let f = rays.brent(ea, eb, lo, hi, pts[k]);
             if f.1 > best.0 {
                 best = (f.1, Some(f.4));

@@ -28,7 +28,7 @@ pub enum SupportModel {
     /// points together (they coincide in the plane) instead of listing each finger.
     Points { rings: usize, points: usize, merge_fingers: bool },
     /// One contact whose friction wrench lies in the scene's ellipsoidal limit surface (the
-    /// model the motion cones use; for cross-checks).
+    /// model the motion cones use with `limit_surface = "ellipsoid"`; for cross-checks).
     LimitSurface,
 }
 

@@ -493,6 +493,27 @@ impl Tables {
     /// face coordinates of the forward table (its interpolant's exact derivatives) from `guess`
     /// (or from the direction itself). None if it fails.
     fn solve(&self, dir: &Vec3, o: &Vec3, guess: Option<Vec3>) -> Option<Vec3> {
+        self.newton(dir, o, guess).ok()
+    }
+
+    /// One undamped step of [`Self::solve`]'s Newton's method from `v` (at most half a face).
+    fn newton_step(&self, dir: &Vec3, o: &Vec3, v: &Vec3) -> Vec3 {
+        let dir = dir / dir.norm();
+        let (e1, e2) = basis(&dir);
+        let proj = |x: &[f64; 3]| nalgebra::Vector2::new(e1.x * x[0] + e1.y * x[1] + e1.z * x[2], e2.x * x[0] + e2.y * x[1] + e2.z * x[2]);
+        let (f, u, w, _) = CubeMap::<3>::face(v);
+        let (x, du, dw) = self.forward.at_face::<true>(f, u, w);
+        let r = proj(&x) - nalgebra::Vector2::new(e1.dot(o), e2.dot(o));
+        let j = nalgebra::Matrix2::from_columns(&[proj(&du), proj(&dw)]);
+        match j.lu().solve(&(-r)) {
+            Some(step) if step.amax() < 0.5 => face_dir(f, u + step.x, w + step.y).normalize(),
+            _ => *v,
+        }
+    }
+
+    /// [`Self::solve`]'s Newton's method: the solution, or the last iterate when it has not
+    /// converged.
+    fn newton(&self, dir: &Vec3, o: &Vec3, guess: Option<Vec3>) -> Result<Vec3, Vec3> {
         let dir = dir / dir.norm();
         let (e1, e2) = basis(&dir);
         let mut v = guess.unwrap_or(dir);
@@ -506,11 +527,11 @@ impl Tables {
             let r = r_of(&x);
             let rn = r.norm();
             if rn < 1e-12 && along(&x) > 0.0 {
-                return Some(v / v.norm());
+                return Ok(v / v.norm());
             }
             if rn >= best && rn < 1e-10 && along(&x) > 0.0 {
                 // at the interpolant's rounding floor
-                return Some(v / v.norm());
+                return Ok(v / v.norm());
             }
             best = best.min(rn);
             let j = nalgebra::Matrix2::from_columns(&[proj(&du), proj(&dw)]);
@@ -541,7 +562,11 @@ impl Tables {
         }
         let x = self.wrench(&v);
         let xa = [x.x, x.y, x.z];
-        (r_of(&xa).norm() < 1e-10 && along(&xa) > 0.0).then(|| v / v.norm())
+        if r_of(&xa).norm() < 1e-10 && along(&xa) > 0.0 {
+            Ok(v / v.norm())
+        } else {
+            Err(v / v.norm())
+        }
     }
 }
 
@@ -630,8 +655,8 @@ impl ExactSurface {
     }
 
     /// [`Self::ray`] with `H(o)` known and perhaps a guess of `λ` (e.g. the ellipsoid's);
-    /// without `POLISH` the inverse table's twist (a relative error of about 1e-5, for searches
-    /// that polish their result).
+    /// without `POLISH` a guess (the inverse table's twist after one Newton step on the
+    /// forward table), for searches that polish their result.
     pub fn ray_from<const POLISH: bool>(&self, u: &Vec3, o: &Vec3, h_o: f64, guess: Option<f64>) -> Option<Vec3> {
         let (us, os) = (self.scale_wrench(u), self.scale_wrench(o));
         let un = us.norm();
@@ -665,7 +690,14 @@ impl ExactSurface {
             l = if next.is_finite() && next > lo && next < hi { next } else { 0.5 * (lo + hi) };
             (h, n) = g(l);
         }
-        let v = if POLISH { self.tables.solve(&us, &os, Some(n))? } else { n };
+        // polished to rounding, or (a guess) one Newton step on the forward table from the
+        // inverse table's twist: steep parts of the normal map (near a disc's pure rotation)
+        // are poorly interpolated by the inverse table alone
+        let v = if POLISH {
+            self.tables.solve(&us, &os, Some(n))?
+        } else {
+            self.tables.newton_step(&us, &os, &n)
+        };
         let v = self.unscale_twist(&v);
         Some(v / self.scale_twist(&v).norm())
     }
