@@ -6,8 +6,12 @@ quasi-static simulator, on every bundled planar example.
 For each example and each limit surface (``true``, ``ellipsoid``) the pushes of
 ``regrasp validate`` are drawn once (seed 0) and simulated with point-set pads of each number of
 rings (3 is the simulator's default: 36 points a pad; 8: 216). Prints a markdown table: the
-agreement, the disagreements by kind (predicted stick / simulated slip, and the reverse) and by
-kind of push (inside the cone, near its boundary, random).
+agreement, the disagreements by kind (predicted stick / simulated slip, and the reverse; and how
+many of them are *withdrawing* pushes, whose contact (a line pusher's middle) moves away from the
+object: the cone
+lets gravity make the object follow the pusher, the simulator finds the object held by the pads
+and the contact opening, both quasi-static solutions) and the agreement by kind of push (inside
+the cone, near its boundary, random).
 """
 
 from __future__ import annotations
@@ -24,6 +28,15 @@ from regrasp.sim import validation as V
 from regrasp.sim.quasistatic import support_kwargs
 
 
+def withdrawing(scene: Scene, pusher: str, twist) -> bool:
+    """Whether the pusher's contact (a line pusher's middle) moves away from the object (along
+    minus its normal)."""
+    p = scene.pusher(pusher)
+    n, v = np.asarray(p.normal, float), np.asarray(twist, float)
+    r = np.mean(p.points, axis=0)
+    return bool(n @ (v[:2] + v[2] * np.array([-r[1], r[0]])) < -1e-9 * np.linalg.norm(v[:2]))
+
+
 def run(path, model: str, pushes: int, rings: list[int]) -> list[dict]:
     scene = Scene.load(path).with_limit_surface(model)
     t0 = time.perf_counter()
@@ -31,6 +44,7 @@ def run(path, model: str, pushes: int, rings: list[int]) -> list[dict]:
     drawn = time.perf_counter() - t0
     pred = np.array([r[4] for r in rows])
     kind = np.array([r[1] for r in rows])
+    away = np.array([withdrawing(scene, r[0], r[3]) for r in rows])
     out = []
     for n in rings:
         t0 = time.perf_counter()
@@ -40,6 +54,7 @@ def run(path, model: str, pushes: int, rings: list[int]) -> list[dict]:
             "scene": scene.name, "limit_surface": model, "rings": n, "pushes": pushes, "solved": int(ok.sum()),
             "agreement": float(((pred == sim) & ok).sum() / max(ok.sum(), 1)),
             "confusion": c,
+            "withdrawing_disagreements": int(((pred != sim) & ok & away).sum()),
             "by_kind": {k: float(((pred == sim) & ok & (kind == k)).sum() / max(((kind == k) & ok).sum(), 1))
                         for k in V.KINDS},
             "draw_s": drawn, "simulate_s": time.perf_counter() - t0,
@@ -58,8 +73,8 @@ def main() -> None:
     paths = examples.planar() if a.examples is None else [examples.path(n) for n in a.examples.split(",")]
     rows = []
     print("| example | limit surface | rings | agreement | pred. stick, sim. slip | pred. slip, sim. stick "
-          "| inside / near / random |")
-    print("|---|---|---|---|---|---|---|")
+          "| of them withdrawing | inside / near / random |")
+    print("|---|---|---|---|---|---|---|---|")
     for p in paths:
         for model in ("true", "ellipsoid"):
             for r in run(p, model, a.pushes, rings):
@@ -68,7 +83,7 @@ def main() -> None:
                 solved = "" if r["solved"] == r["pushes"] else f" ({r['solved']} solved)"
                 print(f"| {r['scene']} | {model} | {r['rings']} | {100 * r['agreement']:.2f}%{solved} "
                       f"| {c['predicted_stick_simulated_slip']} | {c['predicted_slip_simulated_stick']} "
-                      f"| {100 * k['inside']:.1f} / {100 * k['near']:.1f} / {100 * k['random']:.1f}% |", flush=True)
+                      f"| {r['withdrawing_disagreements']} | {100 * k['inside']:.1f} / {100 * k['near']:.1f} / {100 * k['random']:.1f}% |", flush=True)
     if a.json:
         with open(a.json, "w") as f:
             json.dump(rows, f, indent=1)

@@ -44,9 +44,10 @@ def boundary_samples(cone: MotionCone, n: int = 40):
         ws, ts = [], []
         for t in np.linspace(0, 1, n if i != j else 1):
             p = ((1 - t) * ei + t * ej) / S
-            lam = _lambda(A, Js, wg, p)
-            ws.append(wg + lam * p)
-            ts.append(cone.ray(p))
+            ray = cone.ray(p)
+            # the wrench set's boundary point: the support's load of the ray (on either limit surface)
+            ws.append(cone.classify(ray).support_wrench if ray is not None else wg + _lambda(A, Js, wg, p) * p)
+            ts.append(ray)
         out.append((np.array(ws), np.array(ts)))
     return out
 
@@ -97,13 +98,13 @@ def _wrench_panel(ax, cone: MotionCone, samples) -> None:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     Wm = _wrench_metric(cone.scene)
-    A, Js, wg = cone._core.support_matrices
-    # limit surface {Js^T w : w^T A w = 1}: w = A^{-1/2} s for s on the unit sphere
-    evals, evecs = np.linalg.eigh(A)
-    Ainvh = evecs @ np.diag(evals**-0.5) @ evecs.T
-    uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
-    sph = np.stack([np.cos(uu) * np.sin(vv), np.sin(uu) * np.sin(vv), np.cos(vv)], axis=-1)
-    ell = Wm(np.einsum("ij,jk,...k->...i", Js.T, Ainvh, sph))
+    wg = cone._core.support_matrices[2]
+    # the limit surface {Js^T w}: the support's load of twists in every direction (exact or
+    # ellipsoidal, whichever the scene uses)
+    uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(1e-3, np.pi - 1e-3, 20))
+    L = cone.scene.length
+    sph = np.stack([np.cos(uu) * np.sin(vv), np.sin(uu) * np.sin(vv), np.cos(vv) / L], axis=-1)
+    ell = Wm(np.array([[cone.classify(t).support_wrench for t in row] for row in sph]))
     ax.plot_wireframe(ell[..., 0], ell[..., 1], ell[..., 2], color="0.6", linewidth=0.3, alpha=0.5)
     # pusher cone shifted by gravity: apex at w_g
     E = cone._core.pusher_edges

@@ -95,6 +95,23 @@ impl SupportFrame {
         self.ray_with::<false>(p, metric)
     }
 
+    /// [`Self::ray`] starting from `near`, the ray of a nearby pusher wrench (object frame): on
+    /// the exact surface Newton's method from there, cheaper than from the tables.
+    #[inline]
+    pub fn ray_near(&self, p: &Vec3, metric: &Metric, near: &Vec3) -> Option<Vec3> {
+        if let Some((surface, s)) = &self.exact {
+            let scale = p.amax();
+            if scale > 0.0 && scale.is_finite() && near.amax() > 0.0 && self.hold_ratio < 1.0 {
+                let u = self.js_inv.tr_mul(&(p / scale));
+                if let Some(vs) = surface.ray_near(&u, &(self.ug / *s), &(self.js * near)) {
+                    let v = self.js_inv * vs;
+                    return Some(v / metric.twist_norm(&v));
+                }
+            }
+        }
+        self.ray(p, metric)
+    }
+
     #[inline]
     fn ray_with<const POLISH: bool>(&self, p: &Vec3, metric: &Metric) -> Option<Vec3> {
         let scale = p.amax();

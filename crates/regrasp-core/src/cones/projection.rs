@@ -92,7 +92,7 @@ fn centre(frame: &SupportFrame, model: &PusherModel, gens: &[Vec3], margin_min: 
 
 /// A sample of the exact cone's boundary: (parameter along the fan, cosine to the desired
 /// direction, unit ray in the metric, ray, pusher wrench); the fans' rays from
-/// [`SupportFrame::ray_guess`], Brent's search's exact.
+/// [`SupportFrame::ray_guess`], Brent's search's exact (each from the best one so far).
 type Sample = (f64, f64, Vec3, Vec3, Vec3);
 
 /// The rays of the exact cone's boundary fans compared with one desired direction.
@@ -110,6 +110,19 @@ impl BoundaryRays<'_> {
     /// The boundary ray of pusher wrench direction `p` (`t`: its parameter on the fan).
     fn sample(&self, p: &Vec3, t: f64) -> Sample {
         self.sample_with::<false>(p, t)
+    }
+
+    /// [`Self::sample`] with its ray exact, found from the ray `near` of a nearby sample.
+    fn sample_near(&self, p: &Vec3, t: f64, near: &Vec3) -> Sample {
+        let m = &self.model.metric;
+        let w = m.wrench_inv(p);
+        match self.frame.ray_near(&w, m, near) {
+            Some(v) => {
+                let s = m.twist(&v);
+                (t, s.dot(&self.ds), s, v, w)
+            }
+            None => (t, f64::NEG_INFINITY, Vec3::zeros(), Vec3::zeros(), w),
+        }
     }
 
     /// [`Self::sample`], its ray exact (`POLISH`) or a guess ([`SupportFrame::ray_guess`]).
@@ -152,8 +165,8 @@ impl BoundaryRays<'_> {
     fn brent(&self, ea: Vec3, eb: Vec3, mut lo: f64, mut hi: f64, start: Sample) -> Sample {
         const C: f64 = 0.381_966_011_250_105; // (3 − √5)/2
         let at = |t: f64| ea * (1.0 - t) + eb * t;
-        // the search on exact rays
-        let start = self.sample_with::<true>(&at(start.0), start.0);
+        // the search on exact rays (each from the best one so far)
+        let start = self.sample_near(&at(start.0), start.0, &start.3);
         let tol = 1e-8 * (hi - lo);
         // minimize −cos
         let (mut x, mut w, mut v) = (start, start, start);
@@ -190,7 +203,7 @@ impl BoundaryRays<'_> {
                 d = C * e;
             }
             let u = if d.abs() >= tol { x.0 + d } else { x.0 + tol.copysign(d) };
-            let fu = self.sample_with::<true>(&at(u), u);
+            let fu = self.sample_near(&at(u), u, &x.3);
             if fu.1 >= x.1 {
                 if u >= x.0 {
                     lo = x.0;

@@ -646,6 +646,15 @@ impl ExactSurface {
         self.ray(w, &Vec3::zeros())
     }
 
+    /// [`Self::ray`] by Newton's method from `near`, a twist close to the ray (e.g. the ray of a
+    /// nearby `u`); None when that does not converge (then [`Self::ray`] from the tables).
+    pub fn ray_near(&self, u: &Vec3, o: &Vec3, near: &Vec3) -> Option<Vec3> {
+        let (us, os) = (self.scale_wrench(u), self.scale_wrench(o));
+        let v = self.tables.solve(&(us / us.norm()), &os, Some(self.scale_twist(near)))?;
+        let v = self.unscale_twist(&v);
+        Some(v / self.scale_twist(&v).norm())
+    }
+
     /// The sliding twist whose load wrench is `λ u + o` for the `λ > 0` that puts it on the
     /// surface (`H(o) < 1`): with `o` the support-frame gravity load, the motion-cone ray of a
     /// pusher wrench along `u` (eq 3.10 on the exact surface). Twist unit in the scaled metric;
