@@ -302,19 +302,21 @@ impl<const K: usize> CubeMap<K> {
         (v, m)
     }
 
+    /// The node index (ghost row 0) at or below face coordinate `x` and the fraction beyond it.
+    #[inline]
+    fn cell(&self, x: f64) -> (usize, f64) {
+        let g = ((x + 1.0) / self.h() + 1.0).max(0.0);
+        let i = (g as usize).clamp(1, self.n);
+        (i, g - i as f64)
+    }
+
     /// Bilinear interpolation at direction `d` (cheaper, for guesses); also returns `|d_a|`.
     #[inline]
     fn at_linear(&self, d: &Vec3) -> ([f64; K], f64) {
         let (f, u, w, m) = Self::face(d);
         let (u, w) = if f % 2 == 1 { (-u, -w) } else { (u, w) };
-        let (nn, h) = (self.n, self.h());
-        let stride = nn + 3;
-        let split = |x: f64| {
-            let g = ((x + 1.0) / h + 1.0).max(0.0);
-            let i = (g as usize).clamp(1, nn);
-            (i, g - i as f64)
-        };
-        let ((i, s), (j, t)) = (split(u), split(w));
+        let stride = self.n + 3;
+        let ((i, s), (j, t)) = (self.cell(u), self.cell(w));
         let base = (f / 2) * stride * stride + i * stride + j;
         let (a, b, c, e) = (&self.values[base], &self.values[base + 1], &self.values[base + stride], &self.values[base + stride + 1]);
         let mut out = [0.0; K];
@@ -332,14 +334,8 @@ impl<const K: usize> CubeMap<K> {
         // a negative face: the positive one at (−u, −w)
         let neg = f % 2 == 1;
         let (u, w) = if neg { (-u, -w) } else { (u, w) };
-        let (nn, h) = (self.n, self.h());
-        let stride = nn + 3;
-        let split = |x: f64| {
-            let g = ((x + 1.0) / h + 1.0).max(0.0);
-            let i = (g as usize).clamp(1, nn);
-            (i, g - i as f64)
-        };
-        let ((i, s), (j, t)) = (split(u), split(w));
+        let (stride, h) = (self.n + 3, self.h());
+        let ((i, s), (j, t)) = (self.cell(u), self.cell(w));
         let cr = |t: f64| {
             let (t2, t3) = (t * t, t * t * t);
             [(-t3 + 2.0 * t2 - t) / 2.0, (3.0 * t3 - 5.0 * t2 + 2.0) / 2.0, (-3.0 * t3 + 4.0 * t2 + t) / 2.0, (t3 - t2) / 2.0]
