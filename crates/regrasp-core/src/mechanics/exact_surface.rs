@@ -456,7 +456,21 @@ impl Tables {
         };
         let mut t = Tables { region, forward, inverse: CubeMap { n, values: Vec::new(), odd: [false, true, true, true] } };
         let inverse = CubeMap::<4>::build(n / 2, [false, true, true, true], |d| {
-            let v = t.solve(d, &Vec3::zeros(), None).expect("the forward table's wrenches cover every direction");
+            // from the direction itself, else from the axes and diagonals; else the best iterate
+            // (the inverse table only starts the rays' Newton's method on the forward one)
+            let starts = std::iter::once(*d).chain((0..27).map(|k| Vec3::new((k % 3) as f64 - 1.0, ((k / 3) % 3) as f64 - 1.0, (k / 9) as f64 - 1.0)));
+            let mut last = *d;
+            let mut found = None;
+            for g in starts.filter(|g| g.amax() > 0.0) {
+                match t.newton(d, &Vec3::zeros(), Some(g)) {
+                    Ok(v) => {
+                        found = Some(v);
+                        break;
+                    }
+                    Err(v) => last = v,
+                }
+            }
+            let v = found.unwrap_or(last);
             let w = t.wrench(&v);
             // H(d) = |d| / |W(v)| with W(v) ∥ d
             [d.norm() / w.norm(), v.x, v.y, v.z]
