@@ -88,8 +88,9 @@ impl SupportFrame {
         self.ray_with::<true>(p, metric)
     }
 
-    /// [`Self::ray`] to about 1e-5 on the exact surface (the inverse table's twist, not polished
-    /// on the forward one), for searches whose result is polished by [`Self::ray`].
+    /// [`Self::ray`] on the exact surface as a guess (the inverse table's twist after one Newton
+    /// step on the forward table, not polished to rounding), for searches whose result is then
+    /// found by [`Self::ray`]; the ray itself on the ellipsoid.
     #[inline]
     pub fn ray_guess(&self, p: &Vec3, metric: &Metric) -> Option<Vec3> {
         self.ray_with::<false>(p, metric)
