@@ -59,6 +59,10 @@ REFUSED = [
     (["validate", PLANAR, "--workers", "2"], "--workers", "--engines mujoco"),
     (["validate", PLANAR, "--ray", "local"], "--ray", "--engines mujoco"),
     (["validate", PLANAR, "--engines", "mujoco", "--support", "limit_surface"], "--support", "quasi-static"),
+    (["validate", PLANAR, "--engines", "mujoco", "--rings", "8"], "--rings", "quasi-static"),
+    (["validate", PLANAR, "--support", "limit_surface", "--rings", "8"], "--rings", "--support points"),
+    # the limit surface of the motion cones: planar scenes only
+    (["plan", SPATIAL, "--limit-surface", "ellipsoid"], "--limit-surface", "3-D scene"),
     # push, 3-D: the figure is planar
     (["push", SPATIAL, "--pose", "0,0,0,1,0,0,0", "--pusher", "ground", "--twist", "0,0,0.001,0,0,0", "--plot", "P.png"],
      "--plot", "planar"),
@@ -187,3 +191,19 @@ def test_validate_support_changes_the_result():
 def test_cone_twist_changes_the_report():
     args = ("cone", PLANAR, "--pose", "0,0,0", "--pusher", "bottom")
     assert _json(*args, "--twist", "0,0.01,0")["min_grip_force_twist"] != _json(*args)["min_grip_force_twist"]
+
+
+def test_limit_surface_changes_the_cone_and_is_reported():
+    """`--limit-surface` has an effect: the generators differ between the two surfaces, and the
+    report says which one it is on (the scene's default: the exact one)."""
+    out = {}
+    for model in (None, "ellipsoid", "true"):
+        flag = [] if model is None else ["--limit-surface", model]
+        status, stdout, err = run("cone", PLANAR, "--pose", "0,0,0", "--pusher", "left", "--json", *flag)
+        assert status == 0, err
+        out[model] = json.loads(stdout)
+    assert out[None]["limit_surface"] == out["true"]["limit_surface"] == "true"
+    assert out["ellipsoid"]["limit_surface"] == "ellipsoid"
+    assert out[None]["generators"] == out["true"]["generators"]
+    diff = max(abs(a - b) for g, h in zip(out["true"]["generators"], out["ellipsoid"]["generators"]) for a, b in zip(g, h))
+    assert diff > 1e-3
