@@ -50,6 +50,11 @@ def test_fitted_footprint_limit_surface_has_the_right_size():
     mean_r = np.hypot(xs, zs).mean()
     tau_max = 1 / np.sqrt(np.linalg.inv(np.linalg.inv(A))[2, 2])
     assert tau_max == pytest.approx(fmax * mean_r, rel=0.1)
+    # the exact surface (the default) has that moment itself, and the force for a translation
+    c = sc.motion_cone([0, 0, 0], "paddle")
+    assert sc.limit_surface == "true"
+    assert c.classify([0.0, 0.0, 1.0]).support_wrench[2] == pytest.approx(fmax * mean_r, rel=2e-3)
+    assert c.classify([0.0, 1.0, 0.0]).support_wrench == pytest.approx([0.0, fmax, 0.0], abs=1e-3 * fmax)
 
 
 def test_incline_bends_the_cone_and_levels_off_as_it_flattens():

@@ -228,7 +228,8 @@ class MotionCone:
         """Pairs of edge indices spanning the boundary fans of the pusher's friction cone."""
     @property
     def support_matrices(self) -> tuple[_Floats, _Floats, _Floats]:
-        """The limit-surface matrix A (support frame), J_s and the gravity wrench."""
+        """The ellipsoidal limit-surface matrix A (eq 3.7, support frame; the cones use it only on
+        the ellipsoid), J_s and the gravity wrench."""
     def ray(self, wrench: ArrayLike) -> _Floats | None:
         """Motion-cone ray (unit twist) produced by pusher wrench `wrench` `[fx, fz, tau]` (N, N, N·m),
         or None."""

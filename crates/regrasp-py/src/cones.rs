@@ -67,7 +67,8 @@ impl MotionCone {
     }
     /// Pairs of edge indices spanning the boundary fans of the pusher's friction cone.
     #[getter] fn boundary_segments(&self) -> Vec<(usize, usize)> { self.push.pusher_cone().boundary_segments() }
-    /// The limit-surface matrix A (support frame), J_s and the gravity wrench.
+    /// The ellipsoidal limit-surface matrix A (eq 3.7, support frame; the cones use it only on
+    /// the ellipsoid), J_s and the gravity wrench.
     #[getter]
     #[allow(clippy::type_complexity)]
     fn support_matrices<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>) {
