@@ -214,6 +214,33 @@ proptest! {
         }
     }
 
+    /// The projection's boundary ray is the best on the cone's boundary: against 2,000 exact
+    /// rays evenly spaced along each boundary fan (brute force, no pruning, no local search),
+    /// its cosine to the desired twist is never worse than a sampled ray's.
+    #[test]
+    fn projection_matches_a_dense_scan_of_the_boundary(b in block_case(), a1 in -3.2f64..3.2, a2 in -1.5f64..1.5) {
+        let Some(scene) = scene(&b) else { return Ok(()) };
+        let push = scene.push(&b.pose, 0).unwrap();
+        let d = twist_from_angles(a1, a2, scene.length);
+        if push.classify(&d).unwrap().feasible {
+            return Ok(());
+        }
+        let m = push.metric();
+        let ds = m.twist(&d).normalize();
+        let p = push.project(&d).unwrap();
+        let got = if p.amax() > 0.0 { m.twist(&p).normalize().dot(&ds) } else { 0.0 };
+        let cone = push.pusher_cone();
+        for (i, j) in cone.boundary_segments() {
+            for k in 0..=2000 {
+                let t = k as f64 / 2000.0;
+                let w = m.wrench_inv(&(cone.edges[i] * (1.0 - t) + cone.edges[j] * t));
+                let Some(u) = push.ray(&w) else { continue };
+                let c = m.twist(&u).normalize().dot(&ds);
+                prop_assert!(got >= c.min(1.0).max(0.0) - 1e-9, "fan ({i}, {j}) at {t}: cosine {c} > the projection's {got}");
+            }
+        }
+    }
+
     /// On the true limit surface too, every generator's pusher wrench lies on an edge of the
     /// pusher's friction cone and balances gravity with the support's load, and that load is the
     /// pad's friction integrated directly (not from the table) within the table's error.

@@ -44,7 +44,8 @@ pub fn project_with_margin_on(frame: &SupportFrame, model: &PusherModel, gens: &
     let gs: Vec<Vec3> = gens.iter().map(|g| m.twist(g)).collect();
     let (pp, _) = project_onto_generators(&gs, &m.twist(want));
     let mut v = m.twist_inv(&pp);
-    if v.amax() == 0.0 || frame.classify(model, &v).margin < 0.0 {
+    // (feasible to the membership tolerance: a generator's own ray is, up to rounding)
+    if v.amax() == 0.0 || !frame.classify(model, &v).feasible {
         v = project_exact(frame, model, want);
         if v.amax() == 0.0 {
             return None;
@@ -60,7 +61,7 @@ pub fn project_with_margin_on(frame: &SupportFrame, model: &PusherModel, gens: &
     }
     let (vn, cn) = (m.twist_norm(&v), m.twist_norm(&centre));
     let (mut lo, mut hi) = (0.0, 1.0);
-    for _ in 0..30 {
+    for _ in 0..20 {
         let mid = 0.5 * (lo + hi);
         let x = v / vn * (1.0 - mid) + centre / cn * mid;
         if margin(&x) >= margin_min {
@@ -139,24 +140,52 @@ impl BoundaryRays<'_> {
         }
     }
 
-    /// Samples the fan between edges `ea` and `eb` by depth-first subdivision until
-    /// consecutive rays are less than `MAX_STEP` apart.
-    fn fan(&self, ea: Vec3, eb: Vec3) -> Vec<Sample> {
+    /// The fan between edges `ea` and `eb` at five evenly spaced parameters (its coarse samples).
+    fn coarse(&self, ea: Vec3, eb: Vec3) -> Vec<Sample> {
+        (0..=4).map(|k| k as f64 / 4.0).map(|t| self.sample(&(ea * (1.0 - t) + eb * t), t)).collect()
+    }
+
+    /// Refines a fan's coarse samples by depth-first subdivision until consecutive rays are
+    /// less than `MAX_STEP` apart, except between samples that cannot hold a ray with a larger
+    /// cosine than `best` (the largest found so far, raised as samples come): by the triangle
+    /// inequality on the sphere, the rays between two samples `γ` apart lie within `γ` of one
+    /// of them if their path is at most twice as long as the arc between them, so no cosine
+    /// there exceeds `cos(θ − γ)` (`θ` the smaller angle of the two to the desired direction).
+    /// Only samples less than `PRUNE_GAP` apart are so bounded.
+    fn refine(&self, ea: Vec3, eb: Vec3, coarse: Vec<Sample>, best: &mut f64) -> Vec<Sample> {
         let at = |t: f64| ea * (1.0 - t) + eb * t;
         let cos_step = Self::MAX_STEP.cos();
-        let mut pts: Vec<Sample> = vec![self.sample(&at(0.0), 0.0)];
-        let mut stack: Vec<Sample> = (1..=8).rev().map(|k| self.sample(&at(k as f64 / 8.0), k as f64 / 8.0)).collect();
+        let mut stack: Vec<Sample> = coarse;
+        stack.reverse();
+        let mut pts: Vec<Sample> = vec![stack.pop().expect("samples")];
         while let Some(right) = stack.pop() {
             let left = *pts.last().expect("samples");
-            if left.2.dot(&right.2) < cos_step && right.0 - left.0 > 1e-9 && pts.len() + stack.len() < Self::MAX_SAMPLES {
+            let gap = left.2.dot(&right.2);
+            let split = gap < cos_step && right.0 - left.0 > 1e-9 && pts.len() + stack.len() < Self::MAX_SAMPLES;
+            if split && !Self::bounded_below(&left, &right, gap, *best) {
                 let t = 0.5 * (left.0 + right.0);
+                let mid = self.sample(&at(t), t);
+                *best = best.max(mid.1);
                 stack.push(right);
-                stack.push(self.sample(&at(t), t));
+                stack.push(mid);
             } else {
                 pts.push(right);
             }
         }
         pts
+    }
+
+    const PRUNE_GAP: f64 = 0.5; // rad
+
+    /// Whether no ray between samples `left` and `right` (`gap` the cosine between their rays)
+    /// can have a cosine above `best` (see [`Self::refine`]).
+    fn bounded_below(left: &Sample, right: &Sample, gap: f64, best: f64) -> bool {
+        if !(left.1.is_finite() && right.1.is_finite()) {
+            return false;
+        }
+        // cos(θ − γ) = cos θ cos γ + sin θ sin γ where θ ≥ γ, i.e. cos θ ≤ cos γ
+        let (c, g) = (left.1.max(right.1).clamp(-1.0, 1.0), gap.clamp(-1.0, 1.0));
+        g > Self::PRUNE_GAP.cos() && c <= g && c * g + ((1.0 - c * c) * (1.0 - g * g)).sqrt() < best
     }
 
     /// Brent's search (parabolic steps, golden sections where they fail; Brent 1973, ch. 5) for
@@ -167,7 +196,15 @@ impl BoundaryRays<'_> {
         let at = |t: f64| ea * (1.0 - t) + eb * t;
         // the search on exact rays (each from the best one so far)
         let start = self.sample_near(&at(start.0), start.0, &start.3);
-        let tol = 1e-8 * (hi - lo);
+        let tol = 1e-6 * (hi - lo);
+        // a peak at an end of the bracket (where the nearest ray is a cone edge's, often):
+        // the end itself when the cosine falls inwards
+        if start.0 == lo || start.0 == hi {
+            let t = if start.0 == lo { lo + 1e2 * tol } else { hi - 1e2 * tol };
+            if self.sample_near(&at(t), t, &start.3).1 <= start.1 {
+                return start;
+            }
+        }
         // minimize −cos
         let (mut x, mut w, mut v) = (start, start, start);
         let (mut d, mut e): (f64, f64) = (0.0, 0.0);
@@ -230,15 +267,23 @@ impl BoundaryRays<'_> {
 
 /// Maximizes the cosine between `d` and the rays on the boundary of the exact cone (images of
 /// the boundary fans of `W_p`). Each fan is sampled until consecutive rays are less than 4°
-/// apart (the boundary can turn quickly where gravity matters most), then every local maximum
-/// near the best is refined by Brent's search. Returns the cosine and the unit ray.
+/// apart (the boundary can turn quickly where gravity matters most), except where a bound
+/// shows no better ray can lie ([`BoundaryRays::refine`]), then every local maximum near the
+/// best is refined by Brent's search. Returns the cosine and the unit ray.
 fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> (f64, Vec3) {
     let rays = BoundaryRays { frame, model, ds: model.metric.twist(d).normalize() };
     let segments = model.cone.boundary_segments();
     let edges = |(i, j): (usize, usize)| (model.cone.edges[i], model.cone.edges[j]);
-    let sampled: Vec<Vec<Sample>> = segments
+    // every fan's coarse samples first, so that each fan's refinement is bounded by the best
+    let coarse: Vec<Vec<Sample>> = segments
         .iter()
-        .map(|&(i, j)| if i == j { vec![rays.sample(&model.cone.edges[i], 0.0)] } else { rays.fan(edges((i, j)).0, edges((i, j)).1) })
+        .map(|&(i, j)| if i == j { vec![rays.sample(&model.cone.edges[i], 0.0)] } else { rays.coarse(edges((i, j)).0, edges((i, j)).1) })
+        .collect();
+    let mut best_sample = coarse.iter().flatten().map(|s| s.1).fold(f64::NEG_INFINITY, f64::max);
+    let sampled: Vec<Vec<Sample>> = coarse
+        .into_iter()
+        .zip(&segments)
+        .map(|(c, &(i, j))| if i == j { c } else { rays.refine(edges((i, j)).0, edges((i, j)).1, c, &mut best_sample) })
         .collect();
     let top = sampled.iter().flatten().map(|s| s.1).fold(f64::NEG_INFINITY, f64::max);
     // between samples at most MAX_STEP apart the cosine can rise by about MAX_STEP²/2 above

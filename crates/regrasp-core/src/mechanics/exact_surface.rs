@@ -267,10 +267,6 @@ struct CubeMap<const K: usize> {
 }
 
 impl<const K: usize> CubeMap<K> {
-    fn h(&self) -> f64 {
-        2.0 / self.n as f64
-    }
-
     /// The direction (not unit) of node `(i, j)` of positive face `2a`.
     fn node_dir(n: usize, a: usize, i: usize, j: usize) -> Vec3 {
         let h = 2.0 / n as f64;
@@ -291,7 +287,8 @@ impl<const K: usize> CubeMap<K> {
         let a = d.iamax();
         let m = d[a].abs();
         let f = 2 * a + usize::from(d[a] < 0.0);
-        (f, d[(a + 1) % 3] / m, d[(a + 2) % 3] / m, m)
+        let r = 1.0 / m;
+        (f, d[(a + 1) % 3] * r, d[(a + 2) % 3] * r, m)
     }
 
     /// Bicubic (Catmull–Rom) interpolation at direction `d`; also returns `|d_a|`.
@@ -305,7 +302,7 @@ impl<const K: usize> CubeMap<K> {
     /// The node index (ghost row 0) at or below face coordinate `x` and the fraction beyond it.
     #[inline]
     fn cell(&self, x: f64) -> (usize, f64) {
-        let g = ((x + 1.0) / self.h() + 1.0).max(0.0);
+        let g = ((x + 1.0) * (0.5 * self.n as f64) + 1.0).max(0.0);
         let i = (g as usize).clamp(1, self.n);
         (i, g - i as f64)
     }
@@ -334,34 +331,39 @@ impl<const K: usize> CubeMap<K> {
         // a negative face: the positive one at (−u, −w)
         let neg = f % 2 == 1;
         let (u, w) = if neg { (-u, -w) } else { (u, w) };
-        let (stride, h) = (self.n + 3, self.h());
+        let (stride, k) = (self.n + 3, 0.25 * self.n as f64); // k = 1/(2h)
         let ((i, s), (j, t)) = (self.cell(u), self.cell(w));
         let cr = |t: f64| {
             let (t2, t3) = (t * t, t * t * t);
-            [(-t3 + 2.0 * t2 - t) / 2.0, (3.0 * t3 - 5.0 * t2 + 2.0) / 2.0, (-3.0 * t3 + 4.0 * t2 + t) / 2.0, (t3 - t2) / 2.0]
+            [(-t3 + 2.0 * t2 - t) * 0.5, (3.0 * t3 - 5.0 * t2 + 2.0) * 0.5, (-3.0 * t3 + 4.0 * t2 + t) * 0.5, (t3 - t2) * 0.5]
         };
         let dcr = |t: f64| {
             let t2 = t * t;
-            [(-3.0 * t2 + 4.0 * t - 1.0) / (2.0 * h), (9.0 * t2 - 10.0 * t) / (2.0 * h), (-9.0 * t2 + 8.0 * t + 1.0) / (2.0 * h), (3.0 * t2 - 2.0 * t) / (2.0 * h)]
+            [(-3.0 * t2 + 4.0 * t - 1.0) * k, (9.0 * t2 - 10.0 * t) * k, (-9.0 * t2 + 8.0 * t + 1.0) * k, (3.0 * t2 - 2.0 * t) * k]
         };
         let (wi, wj) = (cr(s), cr(t));
-        let (di, dj) = if GRAD { (dcr(s), dcr(t)) } else { ([0.0; 4], [0.0; 4]) };
+        let dj = if GRAD { dcr(t) } else { [0.0; 4] };
         let base = (f / 2) * stride * stride;
+        // separable: each of the 4 rows interpolated along w (and differentiated), then along u
         let (mut out, mut du, mut dw) = ([0.0; K], [0.0; K], [0.0; K]);
+        let di = if GRAD { dcr(s) } else { [0.0; 4] };
         for a in 0..4 {
-            let row = base + (i + a - 1) * stride + j - 1;
-            for b in 0..4 {
-                let v = &self.values[row + b];
-                let k = wi[a] * wj[b];
+            let start = base + (i + a - 1) * stride + j - 1;
+            let row: &[[f32; K]; 4] = self.values[start..start + 4].try_into().expect("4 nodes");
+            let (mut r, mut rd) = ([0.0; K], [0.0; K]);
+            for (b, v) in row.iter().enumerate() {
                 for c in 0..K {
-                    out[c] += k * v[c] as f64;
-                }
-                if GRAD {
-                    let (ku, kw) = (di[a] * wj[b], wi[a] * dj[b]);
-                    for c in 0..K {
-                        du[c] += ku * v[c] as f64;
-                        dw[c] += kw * v[c] as f64;
+                    r[c] += wj[b] * v[c] as f64;
+                    if GRAD {
+                        rd[c] += dj[b] * v[c] as f64;
                     }
+                }
+            }
+            for c in 0..K {
+                out[c] += wi[a] * r[c];
+                if GRAD {
+                    du[c] += di[a] * r[c];
+                    dw[c] += wi[a] * rd[c];
                 }
             }
         }
@@ -508,15 +510,14 @@ impl Tables {
 
     /// One undamped step of [`Self::solve`]'s Newton's method from `v` (at most half a face).
     fn newton_step(&self, dir: &Vec3, o: &Vec3, v: &Vec3) -> Vec3 {
-        let dir = dir / dir.norm();
+        let dir = dir * (1.0 / dir.norm());
         let (e1, e2) = basis(&dir);
         let proj = |x: &[f64; 3]| nalgebra::Vector2::new(e1.x * x[0] + e1.y * x[1] + e1.z * x[2], e2.x * x[0] + e2.y * x[1] + e2.z * x[2]);
         let (f, u, w, _) = CubeMap::<3>::face(v);
         let (x, du, dw) = self.forward.at_face::<true>(f, u, w);
         let r = proj(&x) - nalgebra::Vector2::new(e1.dot(o), e2.dot(o));
-        let j = nalgebra::Matrix2::from_columns(&[proj(&du), proj(&dw)]);
-        match j.lu().solve(&(-r)) {
-            Some(step) if step.amax() < 0.5 => face_dir(f, u + step.x, w + step.y).normalize(),
+        match solve2(&proj(&du), &proj(&dw), &(-r)) {
+            Some(step) if step.amax() < 0.5 => unit(&face_dir(f, u + step.x, w + step.y)),
             _ => *v,
         }
     }
@@ -544,8 +545,7 @@ impl Tables {
                 return Ok(v / v.norm());
             }
             best = best.min(rn);
-            let j = nalgebra::Matrix2::from_columns(&[proj(&du), proj(&dw)]);
-            let step = j.lu().solve(&(-r)).unwrap_or_else(|| -r);
+            let step = solve2(&proj(&du), &proj(&dw), &(-r)).unwrap_or(-r);
             if rn < 1e-4 && along(&x) > 0.0 && step.amax() < 1e-2 {
                 // near: Newton's full step (quadratic convergence), checked at the next lookup
                 v = face_dir(f, u + step.x, w + step.y);
@@ -580,10 +580,24 @@ impl Tables {
     }
 }
 
+/// The solution `x` of `[a b] x = r` (Cramer's rule); None when singular.
+#[inline]
+fn solve2(a: &nalgebra::Vector2<f64>, b: &nalgebra::Vector2<f64>, r: &nalgebra::Vector2<f64>) -> Option<nalgebra::Vector2<f64>> {
+    let det = a.x * b.y - a.y * b.x;
+    let x = nalgebra::Vector2::new(r.x * b.y - r.y * b.x, a.x * r.y - a.y * r.x) * (1.0 / det);
+    (det != 0.0 && x.x.is_finite() && x.y.is_finite()).then_some(x)
+}
+
+/// `v / |v|` with one division.
+#[inline]
+fn unit(v: &Vec3) -> Vec3 {
+    v * (1.0 / v.norm())
+}
+
 /// Two unit vectors completing `d` (unit) to an orthonormal basis.
 fn basis(d: &Vec3) -> (Vec3, Vec3) {
     let a = if d.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
-    let e1 = (a - d * d.dot(&a)).normalize();
+    let e1 = unit(&(a - d * d.dot(&a)));
     (e1, d.cross(&e1))
 }
 
@@ -695,7 +709,8 @@ impl ExactSurface {
         };
         let (mut h, mut n) = g(l);
         for _ in 0..60 {
-            if (h - 1.0).abs() < 1e-6 {
+            // (a guess needs less: the Newton step on the forward table below squares its error)
+            if (h - 1.0).abs() < if POLISH { 1e-6 } else { 1e-3 } {
                 break;
             }
             if h < 1.0 {
