@@ -153,7 +153,6 @@ impl BoundaryRays<'_> {
     /// there exceeds `cos(θ − γ)` (`θ` the smaller angle of the two to the desired direction).
     /// Only samples less than `PRUNE_GAP` apart are so bounded.
     fn refine(&self, ea: Vec3, eb: Vec3, coarse: Vec<Sample>, best: &mut f64) -> Vec<Sample> {
-        let at = |t: f64| ea * (1.0 - t) + eb * t;
         let cos_step = Self::MAX_STEP.cos();
         let mut stack: Vec<Sample> = coarse;
         stack.reverse();
@@ -163,8 +162,7 @@ impl BoundaryRays<'_> {
             let gap = left.2.dot(&right.2);
             let split = gap < cos_step && right.0 - left.0 > 1e-9 && pts.len() + stack.len() < Self::MAX_SAMPLES;
             if split && !Self::bounded_below(&left, &right, gap, *best) {
-                let t = 0.5 * (left.0 + right.0);
-                let mid = self.sample(&at(t), t);
+                let mid = self.between(ea, eb, &left, &right);
                 *best = best.max(mid.1);
                 stack.push(right);
                 stack.push(mid);
@@ -173,6 +171,26 @@ impl BoundaryRays<'_> {
             }
         }
         pts
+    }
+
+    /// A sample between `left` and `right` on the fan `ea`–`eb`: on the exact surface one
+    /// Newton step from the mean of their rays onto the fan ([`SupportFrame::fan_ray_near`]),
+    /// cheaper than a ray from the tables, kept when its parameter falls well inside theirs;
+    /// else the ray at the middle parameter.
+    fn between(&self, ea: Vec3, eb: Vec3, left: &Sample, right: &Sample) -> Sample {
+        let m = &self.model.metric;
+        let (lo, hi) = (left.0, right.0);
+        if left.1.is_finite() && right.1.is_finite() {
+            let (wa, wb) = (m.wrench_inv(&ea), m.wrench_inv(&eb));
+            if let Some((v, t)) = self.frame.fan_ray_near(&wa, &wb, m, &(left.3 + right.3)) {
+                if t > lo + 0.1 * (hi - lo) && t < hi - 0.1 * (hi - lo) {
+                    let s = m.twist(&v);
+                    return (t, s.dot(&self.ds), s, v, wa * (1.0 - t) + wb * t);
+                }
+            }
+        }
+        let t = 0.5 * (lo + hi);
+        self.sample(&(ea * (1.0 - t) + eb * t), t)
     }
 
     const PRUNE_GAP: f64 = 0.5; // rad
