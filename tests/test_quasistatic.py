@@ -172,7 +172,7 @@ def test_validate_json_and_agreement():
     assert {"pushes", "agreement_quasistatic", "confusion_quasistatic"} <= set(out)
     assert out["pushes"] == 120 and sum(out["confusion_quasistatic"].values()) == out["solved"]
     assert out["agreement_quasistatic"] > 0.85
-    assert out["limit_surface"] == "true" and out["rings"] == 3
+    assert out["limit_surface"] == "true" and out["rings"] == regrasp._core.quasistatic_defaults()["validation_rings"] == 8
     # with the motion cones' own limit surface as the pads (the ellipsoid), prediction and
     # simulation coincide
     from regrasp.sim.validation import validate
@@ -183,6 +183,29 @@ def test_validate_json_and_agreement():
     # the exact surface against point-set pads fine enough to share it (8 rings, 216 points)
     fine = validate(scene, 300, 2, rings=8)
     assert fine["rings"] == 8 and fine["agreement_quasistatic"] >= 0.99, fine["confusion_quasistatic"]
+
+
+def test_ambiguous_pushes_are_those_where_the_object_can_also_stay():
+    """A push is ambiguous when it is in the motion cone and no contact point of the pusher moves
+    into the object (checked here by hand from the scene's pushers); block-xztheta's corner point
+    pusher has many, and the simulator mostly lets the contact open there. Counting either
+    outcome as agreeing, xztheta reaches issue 17's 99% against the 8-ring pads."""
+    from regrasp.sim.validation import samples, validate
+
+    scene = regrasp.Scene.load(EXAMPLES / "block-xztheta.toml")
+    rows = samples(scene, 600, 0)
+    amb = [r for r in rows if r[5]]
+    assert amb and all(r[4] for r in amb)
+    for pusher, _kind, pose, u, pred, a in rows:
+        p = scene.pusher(pusher)
+        recedes = all(np.dot(np.array(u[:2]) + u[2] * np.array([-y, x]), p.normal) <= 1e-9 * np.linalg.norm(u)
+                      for x, y in p.points)
+        assert scene.hold_ratio(pose) < 1.0
+        assert a == (bool(pred) and recedes)
+    out = validate(scene, 1200, 0)
+    assert out["rings"] == 8 and out["ambiguous_quasistatic"] > 0
+    assert out["agreement_either_quasistatic"] >= out["agreement_quasistatic"]
+    assert out["agreement_either_quasistatic"] >= 0.99, out["confusion_quasistatic"]
 
 
 def test_push_cli_plot(tmp_path):

@@ -424,7 +424,8 @@ def limit_surface_default() -> str:
 (`regrasp::mechanics::limit_surface::SurfaceModel::default()`): "true" or "ellipsoid"."""
 def quasistatic_defaults() -> dict[str, Any]:
     """The quasi-static model's default options (`regrasp::dynamics::planar::Options::default()`):
-    the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`."""
+    the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`; and
+    `validation_rings`, the pads `regrasp validate` simulates (`VALIDATION_RINGS`)."""
 
 def se3_log(a: ArrayLike, b: ArrayLike) -> list[float]:
     """The constant body twist taking pose `a` to pose `b` in unit time (SE(3) log)."""

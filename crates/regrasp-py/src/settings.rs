@@ -143,14 +143,15 @@ fn support_parts(m: SupportModel) -> (&'static str, usize, usize, bool) {
 }
 
 /// The quasi-static model's default options (`regrasp::dynamics::planar::Options::default()`):
-/// the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`.
+/// the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`; and
+/// `validation_rings`, the pads `regrasp validate` simulates (`VALIDATION_RINGS`).
 #[pyfunction]
 pub fn quasistatic_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     guard(move || {
         let o = Options::default();
         let (support, rings, points, merge_fingers) = support_parts(o.support);
         Ok(dict!(py; "support" => support, "rings" => rings, "points" => points, "merge_fingers" => merge_fingers,
-                     "h" => o.h, "speed" => o.speed))
+                     "h" => o.h, "speed" => o.speed, "validation_rings" => regrasp::dynamics::planar::VALIDATION_RINGS))
     })
 }
 

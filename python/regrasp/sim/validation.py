@@ -9,6 +9,15 @@ moves relative to it by less than 2% of the push — a line pusher's slide or li
 end, a point pusher's slide — MuJoCo's sticking soft contacts creep by about 1% of a push).
 MuJoCo pushes are spread over local processes
 (``workers``) or over a Ray cluster (``ray_address``; ``"local"`` starts a local Ray instance).
+
+Two outcomes. Where the support holds the object alone and no contact point of the pusher
+moves into the object (each recedes or slides along the surface), the object can stay in the
+grasp while the contact opens: a quasi-static outcome that needs no slip at the support. If
+the push is also inside the motion cone (the object follows the pusher, the support slipping),
+both outcomes solve the quasi-static problem, and a simulator picks one (the complementarity
+solver mostly the first for a point pusher, the second for a line pusher's rotations). Such
+pushes are counted as *ambiguous*; ``agreement_either`` counts them as agreeing whichever
+outcome the simulator picks, ``agreement`` (strict) only when it picks the cone's.
 """
 
 from __future__ import annotations
@@ -23,7 +32,7 @@ import numpy as np
 from .. import progress as bars
 from ..errors import ArgumentError, RegraspError, check_seed
 from ..extras import need
-from .quasistatic import SPEED, support_kwargs
+from .quasistatic import DEFAULTS, SPEED, support_kwargs
 from ..scene.planar import Scene, _count
 
 #: most random pushes one validation takes (a bound on its time: about 1 ms a push)
@@ -113,8 +122,24 @@ QS_BATCH = 64
 KINDS = ("inside", "near", "random")
 
 
+def static_alternative(scene: Scene, pusher: str, pose, twist) -> bool:
+    """Whether the object can also stay where it is in the grasp under this push (pusher
+    motion ``twist`` (m/s, m/s, rad/s), object frame, at ``pose``): the support holds it alone
+    and no contact point of the pusher moves into the object (``n·v ≤ 0`` at each, to 1e-9 of the
+    speed), so that the contact opens or slides free (see the module notes)."""
+    if scene.kind == "grasp" and not scene.hold_ratio(pose) < 1.0:
+        return False
+    p = scene.pusher(pusher)
+    v = np.asarray(twist, float)
+    pts = np.asarray(p.points, float).reshape(-1, 2)
+    vel = v[:2] + v[2] * np.c_[-pts[:, 1], pts[:, 0]]
+    tol = 1e-9 * (np.linalg.norm(v[:2]) + abs(v[2]) * scene.length)
+    return bool(np.all(vel @ np.asarray(p.normal, float) <= tol))
+
+
 def samples(scene: Scene, pushes: int, seed: int, progress: bool = False) -> list:
-    """The random pushes: (pusher, kind, pose, twist, predicted stick)."""
+    """The random pushes: (pusher, kind, pose, twist, predicted stick, ambiguous: predicted
+    stick while the object can also stay, :func:`static_alternative`)."""
     rng = np.random.default_rng(seed)
     out = []
     for k in bars.iterate(range(pushes), f"drawing pushes ({scene.name})", unit="push", show=progress):
@@ -122,7 +147,7 @@ def samples(scene: Scene, pushes: int, seed: int, progress: bool = False) -> lis
         pose = _random_pose(scene, rng)
         kind = KINDS[k % 3]
         u, pred = sample_push(scene, pose, pusher, kind, rng)
-        out.append((pusher, kind, pose, u, pred))
+        out.append((pusher, kind, pose, u, pred, bool(pred) and static_alternative(scene, pusher, pose, u)))
     return out
 
 
@@ -247,11 +272,11 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
     """Agreement of the exact motion-cone prediction (on the scene's limit surface,
     ``scene.limit_surface``) with each engine (see the module notes); ``support`` the quasi-static
     pad model, "points" or "limit_surface" (default: the core's), ``rings`` the point-set pads'
-    rings (default: the core's)."""
+    rings (default: the core's ``validation_rings``, finer than the simulator's everyday pads)."""
     pushes, seed = _count(pushes, "pushes", 1, MAX_PUSHES), check_seed(seed)
     if isinstance(engines, str) or not isinstance(engines, (list, tuple)) or not engines:
         raise ArgumentError(f"invalid `engines`: a list of engine names (got {engines!r:.60})", "engines")
-    support = support_kwargs(support, rings=rings)
+    support = support_kwargs(support, rings=DEFAULTS["validation_rings"] if rings is None else rings)
     if workers is not None:
         workers = _count(workers, "workers", 1, 4096)
     for e in engines:
@@ -267,6 +292,7 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
     workers = workers or os.cpu_count() or 1
     rows = samples(scene, pushes, seed, progress)
     pred = np.array([r[4] for r in rows])
+    amb = np.array([r[5] for r in rows], bool)
     kind = np.array([r[1] for r in rows])
     out = {"scene": scene.name, "pushes": pushes, "seed": seed, "limit_surface": scene.limit_surface}
     for engine in engines:
@@ -282,6 +308,8 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
         n = int(ok.sum())
         out[f"solved_{engine}"] = n
         out[f"agreement_{engine}"] = float(((pred == sim) & ok).sum() / max(n, 1))
+        out[f"ambiguous_{engine}"] = int((amb & ok).sum())
+        out[f"agreement_either_{engine}"] = float((((pred == sim) | amb) & ok).sum() / max(n, 1))
         out[f"confusion_{engine}"] = _table(pred, sim, ok, np.ones(pushes, bool))
         out[f"by_sample_kind_{engine}"] = {
             k: {"pushes": int((kind == k).sum()),
@@ -305,6 +333,8 @@ def format_validation(res: dict) -> str:
         lines += [
             f"  {engine}: agreement of the motion-cone prediction {100 * res[f'agreement_{engine}']:.1f}% "
             f"({res[f'solved_{engine}']} pushes simulated)",
+            f"  {res[f'ambiguous_{engine}']} ambiguous pushes (in the cone, and the object can also stay: no pusher "
+            f"point moves into it); either outcome counted as agreeing: {100 * res[f'agreement_either_{engine}']:.1f}%",
             "                         simulated stick   simulated slip",
             f"  predicted stick        {c['predicted_stick_simulated_stick']:15d}   {c['predicted_stick_simulated_slip']:14d}",
             f"  predicted slip         {c['predicted_slip_simulated_stick']:15d}   {c['predicted_slip_simulated_slip']:14d}",
