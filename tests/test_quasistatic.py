@@ -208,6 +208,30 @@ def test_ambiguous_pushes_are_those_where_the_object_can_also_stay():
     assert out["agreement_either_quasistatic"] >= 0.99, out["confusion_quasistatic"]
 
 
+@pytest.mark.parametrize("name", ["block-xztheta", "t-shape"])
+def test_plans_make_no_ambiguous_push(name):
+    """The planner's steps push into the object: none is a push where the object could as well
+    stay in the grasp (deterministic seeds; the twist of a step from its two poses)."""
+    from regrasp.planning.plan import plan
+    from regrasp.sim.validation import static_alternative
+
+    scene = regrasp.Scene.load(EXAMPLES / f"{name}.toml")
+    steps = 0
+    for seed in range(3):
+        r = plan(scene, seed=seed, time_limit=10)
+        assert r.found
+        P = np.asarray(r.poses, float)
+        for k in range(1, len(P)):
+            c, s = np.cos(P[k - 1, 2]), np.sin(P[k - 1, 2])
+            d = P[k, :2] - P[k - 1, :2]
+            u = np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1], P[k, 2] - P[k - 1, 2]])
+            if r.pushers[k] is None or not u.any():
+                continue
+            steps += 1
+            assert not static_alternative(scene, r.pushers[k], P[k - 1], u), (seed, k)
+    assert steps > 5
+
+
 def test_push_cli_plot(tmp_path):
     png = tmp_path / "push.png"
     r = subprocess.run([sys.executable, "-m", "regrasp.cli", "push", str(EXAMPLES / "block-low-friction.toml"),
