@@ -11,7 +11,8 @@ fn refining_long_past_the_first_plan_keeps_the_plan_valid_and_no_costlier() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../python/regrasp/examples/hard/u-shape.toml");
     // on the ellipsoid, whose cones cost less: the test is about the search's long refinement
     let s = Scene::load(&path).unwrap().with_surface_model(SurfaceModel::Ellipsoid);
-    let search = SearchSettings { seed: 0, refine: 10.0, time_limit: 60.0, ..SearchSettings::default() };
+    // (refine 20: ten times the first plan's iterations and more, whatever the first plan takes)
+    let search = SearchSettings { seed: 0, refine: 20.0, time_limit: 60.0, ..SearchSettings::default() };
     let r = plan(&s, None, None, &PlanarSettings { search, ..PlanarSettings::default() }).unwrap();
     let f = r.first.expect("a first plan");
     assert!(r.found && r.iterations > f.iterations + 10_000 && r.cost <= f.cost + 1e-12, "{} iterations, first {f:?}", r.iterations);

@@ -113,22 +113,6 @@ impl SupportFrame {
         self.ray(p, metric)
     }
 
-    /// On the exact surface, a guessed ray of the fan of pusher wrenches `pa`, `pb` (object
-    /// frame) near `near`, and its parameter `t` on the fan (`(1 − t) pa + t pb` up to scale):
-    /// one Newton step from `near` onto the fan's plane ([`ExactSurface::fan_ray_near`]).
-    /// None on the ellipsoid or when the step fails.
-    #[inline]
-    pub fn fan_ray_near(&self, pa: &Vec3, pb: &Vec3, metric: &Metric, near: &Vec3) -> Option<(Vec3, f64)> {
-        let (surface, s) = self.exact.as_ref()?;
-        if !(self.hold_ratio < 1.0) || near.amax() == 0.0 {
-            return None;
-        }
-        let (ua, ub) = (self.js_inv.tr_mul(pa), self.js_inv.tr_mul(pb));
-        let (vs, t) = surface.fan_ray_near(&ua, &ub, &(self.ug / *s), &(self.js * near))?;
-        let v = self.js_inv * vs;
-        Some((v / metric.twist_norm(&v), t))
-    }
-
     #[inline]
     fn ray_with<const POLISH: bool>(&self, p: &Vec3, metric: &Metric) -> Option<Vec3> {
         let scale = p.amax();

@@ -60,18 +60,35 @@ pub fn project_with_margin_on(frame: &SupportFrame, model: &PusherModel, gens: &
         return (margin(&v) >= 0.0).then_some(v);
     }
     let (vn, cn) = (m.twist_norm(&v), m.twist_norm(&centre));
+    let blend = |t: f64| v / vn * (1.0 - t) + centre / cn * t;
+    // the least blend with the margin: the Illinois method (regula falsi that halves the stale
+    // end's value), bracketed, to 1e-6 of the blend (as bisection's 20 halvings, in fewer tests)
     let (mut lo, mut hi) = (0.0, 1.0);
-    for _ in 0..20 {
-        let mid = 0.5 * (lo + hi);
-        let x = v / vn * (1.0 - mid) + centre / cn * mid;
-        if margin(&x) >= margin_min {
-            hi = mid;
+    let (mut g_lo, mut g_hi) = (margin(&v) - margin_min, margin(&centre) - margin_min);
+    let mut side = 0;
+    for _ in 0..60 {
+        if hi - lo < 1e-6 {
+            break;
+        }
+        let t = lo - g_lo * (hi - lo) / (g_hi - g_lo);
+        let t = if t > lo && t < hi && t.is_finite() { t } else { 0.5 * (lo + hi) };
+        let g = margin(&blend(t)) - margin_min;
+        if g >= 0.0 {
+            (hi, g_hi) = (t, g);
+            if side == 1 {
+                g_lo *= 0.5;
+            }
+            side = 1;
         } else {
-            lo = mid;
+            (lo, g_lo) = (t, g);
+            if side == -1 {
+                g_hi *= 0.5;
+            }
+            side = -1;
         }
     }
     // the blend of two unit directions is shorter than either: back to the projection's speed
-    let x = v / vn * (1.0 - hi) + centre / cn * hi;
+    let x = blend(hi);
     Some(x * (vn / m.twist_norm(&x)))
 }
 
@@ -162,7 +179,8 @@ impl BoundaryRays<'_> {
             let gap = left.2.dot(&right.2);
             let split = gap < cos_step && right.0 - left.0 > 1e-9 && pts.len() + stack.len() < Self::MAX_SAMPLES;
             if split && !Self::bounded_below(&left, &right, gap, *best) {
-                let mid = self.between(ea, eb, &left, &right);
+                let t = 0.5 * (left.0 + right.0);
+                let mid = self.sample(&(ea * (1.0 - t) + eb * t), t);
                 *best = best.max(mid.1);
                 stack.push(right);
                 stack.push(mid);
@@ -171,26 +189,6 @@ impl BoundaryRays<'_> {
             }
         }
         pts
-    }
-
-    /// A sample between `left` and `right` on the fan `ea`–`eb`: on the exact surface one
-    /// Newton step from the mean of their rays onto the fan ([`SupportFrame::fan_ray_near`]),
-    /// cheaper than a ray from the tables, kept when its parameter falls well inside theirs;
-    /// else the ray at the middle parameter.
-    fn between(&self, ea: Vec3, eb: Vec3, left: &Sample, right: &Sample) -> Sample {
-        let m = &self.model.metric;
-        let (lo, hi) = (left.0, right.0);
-        if left.1.is_finite() && right.1.is_finite() {
-            let (wa, wb) = (m.wrench_inv(&ea), m.wrench_inv(&eb));
-            if let Some((v, t)) = self.frame.fan_ray_near(&wa, &wb, m, &(left.3 + right.3)) {
-                if t > lo + 0.1 * (hi - lo) && t < hi - 0.1 * (hi - lo) {
-                    let s = m.twist(&v);
-                    return (t, s.dot(&self.ds), s, v, wa * (1.0 - t) + wb * t);
-                }
-            }
-        }
-        let t = 0.5 * (lo + hi);
-        self.sample(&(ea * (1.0 - t) + eb * t), t)
     }
 
     const PRUNE_GAP: f64 = 0.5; // rad
@@ -315,15 +313,14 @@ fn nearest_boundary_ray(frame: &SupportFrame, model: &PusherModel, d: &Vec3) -> 
             if !is_peak || pts[k].1 < top - slack {
                 continue;
             }
-            if pts[k].1 > best.0 {
-                best = (pts[k].1, Some(pts[k].4));
-            }
-            if pts.len() < 2 {
-                continue;
-            }
-            // two samples either side: a guessed ray's error may shift the peak by one
-            let (lo, hi) = (pts[k.saturating_sub(2)].0, pts[(k + 2).min(pts.len() - 1)].0);
-            let f = rays.brent(ea, eb, lo, hi, pts[k]);
+            // (compared by exact rays only: a guess's cosine may exceed any ray's of its fan)
+            let f = if pts.len() < 2 {
+                rays.sample_with::<true>(&model.metric.wrench(&pts[k].4), pts[k].0)
+            } else {
+                // two samples either side: a guessed ray's error may shift the peak by one
+                let (lo, hi) = (pts[k.saturating_sub(2)].0, pts[(k + 2).min(pts.len() - 1)].0);
+                rays.brent(ea, eb, lo, hi, pts[k])
+            };
             if f.1 > best.0 {
                 best = (f.1, Some(f.4));
             }

@@ -522,19 +522,6 @@ impl Tables {
         }
     }
 
-    /// One Newton step from `v` towards the twists whose load `W` satisfies `n·(W − o) = 0`
-    /// (a plane through `o`), along the gradient of `n·W` in face coordinates (the least
-    /// change); None when the gradient vanishes or the step exceeds a tenth of a face.
-    fn plane_step(&self, n: &Vec3, o: &Vec3, v: &Vec3) -> Option<Vec3> {
-        let (f, u, w, _) = CubeMap::<3>::face(v);
-        let (x, du, dw) = self.forward.at_face::<true>(f, u, w);
-        let dot = |y: &[f64; 3]| n.x * y[0] + n.y * y[1] + n.z * y[2];
-        let (g, gu, gw) = (dot(&x) - n.dot(o), dot(&du), dot(&dw));
-        let k = -g / (gu * gu + gw * gw);
-        let (su, sw) = (k * gu, k * gw);
-        (k.is_finite() && su.abs().max(sw.abs()) < 0.1).then(|| unit(&face_dir(f, u + su, w + sw)))
-    }
-
     /// [`Self::solve`]'s Newton's method: the solution, or the last iterate when it has not
     /// converged.
     fn newton(&self, dir: &Vec3, o: &Vec3, guess: Option<Vec3>) -> Result<Vec3, Vec3> {
@@ -692,26 +679,6 @@ impl ExactSurface {
         Some(v / self.scale_twist(&v).norm())
     }
 
-    /// A guess of the ray whose pusher wrench lies in the fan of `a` and `b` (support frame,
-    /// as `u` of [`Self::ray`]), near `near` (e.g. between two rays of the fan): one Newton
-    /// step onto the twists whose load minus `o` lies in the plane of `a` and `b`. Returns the
-    /// twist (as [`Self::ray`]) and the fan's parameter `t` of its pusher wrench,
-    /// `(1 − t) a + t b` up to scale; None when the step fails or leaves the fan.
-    pub fn fan_ray_near(&self, a: &Vec3, b: &Vec3, o: &Vec3, near: &Vec3) -> Option<(Vec3, f64)> {
-        let (a, b, os) = (self.scale_wrench(a), self.scale_wrench(b), self.scale_wrench(o));
-        let n = a.cross(&b);
-        let v = self.tables.plane_step(&(n * (1.0 / n.norm())), &os, &self.scale_twist(near))?;
-        // W − o = α a + β b (in the plane, up to the step's residual)
-        let r = self.tables.wrench(&v) - os;
-        let nn = n.norm_squared();
-        let (alpha, beta) = (r.cross(&b).dot(&n) / nn, a.cross(&r).dot(&n) / nn);
-        if !(alpha >= 0.0 && beta >= 0.0 && alpha + beta > 0.0) {
-            return None;
-        }
-        let v = self.unscale_twist(&v);
-        Some((v / self.scale_twist(&v).norm(), beta / (alpha + beta)))
-    }
-
     /// The sliding twist whose load wrench is `λ u + o` for the `λ > 0` that puts it on the
     /// surface (`H(o) < 1`): with `o` the support-frame gravity load, the motion-cone ray of a
     /// pusher wrench along `u` (eq 3.10 on the exact surface). Twist unit in the scaled metric;
@@ -733,8 +700,8 @@ impl ExactSurface {
         // λ: H(λu + o) = 1. H is a norm (the surface is symmetric), so λH(u) − H(o) ≤
         // H(λu + o) ≤ λH(u) + H(o): the root lies in [(1 − H(o))/H(u), (1 + H(o))/H(u)], and
         // it is the only one there (H convex). Newton's method kept in that bracket.
-        let g = |l: f64| self.tables.gauge_with::<false>(&(us * l + os));
-        let h_u = self.tables.gauge_with::<false>(&us).0;
+        let g = |l: f64| self.tables.gauge_with::<POLISH>(&(us * l + os));
+        let h_u = self.tables.gauge_with::<POLISH>(&us).0;
         let (mut lo, mut hi) = ((1.0 - h_o) / h_u, (1.0 + h_o) / h_u);
         let mut l = match guess {
             Some(l) if l * un > lo && l * un < hi => l * un,
@@ -742,9 +709,10 @@ impl ExactSurface {
         };
         let (mut h, mut n) = g(l);
         for _ in 0..60 {
-            // (to 1e-3 on the bilinear inverse table: the Newton step on the forward table
-            // below squares the error)
-            if (h - 1.0).abs() < 1e-3 {
+            // (a guess to 1e-4 on the bilinear inverse table, the Newton step on the forward
+            // table below squaring its error; 1e-3 left guesses wrong enough near a disc's
+            // pure rotation to mislead the projection's search)
+            if (h - 1.0).abs() < if POLISH { 1e-6 } else { 1e-4 } {
                 break;
             }
             if h < 1.0 {
@@ -758,11 +726,10 @@ impl ExactSurface {
             l = if next.is_finite() && next > lo && next < hi { next } else { 0.5 * (lo + hi) };
             (h, n) = g(l);
         }
-        // one Newton step on the forward table from the inverse table's twist (steep parts of
-        // the normal map, near a disc's pure rotation, are poorly interpolated by the inverse
-        // table alone): the guess; polished to rounding from there
-        let n = self.tables.newton_step(&us, &os, &n);
-        let v = if POLISH { self.tables.solve(&us, &os, Some(n))? } else { n };
+        // polished to rounding, or (a guess) one Newton step on the forward table from the
+        // inverse table's twist: steep parts of the normal map (near a disc's pure rotation)
+        // are poorly interpolated by the inverse table alone
+        let v = if POLISH { self.tables.solve(&us, &os, Some(n))? } else { self.tables.newton_step(&us, &os, &n) };
         let v = self.unscale_twist(&v);
         Some(v / self.scale_twist(&v).norm())
     }
