@@ -172,7 +172,7 @@ def test_validate_json_and_agreement():
     assert {"pushes", "agreement_quasistatic", "confusion_quasistatic"} <= set(out)
     assert out["pushes"] == 120 and sum(out["confusion_quasistatic"].values()) == out["solved"]
     assert out["agreement_quasistatic"] > 0.85
-    assert out["limit_surface"] == "true" and out["rings"] == regrasp._core.quasistatic_defaults()["validation_rings"] == 8
+    assert out["limit_surface"] == "true" and out["rings"] == regrasp._core.validation_rings() == 8
     # with the motion cones' own limit surface as the pads (the ellipsoid), prediction and
     # simulation coincide
     from regrasp.sim.validation import validate

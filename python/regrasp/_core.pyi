@@ -23,6 +23,7 @@ __all__ = [
     "planner_defaults",
     "mpc_defaults",
     "quasistatic_defaults",
+    "validation_rings",
     "limit_surface_default",
     "se3_log",
     "se3_integrate",
@@ -424,8 +425,11 @@ def limit_surface_default() -> str:
 (`regrasp::mechanics::limit_surface::SurfaceModel::default()`): "true" or "ellipsoid"."""
 def quasistatic_defaults() -> dict[str, Any]:
     """The quasi-static model's default options (`regrasp::dynamics::planar::Options::default()`):
-    the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`; and
-    `validation_rings`, the pads `regrasp validate` simulates (`VALIDATION_RINGS`)."""
+    the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`."""
+
+def validation_rings() -> int:
+    """Rings of the point-set pads that `regrasp validate` simulates unless told
+    (`regrasp::dynamics::planar::VALIDATION_RINGS`)."""
 
 def se3_log(a: ArrayLike, b: ArrayLike) -> list[float]:
     """The constant body twist taking pose `a` to pose `b` in unit time (SE(3) log)."""

@@ -32,6 +32,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(settings::planner_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(settings::mpc_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(settings::quasistatic_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(settings::validation_rings, m)?)?;
     m.add_function(wrap_pyfunction!(settings::limit_surface_default, m)?)?;
     m.add_function(wrap_pyfunction!(pose::se3_log, m)?)?;
     m.add_function(wrap_pyfunction!(pose::se3_integrate, m)?)?;

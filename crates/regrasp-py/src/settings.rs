@@ -143,16 +143,22 @@ fn support_parts(m: SupportModel) -> (&'static str, usize, usize, bool) {
 }
 
 /// The quasi-static model's default options (`regrasp::dynamics::planar::Options::default()`):
-/// the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`; and
-/// `validation_rings`, the pads `regrasp validate` simulates (`VALIDATION_RINGS`).
+/// the keywords of the planar `quasistatic_problem`, `push_outcomes` and `simulate_push`.
 #[pyfunction]
 pub fn quasistatic_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     guard(move || {
         let o = Options::default();
         let (support, rings, points, merge_fingers) = support_parts(o.support);
         Ok(dict!(py; "support" => support, "rings" => rings, "points" => points, "merge_fingers" => merge_fingers,
-                     "h" => o.h, "speed" => o.speed, "validation_rings" => regrasp::dynamics::planar::VALIDATION_RINGS))
+                     "h" => o.h, "speed" => o.speed))
     })
+}
+
+/// Rings of the point-set pads that `regrasp validate` simulates unless told
+/// (`regrasp::dynamics::planar::VALIDATION_RINGS`).
+#[pyfunction]
+pub fn validation_rings() -> usize {
+    regrasp::dynamics::planar::VALIDATION_RINGS
 }
 
 /// The limit surface a scene's motion cones use when its file does not say

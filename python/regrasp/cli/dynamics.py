@@ -205,7 +205,7 @@ def add_parsers(sub) -> None:
                    help="quasi-static pads as point sets or as one patch on the ellipsoidal limit surface (eq 3.7) "
                    f"(default: {_core.quasistatic_defaults()['support']})")
     v.add_argument("--rings", type=int, help="quasi-static point-set pads: rings of points per circular pad, 1 to 64 "
-                   f"(6, 12, 18... points; default: {_core.quasistatic_defaults()['validation_rings']})")
+                   f"(6, 12, 18... points; default: {_core.validation_rings()})")
     v.add_argument("--json", action="store_true", help="print the result as JSON")
     add_limit_surface(v)
     add_verbose(v)

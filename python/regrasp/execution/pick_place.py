@@ -413,7 +413,7 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
             seen[key] = reachable(r, avoid, tcp, g.gripper) is not None
         return seen[key]
 
-    planning, banned, cands = time.perf_counter() - t0, set(), []
+    planning, banned, cands, arm_why = time.perf_counter() - t0, set(), [], []
     for _ in range(MAX_ROUNDS):  # without the pushers the arm could not follow, re-planned
         t1 = time.perf_counter()
         cands = planned(with_pushers(scene, [p for p in scene.pusher_names if p not in banned]), picks, places, seed)
@@ -437,6 +437,7 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
                     arm = solve_arm(r, motion, tcp)
                 except ExecutionError as e:
                     c.why = str(e)
+                    arm_why.append(c.why)
                     k = getattr(e, "push", -1)
                     if 0 <= k < len(motion.assignments):
                         blocked.add(motion.assignments[k].pusher)
@@ -447,7 +448,9 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
         if not blocked - banned or len(banned | blocked) >= len(scene.pusher_names):
             break
         banned |= blocked
-    why = next((c.why for c in cands if c.why), "no candidate")
+    # the example: a pair that got as far as the arm (rendered, then refused by the hand or the
+    # arm), else the first refused
+    why = arm_why[0] if arm_why else next((c.why for c in cands if c.why), "no candidate")
     raise ExecutionError(f"no pick-regrasp-place reaches the place pose {np.round(place_pose, 4).tolist()}: "
                          f"{len(cands)} grasp pairs tried"
                          + (f" without pushers {', '.join(sorted(banned))}" if banned else "") + f" (e.g. {why})", "place")

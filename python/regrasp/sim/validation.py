@@ -32,7 +32,8 @@ import numpy as np
 from .. import progress as bars
 from ..errors import ArgumentError, RegraspError, check_seed
 from ..extras import need
-from .quasistatic import DEFAULTS, SPEED, support_kwargs
+from .. import _core
+from .quasistatic import SPEED, support_kwargs
 from ..scene.planar import Scene, _count
 
 #: most random pushes one validation takes (a bound on its time: about 1 ms a push)
@@ -276,7 +277,7 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
     pushes, seed = _count(pushes, "pushes", 1, MAX_PUSHES), check_seed(seed)
     if isinstance(engines, str) or not isinstance(engines, (list, tuple)) or not engines:
         raise ArgumentError(f"invalid `engines`: a list of engine names (got {engines!r:.60})", "engines")
-    support = support_kwargs(support, rings=DEFAULTS["validation_rings"] if rings is None else rings)
+    support = support_kwargs(support, rings=_core.validation_rings() if rings is None else rings)
     if workers is not None:
         workers = _count(workers, "workers", 1, 4096)
     for e in engines:
