@@ -122,8 +122,9 @@ fn angle(a: &Vec3, b: &Vec3) -> f64 {
 /// `tests/exact_surface.rs`) ripple the cone's boundary, so that the cosine along a fan can have
 /// two local maxima a few 1e-6 apart within one bracket of the search, and the local search
 /// stops at one of them. Over 20,000 random cases the largest shortfall was 8.6e-6 in distance
-/// and 2.8e-6 in cosine, the same before and after the search's pruning (a6d3139 and now);
-/// 1e-4 leaves a margin of ten.
+/// and 2.8e-6 in cosine, the same before and after the search's pruning (a6d3139, and with the
+/// pruning while guesses still took `λ` to 1e-6); with guesses to 1e-4, 50,000 cases stayed
+/// within this bound. 1e-4 leaves a margin of ten over the shortfall measured.
 const RIPPLE: f64 = 1e-4;
 
 proptest! {
@@ -225,7 +226,8 @@ proptest! {
 
     /// The projection's boundary ray is the best on the cone's boundary: against 2,000 exact
     /// rays evenly spaced along each boundary fan (brute force, no pruning, no local search),
-    /// its cosine to the desired twist is never worse than a sampled ray's.
+    /// its cosine to the desired twist is never worse than a sampled ray's by more than
+    /// [`RIPPLE`].
     #[test]
     fn projection_matches_a_dense_scan_of_the_boundary(b in block_case(), a1 in -3.2f64..3.2, a2 in -1.5f64..1.5) {
         let Some(scene) = scene(&b) else { return Ok(()) };
