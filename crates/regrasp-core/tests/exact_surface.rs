@@ -9,8 +9,19 @@ use regrasp::mechanics::limit_surface::{Pressure, PressureDistribution};
 use std::f64::consts::PI;
 
 /// Tables against direct integration: the largest error of the load wrench, relative to its
-/// size, in the scaled metric (`τ/ℓ`), over random twists.
+/// size, in the scaled metric (`τ/ℓ`), over random twists: a general shape's cube maps.
 const TABLE_TOLERANCE: f64 = 5e-4;
+/// The same for a disc's 1-D profile (`mechanics::disc_profile`).
+const PROFILE_TOLERANCE: f64 = 1e-7;
+
+/// The stated tolerance of a region's tables.
+fn tolerance(region: &Region) -> f64 {
+    if region.axisymmetric() {
+        PROFILE_TOLERANCE
+    } else {
+        TABLE_TOLERANCE
+    }
+}
 
 fn rect(w: f64, h: f64) -> Vec<Vec2> {
     vec![Vec2::new(-w / 2.0, -h / 2.0), Vec2::new(w / 2.0, -h / 2.0), Vec2::new(w / 2.0, h / 2.0), Vec2::new(-w / 2.0, h / 2.0)]
@@ -100,9 +111,9 @@ fn the_tables_agree_with_integration_within_the_stated_tolerance() {
             worst = worst.max((a - b).norm() / b.norm());
         }
         println!("{name}: largest relative error of the table {worst:.2e}");
-        assert!(worst < TABLE_TOLERANCE, "{name}: {worst}");
+        assert!(worst < tolerance(&region), "{name}: {worst}");
         // the tolerance is not loose: the tables are not exact
-        assert!(worst > 1e-7, "{name}: {worst}");
+        assert!(worst > tolerance(&region) * 1e-3, "{name}: {worst}");
     }
 }
 
@@ -114,7 +125,7 @@ fn the_gauge_is_one_on_the_surface_and_the_twist_is_its_normal() {
         for v in twists(400, l) {
             let w = s.wrench(&v);
             let h = s.gauge(&w);
-            assert!((h - 1.0).abs() < TABLE_TOLERANCE, "{name}: H = {h}");
+            assert!((h - 1.0).abs() < tolerance(&region), "{name}: H = {h}");
             assert!((s.gauge(&(w * 0.5)) - 0.5 * h).abs() < 1e-12, "{name}: homogeneous");
             let t = s.twist_for(&w).expect("every wrench direction has a twist");
             // scaled twists [vx, vz, ωℓ]
@@ -159,7 +170,7 @@ proptest! {
         let w = s.wrench(&v) - o;
         let (ws, us) = (scaled(&w, l), scaled(&u, l));
         prop_assert!(ws.normalize().cross(&us.normalize()).norm() < 1e-9 && ws.dot(&us) > 0.0, "{ws} vs {us}");
-        prop_assert!((s.gauge(&s.wrench(&v)) - 1.0).abs() < TABLE_TOLERANCE);
+        prop_assert!((s.gauge(&s.wrench(&v)) - 1.0).abs() < tolerance(&region));
         // from outside the surface there is no ray
         prop_assert!(s.ray(&u, &(o0 * (1.01 / s.gauge(&o0)))).is_none());
     }

@@ -118,13 +118,14 @@ fn angle(a: &Vec3, b: &Vec3) -> f64 {
 }
 
 /// How far the projection may fall short of a sampled ray (in cosine, or in distance per unit
-/// desired twist): the exact surface's tables (within 5e-4 of the integral,
-/// `tests/exact_surface.rs`) ripple the cone's boundary, so that the cosine along a fan can have
-/// two local maxima a few 1e-6 apart within one bracket of the search, and the local search
-/// stops at one of them. Over 20,000 random cases the largest shortfall was 8.6e-6 in distance
-/// and 2.8e-6 in cosine, the same before and after the search's pruning (a6d3139, and with the
-/// pruning while guesses still took `λ` to 1e-6); with guesses to 1e-4, 50,000 cases stayed
-/// within this bound. 1e-4 leaves a margin of ten over the shortfall measured.
+/// desired twist). The search is local within each bracket of its samples (4° apart in the
+/// rays), and the cosine along a fan can have two local maxima inside one: a wiggle of the
+/// boundary below the samples' spacing, e.g. where it turns sharply near the holding limit
+/// (one case of 20,000: peaks 0.796396 and 0.796373 at fan parameters 0.300 and 0.330, a dip
+/// to 0.796228 between). With discs on their 1-D profile (smooth to about 1e-9) two runs of
+/// 20,000 cases gave largest shortfalls of 4.2e-6 and 2.3e-5 in cosine against the dense
+/// scan, all but one case below 2e-12, and none in distance against the cone's rays; on the
+/// earlier cube maps (ripple about 1e-4 of the load) 8.6e-6 in distance and 2.8e-6 in cosine.
 const RIPPLE: f64 = 1e-4;
 
 proptest! {
@@ -363,7 +364,12 @@ proptest! {
         // margins and projections are frame-invariant too (metrics about the centre of mass)
         prop_assert!((c1.margin - c2.margin).abs() < 1e-8, "margins {} vs {}", c1.margin, c2.margin);
         let (j1, j2) = (p1.project(&v).unwrap(), p2.project(&to2(&v)).unwrap());
-        prop_assert!(p2.twist_norm(&(to2(&j1) - j2)) < 1e-7 * (1.0 + p2.twist_norm(&j2)), "projections differ");
+        // the same distance to rounding; the same point to the search's tolerance (Brent's, 1e-6
+        // of its bracket on a fan: near the peak the distance is flat, so two frames' rounding
+        // can stop it 1e-6 apart with distances equal to 1e-16)
+        let dist = |j: &Vec3| p2.twist_norm(&(j - to2(&v)));
+        prop_assert!((dist(&to2(&j1)) - dist(&j2)).abs() < 1e-9 * (1.0 + p2.twist_norm(&to2(&v))), "distances differ");
+        prop_assert!(p2.twist_norm(&(to2(&j1) - j2)) < 1e-5 * (1.0 + p2.twist_norm(&j2)), "projections differ");
     }
 
     /// Inside the grip-force range the twist sticks; outside it does not (line pushers).
@@ -377,10 +383,22 @@ proptest! {
         let sticks = |f: f64| scene.with_grip_force(f).push(&b.pose, 0).map(|p| p.classify(&v).unwrap().feasible).unwrap_or(false);
         match range {
             Some(r) => {
-                prop_assert!(sticks(r.min * 1.001));
+                // inside by 0.1%, or by a quarter of a narrower range (a nearly frictionless
+                // pusher's can be 2e-4 wide); its middle always
+                let width = r.max / r.min - 1.0;
+                let eps = 1e-3f64.min(0.25 * width);
+                if r.max.is_finite() {
+                    prop_assert!(sticks(0.5 * (r.min + r.max)));
+                }
+                if eps > 1e-9 {
+                    // (no weight to hold: from any positive grip force)
+                    let above_min = if r.min > 0.0 { r.min * (1.0 + eps) } else { 1e-3 };
+                    prop_assert!(sticks(above_min));
+                }
                 prop_assert!(!sticks(r.min * 0.999));
                 if r.max.is_finite() {
-                    prop_assert!(sticks(r.max * 0.999) && !sticks(r.max * 1.001));
+                    prop_assert!(eps <= 1e-9 || sticks(r.max * (1.0 - eps)));
+                    prop_assert!(!sticks(r.max * 1.001));
                 } else {
                     prop_assert!(sticks(r.min * 1e4));
                 }

@@ -11,8 +11,11 @@
 //! a smooth periodic integrand) or Gauss–Legendre after a substitution that removes the
 //! square-root ends of the window the disc fills (`c` outside).
 //!
-//! For speed the surface is tabulated once per shape on two cube maps of directions (bicubic
-//! Catmull–Rom, a ghost row beyond each face's edges):
+//! For speed the surface is tabulated once per shape. A disc's depends on one variable
+//! (axisymmetry): its 1-D profile ([`crate::mechanics::disc_profile`]) gives the load, the gauge
+//! and the twists to about 1e-9 of the integral, each in a few flops. Any other shape's is
+//! tabulated on two cube maps of directions (bicubic Catmull–Rom, a ghost row beyond each face's
+//! edges):
 //! * **forward**: the wrench `W(ṽ)` at twist directions `ṽ = [vx, vz, ωℓ]`;
 //! * **inverse**: at wrench directions `w̃ = [fx, fz, τ/ℓ]`, the gauge `H(w̃)` (`= 1` on the
 //!   surface, degree-1 homogeneous) and the unit twist whose wrench is along `w̃`, found by
@@ -23,6 +26,7 @@
 //! Newton's method on it ([`ExactSurface::ray`]), so that the motion cones' rays and their exact
 //! test agree to rounding. Tables are shared between supports of one shape (scaled to size).
 
+use crate::mechanics::disc_profile::DiscProfile;
 use crate::mechanics::geometry::{cross2, Polygon, Vec2, Vec3};
 use crate::mechanics::limit_surface::Pressure;
 use rayon::prelude::*;
@@ -111,9 +115,8 @@ impl Region {
     /// `I_k = ∫ p s^k ds` over the ray `c + s e(α)` inside the region.
     fn rotation_wrench(&self, c: &Vec2) -> Vec3 {
         let mut w = Vec3::zeros();
-        let mut add = |alpha: f64, weight: f64, i1: f64, i2: f64| {
-            let (s, co) = alpha.sin_cos();
-            w += Vec3::new(-s * i1, co * i1, (c.x * co + c.y * s) * i1 + i2) * weight;
+        let mut add = |e: Vec2, weight: f64, i1: f64, i2: f64| {
+            w += Vec3::new(-e.y * i1, e.x * i1, c.dot(&e) * i1 + i2) * weight;
         };
         match self {
             Region::Disc { radius, pressure } => disc_rays(*radius, *pressure, c, &mut add),
@@ -158,12 +161,18 @@ fn nodes(n: usize) -> &'static [(f64, f64)] {
     m.entry(n).or_insert_with(|| Box::leak(gauss_legendre(n).into_boxed_slice()))
 }
 
-/// Rays from `c` through a disc: `add(α, dα weight, I₁, I₂)`.
-fn disc_rays(r: f64, pressure: Pressure, c: &Vec2, add: &mut impl FnMut(f64, f64, f64, f64)) {
+/// The unit vectors of the trapezoid rule's `TURN` angles on a whole turn.
+const TURN: usize = 512;
+fn turn() -> &'static [Vec2] {
+    static E: OnceLock<Vec<Vec2>> = OnceLock::new();
+    E.get_or_init(|| (0..TURN).map(|k| 2.0 * PI * k as f64 / TURN as f64).map(|a| Vec2::new(a.cos(), a.sin())).collect())
+}
+
+/// Rays from `c` through a disc: `add(e(α), dα weight, I₁, I₂)`.
+fn disc_rays(r: f64, pressure: Pressure, c: &Vec2, add: &mut impl FnMut(Vec2, f64, f64, f64)) {
     let d = c.norm();
-    let chord = |alpha: f64| -> (f64, f64) {
-        let e = Vec2::new(alpha.cos(), alpha.sin());
-        let b = c.dot(&e);
+    let chord = |e: &Vec2| -> (f64, f64) {
+        let b = c.dot(e);
         let disc = b * b - d * d + r * r;
         if disc <= 0.0 {
             return (0.0, 0.0);
@@ -183,20 +192,19 @@ fn disc_rays(r: f64, pressure: Pressure, c: &Vec2, add: &mut impl FnMut(f64, f64
     };
     if d < r {
         // whole turn, periodic and smooth: trapezoid rule
-        let m = 512;
-        for k in 0..m {
-            let a = 2.0 * PI * k as f64 / m as f64;
-            let (i1, i2) = chord(a);
-            add(a, 2.0 * PI / m as f64, i1, i2);
+        for e in turn() {
+            let (i1, i2) = chord(e);
+            add(*e, 2.0 * PI / TURN as f64, i1, i2);
         }
     } else {
         // window α₀ ± β, β = asin(r/d); α = α₀ + β sin φ removes the square-root ends
         let (a0, beta) = ((-c.y).atan2(-c.x), (r / d).min(1.0).asin());
         for &(x, wt) in nodes(64) {
             let phi = x * FRAC_PI_2;
-            let a = a0 + beta * phi.sin();
-            let (i1, i2) = chord(a);
-            add(a, wt * FRAC_PI_2 * beta * phi.cos(), i1, i2);
+            let (sa, ca) = (a0 + beta * phi.sin()).sin_cos();
+            let e = Vec2::new(ca, sa);
+            let (i1, i2) = chord(&e);
+            add(e, wt * FRAC_PI_2 * beta * phi.cos(), i1, i2);
         }
     }
 }
@@ -205,13 +213,12 @@ fn disc_rays(r: f64, pressure: Pressure, c: &Vec2, add: &mut impl FnMut(f64, f64
 /// pressure `p₀/r · √(h² − σ²)` becomes `p₀/r · h cos θ` and the integrals are elementary.
 fn hertz_chord(r: f64, b: f64, h: f64, lo: f64) -> (f64, f64) {
     let p0 = 3.0 / (2.0 * PI * r * r);
-    let ta = ((lo + b) / h).clamp(-1.0, 1.0).asin();
-    // antiderivatives of cos²θ, cos²θ sinθ, cos²θ sin²θ
-    let c2 = |t: f64| 0.5 * (t + t.sin() * t.cos());
-    let c2s = |t: f64| -t.cos().powi(3) / 3.0;
-    let c2s2 = |t: f64| t / 8.0 - (4.0 * t).sin() / 32.0;
-    let int = |f: &dyn Fn(f64) -> f64| f(FRAC_PI_2) - f(ta);
-    let (j0, j1, j2) = (int(&c2), int(&c2s), int(&c2s2));
+    let sa = ((lo + b) / h).clamp(-1.0, 1.0);
+    let (ta, ca) = (sa.asin(), (1.0 - sa * sa).max(0.0).sqrt());
+    // antiderivatives of cos²θ, cos²θ sinθ, cos²θ sin²θ from ta to π/2 (sin 4θ = 4 s c (c² − s²))
+    let j0 = FRAC_PI_2 / 2.0 - 0.5 * (ta + sa * ca);
+    let j1 = ca * ca * ca / 3.0;
+    let j2 = PI / 16.0 - (ta / 8.0 - sa * ca * (ca * ca - sa * sa) / 8.0);
     // s = h sinθ − b; ds √(h² − σ²) = h² cos²θ dθ
     let k = p0 / r * h * h;
     let i1 = k * (h * j1 - b * j0);
@@ -393,10 +400,23 @@ fn face_dir(f: usize, u: f64, w: f64) -> Vec3 {
     d
 }
 
-/// The tables of one shape, in units where its length scale is 1.
+/// The surface of one shape, in units where its length scale is 1: a disc's 1-D profile, or
+/// (any other shape) two cube maps.
 #[derive(Debug)]
 struct Tables {
     region: Region,
+    kind: Kind,
+}
+
+#[derive(Debug)]
+enum Kind {
+    Profile(DiscProfile),
+    Maps(Maps),
+}
+
+/// A general shape's surface on cube maps (module notes).
+#[derive(Debug)]
+struct Maps {
     /// `W(ṽ)` at twist directions
     forward: CubeMap<3>,
     /// `[H(face vector), unit twist]` at wrench directions
@@ -427,36 +447,39 @@ fn shared_tables(unit: Region) -> Arc<Tables> {
 
 impl Tables {
     fn build(region: Region) -> Self {
-        let n = TABLE_CELLS;
-        let forward = match &region {
-            Region::Disc { radius, .. } => {
-                // axisymmetric: W = (F(φ) v̂, sign(ω) M(φ)), φ = atan2(|v|, |ω| r), from a fine
-                // profile (linear interpolation, error ~1e-8)
-                let k = 4096;
-                let at = |i: usize| {
-                    let phi = FRAC_PI_2 * i as f64 / k as f64;
-                    let omega = if i == k { 0.0 } else { phi.cos() / radius };
-                    let w = region.wrench(&Vec3::new(phi.sin(), 0.0, omega));
-                    (w.x, w.z)
-                };
-                let profile: Vec<(f64, f64)> = (0..=k).into_par_iter().map(at).collect();
-                CubeMap::<3>::build(n, [true; 3], |d| {
-                    let t = d.x.hypot(d.y);
-                    let x = t.atan2(d.z.abs() * radius) / FRAC_PI_2 * k as f64;
-                    let i = (x.floor() as usize).min(k - 1);
-                    let f = x - i as f64;
-                    let (a, b) = (profile[i], profile[i + 1]);
-                    let (force, moment) = (a.0 + f * (b.0 - a.0), a.1 + f * (b.1 - a.1));
-                    let dir = if t > 0.0 { Vec2::new(d.x, d.y) / t } else { Vec2::zeros() };
-                    [force * dir.x, force * dir.y, moment * d.z.signum()]
-                })
-            }
-            Region::Polygon { .. } => CubeMap::<3>::build(n, [true; 3], |d| {
-                let w = region.wrench(d);
-                [w.x, w.y, w.z]
-            }),
+        let kind = match &region {
+            Region::Disc { radius, .. } => Kind::Profile(DiscProfile::build(*radius, |v| region.wrench(v))),
+            Region::Polygon { .. } => Kind::Maps(Maps::build(&region)),
         };
-        let mut t = Tables { region, forward, inverse: CubeMap { n, values: Vec::new(), odd: [false, true, true, true] } };
+        Tables { region, kind }
+    }
+
+    fn wrench(&self, v: &Vec3) -> Vec3 {
+        match &self.kind {
+            Kind::Profile(p) => p.wrench(v),
+            Kind::Maps(m) => m.wrench(v),
+        }
+    }
+
+    /// Gauge and twist at wrench `w` ([`Maps::gauge_with`], unit; a profile's is exact and its
+    /// twist not unit).
+    #[inline]
+    fn gauge_with<const CUBIC: bool>(&self, w: &Vec3) -> (f64, Vec3) {
+        match &self.kind {
+            Kind::Profile(p) => p.gauge(w),
+            Kind::Maps(m) => m.gauge_with::<CUBIC>(w),
+        }
+    }
+}
+
+impl Maps {
+    fn build(region: &Region) -> Self {
+        let n = TABLE_CELLS;
+        let forward = CubeMap::<3>::build(n, [true; 3], |d| {
+            let w = region.wrench(d);
+            [w.x, w.y, w.z]
+        });
+        let mut t = Maps { forward, inverse: CubeMap { n, values: Vec::new(), odd: [false, true, true, true] } };
         let inverse = CubeMap::<4>::build(n / 2, [false, true, true, true], |d| {
             // from the direction itself, else from the axes and diagonals; else the best iterate
             // (the inverse table only starts the rays' Newton's method on the forward one)
@@ -490,13 +513,6 @@ impl Tables {
     /// unless `CUBIC`).
     fn gauge_with<const CUBIC: bool>(&self, w: &Vec3) -> (f64, Vec3) {
         let (g, m) = if CUBIC { self.inverse.at(w) } else { self.inverse.at_linear(w) };
-        let v = Vec3::new(g[1], g[2], g[3]);
-        (g[0] * m, v / v.norm())
-    }
-
-    /// Gauge `H(w)` and the unit twist at direction `w` from the inverse table.
-    fn gauge(&self, w: &Vec3) -> (f64, Vec3) {
-        let (g, m) = self.inverse.at(w);
         let v = Vec3::new(g[1], g[2], g[3]);
         (g[0] * m, v / v.norm())
     }
@@ -580,6 +596,32 @@ impl Tables {
     }
 }
 
+/// `|H − 1|` at which a profile's rays stop (its gauge is exact: the load of the ray's twist
+/// minus `o` is then along `u` to about this).
+const PROFILE_RAY_TOL: f64 = 1e-12;
+
+/// The unit twist on a profile's surface with load `λu + o` (`u` unit, scaled units) by
+/// Newton's method on `λ` from `l` (∇H = n H/(n·w), Euler's relation), unbracketed: None unless
+/// `|H − 1| < tol` within 8 steps (then the bracketed search of [`ExactSurface::ray_from`]).
+fn profile_newton(p: &DiscProfile, us: &Vec3, os: &Vec3, mut l: f64, tol: f64) -> Option<Vec3> {
+    for _ in 0..8 {
+        if !(l > 0.0) {
+            return None;
+        }
+        let w = us * l + os;
+        let (h, n) = p.gauge(&w);
+        if (h - 1.0).abs() < tol {
+            return Some(n);
+        }
+        let slope = n.dot(us) / n.dot(&w) * h;
+        if !(slope > 0.0) {
+            return None;
+        }
+        l -= (h - 1.0) / slope;
+    }
+    None
+}
+
 /// The solution `x` of `[a b] x = r` (Cramer's rule); None when singular.
 #[inline]
 fn solve2(a: &nalgebra::Vector2<f64>, b: &nalgebra::Vector2<f64>, r: &nalgebra::Vector2<f64>) -> Option<nalgebra::Vector2<f64>> {
@@ -661,7 +703,7 @@ impl ExactSurface {
         if ws.amax() == 0.0 {
             return 0.0;
         }
-        self.tables.gauge(&ws).0
+        self.tables.gauge_with::<true>(&ws).0
     }
 
     /// The sliding twist (unit in the scaled metric) whose load wrench is along `w` (non-zero),
@@ -674,7 +716,15 @@ impl ExactSurface {
     /// nearby `u`); None when that does not converge (then [`Self::ray`] from the tables).
     pub fn ray_near(&self, u: &Vec3, o: &Vec3, near: &Vec3) -> Option<Vec3> {
         let (us, os) = (self.scale_wrench(u), self.scale_wrench(o));
-        let v = self.tables.solve(&(us / us.norm()), &os, Some(self.scale_twist(near)))?;
+        let v = match &self.tables.kind {
+            Kind::Maps(m) => m.solve(&(us / us.norm()), &os, Some(self.scale_twist(near)))?,
+            Kind::Profile(p) => {
+                // λ from the load of `near`: W(near) ≈ λu + o
+                let us = us / us.norm();
+                let l = (p.wrench(&self.scale_twist(near)) - os).dot(&us);
+                profile_newton(p, &us, &os, l, PROFILE_RAY_TOL)?
+            }
+        };
         let v = self.unscale_twist(&v);
         Some(v / self.scale_twist(&v).norm())
     }
@@ -688,8 +738,9 @@ impl ExactSurface {
     }
 
     /// [`Self::ray`] with `H(o)` known and perhaps a guess of `λ` (e.g. the ellipsoid's);
-    /// without `POLISH` a guess (the inverse table's twist after one Newton step on the
-    /// forward table), for searches that polish their result.
+    /// without `POLISH` a guess, for searches that polish their result: on cube maps the
+    /// inverse table's twist after one Newton step on the forward table; on a disc's profile
+    /// the exact twist of a `λ` within 1e-4 of the root (in `H`).
     pub fn ray_from<const POLISH: bool>(&self, u: &Vec3, o: &Vec3, h_o: f64, guess: Option<f64>) -> Option<Vec3> {
         let (us, os) = (self.scale_wrench(u), self.scale_wrench(o));
         let un = us.norm();
@@ -699,12 +750,28 @@ impl ExactSurface {
         let us = us / un;
         // λ: H(λu + o) = 1. H is a norm (the surface is symmetric), so λH(u) − H(o) ≤
         // H(λu + o) ≤ λH(u) + H(o): the root lies in [(1 − H(o))/H(u), (1 + H(o))/H(u)], and
-        // it is the only one there (H convex). Newton's method kept in that bracket.
+        // it is the only one there (H convex). Newton's method kept in that bracket; on a
+        // profile first unbracketed from the guess (cheaper: no H(u)).
+        let tol = match self.tables.kind {
+            Kind::Profile(_) if POLISH => PROFILE_RAY_TOL,
+            Kind::Profile(_) => 1e-4,
+            Kind::Maps(_) if POLISH => 1e-6,
+            Kind::Maps(_) => 1e-4,
+        };
         let g = |l: f64| self.tables.gauge_with::<POLISH>(&(us * l + os));
-        let h_u = self.tables.gauge_with::<POLISH>(&us).0;
+        if let (Kind::Profile(p), Some(l)) = (&self.tables.kind, guess) {
+            if let Some(v) = profile_newton(p, &us, &os, l * un, tol) {
+                let v = self.unscale_twist(&v);
+                return Some(v / self.scale_twist(&v).norm());
+            }
+        }
+        let (h_u, n_u) = self.tables.gauge_with::<POLISH>(&us);
         let (mut lo, mut hi) = ((1.0 - h_o) / h_u, (1.0 + h_o) / h_u);
+        // else the root of H's expansion to first order in o: λH(u) + ∇H(u)·o = 1
+        let expansion = (1.0 - h_u * n_u.dot(&os) / n_u.dot(&us)) / h_u;
         let mut l = match guess {
             Some(l) if l * un > lo && l * un < hi => l * un,
+            _ if expansion > lo && expansion < hi => expansion,
             _ => lo,
         };
         let (mut h, mut n) = g(l);
@@ -712,7 +779,7 @@ impl ExactSurface {
             // (a guess to 1e-4 on the bilinear inverse table, the Newton step on the forward
             // table below squaring its error; 1e-3 left guesses wrong enough near a disc's
             // pure rotation to mislead the projection's search)
-            if (h - 1.0).abs() < if POLISH { 1e-6 } else { 1e-4 } {
+            if (h - 1.0).abs() < tol {
                 break;
             }
             if h < 1.0 {
@@ -729,7 +796,11 @@ impl ExactSurface {
         // polished to rounding, or (a guess) one Newton step on the forward table from the
         // inverse table's twist: steep parts of the normal map (near a disc's pure rotation)
         // are poorly interpolated by the inverse table alone
-        let v = if POLISH { self.tables.solve(&us, &os, Some(n))? } else { self.tables.newton_step(&us, &os, &n) };
+        let v = match &self.tables.kind {
+            Kind::Profile(_) => n,
+            Kind::Maps(m) if POLISH => m.solve(&us, &os, Some(n))?,
+            Kind::Maps(m) => m.newton_step(&us, &os, &n),
+        };
         let v = self.unscale_twist(&v);
         Some(v / self.scale_twist(&v).norm())
     }
