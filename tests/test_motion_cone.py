@@ -32,19 +32,32 @@ def start_cone(d, limit_surface=None):
     return sc, sc.motion_cone(d["task"]["start"], "p")
 
 
-def required_pusher_wrench(d, twist):
-    """Pusher wrench needed for `twist`, from the raw scene dict (eq 3.10 at a circular pad)."""
+def required_pusher_wrench(d, twist, surface="ellipsoid"):
+    """Pusher wrench needed for `twist`, from the raw scene dict: the pad's load on the ellipsoid
+    (eq 3.10 at a circular pad), or (``"true"``) summed over a 300 × 300 grid of points of the
+    pad (Coulomb at each, uniform pressure), minus gravity."""
     q = np.array(d["task"]["start"])
     c, s = np.cos(q[2]), np.sin(q[2])
     R = np.array([[c, -s], [s, c]])
     pad = R.T @ -q[:2]
     S = 2 * d["grasp"]["force"] * d["grasp"]["friction"]
-    k = 0.6 * d["grasp"]["pad_radius"]
+    r = d["grasp"]["pad_radius"]
     v = np.asarray(twist, float)
-    vel = R @ (v[:2] + v[2] * np.array([-pad[1], pad[0]]))
-    den = np.sqrt(vel @ vel + (k * v[2]) ** 2)
-    f_pad = R.T @ vel * (S / den)
-    tau = S * k * k * v[2] / den + (pad[0] * f_pad[1] - pad[1] * f_pad[0])
+    if surface == "true":
+        xs = (np.arange(300) + 0.5) / 300 * 2 * r - r
+        X, Y = np.meshgrid(xs, xs)
+        inside = X**2 + Y**2 < r * r
+        P = pad + np.c_[X[inside], Y[inside]] @ R  # object-frame points of the pad
+        vel = v[:2] + v[2] * np.c_[-P[:, 1], P[:, 0]]
+        u = vel / np.linalg.norm(vel, axis=1)[:, None]
+        f_pad = S * u.mean(axis=0)
+        tau = S * np.mean(P[:, 0] * u[:, 1] - P[:, 1] * u[:, 0])
+    else:
+        k = 0.6 * r
+        vel = R @ (v[:2] + v[2] * np.array([-pad[1], pad[0]]))
+        den = np.sqrt(vel @ vel + (k * v[2]) ** 2)
+        f_pad = R.T @ vel * (S / den)
+        tau = S * k * k * v[2] / den + (pad[0] * f_pad[1] - pad[1] * f_pad[0])
     gd, g = np.array(d["gravity"]["direction"]), d["gravity"]["g"]
     fg = R.T @ gd * d["object"]["mass"] * g
     com = np.array(d["object"]["com"])
@@ -52,9 +65,9 @@ def required_pusher_wrench(d, twist):
     return np.array([f_pad[0], f_pad[1], tau]) - wg
 
 
-def lp_sticks(d, twist) -> bool:
+def lp_sticks(d, twist, surface="ellipsoid") -> bool:
     """Is there a set of pusher contact forces inside their Coulomb cones giving the wrench?"""
-    w = required_pusher_wrench(d, twist)
+    w = required_pusher_wrench(d, twist, surface)
     p = d["pushers"][0]
     n = np.array(p["normal"], float)
     t = np.array([-n[1], n[0]])
@@ -79,19 +92,23 @@ def lp_sticks(d, twist) -> bool:
 
 
 @SETTINGS
-@given(block_scenes(), st.integers(0, 2**31))
-def test_exact_test_agrees_with_lp_over_contact_forces(d, seed):
-    sc, cone = start_cone(d)
+@given(block_scenes(), st.integers(0, 2**31), st.sampled_from(["ellipsoid", "true"]))
+def test_exact_test_agrees_with_lp_over_contact_forces(d, seed, surface):
+    """Against the LP over the pusher's contact forces with the pad's load from the same limit
+    surface: the ellipsoid's closed form, or the true surface summed over the pad's points (whose
+    grid is good to about 1e-3 of the load: margins closer to 0 than 2e-3 are not compared)."""
+    sc, cone = start_cone(d, surface)
     rng = np.random.default_rng(seed)
     tw = twist_dirs(20, sc.length, rng)
     # and twists near the cone: generator mixes plus noise
     g = cone.generators
     tw = np.vstack([tw, rng.uniform(0, 1, (20, len(g))) @ g + 0.1 * twist_dirs(20, sc.length, rng)])
     margins = cone.margin(tw)
+    band = 1e-6 if surface == "ellipsoid" else 2e-3
     for t, m in zip(tw, margins):
-        if abs(m) < 1e-6:
+        if abs(m) < band:
             continue
-        assert (m >= 0) == lp_sticks(d, t), (t, m)
+        assert (m >= 0) == lp_sticks(d, t, surface), (t, m)
 
 
 @SETTINGS
