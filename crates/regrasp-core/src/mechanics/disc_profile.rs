@@ -28,6 +28,8 @@ const INVERSE_NODES: usize = 4096;
 pub struct DiscProfile {
     /// `R` in units of the length scale
     radius: f64,
+    /// `1/R`
+    inv_radius: f64,
     /// `[F, M, dF/dp, dM/dp]` at `p = i / PROFILE_NODES`
     nodes: Vec<[f64; 4]>,
     /// the root `p` at `q = j / INVERSE_NODES` (decreasing) and `dp/dq` there
@@ -54,7 +56,7 @@ impl DiscProfile {
             i => (values[i + 1][k] - values[i - 1][k]) / (2.0 * h),
         };
         let nodes = (0..=n).map(|i| [values[i][0], values[i][1], slope(i, 0), slope(i, 1)]).collect();
-        let mut profile = Self { radius, nodes, starts: Vec::new() };
+        let mut profile = Self { radius, inv_radius: 1.0 / radius, nodes, starts: Vec::new() };
         profile.starts = (0..=INVERSE_NODES)
             .map(|j| {
                 let q = j as f64 / INVERSE_NODES as f64;
@@ -156,8 +158,9 @@ impl DiscProfile {
             return (0.0, Vec3::zeros());
         }
         let (p, f) = self.root(b / (a + b));
-        let k = if a > 0.0 { p / a } else { 0.0 };
-        ((a + b) / (f[0] + f[1]), Vec3::new(w.x * k, w.y * k, ((1.0 - p) / self.radius).copysign(w.z)))
+        // [p f̂, ±(1 − p)/R] times a (one division fewer), unless a = 0 (then p = 0)
+        let v = if a > 0.0 { Vec3::new(w.x * p, w.y * p, (a * (1.0 - p) * self.inv_radius).copysign(w.z)) } else { Vec3::new(0.0, 0.0, 1.0f64.copysign(w.z)) };
+        ((a + b) / (f[0] + f[1]), v)
     }
 }
 

@@ -613,11 +613,12 @@ fn profile_newton(p: &DiscProfile, us: &Vec3, os: &Vec3, mut l: f64, tol: f64) -
         if (h - 1.0).abs() < tol {
             return Some(n);
         }
-        let slope = n.dot(us) / n.dot(&w) * h;
-        if !(slope > 0.0) {
+        // the step (h − 1)/slope, slope = h n·u/(n·w), in one division
+        let (nu, nw) = (n.dot(us), n.dot(&w));
+        if !(nu * nw > 0.0) {
             return None;
         }
-        l -= (h - 1.0) / slope;
+        l -= (h - 1.0) * nw / (h * nu);
     }
     None
 }
