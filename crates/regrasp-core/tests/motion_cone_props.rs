@@ -273,7 +273,8 @@ proptest! {
             let direct = js.transpose() * exact.wrench_direct(&(js * g)) * spec.friction_scale;
             let d = js.try_inverse().unwrap().transpose() * (c.support_wrench - direct);
             let scaled = Vec3::new(d.x, d.y, d.z / l).norm() / spec.friction_scale;
-            prop_assert!(scaled < 5e-4, "load off the integrated surface by {scaled}");
+            // (the pads are discs: their profile is within 1e-7 of the integral, tests/exact_surface.rs)
+            prop_assert!(scaled < 1e-7, "load off the integrated surface by {scaled}");
             prop_assert!((c.support_wrench - c.pusher_wrench - spec.gravity).norm() < 1e-9 * spec.friction_scale);
         }
     }

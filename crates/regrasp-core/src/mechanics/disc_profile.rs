@@ -102,7 +102,8 @@ impl DiscProfile {
     }
 
     /// The root `p` of `c(p)` (module notes) and `[F, M]` there: Newton's method from the
-    /// starting table (cubic Hermite), kept inside the bracket of its two neighbouring entries.
+    /// starting table (cubic Hermite), kept inside the bracket of its two neighbouring entries
+    /// (widened to the start when the Hermite guess falls outside it).
     /// A step `δ` below `SMALL_STEP` is the last: the profile at `p + δ` is then taken to first
     /// order (its error `F'' δ²/2`, below 1e-15).
     #[inline]
@@ -138,9 +139,10 @@ impl DiscProfile {
         (p, [v[0], v[1]])
     }
 
-    /// The load wrench `W(ṽ)` of a scaled twist (non-zero).
+    /// The load wrench `W(ṽ)` of a scaled twist (non-zero; degree 0 in it).
     #[inline]
     pub fn wrench(&self, v: &Vec3) -> Vec3 {
+        let v = &in_range(v).0;
         let t = (v.x * v.x + v.y * v.y).sqrt();
         let p = t / (t + v.z.abs() * self.radius);
         let f = self.at(p);
@@ -152,15 +154,31 @@ impl DiscProfile {
     /// zero wrench: gauge 0, the zero twist).
     #[inline]
     pub fn gauge(&self, w: &Vec3) -> (f64, Vec3) {
+        // (degree 1: H(w) = s H(w/s); a NaN wrench gives a NaN gauge)
+        let (w, s) = in_range(w);
         let a = (w.x * w.x + w.y * w.y).sqrt();
         let b = w.z.abs();
-        if !(a + b > 0.0) {
+        if a + b == 0.0 {
             return (0.0, Vec3::zeros());
         }
         let (p, f) = self.root(b / (a + b));
         // [p f̂, ±(1 − p)/R] times a (one division fewer), unless a = 0 (then p = 0)
         let v = if a > 0.0 { Vec3::new(w.x * p, w.y * p, (a * (1.0 - p) * self.inv_radius).copysign(w.z)) } else { Vec3::new(0.0, 0.0, 1.0f64.copysign(w.z)) };
-        ((a + b) / (f[0] + f[1]), v)
+        (s * (a + b) / (f[0] + f[1]), v)
+    }
+}
+
+/// `x` scaled to its largest component when that is so large or small that squares would
+/// overflow or underflow, and the scale (1 otherwise).
+#[inline]
+fn in_range(x: &Vec3) -> (Vec3, f64) {
+    let m = x.amax();
+    if m > 1e-100 && m < 1e100 {
+        (*x, 1.0)
+    } else if m > 0.0 && m.is_finite() {
+        (x / m, m)
+    } else {
+        (*x, 1.0)
     }
 }
 
@@ -194,6 +212,22 @@ mod tests {
                 assert!(w[1][0] < 1.0 + 1e-8, "{w:?}");
             }
         }
+    }
+
+    /// Huge and tiny inputs give the loads and gauges of their directions (no overflow), a NaN
+    /// wrench a NaN gauge (never "holds").
+    #[test]
+    fn extreme_inputs_are_scaled_and_nan_propagates() {
+        let d = &profiles()[0];
+        for v in [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.3, -0.2, 0.7), Vec3::new(0.0, 0.0, -1.0)] {
+            for k in [1e-170, 1e200] {
+                assert!((d.wrench(&(v * k)) - d.wrench(&v)).norm() < 1e-14, "{v} × {k}");
+                let (h, _) = d.gauge(&(v * k));
+                assert!((h / k - d.gauge(&v).0).abs() < 1e-13 * d.gauge(&v).0, "{v} × {k}: {h}");
+            }
+        }
+        assert!(d.gauge(&Vec3::new(f64::NAN, 0.0, 1.0)).0.is_nan());
+        assert_eq!(d.gauge(&Vec3::zeros()).0, 0.0);
     }
 
     /// The gauge's twist loads the surface along the wrench, to rounding, at every direction

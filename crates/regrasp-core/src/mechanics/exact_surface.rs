@@ -22,9 +22,10 @@
 //!   Newton's method on the forward table.
 //!
 //! `ℓ` is the pressure-weighted radius of gyration, so the scaled twist and wrench are of one
-//! size. The forward table defines the surface: twists from the inverse table are polished by
-//! Newton's method on it ([`ExactSurface::ray`]), so that the motion cones' rays and their exact
-//! test agree to rounding. Tables are shared between supports of one shape (scaled to size).
+//! size. On cube maps the forward table defines the surface: twists from the inverse table are
+//! polished by Newton's method on it ([`ExactSurface::ray`]), so that the motion cones' rays and
+//! their exact test agree to rounding (a disc's profile is consistent by construction). Tables
+//! are shared between supports of one shape (scaled to size).
 
 use crate::mechanics::disc_profile::DiscProfile;
 use crate::mechanics::geometry::{cross2, Polygon, Vec2, Vec3};
@@ -602,7 +603,8 @@ const PROFILE_RAY_TOL: f64 = 1e-12;
 
 /// The unit twist on a profile's surface with load `λu + o` (`u` unit, scaled units) by
 /// Newton's method on `λ` from `l` (∇H = n H/(n·w), Euler's relation), unbracketed: None unless
-/// `|H − 1| < tol` within 8 steps (then the bracketed search of [`ExactSurface::ray_from`]).
+/// `|H − 1| < tol` within 8 steps (then the caller's fallback: the bracketed search of
+/// [`ExactSurface::ray_from`], or from [`ExactSurface::ray_near`] the frame's ray).
 fn profile_newton(p: &DiscProfile, us: &Vec3, os: &Vec3, mut l: f64, tol: f64) -> Option<Vec3> {
     for _ in 0..8 {
         if !(l > 0.0) {
@@ -677,6 +679,13 @@ impl ExactSurface {
         Vec3::new(v.x, v.y, v.z / self.length)
     }
 
+    /// A scaled twist in physical units, unit in the scaled metric; None unless finite.
+    fn unit_twist(&self, vs: &Vec3) -> Option<Vec3> {
+        let v = self.unscale_twist(vs);
+        let v = v / self.scale_twist(&v).norm();
+        v.iter().all(|x| x.is_finite()).then_some(v)
+    }
+
     fn scale_wrench(&self, w: &Vec3) -> Vec3 {
         Vec3::new(w.x, w.y, w.z / self.length)
     }
@@ -726,8 +735,7 @@ impl ExactSurface {
                 profile_newton(p, &us, &os, l, PROFILE_RAY_TOL)?
             }
         };
-        let v = self.unscale_twist(&v);
-        Some(v / self.scale_twist(&v).norm())
+        self.unit_twist(&v)
     }
 
     /// The sliding twist whose load wrench is `λ u + o` for the `λ > 0` that puts it on the
@@ -762,8 +770,7 @@ impl ExactSurface {
         let g = |l: f64| self.tables.gauge_with::<POLISH>(&(us * l + os));
         if let (Kind::Profile(p), Some(l)) = (&self.tables.kind, guess) {
             if let Some(v) = profile_newton(p, &us, &os, l * un, tol) {
-                let v = self.unscale_twist(&v);
-                return Some(v / self.scale_twist(&v).norm());
+                return self.unit_twist(&v);
             }
         }
         let (h_u, n_u) = self.tables.gauge_with::<POLISH>(&us);
@@ -802,8 +809,7 @@ impl ExactSurface {
             Kind::Maps(m) if POLISH => m.solve(&us, &os, Some(n))?,
             Kind::Maps(m) => m.newton_step(&us, &os, &n),
         };
-        let v = self.unscale_twist(&v);
-        Some(v / self.scale_twist(&v).norm())
+        self.unit_twist(&v)
     }
 }
 
