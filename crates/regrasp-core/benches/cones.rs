@@ -1,7 +1,8 @@
 //! Criterion benchmarks of the motion-cone hot paths: building one cone through the public API,
 //! the fast frame + rays path of the batch API, the exact membership test, the projection, and
 //! the batch generator computation over many poses; on the scenes' default (exact) limit surface,
-//! and the frame, exact test and projection also on the ellipsoid (`*_ellipsoid`).
+//! and the frame, exact test and projection also on the ellipsoid (`*_ellipsoid`); and the exact
+//! surface's own lookups (load and gauge) on a disc's profile and on a polygon's cube maps.
 //!
 //! Run with `cargo bench -p regrasp-core --bench cones`.
 
@@ -181,5 +182,25 @@ fn bench_batch(c: &mut Criterion) {
     assert!(status.iter().all(|s| *s == Status::Ok), "batch: some sampled pose failed");
 }
 
-criterion_group!(benches, bench_cone, bench_membership, bench_batch);
+fn bench_surface(c: &mut Criterion) {
+    use regrasp::mechanics::exact_surface::{ExactSurface, Region};
+    use regrasp::mechanics::geometry::Vec2;
+    use regrasp::mechanics::limit_surface::Pressure;
+    let rect = vec![Vec2::new(-0.02, -0.01), Vec2::new(0.02, -0.01), Vec2::new(0.02, 0.01), Vec2::new(-0.02, 0.01)];
+    let surfaces = [("disc", ExactSurface::new(&Region::Disc { radius: 0.006, pressure: Pressure::Uniform })), ("polygon", ExactSurface::new(&Region::Polygon { vertices: rect }))];
+    let mut g = c.benchmark_group("surface");
+    g.measurement_time(Duration::from_secs(2)).warm_up_time(Duration::from_secs(1));
+    for (name, s) in &surfaces {
+        let l = s.length();
+        // 64 directions spread over the sphere of scaled twists / wrenches
+        let dirs: Vec<Vec3> = (0..64).map(|k| (k as f64 * 2.399963, 1.0 - (k as f64 + 0.5) / 32.0)).map(|(a, z)| Vec3::new(a.cos() * (1.0 - z * z).sqrt(), a.sin() * (1.0 - z * z).sqrt(), z)).collect();
+        let twists: Vec<Vec3> = dirs.iter().map(|d| Vec3::new(d.x, d.y, d.z / l)).collect();
+        let wrenches: Vec<Vec3> = dirs.iter().map(|d| Vec3::new(d.x, d.y, d.z * l)).collect();
+        g.bench_function(format!("load_{name}_x64"), |b| b.iter(|| twists.iter().map(|v| s.wrench(black_box(v)).x).sum::<f64>()));
+        g.bench_function(format!("gauge_{name}_x64"), |b| b.iter(|| wrenches.iter().map(|w| s.gauge(black_box(w))).sum::<f64>()));
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench_cone, bench_membership, bench_batch, bench_surface);
 criterion_main!(benches);
