@@ -142,7 +142,25 @@ impl DiscProfile {
     /// The load wrench `W(ṽ)` of a scaled twist (non-zero; degree 0 in it).
     #[inline]
     pub fn wrench(&self, v: &Vec3) -> Vec3 {
-        let v = &in_range(v).0;
+        if out_of_range(v) {
+            return self.wrench_scaled(v);
+        }
+        self.wrench_in_range(v)
+    }
+
+    /// [`Self::wrench`] of a huge or tiny twist: of its direction (off the hot path).
+    #[cold]
+    #[inline(never)]
+    fn wrench_scaled(&self, v: &Vec3) -> Vec3 {
+        match largest(v) {
+            m if m > 0.0 && m.is_finite() => self.wrench_in_range(&(v / m)),
+            _ => self.wrench_in_range(v),
+        }
+    }
+
+    /// [`Self::wrench`] of a twist whose squares neither overflow nor underflow.
+    #[inline]
+    fn wrench_in_range(&self, v: &Vec3) -> Vec3 {
         let t = (v.x * v.x + v.y * v.y).sqrt();
         let p = t / (t + v.z.abs() * self.radius);
         let f = self.at(p);
@@ -155,7 +173,9 @@ impl DiscProfile {
     #[inline]
     pub fn gauge(&self, w: &Vec3) -> (f64, Vec3) {
         // (degree 1: H(w) = s H(w/s); a NaN wrench gives a NaN gauge)
-        let (w, s) = in_range(w);
+        if out_of_range(w) {
+            return self.gauge_scaled(w);
+        }
         let a = (w.x * w.x + w.y * w.y).sqrt();
         let b = w.z.abs();
         if a + b == 0.0 {
@@ -164,22 +184,35 @@ impl DiscProfile {
         let (p, f) = self.root(b / (a + b));
         // [p f̂, ±(1 − p)/R] times a (one division fewer), unless a = 0 (then p = 0)
         let v = if a > 0.0 { Vec3::new(w.x * p, w.y * p, (a * (1.0 - p) * self.inv_radius).copysign(w.z)) } else { Vec3::new(0.0, 0.0, 1.0f64.copysign(w.z)) };
-        (s * (a + b) / (f[0] + f[1]), v)
+        ((a + b) / (f[0] + f[1]), v)
+    }
+
+    /// [`Self::gauge`] of a huge or tiny wrench (degree 1: `H(w) = m H(w/m)`; zero, NaN and
+    /// infinite wrenches as they are: gauge 0, NaN, NaN). Off the hot path.
+    #[cold]
+    #[inline(never)]
+    fn gauge_scaled(&self, w: &Vec3) -> (f64, Vec3) {
+        let m = largest(w);
+        if !(m > 0.0 && m.is_finite()) {
+            return if m == 0.0 { (0.0, Vec3::zeros()) } else { (f64::NAN, Vec3::zeros()) };
+        }
+        let (h, v) = self.gauge(&(w / m));
+        (m * h, v)
     }
 }
 
-/// `x` scaled to its largest component when that is so large or small that squares would
-/// overflow or underflow, and the scale (1 otherwise).
+/// `|x|∞`.
 #[inline]
-fn in_range(x: &Vec3) -> (Vec3, f64) {
-    let m = x.amax();
-    if m > 1e-100 && m < 1e100 {
-        (*x, 1.0)
-    } else if m > 0.0 && m.is_finite() {
-        (x / m, m)
-    } else {
-        (*x, 1.0)
-    }
+fn largest(x: &Vec3) -> f64 {
+    x.x.abs().max(x.y.abs()).max(x.z.abs())
+}
+
+/// Whether `x` is so large or small (or not finite) that its squares could overflow or
+/// underflow: then it is scaled by [`largest`] first, off the hot path.
+#[inline]
+fn out_of_range(x: &Vec3) -> bool {
+    let m = largest(x);
+    !(m > 1e-100 && m < 1e100)
 }
 
 #[cfg(test)]
