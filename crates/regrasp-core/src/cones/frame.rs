@@ -89,8 +89,9 @@ impl SupportFrame {
     }
 
     /// [`Self::ray`] on the exact surface as a guess, for searches whose result is then found by
-    /// [`Self::ray`] ([`ExactSurface::ray_from`] without polishing: on a disc's profile the exact
-    /// twist of a `λ` within 1e-4 of the root, on cube maps the inverse table's twist after one
+    /// [`Self::ray`] ([`ExactSurface::ray_from`] without polishing: on a disc's profile the twist
+    /// of a `λ` within 1e-4 of the root on the inverse's starting table alone
+    /// ([`crate::mechanics::disc_profile::DiscProfile::gauge_guess`]), on cube maps the inverse table's twist after one
     /// Newton step on the forward table); the ray itself on the ellipsoid.
     #[inline]
     pub fn ray_guess(&self, p: &Vec3, metric: &Metric) -> Option<Vec3> {

@@ -467,7 +467,8 @@ impl Tables {
     #[inline]
     fn gauge_with<const CUBIC: bool>(&self, w: &Vec3) -> (f64, Vec3) {
         match &self.kind {
-            Kind::Profile(p) => p.gauge(w),
+            Kind::Profile(p) if CUBIC => p.gauge(w),
+            Kind::Profile(p) => p.gauge_guess(w),
             Kind::Maps(m) => m.gauge_with::<CUBIC>(w),
         }
     }
@@ -601,17 +602,17 @@ impl Maps {
 /// minus `o` is then along `u` to about this).
 const PROFILE_RAY_TOL: f64 = 1e-12;
 
-/// The unit twist on a profile's surface with load `λu + o` (`u` unit, scaled units) by
+/// The twist (not unit) on a profile's surface with load `λu + o` (`u` unit, scaled units) by
 /// Newton's method on `λ` from `l` (∇H = n H/(n·w), Euler's relation), unbracketed: None unless
 /// `|H − 1| < tol` within 8 steps (then the caller's fallback: the bracketed search of
 /// [`ExactSurface::ray_from`], or from [`ExactSurface::ray_near`] the frame's ray).
-fn profile_newton(p: &DiscProfile, us: &Vec3, os: &Vec3, mut l: f64, tol: f64) -> Option<Vec3> {
+fn profile_newton<const EXACT: bool>(p: &DiscProfile, us: &Vec3, os: &Vec3, mut l: f64, tol: f64) -> Option<Vec3> {
     for _ in 0..8 {
         if !(l > 0.0) {
             return None;
         }
         let w = us * l + os;
-        let (h, n) = p.gauge(&w);
+        let (h, n) = if EXACT { p.gauge(&w) } else { p.gauge_guess(&w) };
         if (h - 1.0).abs() < tol {
             return Some(n);
         }
@@ -732,7 +733,7 @@ impl ExactSurface {
                 // λ from the load of `near`: W(near) ≈ λu + o
                 let us = us / us.norm();
                 let l = (p.wrench(&self.scale_twist(near)) - os).dot(&us);
-                profile_newton(p, &us, &os, l, PROFILE_RAY_TOL)?
+                profile_newton::<true>(p, &us, &os, l, PROFILE_RAY_TOL)?
             }
         };
         self.unit_twist(&v)
@@ -749,7 +750,8 @@ impl ExactSurface {
     /// [`Self::ray`] with `H(o)` known and perhaps a guess of `λ` (e.g. the ellipsoid's);
     /// without `POLISH` a guess, for searches that polish their result: on cube maps the
     /// inverse table's twist after one Newton step on the forward table; on a disc's profile
-    /// the exact twist of a `λ` within 1e-4 of the root (in `H`).
+    /// the twist of a `λ` within 1e-4 of the root (in `H`) on the inverse's starting table
+    /// alone ([`DiscProfile::gauge_guess`], within 1e-7 of the exact gauge).
     pub fn ray_from<const POLISH: bool>(&self, u: &Vec3, o: &Vec3, h_o: f64, guess: Option<f64>) -> Option<Vec3> {
         let (us, os) = (self.scale_wrench(u), self.scale_wrench(o));
         let un = us.norm();
@@ -769,7 +771,7 @@ impl ExactSurface {
         };
         let g = |l: f64| self.tables.gauge_with::<POLISH>(&(us * l + os));
         if let (Kind::Profile(p), Some(l)) = (&self.tables.kind, guess) {
-            if let Some(v) = profile_newton(p, &us, &os, l * un, tol) {
+            if let Some(v) = profile_newton::<POLISH>(p, &us, &os, l * un, tol) {
                 return self.unit_twist(&v);
             }
         }
