@@ -176,6 +176,20 @@ impl DiscProfile {
     /// zero wrench: gauge 0, the zero twist).
     #[inline]
     pub fn gauge(&self, w: &Vec3) -> (f64, Vec3) {
+        self.gauge_by::<true>(w)
+    }
+
+    /// [`Self::gauge`] on the starting table alone (cubic Hermite in `q` of the root and of
+    /// `F + M`; no Newton step on the profile; within `GUESS_TOLERANCE` of the gauge and its
+    /// twist's direction): for searches whose result is then found exactly.
+    #[inline]
+    pub fn gauge_guess(&self, w: &Vec3) -> (f64, Vec3) {
+        self.gauge_by::<false>(w)
+    }
+
+    /// [`Self::gauge`] (`EXACT`) or [`Self::gauge_guess`].
+    #[inline]
+    fn gauge_by<const EXACT: bool>(&self, w: &Vec3) -> (f64, Vec3) {
         // (degree 1: H(w) = s H(w/s); a NaN wrench gives a NaN gauge)
         if out_of_range(w) {
             return self.gauge_scaled(w);
@@ -185,26 +199,21 @@ impl DiscProfile {
         if a + b == 0.0 {
             return (0.0, Vec3::zeros());
         }
-        let (p, f) = self.root(b / (a + b));
+        let (p, g) = if EXACT {
+            let (p, f) = self.root(b / (a + b));
+            (p, f[0] + f[1])
+        } else {
+            self.start(b / (a + b))
+        };
         // [p f̂, ±(1 − p)/R] times a (one division fewer), unless a = 0 (then p = 0)
         let v = if a > 0.0 { Vec3::new(w.x * p, w.y * p, (a * (1.0 - p) * self.inv_radius).copysign(w.z)) } else { Vec3::new(0.0, 0.0, 1.0f64.copysign(w.z)) };
-        ((a + b) / (f[0] + f[1]), v)
+        ((a + b) / g, v)
     }
 
-    /// [`Self::gauge`] on the starting table alone (cubic Hermite in `q` of the root and of
-    /// `F + M`; no Newton step on the profile; within `GUESS_TOLERANCE` of the gauge and its
-    /// twist's direction): for searches whose result is then found exactly.
+    /// The starting table at `q ∈ [0, 1]` (cubic Hermite): the root `p` and `F + M` there.
     #[inline]
-    pub fn gauge_guess(&self, w: &Vec3) -> (f64, Vec3) {
-        if out_of_range(w) {
-            return self.gauge_scaled(w);
-        }
-        let a = (w.x * w.x + w.y * w.y).sqrt();
-        let b = w.z.abs();
-        if a + b == 0.0 {
-            return (0.0, Vec3::zeros());
-        }
-        let x = b / (a + b) * INVERSE_NODES as f64;
+    fn start(&self, q: f64) -> (f64, f64) {
+        let x = q * INVERSE_NODES as f64;
         let j = (x as usize).min(INVERSE_NODES - 1);
         let s = x - j as f64;
         let (l, r) = (&self.starts[j], &self.starts[j + 1]);
@@ -212,9 +221,7 @@ impl DiscProfile {
         let (s2, s3) = (s * s, s * s * s);
         let (h00, h10, h01, h11) = (2.0 * s3 - 3.0 * s2 + 1.0, (s3 - 2.0 * s2 + s) * h, 3.0 * s2 - 2.0 * s3, (s3 - s2) * h);
         let p = (h00 * l[0] + h10 * l[1] + h01 * r[0] + h11 * r[1]).clamp(0.0, 1.0);
-        let g = h00 * l[2] + h10 * l[3] + h01 * r[2] + h11 * r[3];
-        let v = if a > 0.0 { Vec3::new(w.x * p, w.y * p, (a * (1.0 - p) * self.inv_radius).copysign(w.z)) } else { Vec3::new(0.0, 0.0, 1.0f64.copysign(w.z)) };
-        ((a + b) / g, v)
+        (p, h00 * l[2] + h10 * l[3] + h01 * r[2] + h11 * r[3])
     }
 
     /// [`Self::gauge`] of a huge or tiny wrench (degree 1: `H(w) = m H(w/m)`; zero, NaN and
