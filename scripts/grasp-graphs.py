@@ -1,4 +1,4 @@
-"""Measures the grasp graph of each bundled object (prism, cylinder, box) with the arm in MuJoCo
+"""Measures the grasp graph of each bundled object (prism, cylinder, box, bar) with the arm in MuJoCo
 (`regrasp.dexterity.graph.build_graph`), writes each graph to OUT/NAME-graph.json and its
 picture to OUT/NAME-graph.png, and prints the README's table: per object and action, the
 grasps it applies to, its runs and its success rate (the share of runs that reached the grasp

@@ -176,8 +176,9 @@ def test_the_bundled_objects_load_without_task_or_pushers():
     for name in OBJECTS:
         scene = load_object(name)
         counts[name] = len(taxonomy_of(scene).grasps)
-    # prism: 2 orientations x 3 offsets; cylinder: ends 1 x 3, across 2 x 3; box: 3 face pairs x 2 x 3
-    assert counts == {"prism": 6, "cylinder": 9, "box": 18}
+    # prism: 2 orientations x 3 offsets; cylinder: ends 1 x 3, across 2 x 3; box: 3 face pairs x 2 x 3;
+    # bar: 2 face pairs (its ends are 120 mm apart, beyond the 85 mm opening) x 2 x (3 offsets + 2 lateral)
+    assert counts == {"prism": 6, "cylinder": 9, "box": 18, "bar": 20}
 
 
 def test_a_bad_object_file_names_its_field(tmp_path):
@@ -194,6 +195,14 @@ def test_a_bad_object_file_names_its_field(tmp_path):
     with pytest.raises(SceneError) as e:
         load_object(p)
     assert e.value.field == "object.mass"
+    p.write_text(p.read_text().replace("mass = -1", "mass = 0.2") + "[taxonomy]\nlateral = [0.6]\n")
+    with pytest.raises(SceneError) as e:
+        load_object(p)
+    assert e.value.field == "taxonomy.lateral" and "0.5" in str(e.value)
+    p.write_text(p.read_text().replace("lateral = [0.6]", "sideways = [0.3]"))
+    with pytest.raises(SceneError) as e:
+        load_object(p)
+    assert e.value.field.startswith("taxonomy")
 
 
 # --- in MuJoCo, with the arm ----------------------------------------------------------------------------
@@ -261,6 +270,8 @@ def test_the_pivot_breaks_away_at_the_limit_surface_angle_in_mujoco(box):
     ("box", "g12", "place-repick", {"target": "g6"}),  # another width: the TCP corrected for the linkage
     ("box", "g7", "topple-repick", {"target": "g12"}),
     ("prism", "g1", "table-pivot", {}),
+    ("bar", "g9", "gravity-pivot", {}),  # held 42 mm off its centre across the fingers: a quarter turn hangs it
+    ("bar", "g0", "grip-pivot", {}),  # hanging along the fingers: the turning hand lifts it sideways
 ])
 def test_an_action_reaches_its_intended_grasp_in_the_nominal_world(name, grasp, action, params):
     from regrasp.dexterity.actions import ACTIONS, ObjectModel

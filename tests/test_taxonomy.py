@@ -266,9 +266,39 @@ def test_mean_distance_against_a_grid(polygon, c):
 
 
 def test_grasp_dict_round_trip():
-    for g in tax(PRISM).grasps:
+    for g in tax(PRISM).grasps + tax(BOX, lateral=(0.35,)).grasps:
         d = json.loads(json.dumps(g.to_dict()))
         assert Grasp.from_dict(d).to_dict() == g.to_dict()
+    old = tax(BOX).grasps[0].to_dict()
+    del old["lateral"]  # a file written before lateral grasps: centred across the fingers
+    assert Grasp.from_dict(old).lateral == 0.0
+
+
+def test_lateral_grasps_hold_the_object_off_its_centre_across_the_fingers():
+    plain, side = tax(BOX), tax(BOX, lateral=(-0.35, 0.35))
+    lateral = [g for g in side.grasps if g.lateral != 0]
+    assert len(side.grasps) == len(plain.grasps) + len(lateral) and lateral
+    for g in plain.grasps:  # every grasp of the default taxonomy is still there
+        assert side.nearest(g.pose)[1] < 1e-9
+    for g in lateral:
+        centre = P.transform(g.pose, np.zeros(3))  # the box's centre: its region's centroid, in the pads' plane
+        assert centre[[0, 2]] == pytest.approx([g.lateral, 0.0], abs=1e-12) and g.offset == 0
+        assert "lateral" in g.label
+    # a quarter turn about the contact centre hangs it along the fingers: an offset grasp (where
+    # the pad's face is covered, so that the patch is centred on it whatever the offset)
+    covered = [g for g in lateral if g.patch_area == pytest.approx(T._area(T.PAD))]
+    assert covered
+    for g in covered:
+        c = side.patch_centre(g)
+        for sign in (1, -1):
+            turned = P.compose(np.r_[c[0], 0.0, c[1], 1.0, 0, 0, 0], P.compose(
+                P.planar_to_spatial([0.0, 0.0, sign * np.pi / 2]), P.compose(np.r_[-c[0], 0.0, -c[1], 1.0, 0, 0, 0], g.pose)))
+            name, d = side.nearest(turned)
+            if d < 1e-9:
+                assert side.grasp(name).lateral == 0 and side.grasp(name).offset != 0
+                break
+        else:
+            raise AssertionError(f"{g.name}: no quarter turn reaches a grasp")
 
 
 @pytest.mark.parametrize("key,value", [("pose", [0.0] * 7), ("pose", [0, 0, 0, 1, 0, 0]), ("faces", [1]),
@@ -309,6 +339,7 @@ def test_taxonomy_of_a_scene():
     ("com", [0.0, 0.0]), ("com", [0.0, np.nan, 0.0]),
     ("width_range", (0.05, 0.01)), ("width_range", (-0.01, 0.05)), ("width_range", 0.085),
     ("offsets", (0.5,)), ("offsets", ()), ("offsets", (0.0, np.nan)), ("offsets", "abc"),
+    ("lateral", (0.0,)), ("lateral", (0.5,)), ("lateral", (np.nan,)), ("lateral", "abc"), ("lateral", [[0.2]]),
 ])
 def test_bad_arguments_name_the_field(field, value):
     kw = {"vertices": BOX, "mass": MASS, "com": np.zeros(3), "grip_force": FORCE, "friction": MU}

@@ -100,7 +100,7 @@ def add_parsers(sub) -> None:
                     "regrasp grasp-graph prism --trials 20 --out prism-graph.json --plot prism-graph.png",
                     cmd_grasp_graph)
     g.add_argument("object", help="the object: a 3-D scene file (its [object], [grasp] and [gravity] tables; "
-                   "pushers and task optional) or a bundled object's name (prism, cylinder, box)")
+                   "pushers and task optional) or a bundled object's name (prism, cylinder, box, bar)")
     g.add_argument("--trials", type=int, default=TRIALS, help="simulated runs per edge (grasp, action)")
     g.add_argument("--seed", type=seed_arg, default=0, help="the random seed of the perturbed worlds, a whole number >= 0")
     g.add_argument("--workers", type=int, help=f"local processes, 1 to {MAX_WORKERS} (default: the cores, at most 8)")

@@ -32,7 +32,7 @@ RAMP = 0.05  # s, a grip change is ramped over this long (the linkage follows; a
 ARM_LAG = 0.005  # s, toss-catch: how far the arm's hand lags its commanded braking (the joint servo, robot.tracking; measured: the box's toss brakes 5–6 ms late)
 DEFAULTS = {
     "overdrive": 1.4,   # gravity-pivot: the gravity moment at the start over the pads' torsion capacity at the lowered grip
-    "max_tilt": 2.618,  # rad, gravity-pivot: the centre of mass at most this far from hanging at the start (150°)
+    "max_tilt": 0.5236,  # rad, gravity-pivot: the centre of mass at most this far from hanging at the start (30°: the hand turns the rest, the swing stays short; 150° overswung the bar 3 times in 4, docs)
     "pivot_time": 0.8,  # s, gravity-pivot: how long the grip stays low
     "slide_ratio": 0.8,  # gravity-slide: 2 μ N / m g while sliding (the object accelerates at (1 − ratio) g)
     "lag": 0.5236,      # rad, grip-pivot: the angle from the vertical at which the object lags the turning hand (30°)

@@ -1,8 +1,11 @@
 """An object for the grasp graph: a 3-D scene file (docs/scene-file.md) of which the
 ``[object]``, ``[grasp]`` and ``[gravity]`` tables are read; its ``[[pushers]]`` and ``[task]``
 are optional (a task is required by :meth:`regrasp.Scene3D.load`: without one, the object is
-loaded with a still one at the origin, which nothing here uses). The bundled objects
-(:data:`OBJECTS`): the thesis' triangular prism, a cylinder and a box."""
+loaded with a still one at the origin, which nothing here uses). An optional ``[taxonomy]``
+table sets the taxonomy's options (``lateral``: the fractions of the grasps held off the
+object's centre across the fingers, :func:`regrasp.dexterity.taxonomy.taxonomy`). The bundled
+objects (:data:`OBJECTS`): the thesis' triangular prism, a cylinder and a box, and a bar held
+near its ends for the gravity pivots."""
 
 from __future__ import annotations
 
@@ -12,7 +15,7 @@ from pathlib import Path
 
 from ..errors import ArgumentError, SceneError
 
-OBJECTS = ("prism", "cylinder", "box")  # examples/objects/NAME.toml
+OBJECTS = ("prism", "cylinder", "box", "bar")  # examples/objects/NAME.toml
 STILL_TASK = "\n[task]\nstart = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]\ngoal = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]\n" \
              "tolerance = [0.001, 0.001, 0.001, 0.0175]\n"
 
@@ -77,4 +80,15 @@ def load_object(path):
         text += STILL_TASK
     scene = Scene3D.from_toml(text, path.parent)
     scene.path = path
+    scene.taxonomy_lateral = _lateral(data.get("taxonomy", {}).get("lateral", ()))
     return scene
+
+
+def _lateral(value) -> tuple:
+    """``[taxonomy] lateral`` checked: fractions in (−½, ½), not 0 (a SceneError naming it)."""
+    from .taxonomy import _check_lateral
+
+    try:
+        return _check_lateral(value)
+    except ArgumentError as e:
+        raise SceneError(f"scene field `taxonomy.lateral`: {str(e).split(': ', 1)[-1]}", "taxonomy.lateral") from None

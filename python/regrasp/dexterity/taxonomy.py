@@ -18,11 +18,14 @@ A flat pad touches only the object's convex hull, so the grasps are those of the
    palm (its outward normal onto +z) and the one that makes it face the fingertips (onto −z);
 3. the object centred between the pads (its extent along y symmetric about 0), the region's
    centroid at x = 0 and at z = f h for each fraction f of ``offsets``, h the region's extent
-   along z: f > 0 puts the object deeper in the hand (towards the palm);
+   along z: f > 0 puts the object deeper in the hand (towards the palm); and, for each fraction
+   f of ``lateral`` (none by default), at x = f w, z = 0, w the region's extent along x: the
+   object held off its centre across the fingers, sticking out to one side (a bar held near an
+   end, the classic gravity pivot's start: a quarter turn hangs it along the fingers);
 4. candidates that place the object identically up to its symmetry (:func:`grasp_distance`
    below 1e-6 times its size) are one grasp, the first in the enumeration order kept (face
    pairs by index, A on the left first, the region's edges in turn, palm before fingertips,
-   ``offsets`` in order);
+   ``offsets`` then ``lateral`` in order);
 5. each checked to hold under gravity at grip force N per pad with pad friction μ: the patch is
    the region within the pad's face (|x| ≤ 11 mm, |z| ≤ 18.75 mm), uniformly pressed; its two
    pads' ellipsoidal limit surface holds the weight in the worst hand orientation when
@@ -47,6 +50,7 @@ from ..robot.pads import HALF_WIDTH, LENGTH
 TOLERANCE = 1e-6  # rad between faces' normals; × the object's size [m] for planes, corners and symmetric grasps
 WIDTH_RANGE = (0.0, 0.085)  # m, the 2F-85's opening
 OFFSETS = (-0.35, 0.0, 0.35)  # the region's centroid at z = f h (f > 0: towards the palm)
+LATERAL = ()  # the region's centroid at x = f w, z = 0 (an object file's `[taxonomy] lateral`)
 PAD = np.array([[-HALF_WIDTH, -LENGTH / 2], [HALF_WIDTH, -LENGTH / 2], [HALF_WIDTH, LENGTH / 2],
                 [-HALF_WIDTH, LENGTH / 2]])  # the pad's face (x, z) [m] in the TCP frame, counter-clockwise
 NEGLIGIBLE = 1e-6  # a patch smaller than this share of the pad's face bears nothing
@@ -73,8 +77,9 @@ class Grasp:
     towards the palm), ``width`` [m] between the pads, the in-hand ``pose`` (7,), whether it
     ``holds`` the weight in every hand orientation, its ``margin`` = 1 − (m g / 2μN) √(1 +
     (d/k)²), the share of the pads' capacity left in the worst orientation (−1 without a patch),
-    the patch's ``torsion_k`` k [m] (its mean distance from its centroid) and ``patch_area``
-    [m²]."""
+    the patch's ``torsion_k`` k [m] (its mean distance from its centroid), ``patch_area``
+    [m²] and ``lateral`` [m] the region's centroid along x (0 but for the taxonomy's
+    ``lateral`` grasps)."""
 
     name: str
     label: str
@@ -87,23 +92,27 @@ class Grasp:
     margin: float
     torsion_k: float
     patch_area: float
+    lateral: float = 0.0
 
     def to_dict(self) -> dict:
         """The grasp as JSON-able values (lists, floats)."""
         return {"name": self.name, "label": self.label, "faces": [int(f) for f in self.faces],
                 "angle": float(self.angle), "offset": float(self.offset), "width": float(self.width),
                 "pose": [float(x) for x in self.pose], "holds": bool(self.holds), "margin": float(self.margin),
-                "torsion_k": float(self.torsion_k), "patch_area": float(self.patch_area)}
+                "torsion_k": float(self.torsion_k), "patch_area": float(self.patch_area),
+                "lateral": float(self.lateral)}
 
     @classmethod
     def from_dict(cls, d) -> "Grasp":
-        """The grasp of :meth:`to_dict`'s dict; an ArgumentError naming the field at fault."""
+        """The grasp of :meth:`to_dict`'s dict (``lateral`` optional: 0, as files written
+        before it have it); an ArgumentError naming the field at fault."""
         if not isinstance(d, dict):
             raise ArgumentError(f"invalid `grasp`: a dict (got {type(d).__name__})", "grasp")
         return cls(_field(d, "name", _text), _field(d, "label", _text), _field(d, "faces", _faces),
                    _field(d, "angle", _real), _field(d, "offset", _real), _field(d, "width", _real),
                    _field(d, "pose", _pose), _field(d, "holds", _flag), _field(d, "margin", _real),
-                   _field(d, "torsion_k", _real), _field(d, "patch_area", _real))
+                   _field(d, "torsion_k", _real), _field(d, "patch_area", _real),
+                   _field(d, "lateral", _real) if "lateral" in d else 0.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -156,11 +165,12 @@ class Taxonomy:
 
 
 def taxonomy(vertices, mass: float, com, grip_force: float, friction: float, gravity: float = 9.81,
-             width_range=WIDTH_RANGE, offsets=OFFSETS, pad=None) -> Taxonomy:
+             width_range=WIDTH_RANGE, offsets=OFFSETS, pad=None, lateral=LATERAL) -> Taxonomy:
     """The grasp taxonomy (see the module's doc) of the object with ``vertices`` (n ≥ 4, 3) [m],
     ``mass`` [kg], centre of mass ``com`` (3,) [m] (object frame), held at ``grip_force`` [N]
     per pad with the pads' ``friction`` μ under ``gravity`` [m/s²]; pad widths within
-    ``width_range`` (m, m), the region's centroid at z = f h for f in ``offsets`` (in (−½, ½));
+    ``width_range`` (m, m), the region's centroid at z = f h for f in ``offsets`` (in (−½, ½))
+    and at x = f w for f in ``lateral`` (in (−½, ½), not 0; none by default);
     ``pad``: the pad's face (k, 2) (x, z) [m] in the TCP frame, convex, counter-clockwise (default
     the 2F-85's whole face, :data:`PAD`; :func:`pad_disc` for a rubber tip). An ArgumentError
     naming the argument at fault."""
@@ -170,13 +180,14 @@ def taxonomy(vertices, mass: float, com, grip_force: float, friction: float, gra
     com = _check_com(com)
     lo, hi = _check_width_range(width_range)
     fractions = _check_offsets(offsets)
+    sideways = _check_lateral(lateral)
     pad = PAD.copy() if pad is None else _check_pad(pad)
     faces, V = _hull(V)
     eps = TOLERANCE * _size(V)
     kept: list = []
     for a, b in _antipodal(faces, lo - eps, hi + eps):
         for pair in ((a, b), (b, a)):
-            for c in _candidates(faces, V, pair, fractions, eps):
+            for c in _candidates(faces, V, pair, fractions, sideways, eps):
                 placed = P.transform(c["pose"], V)
                 box = np.r_[placed.min(axis=0), placed.max(axis=0)]
                 # a Hausdorff distance below eps needs the bounding boxes within eps: checked first
@@ -189,8 +200,10 @@ def taxonomy(vertices, mass: float, com, grip_force: float, friction: float, gra
 def taxonomy_of(scene, **kw) -> Taxonomy:
     """The taxonomy of a :class:`regrasp.Scene3D`'s object (its mesh, mass, centre of mass, grip
     force, pad friction, gravity's norm and pad: a disc of its ``pad_radius``, :func:`pad_disc`);
-    ``kw``: :func:`taxonomy`'s ``width_range``, ``offsets``, ``pad``."""
+    ``kw``: :func:`taxonomy`'s ``width_range``, ``offsets``, ``pad``, ``lateral`` (default the
+    object file's ``[taxonomy] lateral``, :func:`regrasp.dexterity.objects.load_object`)."""
     kw.setdefault("pad", pad_disc(float(scene._core.pad_radius)))
+    kw.setdefault("lateral", getattr(scene, "taxonomy_lateral", LATERAL))
     return taxonomy(np.asarray(scene.mesh()[0], float), float(scene.mass), np.asarray(scene._core.com, float),
                     float(scene._core.grip_force), float(scene._core.grip_friction),
                     float(np.linalg.norm(scene._core.gravity)), **kw)
@@ -265,9 +278,9 @@ def _antipodal(faces, lo: float, hi: float) -> list:
             and lo <= faces[i].offset + faces[j].offset <= hi]
 
 
-def _candidates(faces, V, pair: tuple, fractions: tuple, eps: float):
+def _candidates(faces, V, pair: tuple, fractions: tuple, lateral: tuple, eps: float):
     """The candidate grasps (dicts) of face ``pair`` (left, right): per edge of the contact
-    region, palm then fingertips, per offset fraction."""
+    region, palm then fingertips, per offset fraction, then per lateral fraction."""
     q0 = np.r_[0.0, 0.0, 0.0, P.turn_onto(faces[pair[0]].normal, [0.0, 1.0, 0.0])]
     region = _region(faces, pair, q0, eps)
     width = faces[pair[0]].offset + faces[pair[1]].offset
@@ -278,9 +291,10 @@ def _candidates(faces, V, pair: tuple, fractions: tuple, eps: float):
             turn = P.compose(P.planar_to_spatial([0.0, 0.0, angle]), q0)
             r = P.planar_rotate(angle, region.T).T
             c, h, y = _centroid(r), float(np.ptp(r[:, 1])), P.transform(turn, V)[:, 1]
-            for f in fractions:
-                t = np.array([-c[0], -(y.max() + y.min()) / 2, f * h - c[1]])
-                yield {"edge": i, "side": side, "angle": angle, "offset": f * h, "width": width,
+            w = float(np.ptp(r[:, 0]))
+            for x, z in [(0.0, f * h) for f in fractions] + [(f * w, 0.0) for f in lateral]:
+                t = np.array([x - c[0], -(y.max() + y.min()) / 2, z - c[1]])
+                yield {"edge": i, "side": side, "angle": angle, "offset": z, "lateral": x, "width": width,
                        "pose": np.r_[t, turn[3:]], "region": r + t[[0, 2]]}
 
 
@@ -288,8 +302,10 @@ def _grasp(name: str, c: dict, com, weight: float, mu: float, grip: float, eps: 
     """The :class:`Grasp` of candidate ``c``, its hold checked."""
     holds, margin, k, area = _hold(c["region"], P.transform(c["pose"], com), weight, mu, grip, eps, pad)
     label = f"faces {c['pair'][0]}|{c['pair'][1]}, edge {c['edge']} to {c['side']}, offset {c['offset'] * 1e3:+.1f} mm"
+    if c["lateral"]:
+        label += f", lateral {c['lateral'] * 1e3:+.1f} mm"
     return Grasp(name, label, tuple(c["pair"]), c["angle"], float(c["offset"]), float(c["width"]), c["pose"],
-                 holds, margin, k, area)
+                 holds, margin, k, area, float(c["lateral"]))
 
 
 def _hold(region, com, weight: float, mu: float, grip: float, eps: float, pad=PAD) -> tuple:
@@ -460,6 +476,13 @@ def _check_offsets(offsets) -> tuple:
     f = _array(offsets, "offsets", "fractions in (-0.5, 0.5)")
     if f.ndim != 1 or len(f) == 0 or not np.all(np.abs(f) < 0.5):
         raise ArgumentError(f"invalid `offsets`: one or more fractions in (-0.5, 0.5) (got {offsets!r})", "offsets")
+    return tuple(float(x) for x in f)
+
+
+def _check_lateral(lateral) -> tuple:
+    f = _array(lateral, "lateral", "fractions in (-0.5, 0.5), not 0")
+    if f.ndim != 1 or not np.all((np.abs(f) < 0.5) & (f != 0)):
+        raise ArgumentError(f"invalid `lateral`: fractions in (-0.5, 0.5), not 0 (got {lateral!r})", "lateral")
     return tuple(float(x) for x in f)
 
 

@@ -21,6 +21,17 @@ struct Raw {
     gravity: Option<RawGravity>,
     pushers: Option<Vec<RawPusher>>,
     task: Option<RawTask>,
+    #[allow(dead_code)] // read by the grasp graph (Python), not the core
+    taxonomy: Option<RawTaxonomy>,
+}
+
+/// `[taxonomy]`: options of the grasp graph's taxonomy (docs/scene-file.md), checked for its keys
+/// here and for its values where the grasp graph reads them.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTaxonomy {
+    #[allow(dead_code)]
+    lateral: Option<Vec<f64>>,
 }
 
 #[derive(Deserialize)]
