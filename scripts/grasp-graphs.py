@@ -2,7 +2,8 @@
 (`regrasp.dexterity.graph.build_graph`), writes each graph to OUT/NAME-graph.json and its
 picture to OUT/NAME-graph.png, and prints the README's table: per object and action, the
 grasps it applies to, its runs and its success rate (the share of runs that reached the grasp
-its model predicts). Usage: python scripts/grasp-graphs.py [--trials N] [--workers K] [--out DIR]."""
+its model predicts). Usage: python scripts/grasp-graphs.py [--trials N] [--workers K] [--out DIR] [--objects A,B]
+[--actions A,B]."""
 
 from __future__ import annotations
 
@@ -23,13 +24,15 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default="out/grasp-graphs")
     ap.add_argument("--objects", default=",".join(OBJECTS))
+    ap.add_argument("--actions", default=None, help="only these actions, comma-separated (default: all)")
     a = ap.parse_args()
+    actions = None if a.actions is None else tuple(a.actions.split(","))
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     total, rows, seconds = 0, [], 0.0
     for name in a.objects.split(","):
         t0 = time.perf_counter()
-        g = build_graph(object_path(name), Settings(trials=a.trials, seed=a.seed), workers=a.workers, progress=True)
+        g = build_graph(object_path(name), Settings(trials=a.trials, seed=a.seed, actions=actions), workers=a.workers, progress=True)
         seconds += time.perf_counter() - t0
         g.save(out / f"{name}-graph.json")
         draw_graph(g, out / f"{name}-graph.png")

@@ -205,6 +205,22 @@ def test_a_bad_object_file_names_its_field(tmp_path):
     assert e.value.field.startswith("taxonomy")
 
 
+def test_a_slide_along_the_fingers_keeps_a_lateral_grasp_lateral():
+    from regrasp.dexterity.actions import ACTIONS, ObjectModel, turn_target
+    from regrasp.dexterity.objects import load_object
+    from regrasp.dexterity.taxonomy import taxonomy_of
+
+    scene = load_object("bar")
+    tax = taxonomy_of(scene)
+    obj = ObjectModel.of(scene, tax)
+    g9 = tax.grasp("g9")  # 42 mm off its centre across the fingers: no grasp along the fingers at that lateral
+    assert g9.lateral == pytest.approx(0.042) and g9.offset == 0
+    for name in ("gravity-slide", "inertial-slide", "drop-catch"):
+        assert "no grasp further" in ACTIONS[name].applies(obj, g9)
+    turn, target, _ = turn_target(obj, g9)  # a quarter turn hangs it along the fingers
+    assert turn == pytest.approx(-np.pi / 2) and tax.grasp(target).offset == pytest.approx(-0.042)
+
+
 # --- in MuJoCo, with the arm ----------------------------------------------------------------------------
 
 mujoco = pytest.importorskip("mujoco")

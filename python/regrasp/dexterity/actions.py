@@ -187,10 +187,11 @@ def _siblings(obj: ObjectModel, grasp) -> list:
 
 
 def _offset_step(obj: ObjectModel, grasp, sign: int) -> Optional[float]:
-    """The distance [m] to the nearest grasp on the same faces at the same turn with an offset
-    further in ``sign`` (+1 towards the palm), or None."""
+    """The distance [m] to the nearest grasp on the same faces at the same turn and lateral
+    offset with an offset further in ``sign`` (+1 towards the palm), or None."""
     steps = [sign * (g.offset - grasp.offset) for g in _siblings(obj, grasp)
-             if abs(np.angle(np.exp(1j * (g.angle - grasp.angle)))) < 1e-6 and sign * (g.offset - grasp.offset) > 1e-6]
+             if abs(np.angle(np.exp(1j * (g.angle - grasp.angle)))) < 1e-6 and abs(g.lateral - grasp.lateral) < 1e-9
+             and sign * (g.offset - grasp.offset) > 1e-6]
     return min(steps) if steps else None
 
 
