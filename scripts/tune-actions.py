@@ -1,4 +1,4 @@
-"""Tunes one parameter of each of five actions per bundled object by a search in simulation
+"""Tunes one parameter of each of six actions per bundled object by a search in simulation
 (`regrasp.dexterity.tune`) and prints the README's table: the default and tuned value, the
 success rate of each on fresh worlds. Usage: python scripts/tune-actions.py [--trials N] (6 by
 default) [--objects A,B] [--actions A,B] (all by default) [--out JSON]."""
@@ -15,6 +15,7 @@ SEARCH = [  # (action, parameter, candidates)
     ("gravity-slide", "slide_ratio", (0.6, 0.7, 0.8, 0.9)),
     ("inertial-slide", "acceleration", (20.0, 30.0, 40.0, 50.0)),
     ("gravity-pivot", "overdrive", (1.2, 1.4, 2.0, 3.0)),
+    ("grip-pivot", "lag", (0.35, 0.52, 0.70, 0.87)),  # rad: 20°, 30°, 40°, 50°
     ("toss-catch", "toss_stop", (20.0, 30.0, 40.0, 50.0)),
     ("table-slide", "rest_ratio", (0.3, 0.4, 0.5, 0.6)),
 ]
