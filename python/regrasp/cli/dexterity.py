@@ -15,7 +15,7 @@ MAX_TRIALS = 100_000
 
 
 def _object_file(text: str) -> Path:
-    """An object file, or a bundled object's name (``prism``, ``cylinder``, ``box``)."""
+    """An object file, or a bundled object's name (``prism``, ``cylinder``, ``box``, ``bar``)."""
     from ..dexterity.objects import OBJECTS, object_path
 
     p = Path(text)

@@ -3,7 +3,8 @@
 are optional (a task is required by :meth:`regrasp.Scene3D.load`: without one, the object is
 loaded with a still one at the origin, which nothing here uses). An optional ``[taxonomy]``
 table sets the taxonomy's options (``lateral``: the fractions of the grasps held off the
-object's centre across the fingers, :func:`regrasp.dexterity.taxonomy.taxonomy`). The bundled
+object's centre across the fingers, :func:`regrasp.dexterity.taxonomy.taxonomy`; read here
+only: :meth:`regrasp.Scene3D.load` accepts the table and ignores it). The bundled
 objects (:data:`OBJECTS`): the thesis' triangular prism, a cylinder and a box, and a bar held
 near its ends for the gravity pivots."""
 

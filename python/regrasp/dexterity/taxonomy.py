@@ -201,7 +201,8 @@ def taxonomy_of(scene, **kw) -> Taxonomy:
     """The taxonomy of a :class:`regrasp.Scene3D`'s object (its mesh, mass, centre of mass, grip
     force, pad friction, gravity's norm and pad: a disc of its ``pad_radius``, :func:`pad_disc`);
     ``kw``: :func:`taxonomy`'s ``width_range``, ``offsets``, ``pad``, ``lateral`` (default the
-    object file's ``[taxonomy] lateral``, :func:`regrasp.dexterity.objects.load_object`)."""
+    object file's ``[taxonomy] lateral`` when the scene was loaded by
+    :func:`regrasp.dexterity.objects.load_object`; none for a scene loaded otherwise)."""
     kw.setdefault("pad", pad_disc(float(scene._core.pad_radius)))
     kw.setdefault("lateral", getattr(scene, "taxonomy_lateral", LATERAL))
     return taxonomy(np.asarray(scene.mesh()[0], float), float(scene.mass), np.asarray(scene._core.com, float),

@@ -462,8 +462,8 @@ impl Tables {
         }
     }
 
-    /// Gauge and twist at wrench `w` ([`Maps::gauge_with`], unit; a profile's is exact and its
-    /// twist not unit).
+    /// Gauge and twist at wrench `w` ([`Maps::gauge_with`], unit; a profile's twist is not unit,
+    /// and its gauge exact with `CUBIC`, else [`DiscProfile::gauge_guess`]).
     #[inline]
     fn gauge_with<const CUBIC: bool>(&self, w: &Vec3) -> (f64, Vec3) {
         match &self.kind {
