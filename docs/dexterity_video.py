@@ -1,6 +1,5 @@
 """One GIF per regrasp action (regrasp.dexterity.actions), each on a bundled object and grasp
-where it reaches its intended grasp in the nominal world (or, for the pivots, where it was
-measured): docs/action-NAME.gif, close on the hand, in real time (the catches, over in a
+where it reaches its intended grasp in the nominal world (the pivots on the bar): docs/action-NAME.gif, close on the hand, in real time (the catches, over in a
 fraction of a second, in slow motion: SLOW). Run: python
 docs/dexterity_video.py [FOLDER [ACTION ...]] (every action of SHOWN, or the ones named)."""
 
@@ -31,8 +30,8 @@ SHOWN = [  # (action, object, grasp, params)
     ("table-pivot", "prism", "g1", {}),
     ("place-repick", "box", "g6", {"target": "g12"}),
     ("topple-repick", "box", "g7", {"target": "g12"}),
-    ("grip-pivot", "box", "g17", {}),
-    ("gravity-pivot", "box", "g17", {}),
+    ("grip-pivot", "bar", "g0", {}),
+    ("gravity-pivot", "bar", "g9", {}),
 ]
 
 
