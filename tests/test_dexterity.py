@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from regrasp.dexterity.graph import Edge, GraspGraph
+from regrasp.dexterity.graph import Chain, Edge, GraspGraph
 from regrasp.dexterity.sequence import plan
 from regrasp.dexterity.slip import Body, simulate
 from regrasp.errors import ArgumentError, SceneError
@@ -163,6 +163,150 @@ def test_planning_refuses_unknown_grasps_and_objectives():
     with pytest.raises(ArgumentError) as e:
         plan(g, "g0", "g1", "fastest")
     assert e.value.field == "objective"
+
+
+# --- chained measurements: each action from where the one before left the object ----------------
+
+
+def chained_graph():
+    """g0 -a-> g1 (from g1's own pose, b reaches g3 19 times in 20, but after a only 2) and g0 -c-> g2 -d-> g3."""
+    pose = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
+    a = Edge("g0", "gravity-slide", "g1", 2, {"g1": 2}, runs=[("g1", np.array(pose)), ("g1", np.array(pose))])
+    b = edge("g1", "g3", "push-down", 19)
+    c = edge("g0", "g2", "inertial-slide", 16)
+    d = edge("g2", "g3", "drop-catch", 16)
+    g = graph_of([a, b, c, d])
+    g.chained = [Chain(0, 1, 20, {"g3": 2, "dropped": 18}, 1)]
+    return g
+
+
+def test_a_chained_rate_replaces_the_edges_own_after_the_action_it_was_measured_after(tmp_path):
+    g = chained_graph()
+    s = plan(g, "g0", "g3")  # alone: 1.0 × 0.95 beats 0.8 × 0.8; after the slide the push reaches g3 2 in 20
+    assert [(x.source, x.action, x.target) for x in s.steps] == [("g0", "inertial-slide", "g2"),
+                                                               ("g2", "drop-catch", "g3")]
+    assert s.probability == pytest.approx(0.64) and s.independent == pytest.approx(0.64)
+    s = plan(g, "g1", "g3")  # from g1's own pose the chain does not apply
+    assert s.probability == pytest.approx(0.95) and not s.steps[0].chained
+    g.chained = []
+    s = plan(g, "g0", "g3")
+    assert s.probability == pytest.approx(0.95) and [x.action for x in s.steps] == ["gravity-slide", "push-down"]
+    g = chained_graph()
+    g.chained[0].outcomes = {"g3": 20}
+    s = plan(g, "g0", "g3")
+    assert s.steps[1].chained and s.steps[1].alone == pytest.approx(0.95)
+    assert s.probability == pytest.approx(1.0) and s.independent == pytest.approx(0.95)
+    back = GraspGraph.load(g.save(tmp_path / "g.json"))
+    assert back.to_dict() == g.to_dict() and plan(back, "g0", "g3").probability == pytest.approx(1.0)
+
+
+def brute_force_chained(g, start, goal, depth):
+    """The largest product over every walk of at most ``depth`` measured edges from ``start`` to
+    ``goal`` (each outcome a transition), a step's rate the chain's after the walk's previous edge."""
+    chains = {(c.after, c.edge): c for c in g.chained}
+    best = 0.0
+
+    def walk(at, prev, p, n):
+        nonlocal best
+        if at == goal and n:
+            best = max(best, p)
+            return
+        if n == depth:
+            return
+        for j, e in enumerate(g.edges):
+            if e.source != at or not e.trials:
+                continue
+            c = chains.get((prev, j)) if prev is not None else None
+            counts, trials = (c.outcomes, c.trials) if c else (e.outcomes, e.trials)
+            for o, k in counts.items():
+                if o in g.node_names and o != at and k:
+                    walk(o, j, p * k / trials, n + 1)
+
+    walk(start, None, 1.0, 0)
+    return best
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.integers(0, 3), st.integers(0, 3), st.integers(1, 10)), min_size=1, max_size=7),
+       st.lists(st.tuples(st.integers(0, 6), st.integers(0, 6), st.integers(0, 10)), max_size=10))
+def test_the_most_reliable_chained_sequence_is_the_brute_force_one(raw, raw_chains):
+    names = [f"g{i}" for i in range(4)]
+    edges = [Edge(names[a], "gravity-slide", names[b], 10, {names[b]: h, **({"dropped": 10 - h} if h < 10 else {})})
+             for a, b, h in raw if a != b]
+    assume = [(i, j, h) for i, j, h in raw_chains if i < len(edges) and j < len(edges)
+              and edges[i].target == edges[j].source]
+    g = graph_of(edges, names)
+    g.chained = list({(i, j): Chain(i, j, 10, {edges[j].target: h, **({"other": 10 - h} if h < 10 else {})}, 1)
+                      for i, j, h in assume}.values())
+    truth = brute_force_chained(g, "g0", "g3", 2 * len(edges) + 1)
+    if truth == 0.0:
+        with pytest.raises(ArgumentError):
+            plan(g, "g0", "g3")
+    else:
+        assert plan(g, "g0", "g3").probability == pytest.approx(truth, rel=1e-12)
+
+
+@pytest.mark.parametrize("change, field", [
+    (lambda d: d["chained"][0].update(after=7), "chained[0].after"),
+    (lambda d: d["chained"][0].update(edge=-1), "chained[0].edge"),
+    (lambda d: d["chained"][0].update(after=2), "chained[0]"),  # g0 -c-> g2 never reached g1
+    (lambda d: d["chained"][0].update(outcomes={"g3": 3}), "chained[0].outcomes"),
+    (lambda d: d["chained"][0].pop("starts"), "chained[0]"),
+    (lambda d: d.update(chained={}), "chained"),
+    (lambda d: d["edges"][0]["runs"].pop(), "edges[0].runs"),
+    (lambda d: d["edges"][0]["runs"][0].update(pose=[0.0] * 6), "edges[0].runs[0]"),
+    (lambda d: d["edges"][0]["runs"][0].update(outcome="g2"), "edges[0].runs"),
+])
+def test_a_bad_chained_graph_file_names_its_field(change, field):
+    d = json.loads(json.dumps(chained_graph().to_dict()))
+    change(d)
+    with pytest.raises(ArgumentError) as e:
+        GraspGraph.from_dict(d)
+    assert e.value.field == field
+
+
+def test_a_start_pose_in_the_hand_is_where_the_world_starts_the_object():
+    # a trial from a given pose is the trial from the grasp when that pose is the grasp's, run for
+    # run (the same world, deterministic); a pose 4 mm further along the fingers starts there
+    from regrasp.dexterity.objects import load_object
+    from regrasp.dexterity.actions import WORK_POINT, hand_pose
+    from regrasp.dexterity.taxonomy import taxonomy_of
+    from regrasp.dexterity.world import HandWorld, Perturbation
+    from regrasp.pose import compose
+
+    scene = load_object("bar")
+    g = taxonomy_of(scene).grasp("g9")
+    w = HandWorld(scene, g.pose, hand_pose(0.0, WORK_POINT))
+    a = w.reset(Perturbation(friction=0.9, grip=1.1)).in_hand()
+    b = w.reset(Perturbation(friction=0.9, grip=1.1, pose=tuple(g.pose))).in_hand()
+    assert np.array_equal(a, b)
+    moved = compose(np.array([0.0, 0.0, 0.004, 1.0, 0.0, 0.0, 0.0]), g.pose)
+    c = w.reset(Perturbation(pose=tuple(moved))).in_hand()
+    assert np.linalg.norm(c[:3] - moved[:3]) < 5e-4 and np.linalg.norm(c[:3] - a[:3]) > 3.5e-3
+
+
+def test_a_chained_graph_runs_each_action_from_the_end_poses_of_the_one_before(tmp_path):
+    # the bar's lateral g9: gravity pivot to g0, then from g0 the grip pivot — after the pivot, from
+    # its measured end poses (the real engine, one nominal run and one perturbed per edge)
+    from regrasp.dexterity.graph import Settings, build_graph, chained_perturbations
+    from regrasp.dexterity.objects import object_path
+
+    g = build_graph(object_path("bar"), Settings(trials=2, actions=("gravity-pivot",), chain=True))
+    assert g.settings["chain"] and all(len(e.runs) == e.trials for e in g.edges)
+    for e in g.edges:
+        for o, pose in e.runs:
+            assert (pose is None) == (o == "dropped")
+    pairs = {(c.after, c.edge) for c in g.chained}
+    expect = {(i, j) for i, a in enumerate(g.edges) for j, e in enumerate(g.edges)
+              if e.trials and e.source != a.source and a.ends(e.source)}
+    assert pairs == expect and expect, [e.to_dict() for e in g.edges]
+    for c in g.chained:
+        assert c.starts == len(g.edges[c.after].ends(g.edges[c.edge].source)) and c.trials == 2
+    starts = g.edges[g.chained[0].after].ends(g.edges[g.chained[0].edge].source)
+    worlds = chained_perturbations(Settings(trials=2), "k", starts)
+    assert [w.pose for w in worlds] == [tuple(starts[i % len(starts)]) for i in range(2)]
+    back = GraspGraph.load(g.save(tmp_path / "g.json"))
+    assert back.to_dict() == g.to_dict()
 
 
 # --- the bundled objects ------------------------------------------------------------------------------
@@ -492,10 +636,12 @@ def run_cli(*args):
 def test_the_cli_measures_a_graph_and_plans_on_it(tmp_path):
     out = tmp_path / "g.json"
     r = run_cli("grasp-graph", "box", "--trials", "1", "--actions", "gravity-slide", "--workers", "1", "--out",
-                str(out), "--json")
+                str(out), "--json", "--chain")
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
-    assert {"nodes", "edges", "actions"} <= set(d) and d["edges"]
+    assert {"nodes", "edges", "actions", "chained"} <= set(d) and d["edges"]
+    assert all({"after", "edge", "trials", "outcomes", "starts"} <= set(c) and c["trials"] == 1 for c in d["chained"])
+    assert GraspGraph.load(out).settings["chain"]
     assert all({"from", "to", "action", "success_rate", "trials"} <= set(e) for e in d["edges"])
     assert [a["name"] for a in d["actions"]] == ["gravity-slide"]
     hits = [e for e in d["edges"] if e["success_rate"] > 0]

@@ -35,7 +35,7 @@ def cmd_grasp_graph(a) -> int:
     check_outputs(a, {"out": (".json",), "plot": (".png", ".svg", ".pdf")}, [path])
     actions = None if a.actions is None else tuple(x.strip() for x in a.actions.split(",") if x.strip())
     workers = a.workers or max(1, min(os.cpu_count() or 1, 8))  # also a local Ray cluster's CPUs
-    graph = build_graph(path, Settings(trials=a.trials, seed=a.seed, actions=actions), workers=workers,
+    graph = build_graph(path, Settings(trials=a.trials, seed=a.seed, actions=actions, chain=a.chain), workers=workers,
                         ray_address=a.ray, robot=None, progress=True)
     if a.out:
         graph.save(a.out)
@@ -55,6 +55,10 @@ def cmd_grasp_graph(a) -> int:
                       f"({', '.join(f'{k} {v}' for k, v in sorted(e.outcomes.items()))})")
             else:
                 print(f"  {e.source} --{e.action}--> refused: {e.detail.get('refused', '')}")
+        for c in graph.chained:
+            before, e = graph.edges[c.after], graph.edges[c.edge]
+            print(f"  after {before.source} --{before.action}--> {e.source}: --{e.action}--> {e.target}: "
+                  f"{c.outcomes.get(e.target, 0) / c.trials:.0%} of {c.trials} (alone {e.success_rate:.0%})")
         for p in (a.out, a.plot):
             if p:
                 print(f"wrote {p}")
@@ -83,9 +87,11 @@ def cmd_regrasp_sequence(a) -> int:
     if a.json:
         print(json.dumps(out, allow_nan=False))
     else:
-        print(f"{a.source} -> {a.target}: {len(seq.steps)} actions, predicted success {seq.probability:.0%}")
+        alone = "" if seq.independent == seq.probability else f" (each action alone: {seq.independent:.0%})"
+        print(f"{a.source} -> {a.target}: {len(seq.steps)} actions, predicted success {seq.probability:.0%}{alone}")
         for s in seq.steps:
-            print(f"  {s.source} --{s.action}--> {s.target} ({s.p:.0%} of {s.trials})")
+            after = f", after the step before; alone {s.alone:.0%}" if s.chained else ""
+            print(f"  {s.source} --{s.action}--> {s.target} ({s.p:.0%} of {s.trials}{after})")
         if a.execute:
             print(f"executed {a.runs} times: {out['measured']:.0%} succeeded")
     return OK if not a.execute or out["measured"] > 0 else CANNOT
@@ -106,6 +112,9 @@ def add_parsers(sub) -> None:
     g.add_argument("--workers", type=int, help=f"local processes, 1 to {MAX_WORKERS} (default: the cores, at most 8)")
     g.add_argument("--ray", metavar="ADDRESS", help="spread the edges over a Ray cluster ('local' starts one)")
     g.add_argument("--actions", metavar="A,B", help="only these actions (default: all)")
+    g.add_argument("--chain", action="store_true", help="also run each action from the poses where every other "
+                   "action left the object at its grasp (--trials runs per pair), so that a sequence's prediction "
+                   "carries them")
     g.add_argument("--out", metavar="GRAPH.json", help="write the graph (docs/grasp-graph.md)")
     g.add_argument("--plot", metavar="PNG", help="draw the graph (grasps as small drawings, edges with their action "
                    "and success rate)")

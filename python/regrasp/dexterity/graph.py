@@ -6,8 +6,12 @@ friction, the grip force and the object's mass each ±spread; the object's start
 hand ±``shift`` [m] and ±``turn`` [rad] about the grasp axis); each run's outcome classified to
 the nearest grasp (or dropped / other). An edge carries the grasp the action is meant to reach
 (the model's prediction), the measured success rate (the share of runs that reached it) and the
-distribution of outcomes. Runs go in parallel over processes or a Ray cluster. The graph file
-(JSON, :class:`GraspGraph`: read and written here only) is documented in docs/grasp-graph.md."""
+distribution of outcomes, with each run's end pose in the hand. With ``chain``, a second pass
+measures every action again from where each other action left the object (:class:`Chain`: the
+next edge's runs start from the previous edge's end poses), so that a sequence's prediction
+carries the poses one action leaves into the next. Runs go in parallel over processes or a Ray
+cluster. The graph file (JSON, :class:`GraspGraph`: read and written here only) is documented in
+docs/grasp-graph.md."""
 
 from __future__ import annotations
 
@@ -36,7 +40,9 @@ FIT = 0.0005  # m, a grasp fits the hand when the object stays this far from the
 @dataclass(frozen=True)
 class Settings:
     """How the graph is measured: ``trials`` per edge, ``seed``, the world's ``spread``,
-    ``shift`` [m], ``turn`` [rad] (see the module's doc), ``actions`` (names; None: all)."""
+    ``shift`` [m], ``turn`` [rad] (see the module's doc), ``actions`` (names; None: all),
+    ``chain``: also measure each action from the end poses of every action that reaches its
+    grasp (:class:`Chain`, ``trials`` runs each)."""
 
     trials: int = TRIALS
     seed: int = 0
@@ -44,18 +50,20 @@ class Settings:
     shift: float = SHIFT
     turn: float = TURN
     actions: tuple | None = None
+    chain: bool = False
 
     def to_dict(self) -> dict:
         """The settings as the graph file records them."""
         return {"trials": self.trials, "seed": self.seed, "spread": self.spread, "shift": self.shift, "turn": self.turn,
-                "actions": None if self.actions is None else list(self.actions)}
+                "actions": None if self.actions is None else list(self.actions), "chain": self.chain}
 
 
 @dataclass
 class Edge:
     """Runs of ``action`` from grasp ``source``: ``target`` the grasp it is meant to reach,
-    ``trials`` run, ``outcomes`` {outcome: count}, ``predicted`` the model's in-hand pose,
-    ``detail`` the action's parameters as set up, ``seconds`` of wall time."""
+    ``trials`` run, ``outcomes`` {outcome: count}, ``detail`` the action's parameters as set up,
+    ``seconds`` of wall time, ``runs`` each run's (outcome, end pose in the hand (7,) or None
+    when dropped) in order (empty in files written before they were recorded)."""
 
     source: str
     action: str
@@ -64,16 +72,28 @@ class Edge:
     outcomes: dict
     detail: dict = field(default_factory=dict)
     seconds: float = 0.0
+    runs: list = field(default_factory=list)
 
     @property
     def success_rate(self) -> float:
         """The share of the runs that reached ``target`` (0 without runs)."""
         return self.outcomes.get(self.target, 0) / self.trials if self.trials else 0.0
 
+    @property
+    def params(self) -> dict:
+        """The action's parameters the edge was measured with (a re-pick's ``target``)."""
+        return {"target": self.detail["target"]} if isinstance(self.detail.get("target"), str) else {}
+
+    def ends(self, outcome: str) -> list:
+        """The end poses (7,) of the runs that reached ``outcome``."""
+        return [pose for o, pose in self.runs if o == outcome and pose is not None]
+
     def to_dict(self) -> dict:
         """The edge as the graph file writes it (docs/grasp-graph.md)."""
         return {"from": self.source, "to": self.target, "action": self.action, "success_rate": self.success_rate,
-                "trials": self.trials, "outcomes": dict(self.outcomes), "detail": self.detail, "seconds": self.seconds}
+                "trials": self.trials, "outcomes": dict(self.outcomes), "detail": self.detail, "seconds": self.seconds,
+                "runs": [{"outcome": o, "pose": None if pose is None else [float(x) for x in pose]}
+                         for o, pose in self.runs]}
 
     @classmethod
     def from_dict(cls, d: dict, i: int, names=None) -> "Edge":
@@ -112,13 +132,88 @@ class Edge:
         seconds = d.get("seconds", 0.0)
         if not isinstance(seconds, (int, float)) or isinstance(seconds, bool):
             raise ArgumentError(f"invalid `{f}.seconds`: a number", f"{f}.seconds")
-        return cls(d["from"], d["action"], d.get("to"), d["trials"], dict(out), dict(detail), float(seconds))
+        runs = _runs(d.get("runs", []), f"{f}.runs", d["trials"], out)
+        return cls(d["from"], d["action"], d.get("to"), d["trials"], dict(out), dict(detail), float(seconds), runs)
+
+
+def _runs(runs, f: str, trials: int, outcomes: dict) -> list:
+    """The (outcome, pose or None) of an edge's ``runs`` JSON, checked against its ``trials`` and
+    ``outcomes`` (none: a file written before runs were recorded); an ArgumentError naming ``f``."""
+    if not isinstance(runs, list) or (runs and len(runs) != trials):
+        raise ArgumentError(f"invalid `{f}`: a list of one {{outcome, pose}} per trial ({trials})", f)
+    out = []
+    for k, r in enumerate(runs):
+        pose = r.get("pose") if isinstance(r, dict) else None
+        if not isinstance(r, dict) or not isinstance(r.get("outcome"), str) or not (
+                pose is None or (isinstance(pose, list) and len(pose) == 7 and all(
+                    isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) for x in pose))):
+            raise ArgumentError(f"invalid `{f}[{k}]`: {{\"outcome\": a string, \"pose\": 7 numbers or null}}",
+                                f"{f}[{k}]")
+        out.append((r["outcome"], None if pose is None else np.array(pose, float)))
+    counts: dict = {}
+    for o, _ in out:
+        counts[o] = counts.get(o, 0) + 1
+    if out and counts != {k: v for k, v in outcomes.items() if v}:
+        raise ArgumentError(f"invalid `{f}`: its outcomes do not match the edge's `outcomes`", f)
+    return out
+
+
+@dataclass
+class Chain:
+    """Runs of ``edges[edge]`` started where ``edges[after]`` left the object: each run's start
+    pose in the hand one of ``after``'s end poses at ``edge``'s grasp (``starts`` of them, taken
+    in turn), its pads' friction, grip force and mass drawn as an edge's; ``trials`` runs,
+    ``outcomes`` {outcome: count}, ``seconds`` of wall time."""
+
+    after: int
+    edge: int
+    trials: int
+    outcomes: dict
+    starts: int
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict:
+        """The chain as the graph file writes it (docs/grasp-graph.md)."""
+        return {"after": self.after, "edge": self.edge, "trials": self.trials, "outcomes": dict(self.outcomes),
+                "starts": self.starts, "seconds": self.seconds}
+
+    @classmethod
+    def from_dict(cls, d, i: int, edges: list) -> "Chain":
+        """The chain of a graph file's ``chained[i]`` ``d`` over its ``edges``; an ArgumentError
+        naming the field."""
+        f = f"chained[{i}]"
+        if not isinstance(d, dict):
+            raise ArgumentError(f"invalid `{f}`: an object (got {type(d).__name__})", f)
+        whole = lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0  # noqa: E731
+        for key in ("after", "edge", "trials", "outcomes", "starts"):
+            if key not in d:
+                raise ArgumentError(f"invalid `{f}`: `{key}` is required (a chain has after, edge, trials, outcomes, "
+                                    "starts)", f)
+        for key in ("after", "edge"):
+            if not whole(d[key]) or d[key] >= len(edges):
+                raise ArgumentError(f"invalid `{f}.{key}`: an index into `edges` (0 to {len(edges) - 1}; got "
+                                    f"{d[key]!r:.40})", f"{f}.{key}")
+        if edges[d["after"]].outcomes.get(edges[d["edge"]].source, 0) == 0:
+            raise ArgumentError(f"invalid `{f}`: edge {d['after']} never reached grasp {edges[d['edge']].source!r}, "
+                                f"where edge {d['edge']} starts", f)
+        if not whole(d["trials"]) or not whole(d["starts"]):
+            raise ArgumentError(f"invalid `{f}.trials`/`starts`: whole numbers >= 0", f"{f}.trials")
+        out = d["outcomes"]
+        if not isinstance(out, dict) or not all(isinstance(k, str) and whole(v) for k, v in out.items()) \
+                or sum(out.values()) != d["trials"]:
+            raise ArgumentError(f"invalid `{f}.outcomes`: {{outcome: whole number >= 0}} adding up to `trials`",
+                                f"{f}.outcomes")
+        seconds = d.get("seconds", 0.0)
+        if not isinstance(seconds, (int, float)) or isinstance(seconds, bool):
+            raise ArgumentError(f"invalid `{f}.seconds`: a number", f"{f}.seconds")
+        return cls(d["after"], d["edge"], d["trials"], dict(out), d["starts"], float(seconds))
 
 
 @dataclass
 class GraspGraph:
     """A measured grasp graph: the ``object`` (its name and file), the ``taxonomy``'s grasps
-    (nodes), the ``edges``, the ``actions`` measured and the ``settings``."""
+    (nodes), the ``edges``, the ``actions`` measured, the ``settings`` and the ``chained``
+    measurements (:class:`Chain`; empty unless measured with ``chain``)."""
 
     object: dict
     nodes: list
@@ -126,12 +221,13 @@ class GraspGraph:
     actions: list
     settings: dict
     seconds: float = 0.0
+    chained: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
         """The graph file's JSON (docs/grasp-graph.md)."""
         return {"format": FORMAT, "version": VERSION, "object": self.object, "nodes": self.nodes,
                 "edges": [e.to_dict() for e in self.edges], "actions": self.actions, "settings": self.settings,
-                "seconds": self.seconds}
+                "seconds": self.seconds, "chained": [c.to_dict() for c in self.chained]}
 
     def save(self, path) -> Path:
         """Writes the graph as JSON to ``path`` (atomically)."""
@@ -173,7 +269,11 @@ class GraspGraph:
             for key, v in (("from", e.source), ("to", e.target)):
                 if v is not None and v not in names:
                     raise ArgumentError(f"invalid `edges[{i}].{key}`: {v!r} is not a node", f"edges[{i}].{key}")
-        return cls(dict(d["object"]), list(d["nodes"]), edges, list(d["actions"]), dict(d["settings"]), float(seconds))
+        if not isinstance(d.get("chained", []), list):
+            raise ArgumentError("invalid `chained`: a JSON array", "chained")
+        chained = [Chain.from_dict(c, i, edges) for i, c in enumerate(d.get("chained", []))]
+        return cls(dict(d["object"]), list(d["nodes"]), edges, list(d["actions"]), dict(d["settings"]), float(seconds),
+                   chained)
 
     @property
     def node_names(self) -> list:
@@ -182,9 +282,10 @@ class GraspGraph:
 
     def summary(self) -> dict:
         """The ``--json`` form: nodes, edges (from, to, action, success_rate, trials, outcomes), actions."""
-        return {"nodes": self.nodes, "edges": [{k: v for k, v in e.to_dict().items() if k not in ("detail", "seconds")}
-                                               for e in self.edges], "actions": self.actions,
-                "trials": sum(e.trials for e in self.edges), "seconds": self.seconds}
+        return {"nodes": self.nodes, "edges": [{k: v for k, v in e.to_dict().items()
+                                                if k not in ("detail", "seconds", "runs")} for e in self.edges],
+                "actions": self.actions, "trials": sum(e.trials for e in self.edges), "seconds": self.seconds,
+                "chained": [c.to_dict() for c in self.chained]}
 
 
 # --- measuring -----------------------------------------------------------------------------------
@@ -222,31 +323,66 @@ def perturbations(settings: Settings, key: str) -> list:
     return out[:settings.trials]
 
 
+def chained_perturbations(settings: Settings, key: str, starts: list) -> list:
+    """The ``settings.trials`` worlds of the chain ``key``: the start poses ``starts`` taken in
+    turn, the pads' friction, the grip force and the mass drawn as an edge's (no extra shift or
+    turn: the start poses carry the spread)."""
+    from .world import Perturbation
+
+    rng = np.random.default_rng([settings.seed, zlib.crc32(key.encode())])
+    out = []
+    for i in range(settings.trials):
+        f = rng.uniform(1 - settings.spread, 1 + settings.spread, 3)
+        out.append(Perturbation(*map(float, f), pose=tuple(float(x) for x in starts[i % len(starts)])))
+    return out
+
+
 def run_edge(job: tuple) -> Edge:
     """Runs the trials of one edge: ``job`` = (object path, grasp name, action name, the
-    action's params (a dict: place-repick's ``target``), settings, robot)."""
+    action's params (a dict: place-repick's ``target``), settings, robot[, start poses, key]):
+    with start poses (a chain's), the worlds of :func:`chained_perturbations` under ``key``."""
     from .actions import action
     from .trial import REFUSED, Runner
 
-    path, grasp_name, action_name, params, settings, robot = job
+    path, grasp_name, action_name, params, settings, robot, *chain = job
     scene, tax, obj = _object(path)
     grasp = tax.grasp(grasp_name)
     t0 = time.perf_counter()
     setup = action(action_name).setup(obj, grasp, params)
     runner = Runner(scene, tax, grasp, setup, robot)
     outcomes: dict = {}
-    key = "/".join([grasp_name, action_name, *(str(v) for v in params.values())])
-    for i, p in enumerate(perturbations(settings, key)):
+    runs: list = []
+    if chain:
+        worlds = chained_perturbations(settings, chain[1], chain[0])
+    else:
+        worlds = perturbations(settings, "/".join([grasp_name, action_name, *(str(v) for v in params.values())]))
+    for i, p in enumerate(worlds):
         try:
-            r = runner.run(p).outcome
+            r = runner.run(p)
+            outcome, pose = r.outcome, r.pose
         except ArgumentError as e:
-            if i == 0:  # the arm cannot do the action here at all (IK in the nominal world): no edge
+            if i == 0 and not chain:  # the arm cannot do the action here at all (IK in the nominal world): no edge
                 return Edge(grasp_name, action_name, setup.intended, 0, {}, {"refused": str(e), **params},
                             time.perf_counter() - t0)
-            r = REFUSED  # this world only (e.g. a grip beyond the gripper's range)
-        outcomes[r] = outcomes.get(r, 0) + 1
+            outcome, pose = REFUSED, None  # this world only (e.g. a grip beyond the gripper's range)
+        outcomes[outcome] = outcomes.get(outcome, 0) + 1
+        runs.append((outcome, pose))
     detail = {k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in setup.detail.items()}
-    return Edge(grasp_name, action_name, setup.intended, settings.trials, outcomes, detail, time.perf_counter() - t0)
+    return Edge(grasp_name, action_name, setup.intended, settings.trials, outcomes, detail, time.perf_counter() - t0,
+                runs)
+
+
+def chains_to_measure(edges: list) -> list:
+    """(after, edge, start poses) of every pair of measured edges where ``after`` reached the
+    grasp ``edge`` starts from in some run (its end poses there: the starts)."""
+    out = []
+    for i, a in enumerate(edges):
+        for j, e in enumerate(edges):
+            if e.trials and e.source != a.source and a.outcomes.get(e.source, 0):
+                starts = a.ends(e.source)
+                if starts:
+                    out.append((i, j, starts))
+    return out
 
 
 def fitting(scene, taxonomy, robot: str | None = None) -> dict:
@@ -285,22 +421,23 @@ def edges_to_measure(obj, settings: Settings, clear: dict | None = None) -> list
     return out
 
 
-def _each(jobs: list, workers: int, ray_address, take) -> None:
+def _each(run, jobs: list, workers: int, ray_address, take) -> None:
+    """``take(run(job))`` for every job, in any order, over ``workers`` processes or Ray."""
     if ray_address is not None:
         from ..sim.validation import ray_init
 
         ray = ray_init(ray_address, workers)
-        remote = ray.remote(run_edge)
+        remote = ray.remote(run)
         pending = [remote.remote(j) for j in jobs]
         while pending:
             done, pending = ray.wait(pending, num_returns=1)
             take(ray.get(done[0]))
     elif workers <= 1:
         for j in jobs:
-            take(run_edge(j))
+            take(run(j))
     else:
         with multiprocessing.get_context("spawn").Pool(workers, initializer=_ignore_sigint) as pool:
-            for e in pool.imap_unordered(run_edge, jobs):
+            for e in pool.imap_unordered(run, jobs):
                 take(e)
 
 
@@ -325,13 +462,41 @@ def build_graph(path, settings: Settings = Settings(), workers: int = 1, ray_add
             edges.append(e)
             bar.update(settings.trials)
 
-        _each(jobs, workers, ray_address, take)
+        _each(run_edge, jobs, workers, ray_address, take)
     order = {(j[1], j[2], j[3].get("target")): i for i, j in enumerate(jobs)}
     edges.sort(key=lambda e: order[(e.source, e.action, e.detail.get("target"))])
+    chained = _chain(path, edges, settings, workers, ray_address, robot, progress) if settings.chain else []
     used = sorted({e.action for e in edges})
     from ..execution.arm import HAND_REACH
 
     nodes = [{**g.to_dict(), "clearance": float(min(clear[g.name], HAND_REACH)), "fits": clear[g.name] >= FIT}
              for g in tax.grasps]
     return GraspGraph({"name": scene.name, "file": path}, nodes, edges,
-                      [ACTIONS[a].to_dict() for a in used], settings.to_dict(), time.perf_counter() - t0)
+                      [ACTIONS[a].to_dict() for a in used], settings.to_dict(), time.perf_counter() - t0, chained)
+
+
+def _chain(path: str, edges: list, settings: Settings, workers: int, ray_address, robot, progress: bool) -> list:
+    """The :class:`Chain` of every pair of :func:`chains_to_measure` (``settings.trials`` runs each)."""
+    todo = chains_to_measure(edges)
+    key = lambda i: "/".join([edges[i].source, edges[i].action, str(edges[i].target)])  # noqa: E731
+    jobs, index = [], {}
+    for i, j, starts in todo:
+        name = f"chain/{key(i)}/then/{key(j)}"
+        index[name] = (i, j, len(starts))
+        jobs.append((path, edges[j].source, edges[j].action, edges[j].params, settings, robot,
+                     [tuple(float(x) for x in p) for p in starts], name))
+    done: dict = {}
+    with bars.bar(len(jobs) * settings.trials, "chained", unit="trial", show=progress) as bar:
+        def take(e_name: tuple) -> None:
+            e, name = e_name
+            i, j, n = index[name]
+            done[(i, j)] = Chain(i, j, e.trials, e.outcomes, n, e.seconds)
+            bar.update(settings.trials)
+
+        _each(run_chain, jobs, workers, ray_address, take)
+    return [done[(i, j)] for i, j, _ in todo]
+
+
+def run_chain(job: tuple) -> tuple:
+    """(the :func:`run_edge` of a chain's ``job``, the chain's key)."""
+    return run_edge(job), job[-1]

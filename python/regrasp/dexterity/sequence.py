@@ -3,8 +3,12 @@ two grasps — the path of maximum product of measured transition probabilities 
 −log p) — or the one of fewest expected attempts (Σ 1/p: each action retried until it succeeds,
 a failure assumed to leave the grasp as it was). Every observed outcome of an (action, grasp)
 is a transition, not only the intended one: an action that lands somewhere useful by a
-different route counts. :func:`execute` runs a sequence end to end in MuJoCo, the arm moving
-from one action's end to the next one's start with the grip firm."""
+different route counts. Where the graph has chained measurements (``chain``: each action run
+again from the poses where another left the object), a step after the first takes its rate from
+the runs that started where the previous step's action left the object, so the plan and its
+prediction carry the poses one action leaves into the next: the search is over states (grasp,
+the action that reached it). :func:`execute` runs a sequence end to end in MuJoCo, the arm
+moving from one action's end to the next one's start with the grip firm."""
 
 from __future__ import annotations
 
@@ -27,7 +31,9 @@ TRANSFER_LIFT = 0.1  # m, a move between two actions that cannot turn the hand i
 @dataclass(frozen=True)
 class Step:
     """One action of a sequence: from grasp ``source`` by ``action`` to ``target`` with measured
-    probability ``p`` (``trials`` runs)."""
+    probability ``p`` (``trials`` runs); ``chained``: ``p`` measured from where the previous
+    step's action left the object (else from the grasp's own pose); ``alone``: the edge's rate
+    from the grasp's own pose."""
 
     source: str
     action: str
@@ -35,51 +41,73 @@ class Step:
     p: float
     trials: int
     params: dict | None = None
+    chained: bool = False
+    alone: float | None = None
 
     def to_dict(self) -> dict:
         """The step as JSON (``params``: the action's parameters as measured, e.g. a re-pick's
         ``target``)."""
         return {"from": self.source, "action": self.action, "to": self.target, "p": self.p, "trials": self.trials,
-                "params": dict(self.params or {})}
+                "params": dict(self.params or {}), "chained": self.chained,
+                "alone": self.p if self.alone is None else self.alone}
 
 
 @dataclass(frozen=True)
 class Sequence:
     """A planned sequence: its ``steps``, the predicted ``probability`` that it all succeeds (the
-    product of the steps' p) and the ``expected_actions`` (Σ 1/p)."""
+    product of the steps' p), the ``expected_actions`` (Σ 1/p) and the ``independent``
+    probability (the product of the steps' ``alone``: as if each action started from its
+    grasp's own pose)."""
 
     steps: tuple
     probability: float
     expected_actions: float
+    independent: float | None = None
 
     def to_dict(self) -> dict:
         """The sequence as JSON (``regrasp regrasp-sequence --json``)."""
         return {"steps": [s.to_dict() for s in self.steps], "probability": self.probability,
-                "expected_actions": self.expected_actions}
+                "expected_actions": self.expected_actions,
+                "independent": self.probability if self.independent is None else self.independent}
 
 
-def transitions(graph: GraspGraph):
-    """The networkx DiGraph of the best transition between each pair of grasps: edge attributes
-    ``action``, ``params`` (a re-pick's ``target``), ``p`` (measured share of runs), ``trials``."""
+def states(graph: GraspGraph):
+    """The networkx DiGraph of the regrasp states: ``(None, g)`` the object held at grasp ``g``'s
+    own pose, ``(j, g)`` at ``g`` where ``graph.edges[j]`` left it. An edge per state, measured
+    edge ``j`` from its grasp and outcome grasp ``o`` of ``j``'s runs (every outcome, not only the
+    intended one), to state ``(j, o)``: attributes ``action``, ``params`` (a re-pick's
+    ``target``), ``p`` (the share of runs that reached ``o``: of the :class:`~.graph.Chain`
+    from the state's edge where measured, else of ``j``'s own), ``trials``, ``chained``,
+    ``alone`` (``j``'s own share)."""
     nx = need("networkx", "robot")
     G = nx.DiGraph()
-    G.add_nodes_from(graph.node_names)
-    for e in graph.edges:
-        for outcome, count in e.outcomes.items():
-            if outcome in (DROPPED, OTHER, UNSTABLE, REFUSED) or outcome == e.source or count == 0 or e.trials == 0:
-                continue
-            p = count / e.trials
-            if not G.has_edge(e.source, outcome) or G[e.source][outcome]["p"] < p:
-                params = {"target": e.detail["target"]} if isinstance(e.detail.get("target"), str) else {}
-                G.add_edge(e.source, outcome, action=e.action, params=params, p=p, trials=e.trials)
+    names = set(graph.node_names)
+    chains = {(c.after, c.edge): c for c in graph.chained}
+    grasp = lambda o, g: o in names and o != g  # noqa: E731
+    found = [(None, n) for n in graph.node_names]
+    found += [(j, o) for j, e in enumerate(graph.edges) for o, k in e.outcomes.items() if k and grasp(o, e.source)]
+    leaving: dict = {}
+    for j, e in enumerate(graph.edges):
+        if e.trials:
+            leaving.setdefault(e.source, []).append(j)
+    G.add_nodes_from(found)
+    for after, g in found:
+        for j in leaving.get(g, ()):
+            e = graph.edges[j]
+            c = chains.get((after, j))
+            counts, n = (c.outcomes, c.trials) if c is not None and c.trials else (e.outcomes, e.trials)
+            for o, k in counts.items():
+                if k and grasp(o, g):
+                    G.add_edge((after, g), (j, o), action=e.action, params=e.params, p=k / n, trials=n,
+                               chained=c is not None and c.trials > 0, alone=e.outcomes.get(o, 0) / e.trials)
     return G
 
 
 def plan(graph: GraspGraph, start: str, goal: str, objective: str = "reliable") -> Sequence:
-    """The best sequence from grasp ``start`` to ``goal`` (``objective``: ``reliable`` or
-    ``expected``, :data:`OBJECTIVES`); an ArgumentError naming ``from``/``to`` for an unknown
-    grasp, ``objective`` for an unknown objective, and one naming ``to`` when no sequence of
-    measured transitions reaches it."""
+    """The best sequence from grasp ``start`` (at its own pose) to ``goal`` over the regrasp
+    :func:`states` (``objective``: ``reliable`` or ``expected``, :data:`OBJECTIVES`); an
+    ArgumentError naming ``from``/``to`` for an unknown grasp, ``objective`` for an unknown
+    objective, and one naming ``to`` when no sequence of measured transitions reaches it."""
     nx = need("networkx", "robot")
     for field_, name in (("from", start), ("to", goal)):
         if name not in graph.node_names:
@@ -87,16 +115,23 @@ def plan(graph: GraspGraph, start: str, goal: str, objective: str = "reliable") 
                                 f"(grasps: {', '.join(graph.node_names)})", field_)
     if objective not in OBJECTIVES:
         raise ArgumentError(f"invalid `objective`: {objective!r} (known: {', '.join(OBJECTIVES)})", "objective")
-    G = transitions(graph)
-    weight = (lambda u, v, d: -math.log(d["p"])) if objective == "reliable" else (lambda u, v, d: 1.0 / d["p"])
+    if start == goal:
+        return Sequence((), 1.0, 0.0, 1.0)
+    G = states(graph)
+    end = ("goal", goal)
+    G.add_edges_from(((s, end) for s in list(G.nodes) if s[1] == goal), p=1.0, end=True)
+    weight = (lambda u, v, d: 0.0 if d.get("end") else -math.log(d["p"])) if objective == "reliable" else \
+        (lambda u, v, d: 0.0 if d.get("end") else 1.0 / d["p"])
     try:
-        nodes = nx.dijkstra_path(G, start, goal, weight=weight)
+        nodes = nx.dijkstra_path(G, (None, start), end, weight=weight)[:-1]
     except nx.NetworkXNoPath:
         raise ArgumentError(f"invalid `to`: no sequence of measured regrasps reaches {goal!r} from {start!r}",
                             "to") from None
-    steps = tuple(Step(u, G[u][v]["action"], v, float(G[u][v]["p"]), int(G[u][v]["trials"]), G[u][v]["params"])
+    steps = tuple(Step(u[1], G[u][v]["action"], v[1], float(G[u][v]["p"]), int(G[u][v]["trials"]),
+                       G[u][v]["params"], bool(G[u][v]["chained"]), float(G[u][v]["alone"]))
                   for u, v in zip(nodes, nodes[1:]))
-    return Sequence(steps, float(np.prod([s.p for s in steps])) if steps else 1.0, float(sum(1 / s.p for s in steps)))
+    return Sequence(steps, float(np.prod([s.p for s in steps])), float(sum(1 / s.p for s in steps)),
+                    float(np.prod([s.alone for s in steps])))
 
 
 @dataclass(frozen=True)

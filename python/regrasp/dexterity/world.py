@@ -35,13 +35,16 @@ class Perturbation:
     """One trial's world: the pads' friction, the grip force and the object's mass scaled by
     ``friction``, ``grip``, ``mass``; the object's start pose in the hand moved by ``shift``
     (3,) [m] (hand frame) and turned by ``turn`` [rad] about the grasp axis (+y: z towards x, the
-    opposite of a planar turn's sign; drawn symmetric, so no result depends on it)."""
+    opposite of a planar turn's sign; drawn symmetric, so no result depends on it); ``pose`` (7,)
+    the object's start pose in the hand in place of the grasp's (None: the grasp's), e.g. where
+    the previous action of a sequence left it (the shift and turn then move it)."""
 
     friction: float = 1.0
     grip: float = 1.0
     mass: float = 1.0
     shift: tuple = (0.0, 0.0, 0.0)
     turn: float = 0.0
+    pose: tuple | None = None
 
     @classmethod
     def draw(cls, rng, spread: float, shift: float, turn: float) -> "Perturbation":
@@ -228,7 +231,8 @@ class HandWorld:
         close_fingers(r)
         r.set_q(self.q0)
         half = perturbation.turn / 2
-        start = P.compose(np.array([*perturbation.shift, np.cos(half), 0.0, np.sin(half), 0.0]), self.grasp)
+        base = self.grasp if perturbation.pose is None else np.asarray(perturbation.pose, float)
+        start = P.compose(np.array([*perturbation.shift, np.cos(half), 0.0, np.sin(half), 0.0]), base)
         d.qpos[self.jq:self.jq + 7] = P.compose(self.hand_frame(), start)
         mujoco.mj_forward(m, d)
         close_on(r, self.body, self.geoms, self.grip_force)
