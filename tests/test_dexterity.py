@@ -171,12 +171,12 @@ def test_planning_refuses_unknown_grasps_and_objectives():
 def chained_graph():
     """g0 -a-> g1 (from g1's own pose, b reaches g3 19 times in 20, but after a only 2) and g0 -c-> g2 -d-> g3."""
     pose = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
-    a = Edge("g0", "gravity-slide", "g1", 2, {"g1": 2}, runs=[("g1", np.array(pose)), ("g1", np.array(pose))])
+    a = Edge("g0", "gravity-slide", "g1", 20, {"g1": 20}, runs=[("g1", np.array(pose), (1.0, 0.9, 1.1))] * 20)
     b = edge("g1", "g3", "push-down", 19)
     c = edge("g0", "g2", "inertial-slide", 16)
     d = edge("g2", "g3", "drop-catch", 16)
     g = graph_of([a, b, c, d])
-    g.chained = [Chain(0, 1, 20, {"g3": 2, "dropped": 18}, 1)]
+    g.chained = [Chain(0, 1, 20, {"g3": 2, "dropped": 18})]
     return g
 
 
@@ -236,7 +236,7 @@ def test_the_most_reliable_chained_sequence_is_the_brute_force_one(raw, raw_chai
     assume = [(i, j, h) for i, j, h in raw_chains if i < len(edges) and j < len(edges)
               and edges[i].target == edges[j].source]
     g = graph_of(edges, names)
-    g.chained = list({(i, j): Chain(i, j, 10, {edges[j].target: h, **({"other": 10 - h} if h < 10 else {})}, 1)
+    g.chained = list({(i, j): Chain(i, j, 10, {edges[j].target: h, **({"other": 10 - h} if h < 10 else {})})
                       for i, j, h in assume}.values())
     truth = brute_force_chained(g, "g0", "g3", 2 * len(edges) + 1)
     if truth == 0.0:
@@ -251,7 +251,9 @@ def test_the_most_reliable_chained_sequence_is_the_brute_force_one(raw, raw_chai
     (lambda d: d["chained"][0].update(edge=-1), "chained[0].edge"),
     (lambda d: d["chained"][0].update(after=2), "chained[0]"),  # g0 -c-> g2 never reached g1
     (lambda d: d["chained"][0].update(outcomes={"g3": 3}), "chained[0].outcomes"),
-    (lambda d: d["chained"][0].pop("starts"), "chained[0]"),
+    (lambda d: d["chained"][0].pop("trials"), "chained[0]"),
+    (lambda d: d["chained"][0].update(trials=19, outcomes={"g3": 19}), "chained[0].trials"),
+    (lambda d: d["edges"][0]["runs"][0].update(world=[1.0, 0.0, 1.0]), "edges[0].runs[0]"),
     (lambda d: d.update(chained={}), "chained"),
     (lambda d: d["edges"][0]["runs"].pop(), "edges[0].runs"),
     (lambda d: d["edges"][0]["runs"][0].update(pose=[0.0] * 6), "edges[0].runs[0]"),
@@ -285,26 +287,30 @@ def test_a_start_pose_in_the_hand_is_where_the_world_starts_the_object():
     assert np.linalg.norm(c[:3] - moved[:3]) < 5e-4 and np.linalg.norm(c[:3] - a[:3]) > 3.5e-3
 
 
-def test_a_chained_graph_runs_each_action_from_the_end_poses_of_the_one_before(tmp_path):
-    # the bar's lateral g9: gravity pivot to g0, then from g0 the grip pivot — after the pivot, from
-    # its measured end poses (the real engine, one nominal run and one perturbed per edge)
-    from regrasp.dexterity.graph import Settings, build_graph, chained_perturbations
+def test_a_chained_graph_continues_each_run_that_reached_a_grasp_with_each_action_from_it(tmp_path):
+    # the bar's lateral g9: gravity pivot to g0, then from g0 the gravity pivot on to g8 — continued
+    # from the first's end poses, in its worlds (the real engine, one nominal run and two perturbed)
+    from regrasp.dexterity.graph import Settings, build_graph, chains_to_measure, continuations, run_edge
     from regrasp.dexterity.objects import object_path
 
-    g = build_graph(object_path("bar"), Settings(trials=2, actions=("gravity-pivot",), chain=True))
+    path = str(object_path("bar"))
+    g = build_graph(path, Settings(trials=3, actions=("gravity-pivot",), chain=True))
     assert g.settings["chain"] and all(len(e.runs) == e.trials for e in g.edges)
     for e in g.edges:
-        for o, pose in e.runs:
-            assert (pose is None) == (o == "dropped")
-    pairs = {(c.after, c.edge) for c in g.chained}
-    expect = {(i, j) for i, a in enumerate(g.edges) for j, e in enumerate(g.edges)
-              if e.trials and e.source != a.source and a.ends(e.source)}
-    assert pairs == expect and expect, [e.to_dict() for e in g.edges]
+        for o, pose, world in e.runs:
+            assert (pose is None) == (o == "dropped") and len(world) == 3
+    pairs = [(c.after, c.edge) for c in g.chained]
+    assert pairs == chains_to_measure(g.edges) and pairs, [e.to_dict() for e in g.edges]
     for c in g.chained:
-        assert c.starts == len(g.edges[c.after].ends(g.edges[c.edge].source)) and c.trials == 2
-    starts = g.edges[g.chained[0].after].ends(g.edges[g.chained[0].edge].source)
-    worlds = chained_perturbations(Settings(trials=2), "k", starts)
-    assert [w.pose for w in worlds] == [tuple(starts[i % len(starts)]) for i in range(2)]
+        ends = g.edges[c.after].ends(g.edges[c.edge].source)
+        assert c.trials == len(ends) == g.edges[c.after].outcomes[g.edges[c.edge].source]
+        assert [(w.friction, w.grip, w.mass) for w in continuations(ends)] == [w for _, w in ends]
+    # a chain's runs are the edge's runs from those worlds: run again, they end where they did
+    c = g.chained[0]
+    ends = g.edges[c.after].ends(g.edges[c.edge].source)
+    e = g.edges[c.edge]
+    again = run_edge((path, e.source, e.action, e.params, Settings(), None, ends))
+    assert again.outcomes == c.outcomes and again.trials == c.trials
     back = GraspGraph.load(g.save(tmp_path / "g.json"))
     assert back.to_dict() == g.to_dict()
 
@@ -640,7 +646,7 @@ def test_the_cli_measures_a_graph_and_plans_on_it(tmp_path):
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
     assert {"nodes", "edges", "actions", "chained"} <= set(d) and d["edges"]
-    assert all({"after", "edge", "trials", "outcomes", "starts"} <= set(c) and c["trials"] == 1 for c in d["chained"])
+    assert all({"after", "edge", "trials", "outcomes"} <= set(c) and c["trials"] == 1 for c in d["chained"])
     assert GraspGraph.load(out).settings["chain"]
     assert all({"from", "to", "action", "success_rate", "trials"} <= set(e) for e in d["edges"])
     assert [a["name"] for a in d["actions"]] == ["gravity-slide"]

@@ -112,9 +112,9 @@ def add_parsers(sub) -> None:
     g.add_argument("--workers", type=int, help=f"local processes, 1 to {MAX_WORKERS} (default: the cores, at most 8)")
     g.add_argument("--ray", metavar="ADDRESS", help="spread the edges over a Ray cluster ('local' starts one)")
     g.add_argument("--actions", metavar="A,B", help="only these actions (default: all)")
-    g.add_argument("--chain", action="store_true", help="also run each action from the poses where every other "
-                   "action left the object at its grasp (--trials runs per pair), so that a sequence's prediction "
-                   "carries them")
+    g.add_argument("--chain", action="store_true", help="also continue every run that reached a grasp by each "
+                   "action from that grasp (from its end pose, in its world), so that a sequence's prediction "
+                   "carries the poses one action leaves into the next")
     g.add_argument("--out", metavar="GRAPH.json", help="write the graph (docs/grasp-graph.md)")
     g.add_argument("--plot", metavar="PNG", help="draw the graph (grasps as small drawings, edges with their action "
                    "and success rate)")

@@ -7,9 +7,10 @@ hand ±``shift`` [m] and ±``turn`` [rad] about the grasp axis); each run's outc
 the nearest grasp (or dropped / other). An edge carries the grasp the action is meant to reach
 (the model's prediction), the measured success rate (the share of runs that reached it) and the
 distribution of outcomes, with each run's end pose in the hand. With ``chain``, a second pass
-measures every action again from where each other action left the object (:class:`Chain`: the
-next edge's runs start from the previous edge's end poses), so that a sequence's prediction
-carries the poses one action leaves into the next. Runs go in parallel over processes or a Ray
+measures every action again from where each other action left the object (:class:`Chain`: each
+run of an edge that reached a grasp is continued once by each action from that grasp, from its
+end pose in the hand and in its world), so that a sequence's prediction carries the poses one
+action leaves, and the world it acted in, into the next. Runs go in parallel over processes or a Ray
 cluster. The graph file (JSON, :class:`GraspGraph`: read and written here only) is documented in
 docs/grasp-graph.md."""
 
@@ -41,8 +42,8 @@ FIT = 0.0005  # m, a grasp fits the hand when the object stays this far from the
 class Settings:
     """How the graph is measured: ``trials`` per edge, ``seed``, the world's ``spread``,
     ``shift`` [m], ``turn`` [rad] (see the module's doc), ``actions`` (names; None: all),
-    ``chain``: also measure each action from the end poses of every action that reaches its
-    grasp (:class:`Chain`, ``trials`` runs each)."""
+    ``chain``: also continue every run that reached a grasp by each action from that grasp
+    (:class:`Chain`)."""
 
     trials: int = TRIALS
     seed: int = 0
@@ -63,7 +64,8 @@ class Edge:
     """Runs of ``action`` from grasp ``source``: ``target`` the grasp it is meant to reach,
     ``trials`` run, ``outcomes`` {outcome: count}, ``detail`` the action's parameters as set up,
     ``seconds`` of wall time, ``runs`` each run's (outcome, end pose in the hand (7,) or None
-    when dropped) in order (empty in files written before they were recorded)."""
+    when dropped, its world (friction, grip, mass) factors) in order (empty in files written
+    before they were recorded)."""
 
     source: str
     action: str
@@ -85,15 +87,15 @@ class Edge:
         return {"target": self.detail["target"]} if isinstance(self.detail.get("target"), str) else {}
 
     def ends(self, outcome: str) -> list:
-        """The end poses (7,) of the runs that reached ``outcome``."""
-        return [pose for o, pose in self.runs if o == outcome and pose is not None]
+        """(end pose (7,), world factors) of the runs that reached ``outcome``."""
+        return [(pose, world) for o, pose, world in self.runs if o == outcome and pose is not None]
 
     def to_dict(self) -> dict:
         """The edge as the graph file writes it (docs/grasp-graph.md)."""
         return {"from": self.source, "to": self.target, "action": self.action, "success_rate": self.success_rate,
                 "trials": self.trials, "outcomes": dict(self.outcomes), "detail": self.detail, "seconds": self.seconds,
-                "runs": [{"outcome": o, "pose": None if pose is None else [float(x) for x in pose]}
-                         for o, pose in self.runs]}
+                "runs": [{"outcome": o, "pose": None if pose is None else [float(x) for x in pose],
+                          "world": [float(x) for x in world]} for o, pose, world in self.runs]}
 
     @classmethod
     def from_dict(cls, d: dict, i: int, names=None) -> "Edge":
@@ -136,22 +138,29 @@ class Edge:
         return cls(d["from"], d["action"], d.get("to"), d["trials"], dict(out), dict(detail), float(seconds), runs)
 
 
+def _numbers(v, n: int, positive: bool = False) -> bool:
+    """Whether ``v`` is a list of ``n`` finite numbers (> 0 with ``positive``)."""
+    return isinstance(v, list) and len(v) == n and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) and (x > 0 or not positive)
+        for x in v)
+
+
 def _runs(runs, f: str, trials: int, outcomes: dict) -> list:
-    """The (outcome, pose or None) of an edge's ``runs`` JSON, checked against its ``trials`` and
-    ``outcomes`` (none: a file written before runs were recorded); an ArgumentError naming ``f``."""
+    """The (outcome, pose or None, world) of an edge's ``runs`` JSON, checked against its
+    ``trials`` and ``outcomes`` (none: a file written before runs were recorded); an
+    ArgumentError naming ``f``."""
     if not isinstance(runs, list) or (runs and len(runs) != trials):
-        raise ArgumentError(f"invalid `{f}`: a list of one {{outcome, pose}} per trial ({trials})", f)
+        raise ArgumentError(f"invalid `{f}`: a list of one {{outcome, pose, world}} per trial ({trials})", f)
     out = []
     for k, r in enumerate(runs):
         pose = r.get("pose") if isinstance(r, dict) else None
         if not isinstance(r, dict) or not isinstance(r.get("outcome"), str) or not (
-                pose is None or (isinstance(pose, list) and len(pose) == 7 and all(
-                    isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) for x in pose))):
-            raise ArgumentError(f"invalid `{f}[{k}]`: {{\"outcome\": a string, \"pose\": 7 numbers or null}}",
-                                f"{f}[{k}]")
-        out.append((r["outcome"], None if pose is None else np.array(pose, float)))
+                pose is None or _numbers(pose, 7)) or not _numbers(r.get("world"), 3, positive=True):
+            raise ArgumentError(f"invalid `{f}[{k}]`: {{\"outcome\": a string, \"pose\": 7 numbers or null, "
+                                f"\"world\": 3 numbers > 0}}", f"{f}[{k}]")
+        out.append((r["outcome"], None if pose is None else np.array(pose, float), tuple(map(float, r["world"]))))
     counts: dict = {}
-    for o, _ in out:
+    for o, *_ in out:
         counts[o] = counts.get(o, 0) + 1
     if out and counts != {k: v for k, v in outcomes.items() if v}:
         raise ArgumentError(f"invalid `{f}`: its outcomes do not match the edge's `outcomes`", f)
@@ -160,22 +169,21 @@ def _runs(runs, f: str, trials: int, outcomes: dict) -> list:
 
 @dataclass
 class Chain:
-    """Runs of ``edges[edge]`` started where ``edges[after]`` left the object: each run's start
-    pose in the hand one of ``after``'s end poses at ``edge``'s grasp (``starts`` of them, taken
-    in turn), its pads' friction, grip force and mass drawn as an edge's; ``trials`` runs,
+    """Runs of ``edges[edge]`` continuing those of ``edges[after]`` that reached ``edge``'s
+    grasp: each starts from one such run's end pose in the hand, in that run's world (its pads'
+    friction, grip force and mass), once: ``trials`` (= ``after``'s count of that grasp),
     ``outcomes`` {outcome: count}, ``seconds`` of wall time."""
 
     after: int
     edge: int
     trials: int
     outcomes: dict
-    starts: int
     seconds: float = 0.0
 
     def to_dict(self) -> dict:
         """The chain as the graph file writes it (docs/grasp-graph.md)."""
         return {"after": self.after, "edge": self.edge, "trials": self.trials, "outcomes": dict(self.outcomes),
-                "starts": self.starts, "seconds": self.seconds}
+                "seconds": self.seconds}
 
     @classmethod
     def from_dict(cls, d, i: int, edges: list) -> "Chain":
@@ -185,19 +193,20 @@ class Chain:
         if not isinstance(d, dict):
             raise ArgumentError(f"invalid `{f}`: an object (got {type(d).__name__})", f)
         whole = lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0  # noqa: E731
-        for key in ("after", "edge", "trials", "outcomes", "starts"):
+        for key in ("after", "edge", "trials", "outcomes"):
             if key not in d:
-                raise ArgumentError(f"invalid `{f}`: `{key}` is required (a chain has after, edge, trials, outcomes, "
-                                    "starts)", f)
+                raise ArgumentError(f"invalid `{f}`: `{key}` is required (a chain has after, edge, trials, outcomes)", f)
         for key in ("after", "edge"):
             if not whole(d[key]) or d[key] >= len(edges):
                 raise ArgumentError(f"invalid `{f}.{key}`: an index into `edges` (0 to {len(edges) - 1}; got "
                                     f"{d[key]!r:.40})", f"{f}.{key}")
-        if edges[d["after"]].outcomes.get(edges[d["edge"]].source, 0) == 0:
+        arrived = edges[d["after"]].outcomes.get(edges[d["edge"]].source, 0)
+        if not arrived or edges[d["after"]].source == edges[d["edge"]].source:
             raise ArgumentError(f"invalid `{f}`: edge {d['after']} never reached grasp {edges[d['edge']].source!r}, "
                                 f"where edge {d['edge']} starts", f)
-        if not whole(d["trials"]) or not whole(d["starts"]):
-            raise ArgumentError(f"invalid `{f}.trials`/`starts`: whole numbers >= 0", f"{f}.trials")
+        if d["trials"] != arrived:
+            raise ArgumentError(f"invalid `{f}.trials`: one run per run of edge {d['after']} that reached "
+                                f"{edges[d['edge']].source!r} ({arrived}; got {d['trials']!r:.40})", f"{f}.trials")
         out = d["outcomes"]
         if not isinstance(out, dict) or not all(isinstance(k, str) and whole(v) for k, v in out.items()) \
                 or sum(out.values()) != d["trials"]:
@@ -206,7 +215,7 @@ class Chain:
         seconds = d.get("seconds", 0.0)
         if not isinstance(seconds, (int, float)) or isinstance(seconds, bool):
             raise ArgumentError(f"invalid `{f}.seconds`: a number", f"{f}.seconds")
-        return cls(d["after"], d["edge"], d["trials"], dict(out), d["starts"], float(seconds))
+        return cls(d["after"], d["edge"], d["trials"], dict(out), float(seconds))
 
 
 @dataclass
@@ -323,24 +332,18 @@ def perturbations(settings: Settings, key: str) -> list:
     return out[:settings.trials]
 
 
-def chained_perturbations(settings: Settings, key: str, starts: list) -> list:
-    """The ``settings.trials`` worlds of the chain ``key``: the start poses ``starts`` taken in
-    turn, the pads' friction, the grip force and the mass drawn as an edge's (no extra shift or
-    turn: the start poses carry the spread)."""
+def continuations(ends: list) -> list:
+    """The worlds of a chain: one per (end pose, world factors) of ``ends``
+    (:meth:`Edge.ends`): that world, the object starting at that pose (no extra shift or turn)."""
     from .world import Perturbation
 
-    rng = np.random.default_rng([settings.seed, zlib.crc32(key.encode())])
-    out = []
-    for i in range(settings.trials):
-        f = rng.uniform(1 - settings.spread, 1 + settings.spread, 3)
-        out.append(Perturbation(*map(float, f), pose=tuple(float(x) for x in starts[i % len(starts)])))
-    return out
+    return [Perturbation(*map(float, world), pose=tuple(float(x) for x in pose)) for pose, world in ends]
 
 
 def run_edge(job: tuple) -> Edge:
     """Runs the trials of one edge: ``job`` = (object path, grasp name, action name, the
-    action's params (a dict: place-repick's ``target``), settings, robot[, start poses, key]):
-    with start poses (a chain's), the worlds of :func:`chained_perturbations` under ``key``."""
+    action's params (a dict: place-repick's ``target``), settings, robot[, ends]): with ``ends``
+    (a chain's: :meth:`Edge.ends` of the edge before), the worlds of :func:`continuations`."""
     from .actions import action
     from .trial import REFUSED, Runner
 
@@ -353,7 +356,7 @@ def run_edge(job: tuple) -> Edge:
     outcomes: dict = {}
     runs: list = []
     if chain:
-        worlds = chained_perturbations(settings, chain[1], chain[0])
+        worlds = continuations(chain[0])
     else:
         worlds = perturbations(settings, "/".join([grasp_name, action_name, *(str(v) for v in params.values())]))
     for i, p in enumerate(worlds):
@@ -366,23 +369,17 @@ def run_edge(job: tuple) -> Edge:
                             time.perf_counter() - t0)
             outcome, pose = REFUSED, None  # this world only (e.g. a grip beyond the gripper's range)
         outcomes[outcome] = outcomes.get(outcome, 0) + 1
-        runs.append((outcome, pose))
+        runs.append((outcome, pose, (p.friction, p.grip, p.mass)))
     detail = {k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in setup.detail.items()}
-    return Edge(grasp_name, action_name, setup.intended, settings.trials, outcomes, detail, time.perf_counter() - t0,
+    return Edge(grasp_name, action_name, setup.intended, len(worlds), outcomes, detail, time.perf_counter() - t0,
                 runs)
 
 
 def chains_to_measure(edges: list) -> list:
-    """(after, edge, start poses) of every pair of measured edges where ``after`` reached the
-    grasp ``edge`` starts from in some run (its end poses there: the starts)."""
-    out = []
-    for i, a in enumerate(edges):
-        for j, e in enumerate(edges):
-            if e.trials and e.source != a.source and a.outcomes.get(e.source, 0):
-                starts = a.ends(e.source)
-                if starts:
-                    out.append((i, j, starts))
-    return out
+    """(after, edge) of every pair of measured edges where ``after`` reached the grasp ``edge``
+    starts from in some run."""
+    return [(i, j) for i, a in enumerate(edges) for j, e in enumerate(edges)
+            if e.trials and e.source != a.source and a.ends(e.source)]
 
 
 def fitting(scene, taxonomy, robot: str | None = None) -> dict:
@@ -476,27 +473,21 @@ def build_graph(path, settings: Settings = Settings(), workers: int = 1, ray_add
 
 
 def _chain(path: str, edges: list, settings: Settings, workers: int, ray_address, robot, progress: bool) -> list:
-    """The :class:`Chain` of every pair of :func:`chains_to_measure` (``settings.trials`` runs each)."""
+    """The :class:`Chain` of every pair of :func:`chains_to_measure`."""
     todo = chains_to_measure(edges)
-    key = lambda i: "/".join([edges[i].source, edges[i].action, str(edges[i].target)])  # noqa: E731
-    jobs, index = [], {}
-    for i, j, starts in todo:
-        name = f"chain/{key(i)}/then/{key(j)}"
-        index[name] = (i, j, len(starts))
-        jobs.append((path, edges[j].source, edges[j].action, edges[j].params, settings, robot,
-                     [tuple(float(x) for x in p) for p in starts], name))
+    jobs = [(path, edges[j].source, edges[j].action, edges[j].params, settings, robot,
+             edges[i].ends(edges[j].source), (i, j)) for i, j in todo]
     done: dict = {}
-    with bars.bar(len(jobs) * settings.trials, "chained", unit="trial", show=progress) as bar:
-        def take(e_name: tuple) -> None:
-            e, name = e_name
-            i, j, n = index[name]
-            done[(i, j)] = Chain(i, j, e.trials, e.outcomes, n, e.seconds)
-            bar.update(settings.trials)
+    with bars.bar(sum(len(j[6]) for j in jobs), "chained", unit="trial", show=progress) as bar:
+        def take(result: tuple) -> None:
+            e, (i, j) = result
+            done[(i, j)] = Chain(i, j, e.trials, e.outcomes, e.seconds)
+            bar.update(e.trials)
 
         _each(run_chain, jobs, workers, ray_address, take)
-    return [done[(i, j)] for i, j, _ in todo]
+    return [done[k] for k in todo]
 
 
 def run_chain(job: tuple) -> tuple:
-    """(the :func:`run_edge` of a chain's ``job``, the chain's key)."""
-    return run_edge(job), job[-1]
+    """(the :func:`run_edge` of a chain's ``job``, its (after, edge))."""
+    return run_edge(job[:7]), job[7]
