@@ -309,7 +309,8 @@ def test_a_chained_graph_continues_each_run_that_reached_a_grasp_with_each_actio
     c = g.chained[0]
     ends = g.edges[c.after].ends(g.edges[c.edge].source)
     e = g.edges[c.edge]
-    again = run_edge((path, e.source, e.action, e.params, Settings(), None, ends))
+    a = g.edges[c.after]
+    again = run_edge((path, e.source, e.action, e.params, Settings(), None, ends, (a.source, a.action, a.params)))
     assert again.outcomes == c.outcomes and again.trials == c.trials
     back = GraspGraph.load(g.save(tmp_path / "g.json"))
     assert back.to_dict() == g.to_dict()
@@ -686,7 +687,7 @@ def test_a_transfer_the_arm_cannot_turn_in_place_goes_through_the_hand_level_abo
     # the straight turn has no IK; the transfer lifts the hand and turns it level on the way
     from regrasp.dexterity.actions import WORK_POINT, hand_pose
     from regrasp.dexterity.objects import load_object
-    from regrasp.dexterity.sequence import TRANSFER_LIFT, _line, transfer
+    from regrasp.dexterity.trial import TRANSFER_LIFT, _line, transfer
     from regrasp.dexterity.taxonomy import taxonomy_of
     from regrasp.dexterity.world import HandWorld, solve_path
     from regrasp.robot.ik import IKError

@@ -171,7 +171,8 @@ def _runs(runs, f: str, trials: int, outcomes: dict) -> list:
 class Chain:
     """Runs of ``edges[edge]`` continuing those of ``edges[after]`` that reached ``edge``'s
     grasp: each starts from one such run's end pose in the hand, in that run's world (its pads'
-    friction, grip force and mass), once: ``trials`` (= ``after``'s count of that grasp),
+    friction, grip force and mass), with the hand where ``after``'s action ended, moving to
+    ``edge``'s start as a sequence does, once: ``trials`` (= ``after``'s count of that grasp),
     ``outcomes`` {outcome: count}, ``seconds`` of wall time."""
 
     after: int
@@ -342,8 +343,11 @@ def continuations(ends: list) -> list:
 
 def run_edge(job: tuple) -> Edge:
     """Runs the trials of one edge: ``job`` = (object path, grasp name, action name, the
-    action's params (a dict: place-repick's ``target``), settings, robot[, ends]): with ``ends``
-    (a chain's: :meth:`Edge.ends` of the edge before), the worlds of :func:`continuations`."""
+    action's params (a dict: place-repick's ``target``), settings, robot[, ends, before]): a
+    chain's, with ``ends`` (:meth:`Edge.ends` of the edge before) the worlds of
+    :func:`continuations`, each run starting where the action ``before`` (its grasp, name and
+    params) ends and moving to this one's start as a sequence does (:class:`~.trial.Runner`'s
+    lead-in)."""
     from .actions import action
     from .trial import REFUSED, Runner
 
@@ -352,7 +356,11 @@ def run_edge(job: tuple) -> Edge:
     grasp = tax.grasp(grasp_name)
     t0 = time.perf_counter()
     setup = action(action_name).setup(obj, grasp, params)
-    runner = Runner(scene, tax, grasp, setup, robot)
+    lead_in = None
+    if chain:
+        source, name, before = chain[1]
+        lead_in = (action(name).setup(obj, tax.grasp(source), before).path.poses[-1], obj.grip)
+    runner = Runner(scene, tax, grasp, setup, robot, lead_in)
     outcomes: dict = {}
     runs: list = []
     if chain:
@@ -475,8 +483,8 @@ def build_graph(path, settings: Settings = Settings(), workers: int = 1, ray_add
 def _chain(path: str, edges: list, settings: Settings, workers: int, ray_address, robot, progress: bool) -> list:
     """The :class:`Chain` of every pair of :func:`chains_to_measure`."""
     todo = chains_to_measure(edges)
-    jobs = [(path, edges[j].source, edges[j].action, edges[j].params, settings, robot,
-             edges[i].ends(edges[j].source), (i, j)) for i, j in todo]
+    jobs = [(path, edges[j].source, edges[j].action, edges[j].params, settings, robot, edges[i].ends(edges[j].source),
+             (edges[i].source, edges[i].action, edges[i].params), (i, j)) for i, j in todo]
     done: dict = {}
     with bars.bar(sum(len(j[6]) for j in jobs), "chained", unit="trial", show=progress) as bar:
         def take(result: tuple) -> None:
@@ -490,4 +498,4 @@ def _chain(path: str, edges: list, settings: Settings, workers: int, ray_address
 
 def run_chain(job: tuple) -> tuple:
     """(the :func:`run_edge` of a chain's ``job``, its (after, edge))."""
-    return run_edge(job[:7]), job[7]
+    return run_edge(job[:8]), job[8]

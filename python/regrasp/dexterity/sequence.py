@@ -14,18 +14,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Optional
 
 import numpy as np
 
 from ..errors import ArgumentError
 from ..extras import need
 from .graph import GraspGraph
-from .trial import DROPPED, OTHER, REFUSED, UNSTABLE
+from .trial import REFUSED, TRANSFER_SETTLE, transfer
 
 OBJECTIVES = ("reliable", "expected")
-TRANSFER_SPEED = 0.25  # m/s, the hand's move between two actions (and 1 rad/s turning)
-TRANSFER_LIFT = 0.1  # m, a move between two actions that cannot turn the hand in place turns it this much higher
 
 
 @dataclass(frozen=True)
@@ -147,39 +144,10 @@ class SequenceRun:
         return {"outcomes": list(self.outcomes), "success": self.success}
 
 
-def _line(a, b) -> "HandPath":
-    """The hand's move from world pose ``a`` to ``b`` at :data:`TRANSFER_SPEED` (and 1 rad/s)."""
-    from ..pose import quat_angle
-    from .world import HandPath
-
-    return HandPath.line(a, b, max(0.5, float(np.linalg.norm(a[:3] - b[:3])) / TRANSFER_SPEED, quat_angle(a[3:], b[3:])))
-
-
-def transfer(robot, here, start) -> tuple:
-    """(the hand's path, the arm's joint path) between two actions, from TCP pose ``here`` to
-    ``start``: straight, or else (a turn the arm cannot make in place, e.g. fingers up to
-    fingers down) through the hand level :data:`TRANSFER_LIFT` above the higher end, turned one
-    way or the other. An IKError (ArgumentError) when none can be followed."""
-    from .actions import hand_pose
-    from .world import solve_path
-
-    here, start = np.asarray(here, float), np.asarray(start, float)
-    ways = [None] + [hand_pose(a, ((here[0] + start[0]) / 2, (here[1] + start[1]) / 2,
-                                   max(here[2], start[2]) + TRANSFER_LIFT)) for a in (np.pi / 2, -np.pi / 2)]
-    error: Optional[ArgumentError] = None
-    for way in ways:
-        path = _line(here, start) if way is None else _line(here, way).then(_line(way, start))
-        try:
-            return path, solve_path(robot, path, robot.q)
-        except ArgumentError as e:
-            error = error or e
-    raise error  # type: ignore[misc]
-
-
 def execute(path, sequence: Sequence, perturbation=None, robot: str | None = None, observe=None) -> SequenceRun:
     """Runs ``sequence`` on the object file ``path`` in MuJoCo, open loop: the world built at the
     first grasp and the first action's start; before each later action the hand moves to its
-    start (:data:`TRANSFER_SPEED`, grip firm); each action set up for the grasp the plan expects
+    start (:func:`~.trial.transfer`, grip firm); each action set up for the grasp the plan expects
     there (with its measured parameters: a re-pick's target). Stops at the first step that misses
     its target; a step the arm cannot reach from where the last one left it (IK) ends the run as
     ``refused``."""
@@ -203,7 +171,7 @@ def execute(path, sequence: Sequence, perturbation=None, robot: str | None = Non
         try:
             if i > 0:
                 move, q_move = transfer(world.robot, world.robot.tcp_pose(), setup.start)
-                world.follow(move, q_move, constant(obj.grip), 0.2, observe)
+                world.follow(move, q_move, constant(obj.grip), TRANSFER_SETTLE, observe)
             q = solve_path(world.robot, setup.path, world.robot.q)
         except ArgumentError:  # the arm cannot go on from where the last action left it (IK)
             return SequenceRun((*outcomes, REFUSED), False)

@@ -5,7 +5,8 @@ object, ``other`` when it is held but farther than the classification tolerance 
 grasp (:data:`TOLERANCE` of the object's size), ``unstable`` when MuJoCo's integration blew up
 (it then resets the state: nothing after it is the action's doing; a failed run), ``refused``
 when the action could not be set up in that world (e.g. a perturbed grip force beyond the
-gripper's range; a failed run)."""
+gripper's range; a failed run). A trial may begin where another action ended: the hand moves to
+the action's start (:func:`transfer`, as between two actions of a sequence) first."""
 
 from __future__ import annotations
 
@@ -15,10 +16,14 @@ from typing import Optional
 
 import numpy as np
 
-from .world import HandWorld, Perturbation, solve_path
+from ..errors import ArgumentError
+from .world import HandPath, HandWorld, Perturbation, constant, solve_path
 
 DROPPED, OTHER, UNSTABLE, REFUSED = "dropped", "other", "unstable", "refused"
 TOLERANCE = 0.15  # the classification tolerance: this share of the object's size (its hull's largest extent) [m/m]
+TRANSFER_SPEED = 0.25  # m/s, the hand's move between two actions (and 1 rad/s turning)
+TRANSFER_LIFT = 0.1  # m, a move between two actions that cannot turn the hand in place turns it this much higher
+TRANSFER_SETTLE = 0.2  # s, the hand held still at the end of a move between two actions
 
 
 @dataclass(frozen=True)
@@ -55,28 +60,66 @@ def classify(world: HandWorld, taxonomy) -> tuple:
     return (name if dist <= tolerance(taxonomy) else OTHER), float(dist), pose
 
 
+def _line(a, b) -> "HandPath":
+    """The hand's move from world pose ``a`` to ``b`` at :data:`TRANSFER_SPEED` (and 1 rad/s)."""
+    from ..pose import quat_angle
+
+    return HandPath.line(a, b, max(0.5, float(np.linalg.norm(a[:3] - b[:3])) / TRANSFER_SPEED, quat_angle(a[3:], b[3:])))
+
+
+def transfer(robot, here, start) -> tuple:
+    """(the hand's path, the arm's joint path) between two actions, from TCP pose ``here`` to
+    ``start``: straight, or else (a turn the arm cannot make in place, e.g. fingers up to
+    fingers down) through the hand level :data:`TRANSFER_LIFT` above the higher end, turned one
+    way or the other. An IKError (ArgumentError) when none can be followed."""
+    from .actions import hand_pose
+
+    here, start = np.asarray(here, float), np.asarray(start, float)
+    ways = [None] + [hand_pose(a, ((here[0] + start[0]) / 2, (here[1] + start[1]) / 2,
+                                   max(here[2], start[2]) + TRANSFER_LIFT)) for a in (np.pi / 2, -np.pi / 2)]
+    error: Optional[ArgumentError] = None
+    for way in ways:
+        path = _line(here, start) if way is None else _line(here, way).then(_line(way, start))
+        try:
+            return path, solve_path(robot, path, robot.q)
+        except ArgumentError as e:
+            error = error or e
+    raise error  # type: ignore[misc]
+
+
 class Runner:
     """Runs trials of one action's :class:`~.actions.Setup` on one grasp of ``scene``: the arm's
-    joint path is solved once (IK in the nominal world) and reused by every trial."""
+    joint path is solved once (IK in the nominal world) and reused by every trial. With
+    ``lead_in`` (a TCP pose (7,), a grip force [N]) each trial starts with the hand there (where
+    the action before it ended) and moves to the action's start by :func:`transfer` at that grip."""
 
-    def __init__(self, scene, taxonomy, grasp, setup, robot: str | None = None):
+    def __init__(self, scene, taxonomy, grasp, setup, robot: str | None = None, lead_in: tuple | None = None):
         self.scene, self.taxonomy, self.grasp, self.setup, self.robot = scene, taxonomy, grasp, setup, robot
+        self.lead_in = lead_in
         self._world: Optional[HandWorld] = None
         self.q: Optional[np.ndarray] = None
+        self.move: Optional[tuple] = None
 
     def world(self, perturbation: Perturbation = Perturbation()) -> HandWorld:
-        """The world of a trial, at the action's start: compiled and the arm's path solved (IK)
-        on first use, reset after."""
+        """The world of a trial, at its start: compiled and the arm's paths solved (IK) on first
+        use, reset after."""
         if self._world is None:
-            self._world = HandWorld(self.scene, self.grasp.pose, self.setup.start, perturbation, self.robot)
-            self.q = solve_path(self._world.robot, self.setup.path, self._world.robot.q)
-            return self._world
+            hand = self.setup.start if self.lead_in is None else np.asarray(self.lead_in[0], float)
+            self._world = w = HandWorld(self.scene, self.grasp.pose, hand, perturbation, self.robot)
+            q = w.robot.q
+            if self.lead_in is not None:
+                self.move = transfer(w.robot, w.robot.tcp_pose(), self.setup.start)
+                q = self.move[1][-1]
+            self.q = solve_path(w.robot, self.setup.path, q)
+            return w
         return self._world.reset(perturbation)
 
     def run(self, perturbation: Perturbation = Perturbation(), observe=None) -> TrialResult:
         """One trial in the world ``perturbation`` (``observe(world)``: called every control period)."""
         t0 = time.perf_counter()
         w = self.world(perturbation)
+        if self.move is not None:
+            w.follow(*self.move, constant(float(self.lead_in[1])), TRANSFER_SETTLE, observe)
         w.follow(self.setup.path, self.q, self.setup.grip, self.setup.settle, observe)
         outcome, dist, pose = classify(w, self.taxonomy)
         return TrialResult(outcome, dist, pose, time.perf_counter() - t0)
