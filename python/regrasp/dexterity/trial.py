@@ -105,12 +105,10 @@ class Runner:
         use, reset after."""
         if self._world is None:
             hand = self.setup.start if self.lead_in is None else np.asarray(self.lead_in[0], float)
-            self._world = w = HandWorld(self.scene, self.grasp.pose, hand, perturbation, self.robot)
-            q = w.robot.q
-            if self.lead_in is not None:
-                self.move = transfer(w.robot, w.robot.tcp_pose(), self.setup.start)
-                q = self.move[1][-1]
-            self.q = solve_path(w.robot, self.setup.path, q)
+            w = HandWorld(self.scene, self.grasp.pose, hand, perturbation, self.robot)
+            move = None if self.lead_in is None else transfer(w.robot, w.robot.tcp_pose(), self.setup.start)
+            self.q = solve_path(w.robot, self.setup.path, w.robot.q if move is None else move[1][-1])
+            self._world, self.move = w, move  # only once every path is solved: an IK error leaves none
             return w
         return self._world.reset(perturbation)
 
