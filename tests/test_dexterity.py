@@ -658,6 +658,7 @@ def test_the_cli_measures_a_graph_and_plans_on_it(tmp_path):
     assert r.returncode == 0, r.stderr
     s = json.loads(r.stdout)["sequence"]
     assert s["steps"][0]["from"] == e["from"] and s["steps"][-1]["to"] == e["to"] and 0 < s["probability"] <= 1
+    assert 0 < s["independent"] <= 1 and all({"chained", "alone", "params"} <= set(x) for x in s["steps"])
 
 
 @pytest.mark.parametrize("args, field", [
