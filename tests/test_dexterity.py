@@ -255,6 +255,8 @@ def test_the_most_reliable_chained_sequence_is_the_brute_force_one(raw, raw_chai
     (lambda d: d["chained"][0].update(trials=19, outcomes={"g3": 19}), "chained[0].trials"),
     (lambda d: d["edges"][0]["runs"][0].update(world=[1.0, 0.0, 1.0]), "edges[0].runs[0]"),
     (lambda d: d.update(chained={}), "chained"),
+    (lambda d: d["chained"][0].update(outcomes={"g3": 2, "g9": 18}), "chained[0].outcomes"),
+    (lambda d: d["chained"].append(dict(d["chained"][0])), "chained[1]"),
     (lambda d: d["edges"][0]["runs"].pop(), "edges[0].runs"),
     (lambda d: d["edges"][0]["runs"][0].update(pose=[0.0] * 6), "edges[0].runs[0]"),
     (lambda d: d["edges"][0]["runs"][0].update(outcome="g2"), "edges[0].runs"),

@@ -187,9 +187,10 @@ class Chain:
                 "seconds": self.seconds}
 
     @classmethod
-    def from_dict(cls, d, i: int, edges: list) -> "Chain":
-        """The chain of a graph file's ``chained[i]`` ``d`` over its ``edges``; an ArgumentError
-        naming the field."""
+    def from_dict(cls, d, i: int, edges: list, names=()) -> "Chain":
+        """The chain of a graph file's ``chained[i]`` ``d`` over its ``edges`` (``names``: the
+        nodes', which an outcome other than dropped, other, unstable or refused must be); an
+        ArgumentError naming the field."""
         f = f"chained[{i}]"
         if not isinstance(d, dict):
             raise ArgumentError(f"invalid `{f}`: an object (got {type(d).__name__})", f)
@@ -208,11 +209,14 @@ class Chain:
         if d["trials"] != arrived:
             raise ArgumentError(f"invalid `{f}.trials`: one run per run of edge {d['after']} that reached "
                                 f"{edges[d['edge']].source!r} ({arrived}; got {d['trials']!r:.40})", f"{f}.trials")
+        from .trial import DROPPED, OTHER, REFUSED, UNSTABLE
+
         out = d["outcomes"]
+        known = set(names) | {DROPPED, OTHER, UNSTABLE, REFUSED}
         if not isinstance(out, dict) or not all(isinstance(k, str) and whole(v) for k, v in out.items()) \
-                or sum(out.values()) != d["trials"]:
-            raise ArgumentError(f"invalid `{f}.outcomes`: {{outcome: whole number >= 0}} adding up to `trials`",
-                                f"{f}.outcomes")
+                or sum(out.values()) != d["trials"] or set(out) - known:
+            raise ArgumentError(f"invalid `{f}.outcomes`: {{outcome (a grasp, dropped, other, unstable or refused): "
+                                f"whole number >= 0}} adding up to `trials`", f"{f}.outcomes")
         seconds = d.get("seconds", 0.0)
         if not isinstance(seconds, (int, float)) or isinstance(seconds, bool):
             raise ArgumentError(f"invalid `{f}.seconds`: a number", f"{f}.seconds")
@@ -281,7 +285,12 @@ class GraspGraph:
                     raise ArgumentError(f"invalid `edges[{i}].{key}`: {v!r} is not a node", f"edges[{i}].{key}")
         if not isinstance(d.get("chained", []), list):
             raise ArgumentError("invalid `chained`: a JSON array", "chained")
-        chained = [Chain.from_dict(c, i, edges) for i, c in enumerate(d.get("chained", []))]
+        chained = [Chain.from_dict(c, i, edges, names) for i, c in enumerate(d.get("chained", []))]
+        pairs = [(c.after, c.edge) for c in chained]
+        if len(set(pairs)) != len(pairs):
+            i = next(k for k, p in enumerate(pairs) if p in pairs[:k])
+            raise ArgumentError(f"invalid `chained[{i}]`: a second chain of edge {pairs[i][1]} after edge "
+                                f"{pairs[i][0]}", f"chained[{i}]")
         return cls(dict(d["object"]), list(d["nodes"]), edges, list(d["actions"]), dict(d["settings"]), float(seconds),
                    chained)
 
