@@ -80,7 +80,11 @@ class Scene:
         """Grip force per finger [N] (None on a surface)."""
     @property
     def friction_scale(self) -> float:
-        """Factor on every pusher's friction (1 unless scaled)."""
+        """The support's friction force capacity [N]: 2μN between the pads, μ·m·g·cos(incline) on
+        a surface (what the motion cones scale the pushers' wrenches by)."""
+    @property
+    def pad_friction(self) -> float | None:
+        """The finger pads' Coulomb coefficient μ (None on a surface)."""
     @property
     def outline(self) -> _Floats:
         """Vertices of the outline in the object frame [m], shape (n, 2)."""
@@ -95,6 +99,10 @@ class Scene:
     @property
     def task(self) -> tuple[list[float], list[float], list[float]] | None:
         """(start, goal, tolerance) or None."""
+    def goal_error(self, pose: ArrayLike, goal: ArrayLike | None = None) -> tuple[list[float], bool]:
+        """The error `pose − goal` `[x, z, theta]` (m, m, rad; theta wrapped into [−π, π)) and
+        whether it is within the task's tolerance (the default tolerance without a task);
+        `goal` defaults to the task's."""
     def admissible(self, pose: ArrayLike) -> bool:
         """Whether the whole finger pad lies on the object at `pose` `[x, z, theta]` (m, m, rad)."""
     def admissible_many(self, poses: ArrayLike) -> _Bools:
@@ -334,6 +342,9 @@ class Scene3D:
         """Pusher `name`'s normal as the scene gives it (object frame; a plane's: gripper frame)."""
     def is_plane(self, name: str) -> bool:
         """Whether pusher `name` is a plane (its normal fixed in the gripper frame)."""
+    def goal_error(self, pose: ArrayLike, goal: ArrayLike | None = None) -> tuple[list[float], bool]:
+        """The error of `pose` `[x, y, z, qw, qx, qy, qz]` to `goal` (default: the task's),
+        `[dx, dy, dz, angle]` (m, m, m, rad), and whether it is within the task's tolerance."""
     @property
     def sphere(self) -> float | None:
         """The sphere's radius, for a spherical object (else None)."""

@@ -520,7 +520,7 @@ def run_mncp(reps: int = 11, ref_reps: int = 3) -> dict:
     from .reference import mncp as mncp_reference
 
     scene = Scene.load(bundled.path("block-low-friction"))
-    p = scene._core.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, 4, False)
+    p = scene.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, 4, False, None, None)
     out = {}
     for name, u in (("stick", [0.01, 0.0, 0.0]), ("slide", [0.002, 0.01, 0.0]), ("separate", [-0.01, 0.0, 0.2])):
         fast = p.solve_forward(u)
@@ -562,7 +562,7 @@ def run_mncp_scaling(points=SCALING_POINTS, reps: int = 5) -> dict:
     scene = Scene.load(bundled.path("block-low-friction"))
     rows = []
     for n in points:
-        p = scene._core.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, max(1, n // 2), False)
+        p = scene.quasistatic_problem([0.0, 0.0, 0.0], "left", "points", 0, max(1, n // 2), False, None, None)
         row = {"points": int(n)}
         for name, u in SCALING_PUSHES:
             m = max(1, 200 // n)

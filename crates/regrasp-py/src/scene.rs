@@ -77,8 +77,17 @@ impl Scene {
     #[getter] fn gravity(&self) -> (f64, f64, f64) { (self.inner.gravity_dir.x, self.inner.gravity_dir.y, self.inner.g) }
     /// Grip force per finger [N] (None on a surface).
     #[getter] fn grip_force(&self) -> Option<f64> { self.inner.grip_force() }
-    /// Factor on every pusher's friction (1 unless scaled).
+    /// The support's friction force capacity [N]: 2μN between the pads, μ·m·g·cos(incline) on
+    /// a surface (what the motion cones scale the pushers' wrenches by).
     #[getter] fn friction_scale(&self) -> f64 { self.inner.friction_scale() }
+    /// The finger pads' Coulomb coefficient μ (None on a surface).
+    #[getter]
+    fn pad_friction(&self) -> Option<f64> {
+        match &self.inner.support {
+            Support::Grasp(g) => Some(g.friction),
+            Support::Surface(_) => None,
+        }
+    }
     /// Vertices of the outline in the object frame [m], shape (n, 2).
     #[getter]
     fn outline<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
@@ -117,6 +126,21 @@ impl Scene {
     fn admissible(&self, pose: &Arg<'_>) -> PyResult<bool> {
         guard(move || {
             Ok(self.inner.admissible(&pose3("pose", pose)?))
+        })
+    }
+
+    /// The error `pose − goal` `[x, z, theta]` (m, m, rad; theta wrapped into [−π, π)) and
+    /// whether it is within the task's tolerance (the default tolerance without a task);
+    /// `goal` defaults to the task's.
+    #[pyo3(signature = (pose, goal=None))]
+    fn goal_error(&self, pose: &Arg<'_>, goal: Option<&Arg<'_>>) -> PyResult<([f64; 3], bool)> {
+        guard(move || {
+            let q = pose3("pose", pose)?;
+            let g = match goal {
+                Some(g) => pose3("goal", g)?,
+                None => self.inner.task.map(|t| t.goal).ok_or_else(|| arg_err("goal", "the scene has no task: give a goal"))?,
+            };
+            Ok(regrasp::scene::planar::goal_error(&q, &g, &self.inner.tolerance()))
         })
     }
 

@@ -88,6 +88,15 @@ impl Scene3D {
             Ok(self.inner.pushers[self.index(name)?].plane)
         })
     }
+    /// The error of `pose` `[x, y, z, qw, qx, qy, qz]` to `goal` (default: the task's),
+    /// `[dx, dy, dz, angle]` (m, m, m, rad), and whether it is within the task's tolerance.
+    #[pyo3(signature = (pose, goal=None))]
+    fn goal_error(&self, pose: &Arg<'_>, goal: Option<&Arg<'_>>) -> PyResult<([f64; 4], bool)> {
+        guard(move || {
+            let g = optional(goal, |v| pose7("goal", v))?.unwrap_or(self.inner.goal);
+            Ok(regrasp::scene::spatial::goal_error(&pose7("pose", pose)?, &g, &self.inner.tolerance))
+        })
+    }
     /// The sphere's radius, for a spherical object (else None).
     #[getter] fn sphere(&self) -> Option<f64> { self.inner.sphere }
     /// T-RRT* over SE(3) with inverse-dynamics unit steps (`regrasp::planning::spatial`):

@@ -163,7 +163,6 @@ class ControlRun:
         task = scene.task
         self.scene, self.policy, self.engine, self.noise, self.dt = scene, policy, engine, noise, dt
         self.goal = np.asarray(task.goal if task is not None else poses[-1], float)
-        self.tol = np.asarray(task.tolerance if task is not None else [1e-3, 1e-3, 0.0175], float)
         cscene = controller_scene or scene
         self.ctrl = _core.Mpc(cscene._core, poses, [k["pusher"] for k in path], self.goal.tolist(), dt=dt,
                               horizon=horizon, speed=speed, seed=check_seed(seed), **mpc)
@@ -279,8 +278,8 @@ class ControlRun:
             self.qs.append(q)
             ref = self.refs[-1] if self.refs else self.knots[-1]
             self._record(ref, self.statuses[-1] if self.statuses else "", None)
-        err = q - self.goal
-        ok = bool(np.all(np.abs(err) <= self.tol)) and not self.world_failed
+        err, ok = self.scene.goal_error(q, self.goal)
+        ok = ok and not self.world_failed
         failure = self.failure
         if not ok and not failure:
             failure = "time out" if self.t > self.max_time else "ended outside the tolerance"

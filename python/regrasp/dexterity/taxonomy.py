@@ -203,11 +203,11 @@ def taxonomy_of(scene, **kw) -> Taxonomy:
     ``kw``: :func:`taxonomy`'s ``width_range``, ``offsets``, ``pad``, ``lateral`` (default the
     object file's ``[taxonomy] lateral`` when the scene was loaded by
     :func:`regrasp.dexterity.objects.load_object`; none for a scene loaded otherwise)."""
-    kw.setdefault("pad", pad_disc(float(scene._core.pad_radius)))
+    kw.setdefault("pad", pad_disc(float(scene.pad_radius)))
     kw.setdefault("lateral", getattr(scene, "taxonomy_lateral", LATERAL))
-    return taxonomy(np.asarray(scene.mesh()[0], float), float(scene.mass), np.asarray(scene._core.com, float),
-                    float(scene._core.grip_force), float(scene._core.grip_friction),
-                    float(np.linalg.norm(scene._core.gravity)), **kw)
+    return taxonomy(np.asarray(scene.mesh()[0], float), float(scene.mass), scene.com,
+                    float(scene.grip_force), float(scene.pad_friction),
+                    float(np.linalg.norm(scene.gravity)), **kw)
 
 
 def grasp_distance(vertices, a, b) -> float:
@@ -532,3 +532,14 @@ def _pose(v) -> np.ndarray:
     if q.shape != (7,) or abs(np.linalg.norm(q[3:]) - 1) > 1e-6:
         raise ValueError(v)
     return q
+
+
+#: The classification tolerance: this share of the object's size (its hull's largest extent)
+#: [m/m]; a trial ends in a grasp when within it (:mod:`.trial`).
+CLASSIFICATION_TOLERANCE = 0.15
+
+
+def classification_tolerance(taxonomy) -> float:
+    """The classification tolerance [m] of ``taxonomy``'s object."""
+    v = np.asarray(taxonomy.vertices, float)
+    return CLASSIFICATION_TOLERANCE * float(np.max(np.ptp(v, axis=0)))

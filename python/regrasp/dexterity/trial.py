@@ -17,10 +17,10 @@ from typing import Optional
 import numpy as np
 
 from ..errors import ArgumentError
-from .world import HandPath, HandWorld, Perturbation, constant, solve_path
+from .taxonomy import CLASSIFICATION_TOLERANCE as TOLERANCE, classification_tolerance as tolerance
+from .world import HandPath, HandWorld, Perturbation, constant, hand_pose, solve_path
 
 DROPPED, OTHER, UNSTABLE, REFUSED = "dropped", "other", "unstable", "refused"
-TOLERANCE = 0.15  # the classification tolerance: this share of the object's size (its hull's largest extent) [m/m]
 TRANSFER_SPEED = 0.25  # m/s, the hand's move between two actions (and 1 rad/s turning)
 TRANSFER_LIFT = 0.1  # m, a move between two actions that cannot turn the hand in place turns it this much higher
 TRANSFER_SETTLE = 0.2  # s, the hand held still at the end of a move between two actions
@@ -41,12 +41,6 @@ class TrialResult:
         """The trial as JSON."""
         return {"outcome": self.outcome, "distance": None if not np.isfinite(self.distance) else float(self.distance),
                 "pose": None if self.pose is None else [float(x) for x in self.pose], "seconds": float(self.seconds)}
-
-
-def tolerance(taxonomy) -> float:
-    """The classification tolerance [m] of ``taxonomy``'s object."""
-    v = np.asarray(taxonomy.vertices, float)
-    return TOLERANCE * float(np.max(np.ptp(v, axis=0)))
 
 
 def classify(world: HandWorld, taxonomy) -> tuple:
@@ -72,8 +66,6 @@ def transfer(robot, here, start) -> tuple:
     ``start``: straight, or else (a turn the arm cannot make in place, e.g. fingers up to
     fingers down) through the hand level :data:`TRANSFER_LIFT` above the higher end, turned one
     way or the other. An IKError (ArgumentError) when none can be followed."""
-    from .actions import hand_pose
-
     here, start = np.asarray(here, float), np.asarray(start, float)
     ways = [None] + [hand_pose(a, ((here[0] + start[0]) / 2, (here[1] + start[1]) / 2,
                                    max(here[2], start[2]) + TRANSFER_LIFT)) for a in (np.pi / 2, -np.pi / 2)]

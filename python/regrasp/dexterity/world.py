@@ -195,7 +195,7 @@ class HandWorld:
 
         try:
             self.robot = build(robot or DEFAULT_ROBOT, pads=Pads.of_scene(scene),
-                               pad_friction=float(scene._core.grip_friction), grasp_width=width, add=add)
+                               pad_friction=float(scene.pad_friction), grasp_width=width, add=add)
         except ArgumentError as e:
             if e.field == "grasp_width":
                 raise ArgumentError(f"invalid `grasp`: the object is {width * 1e3:.1f} mm wide across it; the "
@@ -223,7 +223,7 @@ class HandWorld:
         r = self.robot
         m, d = r.model, r.data
         self.perturbation = perturbation
-        self.grip_force = float(self.scene._core.grip_force) * perturbation.grip
+        self.grip_force = float(self.scene.grip_force) * perturbation.grip
         friction, mass, inertia = self.nominal
         m.geom_friction[self.pads, 0] = friction * perturbation.friction
         m.body_mass[self.body], m.body_inertia[self.body] = mass * perturbation.mass, inertia * perturbation.mass
@@ -410,7 +410,7 @@ def hand_clearances(scene, grasps, robot: str | None = None) -> dict:
     for g in grasps:
         width = round(grasp_of(scene, g.pose)[0], 9)
         if width not in models:
-            r = build(robot or DEFAULT_ROBOT, pads=Pads.of_scene(scene), pad_friction=float(scene._core.grip_friction),
+            r = build(robot or DEFAULT_ROBOT, pads=Pads.of_scene(scene), pad_friction=float(scene.pad_friction),
                       grasp_width=width, add=lambda spec: add_object3d(spec, scene, np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]), mesh, 1.0))
             close_fingers(r)
             models[width] = r
@@ -424,7 +424,7 @@ def finger_reach(scene, robot: str | None = None) -> float:
     """How far [m] the gripper's lowest colliding part (a pad's grid, a finger's tip link) reaches
     below the TCP along the fingers, closed, with ``scene``'s pads: measured once per pad model
     (the arm's IK keeps it ``MIN_DISTANCE`` off the table)."""
-    return _finger_reach(float(scene._core.pad_radius), float(scene._core.grip_friction), robot or "")
+    return _finger_reach(float(scene.pad_radius), float(scene.pad_friction), robot or "")
 
 
 @lru_cache(maxsize=16)
@@ -440,3 +440,11 @@ def _finger_reach(pad_radius: float, friction: float, robot: str) -> float:
     height = 0.04  # m, the TCP above the table: the fingers within the distance query's reach
     q = solve_ik(r, np.array([WORK_POINT[0], WORK_POINT[1], height, 1.0, 0.0, 0.0, 0.0]), r.q)
     return float(height - table_distance(r, q))
+
+
+def hand_pose(alpha: float, point=WORK_POINT) -> np.ndarray:
+    """The TCP's world pose at ``point`` [m] with the grasp axis along the world's y and the
+    hand's x at angle ``alpha`` [rad] from the world's x towards its z (0: fingers down)."""
+    x = np.array([np.cos(alpha), 0.0, np.sin(alpha)])
+    y = np.array([0.0, 1.0, 0.0])
+    return np.concatenate([np.asarray(point, float), P.quat_from_matrix(np.column_stack([x, y, np.cross(x, y)]))])

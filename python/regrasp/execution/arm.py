@@ -108,7 +108,7 @@ def grasp_of(scene, in_hand) -> tuple[float, float]:
 
     if scene.dimension == 2:
         return THICKNESS, 0.0
-    R = scene._core.sphere
+    R = scene.sphere
     if R:
         return 2 * R, float(in_hand[1])
     v = np.asarray(scene.mesh()[0], float)
@@ -117,7 +117,7 @@ def grasp_of(scene, in_hand) -> tuple[float, float]:
 
 
 def _pad_friction(scene) -> float:
-    return scene._core.friction_scale / (2 * scene.grip_force) if scene.dimension == 2 else scene._core.grip_friction
+    return scene.pad_friction
 
 
 def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Scales = Scales(), pads=None):

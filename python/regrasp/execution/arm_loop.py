@@ -245,15 +245,9 @@ def goal_error(scene, plan, pose) -> tuple[np.ndarray, bool]:
     3-D ``[position, angle]`` (m, rad)."""
     q = np.asarray(pose, float)
     if scene.dimension == 2:
-        goal = np.asarray(scene.task.goal if scene.task is not None else plan.poses[-1], float)
-        tol = scene.task.tolerance if scene.task is not None else np.array([1e-3, 1e-3, 0.0175])
-        err = q - goal
-        err[2] = (err[2] + np.pi) % (2 * np.pi) - np.pi
-        return err, bool(np.all(np.abs(err) <= tol))
-    _, goal, tol = scene.task
-    dp = q[:3] - goal[:3]
-    ang = P.quat_angle(q[3:], goal[3:])
-    return np.array([float(np.linalg.norm(dp)), ang]), bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])
+        return scene.goal_error(q, None if scene.task is not None else plan.poses[-1])
+    err, ok = scene.goal_error(q)
+    return np.array([float(np.linalg.norm(err[:3])), err[3]]), ok
 
 
 def control_arm(scene, plan, workcell=None, scales: Scales = Scales(), robot: str | None = None,
@@ -365,7 +359,7 @@ def sticking(scene, a: dict, b: dict) -> bool:
     """Whether the 3-D plan step from path entry ``a`` to ``b`` sticks: its pusher (not a plane,
     whose contact rolls over the object) moves with the object (its pusher twist, when given,
     the object's own twist)."""
-    if scene._core.is_plane(b["pusher"]):
+    if scene.is_plane(b["pusher"]):
         return False
     u = b.get("pusher_twist")
     return u is None or bool(np.allclose(u, P.twist_between(a["pose"], b["pose"]), rtol=1e-6, atol=1e-9))
@@ -387,7 +381,7 @@ def _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_rep
                 timing.sample_period)
         # a sticking step rendered against the feature from the step's planned start, as the
         # open loop does; else from the commanded pose (a plane's from the planned pose)
-        plane, sticks = bool(scene._core.is_plane(b["pusher"])), sticking(scene, a, b)
+        plane, sticks = bool(scene.is_plane(b["pusher"])), sticking(scene, a, b)
         A = np.asarray(a["pose"], float) if plane or sticks else None
         arm.push(b["pusher"], u / T, T, A, absolute=sticks)
         return arm.pose()

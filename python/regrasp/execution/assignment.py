@@ -62,8 +62,8 @@ def pusher_contact(scene, name: str, pose) -> PusherContact:
         pts = np.column_stack([p.points[:, 0], np.zeros(len(p.points)), p.points[:, 1]])
         n, mu, plane = np.array([p.normal[0], 0.0, p.normal[1]]), float(p.friction), False
     else:
-        raw, n, mu = scene._core.pusher_spec(name, [float(x) for x in pose])
-        pts, n, plane = np.asarray(raw, float), np.asarray(n, float), bool(scene._core.is_plane(name))
+        pts, n, mu = scene.pusher_spec(name, pose)
+        plane = scene.is_plane(name)
     n = n / np.linalg.norm(n)
     o = pts.mean(axis=0)
     if len(pts) == 2:
@@ -115,7 +115,7 @@ def gravity_in_gripper(scene) -> np.ndarray:
         d, _ = scene.gravity
         g = np.array([d[0], 0.0, d[1]])
     else:
-        g = np.asarray(scene._core.gravity, float)
+        g = scene.gravity
     ng = np.linalg.norm(g)
     return g / ng if ng > 0 else np.array([0.0, 0.0, -1.0])
 

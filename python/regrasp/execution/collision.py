@@ -105,7 +105,7 @@ def solid(scene) -> Solid:
         segs += [(corners[2 * i], corners[2 * i + 1]) for i in range(len(out))]
         pts = np.vstack([_along(a, b, SPACING) for a, b in segs])
         return Solid(pts, pieces, 0.0, float(np.max(np.linalg.norm(pts, axis=1))))
-    r = scene._core.sphere
+    r = scene.sphere
     if r is not None:
         a = np.linspace(0, 2 * np.pi, max(8, int(2 * np.pi * r / SPACING)), endpoint=False)
         c, s, z = r * np.cos(a), r * np.sin(a), np.zeros_like(a)

@@ -76,7 +76,7 @@ def build(scene, motion: WorldMotion, workcell: Workcell | None = None):
     if scene.dimension == 2:
         g = scene.gravity[1]
     else:
-        g = float(np.linalg.norm(scene._core.gravity))
+        g = float(np.linalg.norm(scene.gravity))
     spec = M.new_spec(f"{scene.name}-free-gripper", [0.0, 0.0, -g], M.Contact())
     add_workcell_geoms(spec, workcell)
     names = {f.name for f in workcell.features}
@@ -109,15 +109,9 @@ def _tolerance_error(scene, plan, q) -> tuple[np.ndarray, bool]:
     goal = np.asarray(plan.poses[-1], float)
     if scene.dimension == 2:
         R = P.quat_matrix(q[3:])
-        got = np.array([q[0], q[2], np.arctan2(R[2, 0], R[0, 0])])
-        err = got - goal
-        err[2] = (err[2] + np.pi) % (2 * np.pi) - np.pi
-        tol = scene.task.tolerance if scene.task is not None else np.array([1e-3, 1e-3, 0.0175])
-        return err, bool(np.all(np.abs(err) <= tol))
-    goal = np.r_[goal[:3], goal[3:] / np.linalg.norm(goal[3:])]
-    err = np.array([float(np.linalg.norm(q[:3] - goal[:3])), P.quat_angle(q[3:], goal[3:])])
-    tol = scene.task[2]
-    return err, bool(np.all(np.abs(q[:3] - goal[:3]) <= tol[:3]) and err[1] <= tol[3])
+        return scene.goal_error([q[0], q[2], np.arctan2(R[2, 0], R[0, 0])], goal)
+    err, ok = scene.goal_error(q, np.r_[goal[:3], goal[3:] / np.linalg.norm(goal[3:])])
+    return np.array([float(np.linalg.norm(err[:3])), err[3]]), ok
 
 
 def execute_free_gripper(scene, plan, motion: WorldMotion, workcell: Workcell | None = None) -> FreeGripperResult:

@@ -15,7 +15,9 @@ import numpy as np
 
 from ..errors import ArgumentError, SceneError
 from ..fields import FieldCheck
-from .world_motion import LABELS
+
+#: Sample labels, in the order a push meets them (a world motion's and its trajectory's).
+LABELS = ("start", "transfer", "approach", "push", "retreat")
 
 #: The file's ``format`` and ``version``.
 FORMAT = "regrasp-trajectory"
@@ -62,7 +64,7 @@ class Trajectory:
     model name, None for a free gripper), ``joint_names`` (empty for a free gripper); per sample
     (n of them): ``times`` (n,) [s], strictly increasing; ``q`` (n, len(joint_names)) joint
     positions [rad]; ``gripper`` (n, 7) the gripper's world pose (m, unit quaternion);
-    ``grip_force`` (n,) [N] per finger; ``labels`` (one of :data:`~regrasp.execution.world_motion.LABELS` each); ``push`` (n,)
+    ``grip_force`` (n,) [N] per finger; ``labels`` (one of :data:`LABELS` each); ``push`` (n,)
     the push index (−1: none, ``null`` in the file); ``assignments``: a :class:`PushRecord` per
     push. Checked on construction (SceneError naming the field)."""
     scene: str

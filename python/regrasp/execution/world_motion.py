@@ -47,10 +47,11 @@ import numpy as np
 from .. import pose as P
 from ..errors import ArgumentError, ExecutionError
 from ..workcell.default import default_workcell
-from ..workcell.description import Workcell
+from ..workcell.description import CLEARANCE, Workcell
 from ..workcell.shapes import EDGE_RADIUS, shapes
 from . import collision
 from .assignment import MAX_TILT, Assignment, candidates
+from .trajectory import LABELS
 
 #: The deepest [m] the object may go into a feature during a push (the plan is rendered exactly
 #: only if it does not go through it).
@@ -80,8 +81,6 @@ SLIDE_GAP = 0.003
 #: (zero speed and acceleration at both ends: no jolt on the held object); its peak speed is this
 #: many times its mean, so its duration is stretched by it to keep the peak at the Timing's speed.
 EASE_PEAK = 1.875
-#: Sample labels, in the order a push meets them.
-LABELS = ("start", "transfer", "approach", "push", "retreat")
 
 
 def eased(tau):
@@ -102,7 +101,7 @@ class Timing:
     push_turn: float = 0.2
     move_speed: float = 0.1
     move_turn: float = 1.0
-    clearance: float = 0.02
+    clearance: float = CLEARANCE
     sample_period: float = 0.02
     dwell: float = 0.25
 
@@ -219,7 +218,7 @@ def object_points(scene) -> np.ndarray:
     if scene.dimension == 2:
         out = np.asarray(scene.outline, float)
         return np.column_stack([out[:, 0], np.zeros(len(out)), out[:, 1]])
-    r = scene._core.sphere
+    r = scene.sphere
     if r is not None:
         return np.vstack([np.eye(3) * r, -np.eye(3) * r])
     return np.asarray(scene.mesh()[0], float)
@@ -232,8 +231,8 @@ EDGE_SPACING = 1e-3
 def edge_points(scene) -> np.ndarray:
     """Points (k, 3) [m] of the object in its frame along its edges, ``EDGE_SPACING`` apart: the
     planar outline's sides (x-z plane), a mesh's triangle edges, a sphere's 3 great circles."""
-    if scene.dimension == 3 and scene._core.sphere is not None:
-        r = scene._core.sphere
+    if scene.dimension == 3 and scene.sphere is not None:
+        r = scene.sphere
         a = np.linspace(0, 2 * np.pi, max(8, int(2 * np.pi * r / EDGE_SPACING)), endpoint=False)
         c, s_ = r * np.cos(a), r * np.sin(a)
         z = np.zeros_like(a)
@@ -255,7 +254,7 @@ def edge_points(scene) -> np.ndarray:
 
 def grip_force(scene) -> float:
     """The scene's grip force per finger [N]."""
-    return float(scene.grip_force if scene.dimension == 2 else scene._core.grip_force)
+    return float(scene.grip_force)
 
 
 class _Samples:

@@ -26,7 +26,7 @@ import numpy as np
 from ..errors import ArgumentError
 from ..extras import need
 from ..polygon import cross, triangulate
-from ..pose import planar_quat
+from ..pose import planar_quat, twist_between
 from ..scene.planar import Scene
 
 THICKNESS = 0.012  # m, the object's thickness along the grasp axis
@@ -275,9 +275,9 @@ def add_planar_pads(parent, scene: Scene, friction_scale: float = 1.0, gravcomp:
     that does not collide."""
     if scene.kind != "grasp":
         raise ArgumentError("invalid `scene`: the MuJoCo model needs a grasp (not an object on a surface)", "grasp")
-    mu_s = scene._core.friction_scale / (2 * scene.grip_force) * friction_scale
+    mu_s = scene.pad_friction * friction_scale
     pad = scene.pad
-    k = scene._core.pad_limit_surface_k
+    k = scene.pad_limit_surface_k
     if pad[0] == "circle":
         shape = dict(kind="cylinder", size=[pad[1], PAD_DEPTH / 2], quat=_EULER_X90)
     else:
@@ -348,9 +348,7 @@ class Driver:
         joint's qvel)."""
         if not self.spatial:
             return (pose - self.pose) / dt
-        from .. import _core
-
-        w = np.array(_core.se3_log([0, 0, 0, *map(float, self.pose[3:])], [0, 0, 0, *map(float, pose[3:])]))[3:] / dt
+        w = np.array(twist_between([0, 0, 0, *self.pose[3:]], [0, 0, 0, *pose[3:]]))[3:] / dt
         return np.r_[(pose[:3] - self.pose[:3]) / dt, w]
 
     def move(self, data, pose, dt: float):

@@ -239,11 +239,8 @@ class PlanarExecution(GripperRig):
         for seg in progress.iterate(_segments(self.path), "MuJoCo execution", unit="push"):
             max_slip = max(max_slip, self.segment(seg["pusher"], seg["knots"]))
         q = self.pose()
-        task = self.scene.task
-        goal = task.goal if task is not None else np.asarray(self.path[-1]["pose"], float)
-        tol = task.tolerance if task is not None else np.array([1e-3, 1e-3, 0.0175])
-        err = q - goal
-        return Replay("mujoco", q, err, bool(np.all(np.abs(err) <= tol)), max_slip, np.array(self.rec_t),
+        err, ok = self.scene.goal_error(q, None if self.scene.task is not None else self.path[-1]["pose"])
+        return Replay("mujoco", q, err, ok, max_slip, np.array(self.rec_t),
                       np.array(self.rec_q), np.array(self.rec_plan), self.steps)
 
 

@@ -55,7 +55,7 @@ def _quat(t1, t2, n) -> np.ndarray:
 def plane_frame(scene, name: str, pose) -> np.ndarray:
     """For a plane pusher brought against the object at ``pose`` (m, unit quaternion): the pose, in the pusher's frame
     (the object frame then), of the plane's own frame (origin at the contact, +Z its normal)."""
-    pts, n, _ = scene._core.pusher_spec(name, list(map(float, pose)))
+    pts, n, _ = scene.pusher_spec(name, pose)
     n = np.asarray(n, float) / np.linalg.norm(n)
     return np.r_[np.asarray(pts, float).mean(axis=0), _quat(*tangents(n), n)]
 
@@ -65,9 +65,9 @@ def add_feature_geoms(body, scene, name: str, friction: float):
     line pusher, a thin plate behind a patch, a thick slab whose top face is the plane z = 0 of
     the feature's frame for a plane (see :func:`plane_frame`)."""
     kw = dict(bits=FEATURE_BITS, friction=[friction], condim=3)
-    if scene._core.is_plane(name):
+    if scene.is_plane(name):
         return add_geom(body, "box", [PLANE_HALF, PLANE_HALF, 0.005], pos=[0.0, 0.0, -0.005], **kw)
-    pts, n, _ = scene._core.pusher_spec(name)
+    pts, n, _ = scene.pusher_spec(name)
     pts, n = np.asarray(pts, float), np.asarray(n, float) / np.linalg.norm(n)
     if len(pts) == 1:
         return add_geom(body, "sphere", [R_FEATURE], pos=pts[0] - n * R_FEATURE, **kw)
@@ -88,10 +88,10 @@ def add_object3d(spec, scene, s0, mesh, mass_scale: float):
     body = spec.worldbody.add_body(name="object", pos=s0[:3], quat=s0[3:])
     body.add_freejoint()
     full = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
-    set_inertial(body, np.asarray(scene._core.com, float), m, full=full)
+    set_inertial(body, scene.com, m, full=full)
     kw = dict(bits=OBJECT_BITS, friction=[0.0], condim=4)
-    if scene._core.sphere:
-        return add_geom(body, "sphere", [scene._core.sphere], **kw)
+    if scene.sphere:
+        return add_geom(body, "sphere", [scene.sphere], **kw)
     parts = scene.parts()
     if len(parts) > 1:
         for k, (v, t) in enumerate(parts):
@@ -108,9 +108,9 @@ def add_pads3d(parent, scene, s0, vertices, friction_scale: float, pad: str):
     ``s0``: one contact each (:func:`add_pad_sphere`, torsional friction (2/3) r μ) or,
     ``pad="ring"``, 8 point contacts on a ring at 2/3 of the pad's radius (the quasi-static
     model's pad)."""
-    mu = scene._core.grip_friction * friction_scale
-    k = 2.0 / 3.0 * scene._core.pad_radius
-    R = scene._core.sphere
+    mu = scene.pad_friction * friction_scale
+    k = scene.pad_limit_surface_k
+    R = scene.sphere
     w = np.array([compose(s0, _shift(x))[:3] for x in vertices])
     ys = [s0[1] + sign * R if R else np.max(sign * w[:, 1]) * sign for sign in (1, -1)]
 
@@ -133,12 +133,12 @@ def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, ma
     s0 = np.asarray(start, float)
     v, t = scene.mesh()
     v, t = np.asarray(v, float), np.asarray(t, int)
-    spec = new_spec(scene.name, np.asarray(scene._core.gravity, float), contact)
+    spec = new_spec(scene.name, scene.gravity, contact)
     add_object3d(spec, scene, s0, (v, t), mass_scale)
     add_pads3d(add_driven_body(spec.worldbody, "gripper", spatial=True) if world else spec.worldbody, scene, s0, v,
               friction_scale, pad)
     for i, p in enumerate(scene.pusher_names):
-        _, _, fr = scene._core.pusher_spec(p)
+        _, _, fr = scene.pusher_spec(p)
         body = (spec.worldbody.add_body(name=f"feature_{p}", mocap=True, pos=PARK + [0.1 * i, 0, 0]) if world
                 else add_driven_body(spec.worldbody, f"feature_{p}", spatial=True))
         add_feature_geoms(body, scene, p, fr * friction_scale)
@@ -164,7 +164,7 @@ class SpatialExecution(Rig):
         _check_options(pad, view)
         self.scene, self.view, self.world = scene, view, view == "world"
         spec = build(scene, start, friction_scale, grip_scale, mass_scale, contact, pad, world=self.world)
-        super().__init__(spec, contact, scene._core.grip_force * grip_scale)
+        super().__init__(spec, contact, scene.grip_force * grip_scale)
         self.gripper = Driver(self.model, "gripper") if self.world else None
         self.drivers = {} if self.world else {p: Driver(self.model, f"feature_{p}") for p in scene.pusher_names}
         if self.world:
@@ -195,7 +195,7 @@ class SpatialExecution(Rig):
     def put(self, p: str, P) -> set:
         """Puts pusher ``p``'s feature at ``P`` in the grasp (where it stays, in the world's view);
         returns its geoms."""
-        self.T = plane_frame(self.scene, p, self.in_grasp()) if self.scene._core.is_plane(p) else IDENTITY
+        self.T = plane_frame(self.scene, p, self.in_grasp()) if self.scene.is_plane(p) else IDENTITY
         if self.world:
             self.F = compose(self.gripper.pose, P)
             F = compose(self.F, self.T)
@@ -233,7 +233,7 @@ class SpatialExecution(Rig):
         gaps)."""
         if self.pusher is not None:
             self.back_off()
-        _, n, _ = self.scene._core.pusher_spec(p, list(map(float, self.in_grasp())))
+        _, n, _ = self.scene.pusher_spec(p, self.in_grasp())
         self.n = np.asarray(n, float) / np.linalg.norm(n)
         self.P = compose(self.in_grasp(), _shift(-GAP * self.n))
         ids = self.put(p, self.P)
@@ -257,7 +257,7 @@ class SpatialExecution(Rig):
         # it is now (offset D from that frame), makes the same rigid motion: P(t) = A exp(ut) D
         # (a plane: the planned frame, so it makes its planned motion in the gripper frame and
         # stays level whatever the object's measured pose)
-        A = np.asarray(a["pose"], float) if self.scene._core.is_plane(p) else self.in_grasp()
+        A = np.asarray(a["pose"], float) if self.scene.is_plane(p) else self.in_grasp()
         D = compose(inverse(A), self.P)
         n = int(round(1.0 / self.dt))
         for k in range(1, n + 1):

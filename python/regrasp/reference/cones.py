@@ -41,7 +41,7 @@ class RefParams:
                              "scene.with_limit_surface('ellipsoid')")
         p = scene.pusher(pusher)
         gdir, g = scene.gravity
-        mu_s = scene._core.friction_scale / (2 * scene.grip_force)
+        mu_s = scene.pad_friction
         return cls(
             mass=scene.mass,
             com=scene.com,

@@ -20,8 +20,8 @@ import numpy as np
 from ..errors import ArgumentError
 from ..extras import need
 from ..pose import inverse, transform
+from .kinds import DEFAULT_ROBOT, GRIP_RANGE, GRIPPER_PREFIX, ROBOTS, gripper_spec, set_options
 
-GRIP_RANGE = 20.0  # N, the grip actuator's force range (≈ 180 N per pad at a 40 mm grasp)
 CALIBRATION_FORCES = (1.0, 5.0)  # N, the actuator forces at which pad_state measures the (affine) map
 CORRECTION = 0.3  # the grip controller's correction bound: a share of the requested force,
 MIN_CORRECTION = 1.0  # N, or this much when more
@@ -106,7 +106,6 @@ def pad_state(grasp_width: float, robot_name: str = "", pads=None, pad_friction:
     ``contact`` settings (``regrasp.mujoco.model.Contact``: timestep, cone, impratio, no-slip);
     the defaults: :func:`~regrasp.robot.model.build`'s. Measured once per distinct set of these."""
     from ..mujoco.model import Contact
-    from .model import DEFAULT_ROBOT
     from .pads import PAD_FRICTION, Pads
 
     return _pad_state(float(grasp_width), robot_name or DEFAULT_ROBOT, pads or Pads(),
@@ -124,7 +123,6 @@ def _calibration_rig(grasp_width: float, robot_name: str, pads, pad_friction: fl
     gravity off, around a fixed tall box ``grasp_width`` [m] wide (the pads meet it wherever the
     linkage puts them)."""
     mujoco = need("mujoco", "robot")
-    from .model import ROBOTS, gripper_spec, set_options
 
     kind = ROBOTS[robot_name]
     g = gripper_spec(kind, pads, pad_friction)
@@ -141,7 +139,6 @@ def _calibration_rig(grasp_width: float, robot_name: str, pads, pad_friction: fl
 @lru_cache(maxsize=32)
 def _pad_state(grasp_width: float, robot_name: str, pads, pad_friction: float, contact) -> tuple:
     mujoco = need("mujoco", "robot")
-    from .model import ROBOTS
     from .pads import LENGTH
 
     kind = ROBOTS[robot_name]
@@ -184,7 +181,6 @@ def least_force(grasp_width: float, robot_name: str = "", pads=None, pad_frictio
     2.6 N at 70 mm with the bundled objects' pads, about 0 at 30 mm). The arguments and their
     defaults: :func:`pad_state`'s."""
     from ..mujoco.model import Contact
-    from .model import DEFAULT_ROBOT
     from .pads import PAD_FRICTION, Pads
 
     return float(_low_force_curve(float(grasp_width), robot_name or DEFAULT_ROBOT, pads or Pads(),
@@ -211,7 +207,6 @@ def close_fingers(robot) -> None:
     linkage moves in and down as it closes: from open, its spring links come 10 mm nearer
     to a feature beside the pads)."""
     mujoco = need("mujoco", "robot")
-    from .model import GRIPPER_PREFIX
 
     m, d = robot.model, robot.data
     for name, q in _pad_state(robot.grasp_width, robot.name, robot.pads, robot.pad_friction, robot.contact)[3]:

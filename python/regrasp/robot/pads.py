@@ -66,7 +66,7 @@ class Pads:
     def of_scene(cls, scene) -> "Pads":
         """The grid of a scene's pad (``Scene.pad``, or a 3-D scene's disc of ``pad_radius``):
         5 x 5 spheres over the pad's shape (a circle keeps the 13 inside it)."""
-        pad = scene.pad if scene.dimension == 2 else ("circle", scene._core.pad_radius, scene._core.pad_radius)
+        pad = scene.pad if scene.dimension == 2 else ("circle", scene.pad_radius, scene.pad_radius)
         if pad is None:
             return cls()
         return cls(5, 5, 0.001, (str(pad[0]), float(pad[1]), float(pad[2])), TIP_SOLREF)
@@ -76,7 +76,7 @@ def single_contact(scene) -> "Pads":
     """The old pad model of ``scene`` (:attr:`Pads.torsion`): one contact at the face's centre
     with the torsional friction of the scene's limit surface (planar ``pad_limit_surface_k``;
     3-D (2/3) × the pad's radius, a uniformly pressed disc's)."""
-    k = scene._core.pad_limit_surface_k if scene.dimension == 2 else 2.0 / 3.0 * scene._core.pad_radius
+    k = scene.pad_limit_surface_k if scene.dimension == 2 else 2.0 / 3.0 * scene.pad_radius
     return Pads(1, 1, 0.001, None, TIP_SOLREF, float(k))
 
 

@@ -4,7 +4,10 @@ read-only properties that hand a value of the Rust core through."""
 from __future__ import annotations
 
 import tomllib
+from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from ..errors import ArgumentError
 from ..files import as_path
@@ -38,3 +41,23 @@ def core_property(name: str, doc: str | None = None, wrap=None) -> property:
         return v if wrap is None else wrap(v)
 
     return property(get, doc=doc)
+
+
+@dataclass(frozen=True)
+class Task:
+    """A regrasp task: ``start`` and ``goal`` poses (planar ``[x, z, theta]`` (m, m, rad); 3-D
+    ``[x, y, z, qw, qx, qy, qz]`` (m, unit quaternion)) and the goal ``tolerance`` (planar: per
+    coordinate (m, m, rad); 3-D: ``[x, y, z, angle]`` (m, m, m, rad)). Unpacks as
+    ``start, goal, tolerance = task``."""
+    start: np.ndarray
+    goal: np.ndarray
+    tolerance: np.ndarray
+
+    def __iter__(self):
+        return iter((self.start, self.goal, self.tolerance))
+
+    def __getitem__(self, i):
+        return (self.start, self.goal, self.tolerance)[i]
+
+    def __len__(self) -> int:
+        return 3

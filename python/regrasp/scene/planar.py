@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from .. import _core
 from ..errors import ArgumentError, SceneError
-from .common import core_property, read_scene_file
+from .common import Task, core_property, read_scene_file
 
 ArrayLike = Sequence[float] | np.ndarray
 
@@ -124,15 +124,6 @@ class Pusher:
 
 
 @dataclass(frozen=True)
-class Task:
-    """A planar regrasp task: ``start`` and ``goal`` poses ``[x, z, theta]`` (m, m, rad) and the
-    goal ``tolerance`` per coordinate (m, m, rad)."""
-    start: np.ndarray
-    goal: np.ndarray
-    tolerance: np.ndarray
-
-
-@dataclass(frozen=True)
 class Classification:
     """Result of the exact motion-cone test of one twist."""
 
@@ -201,6 +192,14 @@ class MotionCone:
         return GravityFreeCone(self)
 
     hold_ratio = core_property("hold_ratio", "Share of the pads' friction that gravity alone uses (< 1 holds).")
+    pusher_edges = core_property("pusher_edges", "The pusher's friction-cone edge wrenches (k, 3), object "
+                                                 "frame, scaled by the support's friction (the cone's rays' "
+                                                 "preimages; :meth:`ray` of a mix of rows).")
+    boundary_segments = core_property("boundary_segments", "Pairs ``(i, j)`` of :attr:`pusher_edges` rows whose "
+                                                           "mixes map onto the cone's boundary.")
+    support_matrices = core_property("support_matrices", "``(A, Js, wg)``: the limit surface's matrix, the "
+                                                         "pusher's contact Jacobians and gravity's wrench "
+                                                         "(eq 3.9's terms).")
     is_line_pusher = core_property("line", "A line pusher (two rigidly connected points) rather than a point pusher.")
 
     @overload
@@ -480,6 +479,33 @@ class Scene:
         return np.array([dx, dz]), g
 
     grip_force = core_property("grip_force", "Grip force per finger [N] (None on a surface scene).")
+    #: a planar object is a lamina, never a sphere (:attr:`Scene3D.sphere`)
+    sphere = None
+    pad_friction = core_property("pad_friction", "The finger pads' Coulomb coefficient μ (None on a surface scene).")
+    pad_limit_surface_k = core_property("pad_limit_surface_k", "The ``k`` of the support's limit surface: its "
+                                                               "largest friction moment per unit μN [m].")
+
+    def quasistatic_problem(self, pose, pusher, support, rings, points, merge_fingers, h, speed):
+        """The core's instantaneous complementarity problem at ``pose`` (m, m, rad) with ``pusher``
+        (None: none) in contact; arguments already checked (see
+        :func:`regrasp.sim.quasistatic.problem`, the public door)."""
+        return self._core.quasistatic_problem(list(map(float, pose)), pusher, support, rings, points, merge_fingers,
+                                              h, speed)
+
+    def simulate_push(self, pose, pusher: str, twist, duration: float, dt: float, support, rings, points,
+                      merge_fingers) -> dict:
+        """The core's time stepping of one push from ``pose`` (m, m, rad), the pusher moving with
+        body ``twist`` (m/s, m/s, rad/s) for ``duration`` [s] in steps of ``dt`` [s] (arguments
+        already checked; see :func:`regrasp.sim.quasistatic.simulate_push`, the public door)."""
+        return self._core.simulate_push(list(map(float, pose)), pusher, list(map(float, twist)), duration, dt,
+                                        support, rings, points, merge_fingers)
+
+    def push_outcomes(self, poses, pusher: str, twists, support, rings, points, merge_fingers):
+        """Whether each push (rows of ``poses`` (n, 3) (m, m, rad) and body ``twists`` (n, 3)
+        (m/s, m/s, rad/s)) of ``pusher``
+        sticks in the quasi-static simulator: (sticks, object twists, residuals, errors) (see
+        :mod:`regrasp.sim.validation`)."""
+        return self._core.push_outcomes(poses, pusher, twists, support, rings, points, merge_fingers)
     pad = core_property("pad", 'The finger pad: ``("circle", radius, radius)`` or ``("rectangle", width, '
                                'height)`` [m]; '
                                "None on a surface.")
@@ -489,6 +515,13 @@ class Scene:
         """The scene's task (start, goal, tolerance), or None when the file has none."""
         t = self._core.task
         return None if t is None else Task(*(np.array(x) for x in t))
+
+    def goal_error(self, pose, goal=None) -> tuple[np.ndarray, bool]:
+        """The error ``pose − goal`` ``[x, z, theta]`` (m, m, rad; theta wrapped into [−π, π)) and
+        whether it is within the task's tolerance (the core's default, 1 mm and 0.0175 rad, without
+        a task); ``goal`` defaults to the task's. Decided once, in the core."""
+        e, ok = self._core.goal_error(pose, goal)
+        return np.array(e), bool(ok)
 
     def with_grip_force(self, force: float) -> "Scene":
         """The same scene with another grip force per finger (not re-validated: the task's

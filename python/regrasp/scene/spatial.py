@@ -15,7 +15,7 @@ from .. import _core
 from ..errors import ArgumentError, RegraspError, SceneError, check_seed
 from ..planning.plan import Plan, as_plan
 from ..pose import quat_angle, twist_between, twist_in
-from .common import core_property, read_scene_file
+from .common import Task, core_property, read_scene_file
 from .planar import _flag, _name, _number, _vec
 
 
@@ -61,13 +61,44 @@ class Scene3D:
     length = core_property("length", "Characteristic length L [m] weighing rotation against translation.")
     mass = core_property("mass", "Mass of the object [kg].")
     inertia = core_property("inertia", "Inertia matrix about the centre of mass, object frame [kg·m²], shape (3, 3).")
+    com = core_property("com", "Centre of mass ``[x, y, z]`` in the object frame [m], shape (3,).", wrap=np.array)
+    grip_force = core_property("grip_force", "Grip force per finger [N].")
+    pad_friction = core_property("grip_friction", "The finger pads' Coulomb coefficient μ.")
+    pad_radius = core_property("pad_radius", "Radius of the finger pads [m].")
+    sphere = core_property("sphere", "The sphere's radius [m] for a spherical object, else None.")
+    gravity = core_property("gravity", "Gravity in the gripper frame [m/s²], shape (3,).", wrap=np.array)
 
     @property
-    def task(self):
-        """The task: start and goal poses ``[x, y, z, qw, qx, qy, qz]`` (m, m, m, -, -, -, -) and the
-        tolerance ``[x, y, z, angle]`` (m, m, m, rad)."""
-        s, g, t = self._core.task
-        return np.array(s), np.array(g), np.array(t)
+    def pad_limit_surface_k(self) -> float:
+        """The ``k`` of a pad's limit surface [m]: 2/3 of its radius (a disc of uniform pressure)."""
+        return 2.0 / 3.0 * float(self._core.pad_radius)
+
+    def pusher_spec(self, name: str, pose=None) -> tuple:
+        """Pusher ``name`` brought against the object at ``pose`` ``[x, y, z, qw, qx, qy, qz]``
+        (default: the task's start): its contact points (k, 3) and normal (3,) in the object frame
+        [m] and its friction coefficient."""
+        q = None if pose is None else list(map(float, _vec(pose, 7, "pose")))
+        pts, n, mu = self._core.pusher_spec(_name(name, "pusher"), q)
+        return np.asarray(pts, float), np.asarray(n, float), float(mu)
+
+    def is_plane(self, name: str) -> bool:
+        """Whether pusher ``name`` is a plane (its normal fixed in the gripper frame)."""
+        return bool(self._core.is_plane(_name(name, "pusher")))
+
+    @property
+    def task(self) -> Task:
+        """The task (a :class:`~regrasp.scene.common.Task`, as the planar scene's): start and goal
+        poses ``[x, y, z, qw, qx, qy, qz]`` (m, m, m, -, -, -, -) and the tolerance
+        ``[x, y, z, angle]`` (m, m, m, rad); unpacks as ``start, goal, tolerance``."""
+        return Task(*(np.array(x) for x in self._core.task))
+
+    def goal_error(self, pose, goal=None) -> tuple[np.ndarray, bool]:
+        """The error of ``pose`` ``[x, y, z, qw, qx, qy, qz]`` to ``goal`` (default: the task's),
+        ``[dx, dy, dz, angle]`` (m, m, m, rad; the angle of the relative rotation), and whether it
+        is within the task's tolerance. Decided once, in the core."""
+        g = None if goal is None else list(map(float, _vec(goal, 7, "goal")))
+        e, ok = self._core.goal_error(list(map(float, _vec(pose, 7, "pose"))), g)
+        return np.array(e), bool(ok)
 
     def mesh(self):
         """The object's mesh: vertices (n, 3) in the object frame [m] and triangles (m, 3) (vertex
@@ -188,11 +219,8 @@ def goal_report(scene: "Scene3D", q) -> dict:
     """The final pose, its error to the task's goal (position [m], angle [rad]) and whether it
     is within the task's tolerance."""
     q = np.asarray(q, float)
-    _, goal, tol = scene.task
-    dp = q[:3] - goal[:3]
-    ang = quat_angle(q[3:], goal[3:])
-    return {"final_pose": q.tolist(), "goal_error": dp.tolist() + [ang],
-            "success": bool(np.all(np.abs(dp) <= tol[:3]) and ang <= tol[3])}
+    err, ok = scene.goal_error(q)
+    return {"final_pose": q.tolist(), "goal_error": err.tolist(), "success": ok}
 
 
 def run_plan3d(scene: "Scene3D", path: list, step, q0, feedback: bool = False, max_replans: int = 10, seed: int = 0):

@@ -45,7 +45,7 @@ def problem(scene: Scene, pose, pusher: str | None = None, h: float | None = Non
     kw = support_kwargs(**support)
     h = None if h is None else _number(h, "h")
     pusher = None if pusher is None else _name(pusher, "pusher")
-    return scene._core.quasistatic_problem(list(_vec(pose, 3, "pose")), pusher, kw["support"], kw["rings"],
+    return scene.quasistatic_problem(_vec(pose, 3, "pose"), pusher, kw["support"], kw["rings"],
                                            kw["points"], kw["merge_fingers"], h, SPEED)
 
 
@@ -62,7 +62,7 @@ def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: f
     kw = support_kwargs(**support)
     duration = _number(duration, "duration")
     dt = _number(push_dt(duration, dt), "dt")
-    return scene._core.simulate_push(list(_vec(pose, 3, "pose")), _name(pusher, "pusher"), list(_vec(twist, 3, "twist")),
+    return scene.simulate_push(_vec(pose, 3, "pose"), _name(pusher, "pusher"), _vec(twist, 3, "twist"),
                                      duration, dt, kw["support"], kw["rings"], kw["points"], kw["merge_fingers"])
 
 
@@ -136,11 +136,8 @@ def replay_plan(scene: Scene, plan, speed: float = SPEED, dt: float = DT, **supp
                         for s in tr["t"][1:] / T])
         t_now += T
         q = tr["pose"][-1]
-    task = scene.task
-    goal = task.goal if task is not None else np.asarray(path[-1]["pose"], float)
-    tol = task.tolerance if task is not None else np.array([1e-3, 1e-3, 0.0175])
-    err = q - goal
-    return Replay("quasistatic", q, err, bool(np.all(np.abs(err) <= tol)), max_slip, np.array(ts),
+    err, ok = scene.goal_error(q, None if scene.task is not None else path[-1]["pose"])
+    return Replay("quasistatic", q, err, ok, max_slip, np.array(ts),
                   np.array(qs), np.array(planned), steps)
 
 

@@ -65,7 +65,7 @@ def sample_push(scene: Scene, pose, pusher: str, kind: str, rng):
     """A pusher motion (m/s, m/s, rad/s) at ``pose`` (m, m, rad) of the given kind ('inside',
     'near', 'random') for the validation."""
     cone = scene.motion_cone(pose, pusher)
-    E = cone._core.pusher_edges
+    E = cone.pusher_edges
     if cone.is_line_pusher:
         if kind == "inside":
             # uniform over the twist directions inside the exact cone (rejection from a cap
@@ -86,7 +86,7 @@ def sample_push(scene: Scene, pose, pusher: str, kind: str, rng):
             if u is None:
                 u = cone.ray(rng.dirichlet(np.ones(len(E))) @ E)
         elif kind == "near":
-            i, j = cone._core.boundary_segments[rng.integers(len(cone._core.boundary_segments))]
+            i, j = cone.boundary_segments[rng.integers(len(cone.boundary_segments))]
             t = rng.uniform()
             u = cone.ray((1 - t) * E[i] + t * E[j])
             m = scene.metric_twist(u)
@@ -249,7 +249,7 @@ def _run_quasistatic(scene: Scene, rows: list, support: dict, progress: bool) ->
         for p, idx in by.items():
             for k in range(0, len(idx), size):
                 part = idx[k:k + size]
-                st, _, _, err = scene._core.push_outcomes(np.array([rows[i][2] for i in part]), p,
+                st, _, _, err = scene.push_outcomes(np.array([rows[i][2] for i in part]), p,
                                                          np.array([rows[i][3] for i in part]), support["support"],
                                                          support["rings"], support["points"], support["merge_fingers"])
                 sim[part] = st

@@ -34,12 +34,12 @@ def boundary_samples(cone: MotionCone, n: int = 40):
     """Points on the boundary of the exact cone: for each boundary fan of the pusher's friction
     cone, pusher wrench directions p(t), the balancing wrench w_g + lambda p (object frame) and
     the twist ray. Returns a list of (wrenches (n, 3), twists (n, 3)) per fan."""
-    A, Js, wg = cone._core.support_matrices
-    E = cone._core.pusher_edges
+    A, Js, wg = cone.support_matrices
+    E = cone.pusher_edges
     L = cone.scene.length
     S = np.array([1.0, 1.0, 1.0 / L])
     out = []
-    for i, j in cone._core.boundary_segments:
+    for i, j in cone.boundary_segments:
         ei, ej = E[i] * S / np.linalg.norm(E[i] * S), E[j] * S / np.linalg.norm(E[j] * S)
         ws, ts = [], []
         for t in np.linspace(0, 1, n if i != j else 1):
@@ -98,7 +98,7 @@ def _wrench_panel(ax, cone: MotionCone, samples) -> None:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     Wm = _wrench_metric(cone.scene)
-    wg = cone._core.support_matrices[2]
+    wg = cone.support_matrices[2]
     # the limit surface {Js^T w}: the support's load of twists in every direction (exact or
     # ellipsoidal, whichever the scene uses)
     uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(1e-3, np.pi - 1e-3, 20))
@@ -107,10 +107,10 @@ def _wrench_panel(ax, cone: MotionCone, samples) -> None:
     ell = Wm(np.array([[cone.classify(t).support_wrench for t in row] for row in sph]))
     ax.plot_wireframe(ell[..., 0], ell[..., 1], ell[..., 2], color="0.6", linewidth=0.3, alpha=0.5)
     # pusher cone shifted by gravity: apex at w_g
-    E = cone._core.pusher_edges
+    E = cone.pusher_edges
     reach = 1.3 * np.max(np.linalg.norm(ell.reshape(-1, 3), axis=1))
     apex = Wm(wg)
-    for i, j in cone._core.boundary_segments:
+    for i, j in cone.boundary_segments:
         ei, ej = Wm(E[i]), Wm(E[j])
         ei, ej = ei / np.linalg.norm(ei) * reach, ej / np.linalg.norm(ej) * reach
         ax.add_collection3d(Poly3DCollection([[apex, apex + ei, apex + ej]], alpha=0.15, color="tab:blue"))
@@ -139,7 +139,7 @@ def _twist_panel(ax, cone: MotionCone, samples) -> None:
     G = Tm(cone.generators)
     for k, g in enumerate(G):
         ax.plot(*np.stack([o, g]).T, color="tab:green", lw=2, label="polyhedral approximation" if k == 0 else None)
-    for i, j in cone._core.boundary_segments:
+    for i, j in cone.boundary_segments:
         if i != j:
             ax.add_collection3d(Poly3DCollection([[o, G[i], G[j]]], alpha=0.12, color="tab:green"))
     for k, g in enumerate(Tm(cone.gravity_free_generators)):
@@ -173,7 +173,7 @@ def _ray_chart(ax, cone: MotionCone, samples) -> None:
         ax.plot(p[:, 0], p[:, 1], color="tab:red", lw=2.5, label="exact cone" if k == 0 else None)
     for name, Gs, style in (("polyhedral approximation", G, dict(color="tab:green", lw=1.5)),
                             ("gravity-free cone", GF, dict(color="k", ls="--", lw=1))):
-        for k, (i, j) in enumerate(cone._core.boundary_segments):
+        for k, (i, j) in enumerate(cone.boundary_segments):
             if i == j:
                 continue
             p = proj(np.stack([Gs[i], Gs[j]]))
@@ -553,7 +553,7 @@ def animate_plan3d(scene, plan, path, fps: int = 12, frames_per_step: int = 6) -
         w = _at(pose, v)
         ax.add_collection3d(Poly3DCollection(w[t], facecolor=face, edgecolor="k", linewidth=0.3 if len(t) < 200 else 0.05,
                                              alpha=0.9))
-        _pads3d(ax, w, float(scene._core.pad_radius), 0.6)
+        _pads3d(ax, w, float(scene.pad_radius), 0.6)
         if name:
             _pusher3d(ax, scene, name, pose, w, size)
         _axes3d(ax, (0.0, 0.0, 0.0), 1.1 * size)
@@ -597,7 +597,7 @@ def plot_plan3d(scene, plan, path, intermediate: int = 3) -> Path:
         c = w.mean(axis=0)
         ax.text(c[0], c[1], c[2], label if k in (0, last) else str(k), fontsize=8, color=color)
     pts = np.vstack(list(world.values()))
-    _pads3d(ax, world[0], float(scene._core.pad_radius), 0.5)  # where the fingers hold it at the start
+    _pads3d(ax, world[0], float(scene.pad_radius), 0.5)  # where the fingers hold it at the start
     ax.plot([], [], color="0.3", lw=6, alpha=0.5, label="finger pads")
     _axes3d(ax, (pts.max(axis=0) + pts.min(axis=0)) / 2, 1.2 * (float(np.ptp(pts, axis=0).max()) / 2 or 0.01))
     ax.legend(fontsize=7, loc="upper left")

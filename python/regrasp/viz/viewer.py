@@ -23,7 +23,6 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..files import write_text
-from ..planning.plan import as_plan
 from .view_data import planar_description, spatial_description
 
 SCRIPT = Path(__file__).with_name("viewer.js")
@@ -74,7 +73,7 @@ def marks(scene) -> np.ndarray:
     """Which of the object's triangles are painted (1) — a sphere's alternate octants, so its
     turning shows (the thesis' paint marks on the ball, Fig 4-8); none for other objects."""
     v, t = scene.mesh()
-    if not scene._core.sphere:
+    if not scene.sphere:
         return np.zeros(len(t), int)
     c = np.asarray(v, float)[np.asarray(t, int)].mean(axis=1)
     return (np.prod(np.sign(c + 1e-12), axis=1) > 0).astype(int)
@@ -83,11 +82,15 @@ def marks(scene) -> np.ndarray:
 def description(scene, plan=None) -> dict:
     """What the page draws (see :mod:`regrasp.viz.view_data`), for ``scene`` (a planar
     :class:`~regrasp.Scene` or a :class:`~regrasp.Scene3D`) and ``plan`` (a :class:`~regrasp.Plan`
-    or plan dict for that scene; None: the scene alone, at its start, with its goal)."""
-    if getattr(scene, "dimension", None) not in (2, 3) or not hasattr(scene, "_core"):
+    for that scene; None: the scene alone, at its start, with its goal)."""
+    if getattr(scene, "dimension", None) not in (2, 3) or not hasattr(scene, "pusher_names"):
         raise ArgumentError(f"invalid `scene`: a regrasp Scene or Scene3D (got {type(scene).__name__})", "scene")
-    p = None if plan is None else as_plan(plan, scene)
-    poses, pushers = (None, None) if p is None else (p.poses, p.pushers)
+    if plan is not None and not hasattr(plan, "check_for"):
+        raise ArgumentError(f"invalid `plan`: a regrasp Plan (got {type(plan).__name__}; a plan dict: "
+                            "Plan.from_json)", "plan")
+    if plan is not None:
+        plan.check_for(scene, "plan")
+    poses, pushers = (None, None) if plan is None else (plan.poses, plan.pushers)
     if scene.dimension == 2:
         d = planar_description(scene, poses, pushers)
     else:
@@ -181,9 +184,7 @@ def world_page(d: dict, title: str) -> str:
 
 
 def _check_workcell(workcell):
-    from ..workcell.description import Workcell
-
-    if not isinstance(workcell, Workcell):
+    if not all(hasattr(workcell, k) for k in ("table", "features", "robot", "contact_owners", "clearance")):
         raise ArgumentError(f"invalid `workcell`: a Workcell (got {type(workcell).__name__})", "workcell")
 
 
@@ -191,8 +192,7 @@ def workcell_description_of(workcell, scene=None) -> dict:
     """The world view's data of ``workcell`` (see :mod:`regrasp.viz.world_data`); with ``scene``
     (a :class:`~regrasp.Scene` or :class:`~regrasp.Scene3D`) its object where the workcell starts
     it: on the table, or held at the scene's start by the gripper above the table's centre at
-    the safe height (every feature's top + the default clearance + the object's reach) [m]."""
-    from ..execution.world_motion import Timing
+    the safe height (every feature's top + the workcell's clearance + the object's reach) [m]."""
     from .world_data import still_description, workcell_description
 
     _check_workcell(workcell)
@@ -203,7 +203,7 @@ def workcell_description_of(workcell, scene=None) -> dict:
         return d
     v = description(scene)
     reach = float(np.linalg.norm(np.asarray(v["vertices"], float), axis=1).max())
-    hand = [*workcell.table.center, workcell.top() + Timing().clearance + reach, 1.0, 0.0, 0.0, 0.0]
+    hand = [*workcell.table.center, workcell.top() + workcell.clearance + reach, 1.0, 0.0, 0.0, 0.0]
     return still_description(v, workcell, hand)
 
 
@@ -218,10 +218,9 @@ def motion_description_of(scene, motion) -> dict:
     """The world view's data of ``motion`` (a :class:`~regrasp.execution.WorldMotion` of
     ``scene``; None: without the object, the gripper as its axes; see
     :func:`regrasp.viz.world_data.motion_description`)."""
-    from ..execution.world_motion import WorldMotion
     from .world_data import motion_description
 
-    if not isinstance(motion, WorldMotion):
+    if not all(hasattr(motion, k) for k in ("workcell", "times", "gripper", "object", "assignments", "in_hand")):
         raise ArgumentError(f"invalid `motion`: a WorldMotion (got {type(motion).__name__})", "motion")
     if scene is None:
         return motion_description(None, motion)

@@ -13,7 +13,6 @@ import itertools
 import numpy as np
 
 from .. import pose as P
-from ..workcell.description import block_contacts
 from .view_data import _outward, _world, feature_mesh, jaws
 
 #: The table's drawn slab thickness under its top [m] and its legs' side [m].
@@ -105,10 +104,7 @@ def feature_body(f) -> dict:
 def contact_owners(workcell) -> dict:
     """The feature (``"table"`` for the table) that owns each contact name of ``workcell``: a
     block's ``NAME.faces[i]`` etc. belong to ``NAME``."""
-    out = {"table": "table"}
-    for f in workcell.features:
-        out.update({c.name: f.name for c in block_contacts(f)} if f.kind == "block" else {f.name: f.name})
-    return out
+    return workcell.contact_owners()
 
 
 def workcell_description(workcell) -> dict:

@@ -69,7 +69,7 @@ def pusher_extent(scene) -> tuple[float, float]:
     else:
         specs = []
         for name in scene.pusher_names:
-            pts, _, mu = scene._core.pusher_spec(name)
+            pts, _, mu = scene.pusher_spec(name)
             specs.append((np.asarray(pts, float), mu))
     size = max((float(np.max(np.linalg.norm(p[:, None] - p[None], axis=-1))) for p, _ in specs), default=0.0)
     return size, max(mu for _, mu in specs)
@@ -82,8 +82,8 @@ def patch_extent(scene) -> float:
         return 0.0
     out = 0.0
     for name in scene.pusher_names:
-        pts = np.asarray(scene._core.pusher_spec(name)[0], float)
-        if len(pts) >= 3 and not scene._core.is_plane(name):
+        pts = np.asarray(scene.pusher_spec(name)[0], float)
+        if len(pts) >= 3 and not scene.is_plane(name):
             out = max(out, 2 * float(np.max(np.linalg.norm(pts - pts.mean(axis=0), axis=1))))
     return out
 

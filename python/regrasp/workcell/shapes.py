@@ -21,7 +21,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import pose as P
-from .description import Workcell
 
 #: Radius [m] of an edge's bar and of a corner's ball tip.
 EDGE_RADIUS = 0.003

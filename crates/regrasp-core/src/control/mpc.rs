@@ -247,7 +247,7 @@ impl Mpc {
         if !scene.admissible(&goal) || !(scene.hold_ratio(&goal) < 1.0) {
             return Err(Error::arg("goal", format!("{goal:?}: the pad is not on the object there or the grasp cannot hold it")));
         }
-        let tol = scene.task.map(|t| t.tolerance).unwrap_or([1e-3, 1e-3, 0.0175]);
+        let tol = scene.tolerance();
         let (knots, pushers) = resample(scene, path, settings.speed * settings.dt)?;
         Ok(Self {
             scene: scene.clone(),

@@ -497,7 +497,7 @@ pub fn plan_tree(
     let task = scene.task;
     let start = start.or(task.map(|t| t.start)).ok_or_else(|| Error::arg("start", "the scene has no task: give a start"))?;
     let goal = goal.or(task.map(|t| t.goal)).ok_or_else(|| Error::arg("goal", "the scene has no task: give a goal"))?;
-    let tol = task.map(|t| t.tolerance).unwrap_or([1e-3, 1e-3, 0.0175]);
+    let tol = scene.tolerance();
     let t0 = std::time::Instant::now();
     let mut space = PlanarSpace::new(scene, start, goal, tol, settings)?;
     let reach = crate::planning::reachability::unreachable(scene, &start, &goal, &tol);

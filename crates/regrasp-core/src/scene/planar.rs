@@ -69,6 +69,19 @@ pub struct Task {
     pub tolerance: [f64; 3],
 }
 
+/// The goal tolerance `[x, z, θ]` (m, m, rad) where a scene states none: 1 mm and 1°.
+pub const DEFAULT_TOLERANCE: [f64; 3] = [1e-3, 1e-3, 0.0175];
+
+/// The error `pose − goal` `[x, z, θ]` (m, m, rad; θ wrapped into [−π, π)) and whether every
+/// component is within `tolerance`: the one test of "is it at the goal?" for planar poses.
+pub fn goal_error(pose: &[f64; 3], goal: &[f64; 3], tolerance: &[f64; 3]) -> ([f64; 3], bool) {
+    use std::f64::consts::{PI, TAU};
+    let mut e = [pose[0] - goal[0], pose[1] - goal[1], pose[2] - goal[2]];
+    e[2] = (e[2] + PI).rem_euclid(TAU) - PI;
+    let within = e.iter().zip(tolerance).all(|(x, t)| x.abs() <= *t);
+    (e, within)
+}
+
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub name: String,
@@ -142,6 +155,11 @@ impl Grasp {
 }
 
 impl Scene {
+    /// The task's goal tolerance, or [`DEFAULT_TOLERANCE`] without a task.
+    pub fn tolerance(&self) -> [f64; 3] {
+        self.task.map(|t| t.tolerance).unwrap_or(DEFAULT_TOLERANCE)
+    }
+
     /// The limit surface the motion cones use.
     pub fn surface_model(&self) -> SurfaceModel {
         let exact = match &self.support {

@@ -310,6 +310,16 @@ pub(crate) fn surface_distance(mesh: &ConvexMesh, parts: &[ConvexMesh], sphere: 
     }
 }
 
+/// The error of `pose` to `goal` `[dx, dy, dz, angle]` (m, m, m, rad; the angle of the relative
+/// rotation, in [0, π]) and whether each is within `tolerance` `[x, y, z, angle]`: the one test
+/// of "is it at the goal?" for 3-D poses.
+pub fn goal_error(pose: &Isometry3<f64>, goal: &Isometry3<f64>, tolerance: &[f64; 4]) -> ([f64; 4], bool) {
+    let d = pose.translation.vector - goal.translation.vector;
+    let angle = goal.rotation.angle_to(&pose.rotation);
+    let e = [d.x, d.y, d.z, angle];
+    (e, e.iter().zip(tolerance).all(|(x, t)| x.abs() <= *t))
+}
+
 impl Scene3 {
     /// What the loader changed in the file's values (pusher points snapped onto the surface).
     pub fn notes(&self) -> &[String] {
