@@ -1,7 +1,10 @@
-"""Checks of the values in a file that regrasp reads besides scenes (workcell, trajectory): each
-value's type, finiteness, bounds and length, and an object's keys. A fault is a
-:class:`~regrasp.errors.SceneError` naming the dotted field (``samples[3].t``,
-``features[2].pose[4]``) and the value found. Scene files are checked by the Rust core."""
+"""The one validation module. Arguments of the API (``check_*``: numbers, counts, names, flags,
+vectors, rows of vectors; a fault is an :class:`~regrasp.errors.ArgumentError` naming the
+argument) and the values of every file regrasp reads besides scenes (:class:`FieldCheck`:
+workcell, robot, trajectory, plan, graph; each value's type, finiteness, bounds and length, and
+an object's keys; a fault is a :class:`~regrasp.errors.SceneError` naming the dotted field,
+``samples[3].t``, ``features[2].pose[4]``, and the value found). Scene files are checked by the
+Rust core, which bounds every number by ``MAX_MAGNITUDE``."""
 
 from __future__ import annotations
 
@@ -10,7 +13,102 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import SceneError
+from . import _core
+from .errors import ArgumentError, SceneError
+
+#: The bound the core puts on the magnitude of every number argument (1e9).
+MAX_MAGNITUDE = _core.MAX_MAGNITUDE
+
+
+def check_array(x, name: str) -> np.ndarray:
+    """``x`` as a float array, or an ArgumentError naming ``name`` (text, ragged lists, objects
+    that are not numbers, integers too large for a float)."""
+    if isinstance(x, (str, bytes)):
+        raise ArgumentError(f"invalid `{name}`: expected numbers, got {type(x).__name__} {x!r:.60}", name)
+    try:
+        a = np.asarray(x)
+        if a.dtype.kind not in "biuf":
+            if a.dtype.kind != "O":
+                raise TypeError(f"{a.dtype} values")
+            a = a.astype(float)
+        return np.asarray(a, dtype=float)
+    except (TypeError, ValueError, OverflowError) as e:
+        raise ArgumentError(f"invalid `{name}`: expected numbers ({e})", name) from None
+
+
+def check_finite(a: np.ndarray, name: str) -> np.ndarray:
+    """``a`` when every component is finite and at most ``MAX_MAGNITUDE`` (1e9) in
+    magnitude, the bound the core puts on every number argument."""
+    if not np.all(np.isfinite(a)):
+        raise ArgumentError(f"invalid `{name}`: has a non-finite component", name)
+    if a.size and np.max(np.abs(a)) > MAX_MAGNITUDE:
+        raise ArgumentError(f"invalid `{name}`: components must be at most {MAX_MAGNITUDE:g} in magnitude", name)
+    return a
+
+
+def check_vector(x, n: int, name: str) -> np.ndarray:
+    """A vector of ``n`` finite numbers."""
+    a = check_array(x, name)
+    if a.shape != (n,):
+        raise ArgumentError(f"invalid `{name}`: expected {n} numbers, got shape {a.shape}", name)
+    return check_finite(a, name)
+
+
+def check_rows(x, name: str, n: int = 3, finite: bool = False) -> np.ndarray:
+    """An (m, n) array (one vector of ``n`` is one row), m >= 1; of finite numbers with ``finite``
+    (batches report a non-finite row in its status instead)."""
+    a = np.ascontiguousarray(check_array(x, name))
+    if a.ndim == 1 and a.shape == (n,):
+        a = a[None, :]
+    if a.ndim != 2 or a.shape[1] != n or a.shape[0] == 0:
+        raise ArgumentError(f"invalid `{name}`: expected an (m, {n}) array with m >= 1, got shape {a.shape}", name)
+    return check_finite(a, name) if finite else a
+
+
+def check_vec_or_rows(x, name: str):
+    """One 3-vector (a list for the core) or an (m, 3) array: what the cone tests take."""
+    a = check_array(x, name)
+    return check_rows(a, name, finite=True) if a.ndim == 2 else list(check_vector(a, 3, name))
+
+
+def check_twists(x, name: str) -> np.ndarray:
+    """Twists: one 3-vector or an array of them (shape (..., 3)), finite."""
+    a = check_array(x, name)
+    if a.ndim == 0 or a.shape[-1] != 3:
+        raise ArgumentError(f"invalid `{name}`: expected twists of 3 numbers, got shape {a.shape}", name)
+    return check_finite(a, name)
+
+
+def check_number(x, name: str, low: float = 0.0, strict: bool = True, high: float = np.inf) -> float:
+    """A finite real number in (low, high] (``strict``) or [low, high]."""
+    ok = isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, (bool, np.bool_))
+    v = float(x) if ok and abs(x) < 1e308 else np.nan
+    if not (np.isfinite(v) and (v > low if strict else v >= low) and v <= high):
+        what = f"{'>' if strict else '>='} {low:g}" + ("" if high == np.inf else f" and <= {high:g}")
+        raise ArgumentError(f"invalid `{name}`: must be a finite number {what} (got {x!r:.60})", name)
+    return v
+
+
+def check_count(x, name: str, low: int = 1, high: int = 2**31 - 1) -> int:
+    """A whole number in [low, high]."""
+    ok = isinstance(x, (int, np.integer)) and not isinstance(x, (bool, np.bool_))
+    if not (ok and low <= int(x) <= high):
+        raise ArgumentError(f"invalid `{name}`: must be a whole number in [{low}, {high}] (got {x!r:.60})", name)
+    return int(x)
+
+
+def check_name(x, name: str) -> str:
+    """A name (of a pusher, a mode): a non-empty string."""
+    if not isinstance(x, str) or not x.strip():
+        raise ArgumentError(f"invalid `{name}`: must be a non-empty name (got {x!r:.60})", name)
+    return x
+
+
+def check_flag(x, name: str) -> bool:
+    """``True`` or ``False`` (a bool, not a number)."""
+    if not isinstance(x, (bool, np.bool_)):
+        raise ArgumentError(f"invalid `{name}`: must be True or False (got {x!r:.60})", name)
+    return bool(x)
 
 
 @dataclass(frozen=True)

@@ -19,13 +19,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import _core, errors, progress
+from .. import errors, progress
 from ..errors import ArgumentError, MissingExtraError, RegraspError, SceneError
 from ..extras import need
 from ..files import check_writable, refuse_overwrite_input
 from ..planning.plan import Plan, planner_defaults
 from ..scene import load_scene
 from ..scene.planar import Scene
+from ..scene.settings import core_build, limit_surface_default, mpc_defaults
 
 
 #: exit statuses (docs/cli.md): 130 = 128 + SIGINT, 141 = 128 + SIGPIPE (the shell's convention)
@@ -148,9 +149,7 @@ def api_default(fn, name: str):
 
 def mpc_default(key: str) -> str:
     """The MPC's default of setting ``key`` for a help text (the Rust core's)."""
-    from .. import _core
-
-    return f"default: {_core.mpc_defaults()[key]}"
+    return f"default: {mpc_defaults()[key]}"
 
 
 def given(a, *names: str) -> dict:
@@ -227,7 +226,7 @@ def add_limit_surface(p) -> None:
     p.add_argument("--limit-surface", choices=["true", "ellipsoid"],
                    help="the motion cones' limit surface: the exact one of the pad's or footprint's pressure, or "
                    "the ellipsoid of eq 3.7 (default: the scene's `limit_surface`, else "
-                   f"{_core.limit_surface_default()})")
+                   f"{limit_surface_default()})")
 
 
 def unreadable(path, e: ArgumentError, arg: str = "scene") -> ArgumentError:
@@ -373,12 +372,12 @@ def example_epilog(example: str) -> str:
 
 def version() -> str:
     """``regrasp VERSION (core NAME, ABI, PYTHON)``: the package and its compiled core."""
-    from .. import __version__, _core
+    from .. import __version__
 
-    name = Path(_core.__file__).name
+    core, name = core_build()
     abi = "abi3" if ".abi3." in name else name.split(".")[1] if name.count(".") > 1 else "unknown ABI"
     py = f"{sys.implementation.name} {sys.version_info.major}.{sys.version_info.minor}"
-    return f"regrasp {__version__} (core {_core.__version__}: {name}, {abi}; {py})"
+    return f"regrasp {__version__} (core {core}: {name}, {abi}; {py})"
 
 
 def add_quiet(p, default=False) -> None:

@@ -6,7 +6,7 @@ import json
 
 import numpy as np
 
-from .. import _core
+from ..scene.settings import mpc_defaults
 from ..errors import ArgumentError
 from ..planning.plan import Plan
 from . import (CANNOT, api_default, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_command, add_scale_options, add_verbose, check_count,
@@ -103,7 +103,7 @@ def add_parsers(sub) -> None:
                    f"NOISE/L [rad] with L the object's length (default: {api_default(control, 'noise')})")
     k.add_argument("--dt", type=float, help=f"planar: control period [s] ({mpc_default('dt')})")
     k.add_argument("--horizon", type=int, help=f"planar: MPC horizon in steps ({mpc_default('horizon')})")
-    k.add_argument("--seed", type=seed_arg, default=_core.mpc_defaults()["seed"],
+    k.add_argument("--seed", type=seed_arg, default=mpc_defaults()["seed"],
                    help="random seed (measurement noise; seeds of re-plans)")
     k.add_argument("--plot", metavar="PNG", help="planar: planned against executed poses, pokes marked")
     k.add_argument("--json", action="store_true", help="print the result as JSON")

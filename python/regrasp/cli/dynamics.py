@@ -6,7 +6,8 @@ import json
 
 import numpy as np
 
-from .. import _core, progress
+from .. import progress
+from ..scene.settings import quasistatic_defaults, validation_rings
 from ..errors import ArgumentError
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
@@ -203,9 +204,9 @@ def add_parsers(sub) -> None:
     v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
     v.add_argument("--support", choices=["points", "limit_surface"],
                    help="quasi-static pads as point sets or as one patch on the ellipsoidal limit surface (eq 3.7) "
-                   f"(default: {_core.quasistatic_defaults()['support']})")
+                   f"(default: {quasistatic_defaults()['support']})")
     v.add_argument("--rings", type=int, help="quasi-static point-set pads: rings of points per circular pad, 1 to 64 "
-                   f"(6, 12, 18... points; default: {_core.validation_rings()})")
+                   f"(6, 12, 18... points; default: {validation_rings()})")
     v.add_argument("--json", action="store_true", help="print the result as JSON")
     add_limit_surface(v)
     add_verbose(v)

@@ -15,12 +15,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _core, progress
+from .. import progress
 from ..errors import ArgumentError, RegraspError, check_seed
 from ..mujoco.model import plan_dict
 from ..mujoco.planar import Perturbation
 from ..sim.quasistatic import body_twist, simulate_push
-from ..scene.planar import Scene, _count, _number, _vec
+from ..scene.planar import Scene
+from ..scene.settings import mpc_defaults
+from ..fields import check_count, check_number, check_vector
 
 ENGINES = ("quasistatic", "mujoco")
 POLICIES = ("mpc", "open_loop")
@@ -130,14 +132,14 @@ def _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error, 
         raise ArgumentError(f"invalid `policy`: must be one of {POLICIES} (got {policy!r})", "policy")
     # bounds: a control period up to 10 s, the core's pusher speed limit (100 m/s), a day of
     # control, measurement noise up to 1 m
-    _number(dt, "dt", high=10.0), _number(speed, "speed", high=100.0), _count(horizon, "horizon", 1, 10_000)
+    check_number(dt, "dt", high=10.0), check_number(speed, "speed", high=100.0), check_count(horizon, "horizon", 1, 10_000)
     if max_time is not None:
-        _number(max_time, "max_time", high=86_400.0)
-    _number(noise, "noise", strict=False, high=1.0)
+        check_number(max_time, "max_time", high=86_400.0)
+    check_number(noise, "noise", strict=False, high=1.0)
     check_seed(seed)
     if not all(isinstance(p, Poke) for p in _iterable(pokes, "pokes")):
         raise ArgumentError("invalid `pokes`: a list of Poke (Poke.parse('T,dx,dz,dtheta'))", "pokes")
-    return _vec(start_error, 3, "start_error")
+    return check_vector(start_error, 3, "start_error")
 
 
 def _iterable(x, name: str) -> list:
@@ -164,8 +166,8 @@ class ControlRun:
         self.scene, self.policy, self.engine, self.noise, self.dt = scene, policy, engine, noise, dt
         self.goal = np.asarray(task.goal if task is not None else poses[-1], float)
         cscene = controller_scene or scene
-        self.ctrl = _core.Mpc(cscene._core, poses, [k["pusher"] for k in path], self.goal.tolist(), dt=dt,
-                              horizon=horizon, speed=speed, seed=check_seed(seed), **mpc)
+        self.ctrl = cscene.mpc(poses, [k["pusher"] for k in path], self.goal.tolist(), dt=dt, horizon=horizon,
+                               speed=speed, seed=check_seed(seed), **mpc)
         self.knots = np.asarray(self.ctrl.knots)
         self.knot_pushers = self.ctrl.knot_pushers
         self.pokes = sorted(pokes, key=lambda k: k.t)
@@ -304,7 +306,7 @@ def control(scene: Scene, plan, engine: str = "quasistatic", policy: str = "mpc"
     ``dt`` [s], ``speed`` [m/s], ``horizon`` and the other MPC settings default to the core's
     (``regrasp._core.mpc_defaults()``).
     """
-    d = _core.mpc_defaults()
+    d = mpc_defaults()
     dt, speed, horizon = (d[k] if v is None else v for k, v in (("dt", dt), ("speed", speed), ("horizon", horizon)))
     se = _check_arguments(engine, policy, dt, speed, horizon, max_time, start_error, noise, seed, pokes)
     run = ControlRun(scene, plan, engine, policy, pokes, se, perturb, controller_scene, noise, seed, dt, speed, horizon,

@@ -28,13 +28,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _core
 from .. import pose as P
 from ..errors import ArgumentError, ExecutionError, RegraspError
 from ..extras import need
+from ..scene.settings import mpc_defaults
 from .arm import CONTACT_CLEARANCE, Scales, arm_motion, build_robot, close_on, first_solution
 from .assignment import assign, pusher_contact
-from .world_motion import Segments, Timing, world_motion
+from .world_motion import Segments, Timing
 
 
 @dataclass
@@ -267,9 +267,9 @@ def control_arm(scene, plan, workcell=None, scales: Scales = Scales(), robot: st
         raise ArgumentError(f"invalid `plan`: a regrasp Plan (got {type(plan).__name__})", "plan")
     if not isinstance(scales, Scales):
         raise ArgumentError(f"invalid `scales`: a Scales (got {type(scales).__name__})", "scales")
-    from ..scene.planar import _vec
+    from ..fields import check_vector
 
-    if scene.dimension != 2 and np.any(_vec(start_error, 3, "start_error") != 0):
+    if scene.dimension != 2 and np.any(check_vector(start_error, 3, "start_error") != 0):
         raise ArgumentError("invalid `start_error`: planar scenes only (3-D re-planning starts from the plan's start)",
                             "start_error")
     _check_features(scene, plan, workcell)
@@ -335,7 +335,7 @@ def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time
     from ..control.loop import ControlRun, _check_arguments
     from ..mujoco.planar import Perturbation
 
-    d = _core.mpc_defaults()
+    d = mpc_defaults()
     dt, speed, horizon = (mpc.pop(k, d[k]) for k in ("dt", "speed", "horizon"))
     se = _check_arguments("quasistatic", "mpc", dt, speed, horizon, max_time, start_error, 0.0, seed, ())  # before any work
     made = []

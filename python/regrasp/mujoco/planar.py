@@ -24,7 +24,8 @@ import numpy as np
 
 from .. import progress
 from ..errors import ArgumentError
-from ..scene.planar import Scene, _number
+from ..scene.planar import Scene
+from ..fields import check_number
 from ..sim.quasistatic import Replay, body_twist, integrate_pose
 from .push import MAX_DURATION
 from ..pose import planar_compose, planar_inverse, planar_quat, planar_rotate
@@ -249,8 +250,8 @@ def execute_plan(scene: Scene, plan, perturb: Perturbation = Perturbation(), spe
     """Executes ``plan`` (a ``regrasp.Plan`` or its dict) open loop in MuJoCo; returns the
     recorded object pose in the grasp (:class:`PlanarExecution`). ``speed`` [m/s] at most 100 m/s
     (the core's bound on a pusher's speed), ``record_dt`` and ``settle`` [s] at most 60 s."""
-    speed = _number(speed, "speed", high=100.0)
-    record_dt, settle = _number(record_dt, "record_dt", high=MAX_DURATION), _number(settle, "settle", 0.0, False, MAX_DURATION)
+    speed = check_number(speed, "speed", high=100.0)
+    record_dt, settle = check_number(record_dt, "record_dt", high=MAX_DURATION), check_number(settle, "settle", 0.0, False, MAX_DURATION)
     return PlanarExecution(scene, plan, perturb, contact, speed, record_dt).run(settle)
 
 

@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..extras import need
-from ..scene.planar import Scene, _name, _number, _vec
+from ..scene.planar import Scene
+from ..fields import check_name, check_number, check_vector
 
 #: the longest push :func:`simulate_push` simulates [s] (MuJoCo steps of 0.5 ms: a bound on its time)
 MAX_DURATION = 60.0
@@ -140,9 +141,9 @@ def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, recor
     """A push in MuJoCo: the pads squeeze for 0.3 s, then the pusher moves with constant body
     ``twist`` (m/s, m/s, rad/s; object frame at the start) from ``pose`` (m, m, rad) for ``duration``
     [s], recorded every ``record_dt`` [s]. Returns times and object poses (gripper frame)."""
-    pose, twist, pusher = _vec(pose, 3, "pose"), _vec(twist, 3, "twist"), _name(pusher, "pusher")
-    duration = _number(duration, "duration", high=MAX_DURATION)
-    record_dt = _number(record_dt, "record_dt", high=MAX_DURATION)
+    pose, twist, pusher = check_vector(pose, 3, "pose"), check_vector(twist, 3, "twist"), check_name(pusher, "pusher")
+    duration = check_number(duration, "duration", high=MAX_DURATION)
+    record_dt = check_number(record_dt, "record_dt", high=MAX_DURATION)
     rig = PushRig(scene, pusher, settings)
     r = rig.push(pose, twist, duration, settle=0.3, record_dt=record_dt)
     return {"t": r["t"], "pose": r["pose"], "settled_pose": r["pose"][0]}

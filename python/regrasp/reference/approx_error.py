@@ -21,7 +21,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ArgumentError, GraspError, check_seed
-from ..scene.planar import Scene, _count, _name, _vec
+from ..scene.planar import Scene
+from ..fields import check_count, check_name, check_vector
 
 #: most random pushes one row takes (a bound on its time)
 MAX_SAMPLES = 1_000_000
@@ -47,8 +48,8 @@ def approximation_error(scene: Scene, pusher: str, pose=None, samples: int = 200
     ``[x, z, theta]`` (m, m, rad; default: the task's start)."""
     if pose is None and scene.task is None:
         raise ArgumentError("invalid `pose`: the scene has no [task]; give the pose", "pose")
-    pose = scene.task.start if pose is None else _vec(pose, 3, "pose")
-    samples, pusher = _count(samples, "samples", 1, MAX_SAMPLES), _name(pusher, "pusher")
+    pose = scene.task.start if pose is None else check_vector(pose, 3, "pose")
+    samples, pusher = check_count(samples, "samples", 1, MAX_SAMPLES), check_name(pusher, "pusher")
     rng = np.random.default_rng(check_seed(seed))
     try:
         cone = scene.motion_cone(pose, pusher)

@@ -17,99 +17,12 @@ from numpy.typing import NDArray
 
 from .. import _core
 from ..errors import ArgumentError, SceneError
+from ..fields import check_array as _array, check_flag as _flag, check_name as _name
+from ..fields import check_number as _number, check_rows as _rows, check_twists as _twists
+from ..fields import check_vec_or_rows as _vec_or_rows, check_vector as _vec
 from .common import Task, core_property, read_scene_file
 
 ArrayLike = Sequence[float] | np.ndarray
-
-
-def _array(x, name: str) -> np.ndarray:
-    """``x`` as a float array, or an ArgumentError naming ``name`` (text, ragged lists, objects
-    that are not numbers, integers too large for a float)."""
-    if isinstance(x, (str, bytes)):
-        raise ArgumentError(f"invalid `{name}`: expected numbers, got {type(x).__name__} {x!r:.60}", name)
-    try:
-        a = np.asarray(x)
-        if a.dtype.kind not in "biuf":
-            if a.dtype.kind != "O":
-                raise TypeError(f"{a.dtype} values")
-            a = a.astype(float)
-        return np.asarray(a, dtype=float)
-    except (TypeError, ValueError, OverflowError) as e:
-        raise ArgumentError(f"invalid `{name}`: expected numbers ({e})", name) from None
-
-
-def _finite(a: np.ndarray, name: str) -> np.ndarray:
-    """``a`` when every component is finite and at most ``_core.MAX_MAGNITUDE`` (1e9) in
-    magnitude, the bound the core puts on every number argument."""
-    if not np.all(np.isfinite(a)):
-        raise ArgumentError(f"invalid `{name}`: has a non-finite component", name)
-    if a.size and np.max(np.abs(a)) > _core.MAX_MAGNITUDE:
-        raise ArgumentError(f"invalid `{name}`: components must be at most {_core.MAX_MAGNITUDE:g} in magnitude", name)
-    return a
-
-
-def _vec(x, n: int, name: str) -> np.ndarray:
-    """A vector of ``n`` finite numbers."""
-    a = _array(x, name)
-    if a.shape != (n,):
-        raise ArgumentError(f"invalid `{name}`: expected {n} numbers, got shape {a.shape}", name)
-    return _finite(a, name)
-
-
-def _rows(x, name: str, n: int = 3, finite: bool = False) -> np.ndarray:
-    """An (m, n) array (one vector of ``n`` is one row), m >= 1; of finite numbers with ``finite``
-    (batches report a non-finite row in its status instead)."""
-    a = np.ascontiguousarray(_array(x, name))
-    if a.ndim == 1 and a.shape == (n,):
-        a = a[None, :]
-    if a.ndim != 2 or a.shape[1] != n or a.shape[0] == 0:
-        raise ArgumentError(f"invalid `{name}`: expected an (m, {n}) array with m >= 1, got shape {a.shape}", name)
-    return _finite(a, name) if finite else a
-
-
-def _vec_or_rows(x, name: str):
-    """One 3-vector (a list for the core) or an (m, 3) array: what the cone tests take."""
-    a = _array(x, name)
-    return _rows(a, name, finite=True) if a.ndim == 2 else list(_vec(a, 3, name))
-
-
-def _twists(x, name: str) -> np.ndarray:
-    """Twists: one 3-vector or an array of them (shape (..., 3)), finite."""
-    a = _array(x, name)
-    if a.ndim == 0 or a.shape[-1] != 3:
-        raise ArgumentError(f"invalid `{name}`: expected twists of 3 numbers, got shape {a.shape}", name)
-    return _finite(a, name)
-
-
-def _number(x, name: str, low: float = 0.0, strict: bool = True, high: float = np.inf) -> float:
-    """A finite real number in (low, high] (``strict``) or [low, high]."""
-    ok = isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, (bool, np.bool_))
-    v = float(x) if ok and abs(x) < 1e308 else np.nan
-    if not (np.isfinite(v) and (v > low if strict else v >= low) and v <= high):
-        what = f"{'>' if strict else '>='} {low:g}" + ("" if high == np.inf else f" and <= {high:g}")
-        raise ArgumentError(f"invalid `{name}`: must be a finite number {what} (got {x!r:.60})", name)
-    return v
-
-
-def _count(x, name: str, low: int = 1, high: int = 2**31 - 1) -> int:
-    """A whole number in [low, high]."""
-    ok = isinstance(x, (int, np.integer)) and not isinstance(x, (bool, np.bool_))
-    if not (ok and low <= int(x) <= high):
-        raise ArgumentError(f"invalid `{name}`: must be a whole number in [{low}, {high}] (got {x!r:.60})", name)
-    return int(x)
-
-
-def _name(x, name: str) -> str:
-    """A name (of a pusher, a mode): a non-empty string."""
-    if not isinstance(x, str) or not x.strip():
-        raise ArgumentError(f"invalid `{name}`: must be a non-empty name (got {x!r:.60})", name)
-    return x
-
-
-def _flag(x, name: str) -> bool:
-    if not isinstance(x, (bool, np.bool_)):
-        raise ArgumentError(f"invalid `{name}`: must be True or False (got {x!r:.60})", name)
-    return bool(x)
 
 
 @dataclass(frozen=True)
@@ -582,6 +495,13 @@ class Scene:
         f = {k: float(u.get(k, 0.0)) for k in keys}
         s = self.scaled(1 - f["finger_friction"], 1 - f["grip_force"], 1 + f["mass"], 1 - f["pusher_friction"], "robust")
         return s
+
+    def mpc(self, poses, pushers, goal=None, **settings):
+        """The MPC of thesis §5.2 (the core's ``Mpc``) tracking the plan ``poses`` (n, 3) [m, m, rad]
+        with ``pushers`` (n names) in this scene's cones, towards ``goal`` (default: the task's);
+        ``settings`` (``dt`` [s], ``horizon``, ``speed`` [m/s], weights, ``seed``...) default to
+        :func:`~regrasp.scene.settings.mpc_defaults`."""
+        return _core.Mpc(self._core, poses, pushers, goal, **settings)
 
     def fixtureless(self) -> "Scene":
         """Fixtureless fixturing (CASE 2018): only pushes by pushers that carry the object's

@@ -16,7 +16,7 @@ from ..errors import ArgumentError, RegraspError, SceneError, check_seed
 from ..planning.plan import Plan, as_plan
 from ..pose import quat_angle, twist_between, twist_in
 from .common import Task, core_property, read_scene_file
-from .planar import _flag, _name, _number, _vec
+from ..fields import check_flag, check_name, check_number, check_vector
 
 
 class Scene3D:
@@ -77,13 +77,23 @@ class Scene3D:
         """Pusher ``name`` brought against the object at ``pose`` ``[x, y, z, qw, qx, qy, qz]``
         (default: the task's start): its contact points (k, 3) and normal (3,) in the object frame
         [m] and its friction coefficient."""
-        q = None if pose is None else list(map(float, _vec(pose, 7, "pose")))
-        pts, n, mu = self._core.pusher_spec(_name(name, "pusher"), q)
+        q = None if pose is None else list(map(float, check_vector(pose, 7, "pose")))
+        pts, n, mu = self._core.pusher_spec(check_name(name, "pusher"), q)
         return np.asarray(pts, float), np.asarray(n, float), float(mu)
+
+    def pusher_points(self, name: str, pose=None) -> np.ndarray:
+        """Contact points (k, 3) [m] of pusher ``name`` in the object frame at ``pose``
+        ``[x, y, z, qw, qx, qy, qz]`` (default: the task's start)."""
+        q = None if pose is None else list(map(float, check_vector(pose, 7, "pose")))
+        return np.asarray(self._core.pusher_points(check_name(name, "pusher"), q), float)
+
+    def pusher_normal(self, name: str) -> np.ndarray:
+        """Pusher ``name``'s normal (3,) as the scene gives it (object frame; a plane's: gripper frame)."""
+        return np.asarray(self._core.pusher_normal(check_name(name, "pusher")), float)
 
     def is_plane(self, name: str) -> bool:
         """Whether pusher ``name`` is a plane (its normal fixed in the gripper frame)."""
-        return bool(self._core.is_plane(_name(name, "pusher")))
+        return bool(self._core.is_plane(check_name(name, "pusher")))
 
     @property
     def task(self) -> Task:
@@ -96,8 +106,8 @@ class Scene3D:
         """The error of ``pose`` ``[x, y, z, qw, qx, qy, qz]`` to ``goal`` (default: the task's),
         ``[dx, dy, dz, angle]`` (m, m, m, rad; the angle of the relative rotation), and whether it
         is within the task's tolerance. Decided once, in the core."""
-        g = None if goal is None else list(map(float, _vec(goal, 7, "goal")))
-        e, ok = self._core.goal_error(list(map(float, _vec(pose, 7, "pose"))), g)
+        g = None if goal is None else list(map(float, check_vector(goal, 7, "goal")))
+        e, ok = self._core.goal_error(list(map(float, check_vector(pose, 7, "pose"))), g)
         return np.array(e), bool(ok)
 
     def mesh(self):
@@ -124,12 +134,12 @@ class Scene3D:
     def pad_contacts(self, pose) -> list:
         """Contact points of the two finger pads at ``pose`` ``[x, y, z, qw, qx, qy, qz]`` (m, quaternion),
         in the object frame [m]: one (k, 3) array per pad."""
-        return [np.array(p) for p in self._core.pad_contacts(list(_vec(pose, 7, "pose")))]
+        return [np.array(p) for p in self._core.pad_contacts(list(check_vector(pose, 7, "pose")))]
 
     def quasistatic_problem(self, pose, pusher: str, h: float = 1.0):
         """The quasi-static problem (a ``_core.MncpProblem``) of ``pusher`` in contact at ``pose``
         ``[x, y, z, qw, qx, qy, qz]`` (m, quaternion), with time step ``h`` [s] > 0."""
-        return self._core.quasistatic_problem(list(_vec(pose, 7, "pose")), _name(pusher, "pusher"), _number(h, "h"))
+        return self._core.quasistatic_problem(list(check_vector(pose, 7, "pose")), check_name(pusher, "pusher"), check_number(h, "h"))
 
     def simulate_push(self, pose, pusher: str, twist, duration: float, dt: Optional[float] = None) -> dict:
         """The pusher moves with constant body ``twist`` (m/s, rad/s) for ``duration`` [s] > 0 in steps
@@ -137,9 +147,9 @@ class Scene3D:
         :func:`~regrasp.sim.quasistatic.simulate_push`)."""
         from ..sim.quasistatic import push_dt
 
-        duration = _number(duration, "duration")
-        dt = push_dt(duration, None if dt is None else _number(dt, "dt"))
-        return self._core.simulate_push(list(_vec(pose, 7, "pose")), _name(pusher, "pusher"), list(_vec(twist, 6, "twist")),
+        duration = check_number(duration, "duration")
+        dt = push_dt(duration, None if dt is None else check_number(dt, "dt"))
+        return self._core.simulate_push(list(check_vector(pose, 7, "pose")), check_name(pusher, "pusher"), list(check_vector(twist, 6, "twist")),
                                         duration, dt)
 
     def plan(self, start=None, goal=None, **settings) -> Plan:
@@ -166,7 +176,7 @@ class Scene3D:
         the object is. Returns the final pose, the error to the goal (position [m] and angle
         [rad]), success (within the task's tolerance), the poses after each step and the
         re-plans made (``feedback``: see :func:`run_plan3d`)."""
-        dt, feedback, seed = _number(dt, "dt"), _flag(feedback, "feedback"), check_seed(seed)
+        dt, feedback, seed = check_number(dt, "dt"), check_flag(feedback, "feedback"), check_seed(seed)
         path = as_plan(plan, self).path
 
         def step(a, b):

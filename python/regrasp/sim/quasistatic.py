@@ -12,13 +12,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _core
 from ..errors import ArgumentError
 from ..planning.plan import as_plan
-from ..scene.planar import Scene, _count, _flag, _name, _number, _vec
+from ..scene.planar import Scene
+from ..scene.settings import quasistatic_defaults
+from ..fields import check_count, check_flag, check_name, check_number, check_vector
 
 #: The simulator's defaults, stated once in the Rust core (``quasistatic::Options``).
-DEFAULTS = _core.quasistatic_defaults()
+DEFAULTS = quasistatic_defaults()
 SPEED = DEFAULTS["speed"]  # m/s, the thesis' pushing speed
 #: time step of simulated pushes and plan replays [s] (``regrasp push --dt``, ``regrasp simulate --dt``)
 DT = 0.05
@@ -33,9 +34,9 @@ def support_kwargs(support: str | None = None, rings: int | None = None, points:
     kw = {k: DEFAULTS[k] if v is None else v for k, v in given.items()}
     if not isinstance(kw["support"], str) or kw["support"] not in ("points", "limit_surface"):
         raise ArgumentError(f"invalid `support`: must be 'points' or 'limit_surface', got {kw['support']!r:.60}", "support")
-    kw["rings"] = _count(kw["rings"], "rings", 1, 64)
-    kw["points"] = _count(kw["points"], "points", 0, 4096)
-    kw["merge_fingers"] = _flag(kw["merge_fingers"], "merge_fingers")
+    kw["rings"] = check_count(kw["rings"], "rings", 1, 64)
+    kw["points"] = check_count(kw["points"], "points", 0, 4096)
+    kw["merge_fingers"] = check_flag(kw["merge_fingers"], "merge_fingers")
     return kw
 
 
@@ -43,9 +44,9 @@ def problem(scene: Scene, pose, pusher: str | None = None, h: float | None = Non
     """The instantaneous complementarity problem (``regrasp._core.MncpProblem``); ``h`` the time
     step [s] (default: the core's)."""
     kw = support_kwargs(**support)
-    h = None if h is None else _number(h, "h")
-    pusher = None if pusher is None else _name(pusher, "pusher")
-    return scene.quasistatic_problem(_vec(pose, 3, "pose"), pusher, kw["support"], kw["rings"],
+    h = None if h is None else check_number(h, "h")
+    pusher = None if pusher is None else check_name(pusher, "pusher")
+    return scene.quasistatic_problem(check_vector(pose, 3, "pose"), pusher, kw["support"], kw["rings"],
                                            kw["points"], kw["merge_fingers"], h, SPEED)
 
 
@@ -60,9 +61,9 @@ def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: f
     constant body ``twist`` (m/s, m/s, rad/s) for ``duration`` [s] in steps of ``dt`` [s]
     (dt: time step [s], default min(0.05, duration))."""
     kw = support_kwargs(**support)
-    duration = _number(duration, "duration")
-    dt = _number(push_dt(duration, dt), "dt")
-    return scene.simulate_push(_vec(pose, 3, "pose"), _name(pusher, "pusher"), _vec(twist, 3, "twist"),
+    duration = check_number(duration, "duration")
+    dt = check_number(push_dt(duration, dt), "dt")
+    return scene.simulate_push(check_vector(pose, 3, "pose"), check_name(pusher, "pusher"), check_vector(twist, 3, "twist"),
                                      duration, dt, kw["support"], kw["rings"], kw["points"], kw["merge_fingers"])
 
 
@@ -113,7 +114,7 @@ def replay_plan(scene: Scene, plan, speed: float = SPEED, dt: float = DT, **supp
     """Replays a plan (a :class:`~regrasp.Plan` or a plan dict) in the quasi-static simulator:
     for each step the pusher is put in contact with the object where it is now, then follows the
     planned object motion of that step (its body twist, at ``speed`` [m/s]) in steps of ``dt`` [s]."""
-    speed, dt = _number(speed, "speed"), _number(dt, "dt")
+    speed, dt = check_number(speed, "speed"), check_number(dt, "dt")
     path = as_plan(plan, scene).path
     q = np.asarray(path[0]["pose"], float)
     ts, qs, planned = [0.0], [q.copy()], [q.copy()]

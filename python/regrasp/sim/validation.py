@@ -32,9 +32,10 @@ import numpy as np
 from .. import progress as bars
 from ..errors import ArgumentError, RegraspError, check_seed
 from ..extras import need
-from .. import _core
 from .quasistatic import SPEED, support_kwargs
-from ..scene.planar import Scene, _count
+from ..scene.planar import Scene
+from ..scene.settings import validation_rings
+from ..fields import check_count
 
 #: most random pushes one validation takes (a bound on its time: about 1 ms a push)
 MAX_PUSHES = 1_000_000
@@ -274,12 +275,12 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
     ``scene.limit_surface``) with each engine (see the module notes); ``support`` the quasi-static
     pad model, "points" or "limit_surface" (default: the core's), ``rings`` the point-set pads'
     rings (default: the core's ``validation_rings``, finer than the simulator's everyday pads)."""
-    pushes, seed = _count(pushes, "pushes", 1, MAX_PUSHES), check_seed(seed)
+    pushes, seed = check_count(pushes, "pushes", 1, MAX_PUSHES), check_seed(seed)
     if isinstance(engines, str) or not isinstance(engines, (list, tuple)) or not engines:
         raise ArgumentError(f"invalid `engines`: a list of engine names (got {engines!r:.60})", "engines")
-    support = support_kwargs(support, rings=_core.validation_rings() if rings is None else rings)
+    support = support_kwargs(support, rings=validation_rings() if rings is None else rings)
     if workers is not None:
-        workers = _count(workers, "workers", 1, 4096)
+        workers = check_count(workers, "workers", 1, 4096)
     for e in engines:
         if e not in ENGINES:
             raise ArgumentError(f"invalid `engines`: unknown engine {e!r} (available: {', '.join(ENGINES)})", "engines")

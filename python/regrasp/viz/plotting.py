@@ -505,13 +505,12 @@ def _pusher3d(ax, scene, name: str, pose, w, size: float) -> None:
     object's vertices ``w`` [m] there; a plane also as a translucent square of half side 1.3 ``size`` [m]."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    core = scene._core
-    if not core.is_plane(name):
-        pts = _at(pose, np.asarray(core.pusher_points(name), float))
+    if not scene.is_plane(name):
+        pts = _at(pose, scene.pusher_points(name))
     else:  # where the object is lowest along the plane's normal (gripper frame)
-        nrm = np.asarray(core.pusher_normal(name), float)
+        nrm = scene.pusher_normal(name)
         low = (w @ nrm).min()
-        pts = w[w @ nrm < low + 1e-6 * size] if not core.sphere else (pose[:3] - core.sphere * nrm)[None]
+        pts = w[w @ nrm < low + 1e-6 * size] if not scene.sphere else (pose[:3] - scene.sphere * nrm)[None]
         t1, t2 = tangents(nrm)
         sq = [pts[0] + 1.3 * size * (i * t1 + j * t2) for i, j in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
         ax.add_collection3d(Poly3DCollection([sq], facecolor="tab:red", alpha=0.12))

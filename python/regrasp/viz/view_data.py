@@ -205,7 +205,6 @@ def spatial_description(scene, plan_poses, plan_pushers, marks) -> dict:
     """The view's data for a :class:`~regrasp.Scene3D` (see the module doc); ``plan_poses``: object
     poses [x, y, z, qw, qx, qy, qz] (m, unit quaternion) in the gripper frame, ``plan_pushers``
     their pusher names."""
-    core = scene._core
     v, t = scene.surface()
     v = np.asarray(v, float)
     size = float(np.linalg.norm(v, axis=1).max())
@@ -213,30 +212,30 @@ def spatial_description(scene, plan_poses, plan_pushers, marks) -> dict:
     poses = [list(map(float, q)) for q in (plan_poses if plan_poses is not None else [start])]
     contacts = np.concatenate(scene.pad_contacts(start))
     width = float(contacts[:, 1].max() - contacts[:, 1].min())
-    gvec = np.asarray(core.gravity, float)
+    gvec = np.asarray(scene.gravity, float)
     gn = float(np.linalg.norm(gvec))
     gdir = gvec / gn if gn > 0 else np.array([0.0, 0.0, -1.0])
     names = list(scene.pusher_names)
-    planes = {n: np.asarray(core.pusher_normal(n), float).tolist() for n in names if core.is_plane(n)}
+    planes = {n: scene.pusher_normal(n).tolist() for n in names if scene.is_plane(n)}
     support = None
     for n, normal in planes.items():
         if np.dot(normal, -gdir) > 0.99:  # a floor: the ground through the object's lowest point
             w = _world(poses, v)
             support = {"name": n, "normal": normal, "point": (w.reshape(-1, 3)[np.argmin(w.reshape(-1, 3) @ normal)]).tolist()}
-    pushers = [(n, np.asarray(core.pusher_points(n), float), np.asarray(core.pusher_normal(n), float))
-               for n in names if not core.is_plane(n)]
+    pushers = [(n, scene.pusher_points(n), scene.pusher_normal(n))
+               for n in names if not scene.is_plane(n)]
     feats = _features(pushers, FEATURE_DEPTH * size)
     return framing({
         "dimension": 3, "edges": feature_edges(v, t),
         "vertices": v.tolist(), "triangles": np.asarray(t, int).tolist(), "marks": list(map(int, marks)),
-        "sphere": core.sphere, "size": size,
+        "sphere": scene.sphere, "size": size,
         "poses": poses, "pushers_of_steps": list(plan_pushers) if plan_pushers is not None else [None],
-        "pusher_points": {n: np.asarray(core.pusher_points(n), float).tolist() for n in names},
+        "pusher_points": {n: scene.pusher_points(n).tolist() for n in names},
         # plane pushers: their normals (gripper frame); the page finds where they touch
         "planes": planes,
         "features": feats,
-        "pad": float(core.pad_radius), "pad_rect": None,
-        "jaws": jaws(poses, _with_features(v, feats), float(core.pad_radius), width, size),
+        "pad": float(scene.pad_radius), "pad_rect": None,
+        "jaws": jaws(poses, _with_features(v, feats), float(scene.pad_radius), width, size),
         "ground": ground(poses, v, gdir, size, support),
         "gravity": {"direction": gdir.tolist(), "g": gn, "in_plane": False},
         "goal": list(map(float, goal)),
