@@ -23,7 +23,7 @@ if __name__ == "__main__":
         if name in ("t-shape", "block-xztheta"):
             animate_plan(sc, p, OUT / f"plan-{name}.gif")
     # 3-D plans: GIFs (seed 0)
-    from regrasp.viz.plotting import animate_plan3d
+    from regrasp.viz.plotting3d import animate_plan3d
 
     for name, fps in (("pivot-3d", 6), ("pivot-single-3d", 6), ("ball-roll-3d", 4), ("pivot-90-3d", 4), ("offset-pivot-3d", 6),
                       ("bracket-pivot-3d", 6)):

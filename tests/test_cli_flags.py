@@ -150,7 +150,7 @@ def test_the_3d_plot_shows_the_start_goal_and_pusher_runs(tmp_path, plans):
 
     from regrasp import load_scene
     from regrasp.planning.plan import Plan
-    from regrasp.viz.plotting import plot_plan3d
+    from regrasp.viz.plotting3d import plot_plan3d
 
     scene = load_scene(SPATIAL)
     plan = Plan.load(plans["3d"], scene)

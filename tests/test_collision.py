@@ -11,7 +11,8 @@ import regrasp
 from regrasp import ArgumentError, ExecutionError
 from regrasp.execution import world_motion
 from regrasp.execution import collision as C
-from regrasp.execution.world_motion import GRIPPER_ENVELOPE, GRIPPER_RADIUS, PENETRATION_LIMIT
+from regrasp.execution.motion_check import PENETRATION_LIMIT
+from regrasp.execution.world_motion import GRIPPER_ENVELOPE, GRIPPER_RADIUS
 from regrasp.workcell import Workcell, default_workcell, shapes
 from regrasp.workcell.description import Feature
 from regrasp.workcell.shapes import EDGE_RADIUS, PLATE_DEPTH, TABLE_DEPTH

@@ -184,3 +184,13 @@ def test_goal_error_wraps_the_angle_and_uses_the_tolerance(kind):
         assert ok == (turn <= tol[3])
         q[0] += 2 * tol[0]
         assert not s.goal_error(q)[1]
+
+
+#: The longest a module may be, in lines: read at once (DEVELOPERS.md "Style").
+MAX_LINES = 600
+
+
+def test_every_module_reads_at_once():
+    long = {str(p.relative_to(PKG)): n for p in PKG.rglob("*.py")
+            if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_LINES}
+    assert long == {}, f"modules over {MAX_LINES} lines: {long}"

@@ -13,7 +13,9 @@ import regrasp
 from regrasp import ArgumentError, ExecutionError, Plan
 from regrasp.execution import Timing, world_motion
 from regrasp.execution.assignment import MAX_TILT
-from regrasp.execution.world_motion import LABELS, PENETRATION_LIMIT, SLIDE_GAP, edge_points, object_points
+from regrasp.execution.motion_check import PENETRATION_LIMIT, edge_points, object_points
+from regrasp.execution.trajectory import LABELS
+from regrasp.execution.world_motion import SLIDE_GAP
 from regrasp.workcell import Table, Workcell, default_workcell
 from regrasp.workcell.description import Feature, Robot
 

@@ -40,15 +40,15 @@ def _endpoints(scene, a):
 
 def _figure_writers(scene, p: Plan, a) -> list:
     """(option, path, write_fn) of --plot, --animate and --html given (planar or 3-D)."""
-    from ..viz import plotting
+    from ..viz import plotting, plotting3d
 
     three = scene.dimension == 3
     out = []
     if a.plot:
-        draw = plotting.plot_plan3d if three else plotting.plot_plan
+        draw = plotting3d.plot_plan3d if three else plotting.plot_plan
         out.append(("--plot", a.plot, lambda tmp: draw(scene, p, tmp)))
     if a.animate:
-        animate = plotting.animate_plan3d if three else plotting.animate_plan
+        animate = plotting3d.animate_plan3d if three else plotting.animate_plan
         out.append(("--animate", a.animate, lambda tmp: animate(scene, p, tmp)))
     if a.html:
         from ..viz.viewer import write_html

@@ -234,7 +234,7 @@ class ArmPlant:
 
 def _reach(scene, O) -> float:
     """The object's reach [m] from the gripper origin at in-hand pose ``O``."""
-    from .world_motion import object_points
+    from .motion_check import object_points
 
     return float(np.max(np.linalg.norm(P.transform(O, object_points(scene)), axis=1)))
 
