@@ -25,7 +25,7 @@ import numpy as np
 
 import regrasp
 from regrasp.control.loop import Poke, control
-from regrasp.mujoco.planar import Perturbation
+from regrasp import Perturbation
 from regrasp.viz.plotting import plot_control
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -63,7 +63,7 @@ def trial(args):
     name, k = args
     s = load(name)
     rng = np.random.default_rng(10_000 + k)
-    pert = Perturbation.draw(0.2, rng)
+    pert = Perturbation.draw(rng, 0.2, features="finger")
     start_error = np.r_[rng.uniform(-0.002, 0.002, 2), np.radians(rng.uniform(-2, 2))]
     poke = Poke(rng.uniform(0.5, 1.5), np.r_[rng.uniform(-0.002, 0.002, 2), np.radians(rng.uniform(-2, 2))])
     robust = s.robust(SPREAD)
@@ -120,7 +120,7 @@ def physics_trial(args):
     # plans of seed k // 8, world at corner k % 8 of friction, grip, mass within ±40%, pushers'
     # friction 40% low
     f, g, m = ((1 + CORNER_SPREAD * (2 * ((k % 8 >> b) & 1) - 1)) for b in range(3))
-    pert = Perturbation(f, g, m, pusher_friction=1 - CORNER_SPREAD)
+    pert = Perturbation(f, g, m, feature_friction=1 - CORNER_SPREAD)
     u = {key: CORNER_SPREAD for key in SPREAD}
     nominal = regrasp.plan(s, seed=k // 8).to_json()
     rp = regrasp.plan(s.robust(u), seed=k // 8, time_limit=5.0)
@@ -165,8 +165,8 @@ def fixtureless(n):
         for engine in ("mujoco", "quasistatic"):
             runs = []
             for k in range(n):
-                d = Perturbation.draw(0.5, np.random.default_rng(20_000 + k))
-                pert = Perturbation(d.friction, d.grip, d.mass, pusher_friction=1.0)
+                d = Perturbation.draw(np.random.default_rng(20_000 + k), 0.5, features="finger")
+                pert = Perturbation(d.finger_friction, d.grip, d.mass, feature_friction=1.0)
                 r = control(s, plan, engine=engine, policy="open_loop", perturb=pert)
                 runs.append({"success": r.success, "goal_error": r.goal_error.tolist(),
                              "factors": [d.friction, d.grip, d.mass]})

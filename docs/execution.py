@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 import regrasp
-from regrasp.mujoco.planar import Perturbation, execute_plan
+from regrasp import Perturbation
+from regrasp.mujoco.planar import execute_plan
 from regrasp.mujoco.model import SOFT, creep
 from regrasp.viz.plotting import plot_replay
 from regrasp.sim.quasistatic import replay_plan
@@ -33,7 +34,7 @@ def main(runs: int = 20, spread: float = 0.1):
         failures = []
         for k in range(runs):
             pk = regrasp.plan(s, seed=k).to_json()
-            rep = execute_plan(s, pk, Perturbation.draw(spread, np.random.default_rng(1000 + k)))
+            rep = execute_plan(s, pk, Perturbation.draw(np.random.default_rng(1000 + k), spread, features="finger"))
             ok += rep.success
             errs.append(np.abs(rep.goal_error))
             slips.append(rep.max_pusher_slip)

@@ -11,7 +11,8 @@ import pytest
 import regrasp
 from regrasp import ExecutionError
 from regrasp.execution import Trajectory, world_motion
-from regrasp.execution.arm import Scales, build_robot, execute_arm, grasp_of, solve_arm, where
+from regrasp import Perturbation
+from regrasp.execution.arm import build_robot, execute_arm, grasp_of, solve_arm, where
 from regrasp.robot.ik import MAX_JUMP
 from regrasp.robot.pads import Pads
 from regrasp.workcell import Workcell
@@ -81,7 +82,7 @@ def test_the_arm_executes_a_3d_plan_in_the_workcell():
 
 def test_a_world_perturbation_changes_the_world_but_not_the_trajectory():
     scene, plan, motion, robot, tcp, arm = case("block-3d")
-    k = Scales(finger_friction=0.8, grip=0.5, mass=3.0, feature_friction=1.2)
+    k = Perturbation(finger_friction=0.8, grip=0.5, mass=3.0, feature_friction=1.2)
     scaled, body, _, _ = build_robot(scene, motion, scales=k)
     m0, m1 = robot.model, scaled.model
     assert m1.body_mass[body] == pytest.approx(3.0 * m0.body_mass[body])

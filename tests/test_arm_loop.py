@@ -17,12 +17,13 @@ pytest.importorskip("mujoco")
 pytest.importorskip("mink")
 
 from regrasp.execution import world_motion  # noqa: E402
-from regrasp.execution.arm import Scales, execute_arm  # noqa: E402
+from regrasp import Perturbation  # noqa: E402
+from regrasp.execution.arm import execute_arm  # noqa: E402
 from regrasp.execution.arm_loop import ArmPlant, control_arm, controller_scene  # noqa: E402
 from regrasp.workcell.default import default_workcell  # noqa: E402
 
 #: A perturbed world (finger and feature friction, grip force up 30 %, the mass down 30 %).
-STIFF = Scales(1.3, 1.3, 0.7, 1.3)
+STIFF = Perturbation(1.3, 1.3, 0.7, 1.3)
 
 
 def example(name: str):

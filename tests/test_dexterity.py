@@ -275,14 +275,15 @@ def test_a_start_pose_in_the_hand_is_where_the_world_starts_the_object():
     from regrasp.dexterity.objects import load_object
     from regrasp.dexterity.actions import WORK_POINT, hand_pose
     from regrasp.dexterity.taxonomy import taxonomy_of
-    from regrasp.dexterity.world import HandWorld, Perturbation
+    from regrasp import Perturbation
+    from regrasp.dexterity.world import HandWorld
     from regrasp.pose import compose
 
     scene = load_object("bar")
     g = taxonomy_of(scene).grasp("g9")
     w = HandWorld(scene, g.pose, hand_pose(0.0, WORK_POINT))
-    a = w.reset(Perturbation(friction=0.9, grip=1.1)).in_hand()
-    b = w.reset(Perturbation(friction=0.9, grip=1.1, pose=tuple(g.pose))).in_hand()
+    a = w.reset(Perturbation(finger_friction=0.9, grip=1.1)).in_hand()
+    b = w.reset(Perturbation(finger_friction=0.9, grip=1.1, pose=tuple(g.pose))).in_hand()
     assert np.array_equal(a, b)
     moved = compose(np.array([0.0, 0.0, 0.004, 1.0, 0.0, 0.0, 0.0]), g.pose)
     c = w.reset(Perturbation(pose=tuple(moved))).in_hand()

@@ -194,3 +194,11 @@ def test_every_module_reads_at_once():
     long = {str(p.relative_to(PKG)): n for p in PKG.rglob("*.py")
             if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_LINES}
     assert long == {}, f"modules over {MAX_LINES} lines: {long}"
+
+
+def test_one_perturbation_type():
+    """One class describes a perturbed world; the old names are shims that make it."""
+    classes = [(name, node.name) for name, tree in modules().items() for node in ast.walk(tree)
+               if isinstance(node, ast.ClassDef) and ("Perturbation" in node.name or "Scales" in node.name)]
+    assert sorted(c for _, c in classes) == ["ArmScales", "HandPerturbation", "Perturbation", "PlanarEnginePerturbation"]
+    assert {m for m, _ in classes} == {"regrasp.scene.perturbation"}

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 import regrasp
-from regrasp.mujoco.planar import Perturbation, execute_plan
+from regrasp import Perturbation
+from regrasp.mujoco.planar import execute_plan
 from regrasp.mujoco.model import SOFT, convex_pieces, creep
 from regrasp.mujoco.push import PushRig
 from regrasp.sim.validation import validate
@@ -49,7 +50,7 @@ def test_plans_execute_in_mujoco_with_perturbed_physics():
         s = regrasp.Scene.load(EXAMPLES / f"{name}.toml")
         p = regrasp.plan(s, seed=1).to_json()
         rng = np.random.default_rng(7)
-        rep = execute_plan(s, p, Perturbation.draw(0.1, rng))
+        rep = execute_plan(s, p, Perturbation.draw(rng, 0.1, features="finger"))
         assert rep.success, (name, rep.goal_error)
         assert rep.poses.shape[1] == 3 and len(rep.t) == len(rep.poses)
 
@@ -109,7 +110,7 @@ def test_models_carry_the_contact_settings_and_physics():
 
     s = regrasp.Scene.load(EXAMPLES / "block-low-friction.toml")
     plan = {"path": [{"pose": [0, 0, 0], "pusher": None}, {"pose": [0.002, 0, 0], "pusher": "left"}]}
-    m = planar.build(s, plan, Perturbation(friction=1.1, mass=0.9)).compile()
+    m = planar.build(s, plan, Perturbation(finger_friction=1.1, mass=0.9, feature_friction=1.1)).compile()
     c = Contact()
     assert m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC and m.opt.impratio == c.impratio
     assert m.opt.noslip_iterations == c.noslip_iterations and m.opt.timestep == c.timestep

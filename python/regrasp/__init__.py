@@ -16,6 +16,7 @@ from ._core import __version__
 from .errors import ArgumentError, ExecutionError, GraspError, InternalError, MissingExtraError, RegraspError, SceneError
 from .planning.plan import Plan, plan, planner_defaults
 from .scene import load_scene
+from .scene.perturbation import Perturbation
 from .scene.planar import Classification, GravityFreeCone, MotionCone, MotionConeBatch, Pusher, Scene, Task
 from .scene.spatial import Scene3D
 from . import _moved, examples
@@ -44,4 +45,5 @@ __all__ = [
     "plan",
     "planner_defaults",
     "Task",
+    "Perturbation",
 ]

@@ -180,6 +180,13 @@ def scales(a) -> tuple[float, float, float]:
     return tuple(out)
 
 
+def every_friction(s: tuple) -> tuple[float, float, float, float]:
+    """The factors of :func:`scales` as a :class:`~regrasp.Perturbation`'s: --scale-friction on
+    the fingers' and the features' friction alike."""
+    f, g, m = s
+    return f, g, m, f
+
+
 def check_positive(a, name: str, what: str) -> None:
     """Option ``name``, when given, must be a positive finite number."""
     v = getattr(a, name)
@@ -301,15 +308,18 @@ def pusher_runs(pushers) -> str:
     return " -> ".join(f"{n} x{c}" for n, c in runs(pushers)) or "no pushes"
 
 
-def execute3d(scene, plan: Plan, a, **kw) -> dict:
-    """A 3-D plan executed in the world of --engine: the quasi-static replay or MuJoCo with the
-    --scale-* factors (``kw``: settings both take, e.g. ``feedback``)."""
-    if a.engine == "mujoco":
-        from ..mujoco.spatial import execute_plan3d
+def execute3d(scene, plan: Plan, a, loop: str = "open", **options) -> dict:
+    """A 3-D plan executed (:func:`~regrasp.execution.execute`) in the planner's-view world of
+    --engine, the quasi-static replay or MuJoCo with the --scale-* factors, ``loop`` open or
+    closed (re-planning); ``options``: settings both engines take (``dt``, ``seed``)."""
+    from ..execution.execute import World, execute
+    from ..scene.perturbation import Perturbation
 
-        return execute_plan3d(scene, plan, *scales(a), **kw)
-    with progress.elapsed(None, f"quasi-static replay of {scene.name}"):
-        return scene.replay(plan, **kw)
+    world = World(scene, engine=a.engine, options=options)
+    with progress.elapsed(None, f"quasi-static replay of {scene.name}", show=a.engine == "quasistatic"):
+        run = execute(world, plan, loop=loop, perturbation=Perturbation(*every_friction(scales(a))))
+    return {"engine": a.engine, "final_pose": run.final_pose.tolist(), "goal_error": run.goal_error.tolist(),
+            "success": run.success, "replans": run.replans, "plan_end_error": run.plan_end_error.tolist()}
 
 
 # --- the command -------------------------------------------------------------------------------

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 
@@ -11,7 +12,7 @@ from ..errors import ArgumentError
 from ..planning.plan import Plan
 from . import (CANNOT, api_default, FIGURE_SUFFIXES, MAX_HORIZON, OK, SCALES, add_command, add_scale_options, add_verbose, check_count,
                check_number, check_outputs, check_positive, execute3d, floats, given, load, mode_scene, mpc_default,
-               plural, refuse_flags, rounded, scales, seed_arg, error3d)
+               plural, refuse_flags, rounded, scales, every_friction, seed_arg, error3d)
 
 #: options of the planar MPC, without meaning for 3-D control
 PLANAR_ONLY = ("poke", "start_error", "robust", "uncertainty", "fixtureless", "plot", "dt", "horizon", "noise")
@@ -24,7 +25,7 @@ def _control3d(scene, plan: Plan, a) -> int:
     if a.engine == "quasistatic" and any(getattr(a, f) is not None for f in SCALES):
         raise ArgumentError("invalid `--scale-*`: the quasi-static 3-D world is the scene itself (MuJoCo only)", "--engine")
     fb = not a.open_loop
-    r = execute3d(scene, plan, a, feedback=fb, seed=a.seed)
+    r = execute3d(scene, plan, a, loop="closed" if fb else "open", seed=a.seed)
     out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success", "replans")}
     out["policy"] = "replan" if fb else "open_loop"
     if a.json:
@@ -43,7 +44,8 @@ def _check_mpc_options(a) -> None:
 
 def cmd_control(a) -> int:
     from ..control.loop import Poke, control
-    from ..mujoco.planar import Perturbation
+    from ..execution.execute import World, execute
+    from ..scene.perturbation import Perturbation
 
     scales(a)
     check_outputs(a, {"plot": FIGURE_SUFFIXES}, [a.scene, a.plan])
@@ -57,9 +59,14 @@ def cmd_control(a) -> int:
                      "they shape the MPC's feedback, which open-loop execution does not use")
     pokes = [Poke.parse(t) for t in a.poke or []]
     start_error = np.zeros(3) if a.start_error is None else floats(a.start_error, 3, "--start-error")
-    res = control(scene, plan, engine=a.engine, policy="open_loop" if a.open_loop else "mpc", pokes=pokes,
-                  start_error=start_error, perturb=Perturbation(*scales(a)), controller_scene=mode_scene(scene, a),
-                  seed=a.seed, **given(a, "noise", "dt", "horizon"))
+    settings = dict(pokes=pokes, controller_scene=mode_scene(scene, a), seed=a.seed, **given(a, "noise", "dt", "horizon"))
+    world = Perturbation(*every_friction(scales(a)))
+    if a.open_loop:  # the baseline: the plan's pushes on the controller's clock, pokes and all
+        res = control(scene, plan, engine=a.engine, policy="open_loop", start_error=start_error, perturb=world, **settings)
+    else:
+        dx, dz, dth = map(float, start_error)
+        world = replace(world, shift=(dx, 0.0, dz), turn=-dth)  # the start moved as a Perturbation says it
+        res = execute(World(scene, engine=a.engine, options=settings), plan, loop="closed", perturbation=world).detail
     if a.plot:
         from ..viz.plotting import plot_control
 

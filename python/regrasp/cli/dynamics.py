@@ -13,7 +13,7 @@ from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
 from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX_WORKERS, OK, pusher_help, VIDEO_SUFFIXES,
                add_command, add_limit_surface, add_scale_options, api_default, add_verbose, check_count, check_number, check_outputs, check_positive,
-               check_pusher, execute3d, floats, given, load, load_planar, plural, refuse_flags, runs, rounded, scales, seed_arg, error3d)
+               check_pusher, execute3d, floats, given, load, load_planar, plural, refuse_flags, runs, rounded, scales, every_friction, seed_arg, error3d)
 
 
 def cmd_validate(a) -> int:
@@ -54,7 +54,7 @@ def _simulate3d(scene, plan: Plan, a) -> int:
                  "(3-D: --scale-*, --dt, --json; `regrasp plan --html` for a view)")
     _check_engine_flags(a)
     r = execute3d(scene, plan, a, **given(a, "dt"))
-    out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success")}
+    out = {k: r[k] for k in ("engine", "final_pose", "goal_error", "success", "plan_end_error")}
     out["max_pusher_slip"] = None
     print(json.dumps(out) if a.json else f"{scene.name}: {r['engine']}: "
           f"{'success' if r['success'] else 'outside the tolerance'}, error {error3d(r['goal_error'])}")
@@ -66,18 +66,15 @@ PERTURB_SEED = 0
 
 
 def _replay_planar(scene, plan: Plan, a):
-    """The planar plan replayed in the engine of --engine."""
-    if a.engine == "quasistatic":
-        from ..sim.quasistatic import replay_plan
+    """The planar plan run open loop (:func:`~regrasp.execution.execute`) in the planner's-view
+    world of --engine, perturbed by the --scale-* factors and --perturb's draw."""
+    from ..execution.execute import World, execute
+    from ..scene.perturbation import Perturbation
 
-        return replay_plan(scene, plan, **given(a, "dt"))
-    from ..mujoco.planar import Perturbation, execute_plan
-
-    base = Perturbation(*scales(a))
+    base = Perturbation(*every_friction(scales(a)))
     seed = PERTURB_SEED if a.seed is None else a.seed
-    pert = Perturbation.draw(a.perturb, np.random.default_rng(seed), base) if a.perturb else base
-    rep = execute_plan(scene, plan, pert)
-    return rep
+    pert = Perturbation.draw(np.random.default_rng(seed), a.perturb, features="finger", base=base) if a.perturb else base
+    return execute(World(scene, engine=a.engine, options=given(a, "dt")), plan, perturbation=pert)
 
 
 def _print_replay(scene, plan: Plan, rep) -> None:
@@ -121,13 +118,14 @@ def cmd_simulate(a) -> int:
     if scene.dimension == 3:
         return _simulate3d(scene, plan, a)
     _check_engine_flags(a)
-    rep = _replay_planar(scene, plan, a)
+    run = _replay_planar(scene, plan, a)
+    rep = run.detail
     _write_figures(scene, rep, a)
     if a.json:
-        print(json.dumps(rep.to_json()))
+        print(json.dumps({**rep.to_json(), "success": run.success, "plan_end_error": run.plan_end_error.tolist()}))
     else:
         _print_replay(scene, plan, rep)
-    return OK if rep.success else CANNOT
+    return OK if run.success else CANNOT
 
 
 # --- push --------------------------------------------------------------------------------------

@@ -34,11 +34,11 @@ def _check(a) -> None:
 
 
 def goal_text(scene, err) -> str:
-    """A goal error for people: planar ``[x, z, theta]`` (m, m, rad), 3-D ``[position, angle]``
-    (m, rad)."""
+    """A goal error for people (``Scene.goal_error``'s): planar ``[x, z, theta]`` (m, m, rad),
+    3-D ``[dx, dy, dz, angle]`` as a distance and an angle (m, rad)."""
     if scene.dimension == 2:
         return f"{rounded(err)} (m, m, rad)"
-    return f"{float(err[0]) * 1e3:.2f} mm, {float(err[1]):.4f} rad"
+    return f"{float(np.linalg.norm(err[:3])) * 1e3:.2f} mm, {float(err[3]):.4f} rad"
 
 
 def _workcell(a):
@@ -63,22 +63,20 @@ def _start_error(scene, a, plan=None):
 
 def _free(scene, plan, a):
     """The free-flying gripper: (result dict, motion, None)."""
-    from ..execution import execute_free_gripper, world_motion
+    from ..execution.execute import World, execute
 
     refuse_flags(a, ("scale_friction", "scale_grip", "scale_mass", "start_error"), "with --robot free-gripper",
                  "the free-gripper rig is not perturbed (use the arm)")
-    motion = world_motion(scene, plan, _workcell(a))
-    r = execute_free_gripper(scene, plan, motion)
-    return dict(success=r.success, goal_error=r.goal_error, max_creep=r.max_creep, max_creep_angle=r.max_creep_angle,
-                duration_s=r.duration, robot=FREE_GRIPPER), motion, None
+    run = execute(World(scene, rig="free-gripper", workcell=_workcell(a)), plan)
+    r = run.detail
+    return dict(success=run.success, goal_error=r.goal_error, max_creep=r.max_creep, max_creep_angle=r.max_creep_angle,
+                duration_s=r.duration, robot=FREE_GRIPPER, task_error=run.goal_error), run.motion, None
 
 
 def _arm(scene, plan, a):
     """The arm: (result dict, motion, (result, recorder or None))."""
-    from ..execution.arm import Scales, arm_motion, execute_arm
+    from ..execution.execute import World, execute
 
-    f, g, m = scales(a)
-    am = arm_motion(scene, plan, _workcell(a), a.robot, Scales(f, g, m, f))
     holder: dict = {}
     observe = None
     if a.video:
@@ -88,22 +86,33 @@ def _arm(scene, plan, a):
             if "r" not in holder:
                 holder["r"] = Recorder(robot.model, robot.data)
             holder["r"].capture()
-    se = _start_error(scene, a)
-    start = None if se is None else np.asarray(plan.poses[0], float) + se
-    r = execute_arm(scene, plan, am.motion, scales=Scales(f, g, m, f), observe=observe, trajectory=am.trajectory,
-                    start=start)
-    out = dict(success=r.success, goal_error=r.goal_error, max_creep=r.max_creep, max_creep_angle=r.max_creep_angle,
+    run = execute(World(scene, rig="arm", workcell=_workcell(a), robot=a.robot), plan,
+                  perturbation=_perturbation(scene, a), observe=observe)
+    r = run.detail
+    out = dict(success=run.success, goal_error=r.goal_error, max_creep=r.max_creep, max_creep_angle=r.max_creep_angle,
                duration_s=r.duration, robot=r.trajectory.robot,
                tracking=dict(max_joint_error=r.tracking.max_error, rms_joint_error=r.tracking.rms_error,
                              max_tcp_error=r.tracking.tcp_error),
-               refused=[dict(push=k, feature=f_, why=why) for k, f_, why in am.refused])
-    return out, am.motion, (r, holder.get("r"))
+               refused=[dict(push=k, feature=f_, why=why) for k, f_, why in run.refused],
+               task_error=run.goal_error)
+    return out, run.motion, (r, holder.get("r"))
+
+
+def _perturbation(scene, a):
+    """The world of --scale-* (--scale-friction on the fingers and the features) and --start-error
+    (a planar ``[dx, dz, dθ]``: a shift in x-z and a turn of −dθ about the grasp axis)."""
+    from ..scene.perturbation import Perturbation
+
+    f, g, m = scales(a)
+    se = _start_error(scene, a)
+    if se is None:
+        return Perturbation(f, g, m, f)
+    return Perturbation(f, g, m, f, shift=(float(se[0]), 0.0, float(se[1])), turn=-float(se[2]))
 
 
 def _closed_loop(scene, plan, a) -> int:
     """`--closed-loop`: the arm in the loop (docs/robot.md, "Closed loop with the arm")."""
-    from ..execution.arm import Scales
-    from ..execution.arm_loop import control_arm
+    from ..execution.execute import World, execute
 
     for opt in ("trajectory", "video", "html"):
         if getattr(a, opt):
@@ -111,20 +120,19 @@ def _closed_loop(scene, plan, a) -> int:
                                 f"--{opt}")
     if a.robot == FREE_GRIPPER:
         raise ArgumentError("invalid `--robot`: --closed-loop runs the arm (not the free gripper)", "--robot")
-    f, g, m = scales(a)
-    se = _start_error(scene, a)
-    r = control_arm(scene, plan, _workcell(a), Scales(f, g, m, f), a.robot,
-                    start_error=np.zeros(3) if se is None else se)
-    out = dict(success=r.success, goal_error=r.goal_error, replans=r.replans, switch_overs=r.switch_overs,
+    run = execute(World(scene, rig="arm", workcell=_workcell(a), robot=a.robot), plan, loop="closed",
+                  perturbation=_perturbation(scene, a))
+    r = run.detail
+    out = dict(success=run.success, goal_error=r.goal_error, task_error=run.goal_error, replans=r.replans, switch_overs=r.switch_overs,
                duration_s=r.duration, failure=r.failure, closed_loop=True)
     if a.json:
         print(json.dumps({k: (rounded(v) if isinstance(v, np.ndarray) else v) for k, v in out.items()}, allow_nan=False))
     else:
-        err = goal_text(scene, r.goal_error)
+        err = goal_text(scene, run.goal_error)
         print(f"{scene.name}: closed loop with the arm, {r.duration:.1f} s, {r.replans} re-plans, {r.switch_overs} "
-              f"switch-overs: {'success' if r.success else 'outside the tolerance'}, error to goal {err}"
+              f"switch-overs: {'success' if run.success else 'outside the tolerance'}, error to goal {err}"
               + (f" ({r.failure})" if r.failure else ""))
-    return OK if r.success else CANNOT
+    return OK if run.success else CANNOT
 
 
 def cmd_execute(a) -> int:
@@ -152,7 +160,7 @@ def cmd_execute(a) -> int:
         print(json.dumps({k: (rounded(v) if isinstance(v, np.ndarray) else v) for k, v in out.items()},
                          allow_nan=False))
     else:
-        err = goal_text(scene, out["goal_error"])
+        err = goal_text(scene, out["task_error"])
         print(f"{scene.name}: {out['robot']} in workcell {out['workcell']}, {len(motion.assignments)} pushes "
               f"({', '.join(f'{p.pusher} on {p.feature}' for p in motion.assignments)}), {out['duration_s']:.1f} s: "
               f"{'success' if out['success'] else 'outside the tolerance'}, error to goal {err}; "

@@ -18,8 +18,8 @@ import numpy as np
 from .. import progress
 from ..errors import ArgumentError, RegraspError, check_seed
 from ..mujoco.model import plan_dict
-from ..mujoco.planar import Perturbation
 from ..sim.quasistatic import body_twist, simulate_push
+from ..scene.perturbation import Perturbation
 from ..scene.planar import Scene
 from ..scene.settings import mpc_defaults
 from ..fields import check_count, check_number, check_vector
@@ -111,8 +111,7 @@ class QuasistaticPlant:
 
 def _plant(engine: str, scene: Scene, q0, perturb: Perturbation):
     if engine == "quasistatic":
-        world = scene.scaled(perturb.friction, perturb.grip, perturb.mass, perturb.pusher)
-        return QuasistaticPlant(world, q0)
+        return QuasistaticPlant(perturb.scene(scene), q0)
     from ..mujoco.planar import WorldRig
 
     return WorldRig(scene, q0, perturb)

@@ -333,19 +333,19 @@ def _object(path: str):
 def perturbations(settings: Settings, key: str) -> list:
     """The ``settings.trials`` worlds of the edge ``key`` (the first nominal), drawn from a seed
     made of ``settings.seed`` and ``key`` (an edge's worlds do not depend on the others)."""
-    from .world import Perturbation
+    from ..scene.perturbation import Perturbation
 
     rng = np.random.default_rng([settings.seed, zlib.crc32(key.encode())])
     out = [Perturbation()]
     while len(out) < settings.trials:
-        out.append(Perturbation.draw(rng, settings.spread, settings.shift, settings.turn))
+        out.append(Perturbation.draw(rng, settings.spread, shift=settings.shift, turn=settings.turn))
     return out[:settings.trials]
 
 
 def continuations(ends: list) -> list:
     """The worlds of a chain: one per (end pose, world factors) of ``ends``
     (:meth:`Edge.ends`): that world, the object starting at that pose (no extra shift or turn)."""
-    from .world import Perturbation
+    from ..scene.perturbation import Perturbation
 
     return [Perturbation(*map(float, world), pose=tuple(float(x) for x in pose)) for pose, world in ends]
 
@@ -386,7 +386,7 @@ def run_edge(job: tuple) -> Edge:
                             time.perf_counter() - t0)
             outcome, pose = REFUSED, None  # this world only (e.g. a grip beyond the gripper's range)
         outcomes[outcome] = outcomes.get(outcome, 0) + 1
-        runs.append((outcome, pose, (p.friction, p.grip, p.mass)))
+        runs.append((outcome, pose, (p.finger_friction, p.grip, p.mass)))
     detail = {k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in setup.detail.items()}
     return Edge(grasp_name, action_name, setup.intended, len(worlds), outcomes, detail, time.perf_counter() - t0,
                 runs)

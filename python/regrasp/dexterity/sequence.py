@@ -154,7 +154,8 @@ def execute(path, sequence: Sequence, perturbation=None, robot: str | None = Non
     from .actions import action
     from .graph import _object
     from .trial import classify
-    from .world import HandWorld, Perturbation, constant, solve_path
+    from ..scene.perturbation import Perturbation
+    from .world import HandWorld, constant, solve_path
 
     scene, tax, obj = _object(str(path))
     if not sequence.steps:

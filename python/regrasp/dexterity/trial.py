@@ -18,7 +18,8 @@ import numpy as np
 
 from ..errors import ArgumentError
 from .taxonomy import CLASSIFICATION_TOLERANCE as TOLERANCE, classification_tolerance as tolerance
-from .world import HandPath, HandWorld, Perturbation, constant, hand_pose, solve_path
+from ..scene.perturbation import Perturbation
+from .world import HandPath, HandWorld, constant, hand_pose, solve_path
 
 DROPPED, OTHER, UNSTABLE, REFUSED = "dropped", "other", "unstable", "refused"
 TRANSFER_SPEED = 0.25  # m/s, the hand's move between two actions (and 1 rad/s turning)

@@ -1,6 +1,6 @@
 """The world a regrasp action runs in: the arm and its gripper (UR5e + 2F-85 with force-controlled
 fingers and distributed-contact pads, :mod:`regrasp.robot`) holding an object at a grasp, above
-the workcell's table, in MuJoCo. The world is perturbed per trial (:class:`Perturbation`: the
+the workcell's table, in MuJoCo. The world is perturbed per trial (:class:`~regrasp.Perturbation`: the
 pads' friction, the grip force, the object's mass and its start pose in the hand). Primitives:
 move the hand along a timed TCP path (IK once per path, :func:`solve_path`; followed by the
 joint servo, :func:`~regrasp.robot.tracking.track`) under a grip-force schedule
@@ -18,6 +18,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from .. import pose as P
+from ..scene.perturbation import HandPerturbation, Perturbation as _Perturbation
 from ..errors import ArgumentError, SceneError
 from ..extras import need
 
@@ -28,31 +29,6 @@ POST_FRICTION = 1.0  # the post's Coulomb friction with the object (a rubber-fac
 PATH_STEP = 0.01  # s, a hand path's sample spacing for the IK (dense: followed piecewise linearly)
 SETTLE = 0.3  # s, after each path, the arm's servo holds its end
 OPEN = None  # a grip schedule's value for "fingers open"
-
-
-@dataclass(frozen=True)
-class Perturbation:
-    """One trial's world: the pads' friction, the grip force and the object's mass scaled by
-    ``friction``, ``grip``, ``mass``; the object's start pose in the hand moved by ``shift``
-    (3,) [m] (hand frame) and turned by ``turn`` [rad] about the grasp axis (+y: z towards x, the
-    opposite of a planar turn's sign; drawn symmetric, so no result depends on it); ``pose`` (7,)
-    the object's start pose in the hand in place of the grasp's (None: the grasp's), e.g. where
-    the previous action of a sequence left it (the shift and turn then move it)."""
-
-    friction: float = 1.0
-    grip: float = 1.0
-    mass: float = 1.0
-    shift: tuple = (0.0, 0.0, 0.0)
-    turn: float = 0.0
-    pose: tuple | None = None
-
-    @classmethod
-    def draw(cls, rng, spread: float, shift: float, turn: float) -> "Perturbation":
-        """Each factor uniform in [1 − ``spread``, 1 + ``spread``], the shift uniform in a cube
-        of half-side ``shift`` [m] (x, z only: y is the pads'), the turn in ±``turn`` [rad]."""
-        f = rng.uniform(1 - spread, 1 + spread, 3)
-        s = rng.uniform(-shift, shift, 2)
-        return cls(*map(float, f), (float(s[0]), 0.0, float(s[1])), float(rng.uniform(-turn, turn)))
 
 
 @dataclass(frozen=True)
@@ -173,7 +149,7 @@ class HandWorld:
     the table under the work point, a post beyond it (:func:`add_post`). The model is compiled once: :meth:`reset` starts another
     trial in it (another perturbation), as a fresh build would, in a fraction of the time."""
 
-    def __init__(self, scene, grasp, hand, perturbation: Perturbation = Perturbation(), robot: str | None = None,
+    def __init__(self, scene, grasp, hand, perturbation: _Perturbation = _Perturbation(), robot: str | None = None,
                  q=None):
         from ..execution.arm import GRIP_PERIOD, grasp_of
         from ..mujoco.spatial import add_object3d
@@ -208,14 +184,15 @@ class HandWorld:
         self.jq = int(m.jnt_qposadr[m.body_jntadr[self.body]])
         self.jv = int(m.jnt_dofadr[m.body_jntadr[self.body]])
         self.pads = np.concatenate([np.asarray(p, int) for p in r.pad_geoms])
+        self.features = np.array([r.table, m.geom("post").id], int)  # the table and the post
         self.nominal = (m.geom_friction[self.pads, 0].copy(), float(m.body_mass[self.body]),
-                        m.body_inertia[self.body].copy())
+                        m.body_inertia[self.body].copy(), m.geom_friction[self.features, 0].copy())
         self.q0 = solve_ik_from_home(r, hand) if q is None else np.asarray(q, float)
         self.reset(perturbation)
 
-    def reset(self, perturbation: Perturbation = Perturbation()) -> "HandWorld":
+    def reset(self, perturbation: _Perturbation = _Perturbation()) -> "HandWorld":
         """Starts a trial: the arm at its start, the object at the grasp moved by
-        ``perturbation`` (its pads' friction, mass and grip force scaled), the fingers closed on it."""
+        ``perturbation`` (:class:`~regrasp.Perturbation`: its pads', the table's and the post's friction, its mass and the grip force scaled), the fingers closed on it."""
         mujoco = need("mujoco", "robot")
         from ..execution.arm import close_on
         from ..robot.grip import close_fingers
@@ -224,8 +201,9 @@ class HandWorld:
         m, d = r.model, r.data
         self.perturbation = perturbation
         self.grip_force = float(self.scene.grip_force) * perturbation.grip
-        friction, mass, inertia = self.nominal
-        m.geom_friction[self.pads, 0] = friction * perturbation.friction
+        friction, mass, inertia, features = self.nominal
+        m.geom_friction[self.pads, 0] = friction * perturbation.finger_friction
+        m.geom_friction[self.features, 0] = features * perturbation.feature_friction
         m.body_mass[self.body], m.body_inertia[self.body] = mass * perturbation.mass, inertia * perturbation.mass
         mujoco.mj_resetData(m, d)
         close_fingers(r)
@@ -448,3 +426,7 @@ def hand_pose(alpha: float, point=WORK_POINT) -> np.ndarray:
     x = np.array([np.cos(alpha), 0.0, np.sin(alpha)])
     y = np.array([0.0, 1.0, 0.0])
     return np.concatenate([np.asarray(point, float), P.quat_from_matrix(np.column_stack([x, y, np.cross(x, y)]))])
+
+
+#: The old name (deprecated): ``regrasp.Perturbation``.
+Perturbation = HandPerturbation

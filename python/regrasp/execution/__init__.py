@@ -7,12 +7,18 @@ executes the plan (:mod:`~regrasp.execution.world_motion`)::
     motion.times, motion.gripper, motion.labels, motion.assignments
     motion.to_trajectory().save("plan.trajectory.json")   # docs/trajectory-file.md
     result = execute_free_gripper(scene, plan, motion)   # MuJoCo, a free-flying gripper (extra `mujoco`)
+
+One entry point runs a plan in any rig (:mod:`~regrasp.execution.execute`)::
+
+    run = execute(World(scene, rig="arm"), plan, loop="open", perturbation=Perturbation(0.9, 1.1, 1.0, 1.0))
+    run.success, run.goal_error, run.plan_end_error
 """
 
+from .execute import Execution, World, execute
 from .assignment import Assignment, PusherContact, assign, pusher_contact
 from .free_gripper import FreeGripperResult, execute_free_gripper
 from .trajectory import PushRecord, Trajectory
 from .world_motion import Timing, WorldMotion, world_motion
 
-__all__ = ["Assignment", "FreeGripperResult", "PusherContact", "PushRecord", "Timing", "Trajectory", "WorldMotion",
+__all__ = ["Execution", "World", "execute", "Assignment", "FreeGripperResult", "PusherContact", "PushRecord", "Timing", "Trajectory", "WorldMotion",
            "assign", "execute_free_gripper", "pusher_contact", "world_motion"]

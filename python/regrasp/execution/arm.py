@@ -29,6 +29,7 @@ import numpy as np
 from .. import pose as P
 from ..errors import ArgumentError, ExecutionError
 from ..extras import need
+from ..scene.perturbation import ArmScales, Perturbation
 from .world_motion import WorldMotion
 
 #: The object's colour in the arm's model (red, green, blue, alpha): seen in videos.
@@ -54,14 +55,8 @@ MAX_TRIES = 6
 SETTLE = 0.3
 
 
-@dataclass(frozen=True)
-class Scales:
-    """Factors on the finger (pad) friction, the grip force and the object's mass, and on every
-    feature's and the table's friction (a perturbed world: ±10 % draws for the statistics)."""
-    finger_friction: float = 1.0
-    grip: float = 1.0
-    mass: float = 1.0
-    feature_friction: float = 1.0
+#: The old name (deprecated): ``regrasp.Perturbation`` (the features at their nominal friction by default, as there).
+Scales = ArmScales
 
 
 @dataclass
@@ -120,7 +115,7 @@ def _pad_friction(scene) -> float:
     return scene.pad_friction
 
 
-def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Scales = Scales(), pads=None):
+def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Perturbation = Perturbation(), pads=None):
     """The robot (:func:`regrasp.robot.model.build`) in ``motion``'s workcell with the object on
     a free joint at the motion's first world pose, the fingers closed at its width
     (:func:`~regrasp.robot.grip.close_fingers`), the pads of the scene's pad shape and finger
@@ -316,7 +311,7 @@ class ArmMotion:
     refused: list
 
 
-def arm_motion(scene, plan, workcell=None, robot: str | None = None, scales: Scales = Scales(), timing=None,
+def arm_motion(scene, plan, workcell=None, robot: str | None = None, scales: Perturbation = Perturbation(), timing=None,
                max_tries: int = MAX_TRIES) -> ArmMotion:
     """The world motion of ``plan`` in ``workcell`` (default: the scene's default workcell) that the
     arm ``robot`` (default: the workcell's) can follow, and its joint trajectory: when the arm
@@ -374,7 +369,7 @@ def close_on(robot, body: int, geoms, grip_force: float):
     return grip
 
 
-def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scales: Scales = Scales(),
+def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scales: Perturbation = Perturbation(),
                 observe=None, trajectory: ArmTrajectory | None = None, pads=None, start=None) -> ArmResult:
     """Executes ``motion`` (the :class:`WorldMotion` of ``plan`` for ``scene``) with the arm
     ``robot`` (default: the workcell's) in MuJoCo, in a world perturbed by ``scales``, and

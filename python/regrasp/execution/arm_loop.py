@@ -31,8 +31,9 @@ import numpy as np
 from .. import pose as P
 from ..errors import ArgumentError, ExecutionError, RegraspError
 from ..extras import need
+from ..scene.perturbation import Perturbation
 from ..scene.settings import mpc_defaults
-from .arm import CONTACT_CLEARANCE, Scales, arm_motion, build_robot, close_on, first_solution
+from .arm import CONTACT_CLEARANCE, arm_motion, build_robot, close_on, first_solution
 from .assignment import assign, pusher_contact
 from .world_motion import Segments, Timing
 
@@ -65,7 +66,7 @@ class ArmPlant:
     (:class:`~regrasp.execution.world_motion.Timing`) as for an open-loop execution."""
 
     def __init__(self, scene, plan, start=None, workcell=None, robot: str | None = None,
-                 scales: Scales = Scales(), timing: Timing = Timing()):
+                 scales: Perturbation = Perturbation(), timing: Timing = Timing()):
         mujoco = need("mujoco", "robot")
         from ..robot.ik import IKError, IKSolver, fixed_geoms
 
@@ -250,7 +251,7 @@ def goal_error(scene, plan, pose) -> tuple[np.ndarray, bool]:
     return np.array([float(np.linalg.norm(err[:3])), err[3]]), ok
 
 
-def control_arm(scene, plan, workcell=None, scales: Scales = Scales(), robot: str | None = None,
+def control_arm(scene, plan, workcell=None, scales: Perturbation = Perturbation(), robot: str | None = None,
                 timing: Timing = Timing(), seed: int = 0, max_replans: int = 10, max_time: float | None = None,
                 start_error=(0.0, 0.0, 0.0), **mpc) -> ArmLoopResult:
     """Executes ``plan`` (a :class:`~regrasp.Plan` of ``scene``) closed loop with the arm in
@@ -265,8 +266,8 @@ def control_arm(scene, plan, workcell=None, scales: Scales = Scales(), robot: st
 
     if not isinstance(plan, Plan):
         raise ArgumentError(f"invalid `plan`: a regrasp Plan (got {type(plan).__name__})", "plan")
-    if not isinstance(scales, Scales):
-        raise ArgumentError(f"invalid `scales`: a Scales (got {type(scales).__name__})", "scales")
+    if not isinstance(scales, Perturbation):
+        raise ArgumentError(f"invalid `scales`: a regrasp.Perturbation (got {type(scales).__name__})", "scales")
     from ..fields import check_vector
 
     if scene.dimension != 2 and np.any(check_vector(start_error, 3, "start_error") != 0):
@@ -333,7 +334,6 @@ def _served(scene, pusher: str, pose, workcell) -> bool:
 
 def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, start_error, mpc) -> ArmLoopResult:
     from ..control.loop import ControlRun, _check_arguments
-    from ..mujoco.planar import Perturbation
 
     d = mpc_defaults()
     dt, speed, horizon = (mpc.pop(k, d[k]) for k in ("dt", "speed", "horizon"))

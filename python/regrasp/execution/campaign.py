@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import RegraspError
+from ..scene.perturbation import Perturbation
 
 
 @dataclass
@@ -39,15 +40,12 @@ class Outcome:
 
 
 def draws(runs: int, spread: float, seed: int):
-    """``runs`` :class:`~regrasp.execution.arm.Scales`, each factor uniform in [1 − spread,
+    """``runs`` :class:`~regrasp.Perturbation`, each of the four factors uniform in [1 − spread,
     1 + spread] (the first run nominal)."""
-    from .arm import Scales
-
     rng = np.random.default_rng(seed)
-    out = [Scales()]
+    out = [Perturbation()]
     for _ in range(runs - 1):
-        f = rng.uniform(1 - spread, 1 + spread, 4)
-        out.append(Scales(*map(float, f)))
+        out.append(Perturbation.draw(rng, spread, features="drawn"))
     return out[:runs]
 
 

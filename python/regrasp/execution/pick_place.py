@@ -511,7 +511,7 @@ OPEN_TIME = 0.5
 def execute_pick_place(scene, r: PickPlace, scales=None, observe=None) -> PickPlaceRun:
     """Executes the planned pick-regrasp-place ``r`` of ``scene`` in MuJoCo with its arm
     (:func:`~regrasp.execution.arm.build_robot`: the UR5e + 2F-85 with the scene's pads), in a
-    world perturbed by ``scales`` (:class:`~regrasp.execution.arm.Scales`): the object on the
+    world perturbed by ``scales`` (:class:`~regrasp.Perturbation`): the object on the
     table at the pick pose, the fingers open; the approach; the fingers close
     (:func:`~regrasp.execution.arm.close_on`); lift, regrasp, carry and lower under the grip
     force loop; the fingers open (:func:`~regrasp.robot.grip.open_gripper`); the retreat.
@@ -519,9 +519,10 @@ def execute_pick_place(scene, r: PickPlace, scales=None, observe=None) -> PickPl
     mujoco = need("mujoco", "robot")
     from ..robot.grip import body_pose, open_gripper
     from ..robot.tracking import track
-    from .arm import Scales, build_robot, close_on
+    from ..scene.perturbation import Perturbation
+    from .arm import build_robot, close_on
 
-    scales = Scales() if scales is None else scales
+    scales = Perturbation() if scales is None else scales
     rob, body, geoms, tcp = build_robot(scene, r.motion, scales=scales)
     m, d = rob.model, rob.data
     q, t = r.arm.q, r.motion.times

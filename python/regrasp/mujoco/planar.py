@@ -17,13 +17,13 @@ drives push by push.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 
 from .. import progress
 from ..errors import ArgumentError
+from ..scene.perturbation import PlanarEnginePerturbation, Perturbation as _Perturbation
 from ..scene.planar import Scene
 from ..fields import check_number
 from ..sim.quasistatic import Replay, body_twist, integrate_pose
@@ -34,29 +34,6 @@ from .model import (Contact, Driver, Rig, add_driven_body, add_feature, add_grip
 
 GAP = 0.002  # m between the object and a feature when it is brought
 PARK = np.array([0.0, 5.0, 0.0])
-
-
-@dataclass
-class Perturbation:
-    """Scale factors of the physical parameters (the executed world differs from the plan's)."""
-
-    friction: float = 1.0
-    grip: float = 1.0
-    mass: float = 1.0
-    #: factor on the features' (pushers') friction; None: ``friction``
-    pusher_friction: float | None = None
-
-    @property
-    def pusher(self) -> float:
-        """The pusher's friction scale factor (the common ``friction`` one when none is given)."""
-        return self.friction if self.pusher_friction is None else self.pusher_friction
-
-    @classmethod
-    def draw(cls, spread: float, rng, base: "Perturbation" = None) -> "Perturbation":
-        """Each factor uniformly in [1 − spread, 1 + spread], times ``base``."""
-        b = base or cls()
-        u = rng.uniform(1 - spread, 1 + spread, 3)
-        return cls(b.friction * u[0], b.grip * u[1], b.mass * u[2])
 
 
 class Feature(NamedTuple):
@@ -80,17 +57,17 @@ def _segments(path: list) -> list:
     return segs
 
 
-def _spec(scene: Scene, q0, pushers, perturb: Perturbation, contact: Contact):
+def _spec(scene: Scene, q0, pushers, perturb: _Perturbation, contact: Contact):
     spec = planar_spec(scene, f"{scene.name}-execution", contact)
     add_object(spec, scene, q0, mass_scale=perturb.mass)
-    add_planar_pads(add_driven_body(spec.worldbody, "gripper"), scene, friction_scale=perturb.friction)
+    add_planar_pads(add_driven_body(spec.worldbody, "gripper"), scene, friction_scale=perturb.finger_friction)
     for p in pushers:
-        add_feature(spec, scene, p, f"feature_{p}", perturb.pusher, PARK)
+        add_feature(spec, scene, p, f"feature_{p}", perturb.feature_friction, PARK)
     add_grip_motors(spec)
     return spec
 
 
-def build(scene: Scene, plan, perturb: Perturbation = Perturbation(), contact: Contact = Contact()):
+def build(scene: Scene, plan, perturb: _Perturbation = _Perturbation(), contact: Contact = Contact()):
     """The execution's model, a ``mujoco.MjSpec`` (``.compile()`` it; ``.to_xml()`` is its MJCF):
     the object at the plan's start, the gripper (a driven body) with force-driven pads, one parked
     feature (a mocap body) per pusher the plan uses."""
@@ -103,7 +80,7 @@ class GripperRig(Rig):
     planar pose :attr:`g` in the world), the ``pushers``' features parked until one is brought
     against the object (:attr:`current`)."""
 
-    def __init__(self, scene: Scene, q0, pushers, perturb: Perturbation = Perturbation(), contact: Contact = Contact()):
+    def __init__(self, scene: Scene, q0, pushers, perturb: _Perturbation = _Perturbation(), contact: Contact = Contact()):
         super().__init__(_spec(scene, q0, pushers, perturb, contact), contact, scene.grip_force * perturb.grip)
         self.scene = scene
         self.gripper = Driver(self.model, "gripper")
@@ -160,7 +137,7 @@ class PlanarExecution(GripperRig):
     """One open-loop execution of a plan in the world's view (see the module), recorded: the
     object's pose in the grasp and the planned one every ``record_dt`` [s], and per push its slip."""
 
-    def __init__(self, scene: Scene, plan, perturb: Perturbation = Perturbation(), contact: Contact = Contact(),
+    def __init__(self, scene: Scene, plan, perturb: _Perturbation = _Perturbation(), contact: Contact = Contact(),
                  speed: float = 0.01, record_dt: float = 0.02):
         path = plan_dict(plan)["path"]
         for i, k in enumerate(path[1:], 1):
@@ -245,7 +222,7 @@ class PlanarExecution(GripperRig):
                       np.array(self.rec_q), np.array(self.rec_plan), self.steps)
 
 
-def execute_plan(scene: Scene, plan, perturb: Perturbation = Perturbation(), speed: float = 0.01,
+def execute_plan(scene: Scene, plan, perturb: _Perturbation = _Perturbation(), speed: float = 0.01,
                  record_dt: float = 0.02, contact: Contact = Contact(), settle: float = 0.2) -> Replay:
     """Executes ``plan`` (a ``regrasp.Plan`` or its dict) open loop in MuJoCo; returns the
     recorded object pose in the grasp (:class:`PlanarExecution`). ``speed`` [m/s] at most 100 m/s
@@ -303,7 +280,7 @@ class WorldRig(GripperRig):
 
     APPROACH = 0.012  # m
 
-    def __init__(self, scene: Scene, q0, perturb: Perturbation = Perturbation(), contact: Contact = Contact(),
+    def __init__(self, scene: Scene, q0, perturb: _Perturbation = _Perturbation(), contact: Contact = Contact(),
                  settle: float = 0.2):
         super().__init__(scene, q0, sorted(scene.pusher_names), perturb, contact)
         self.idle(settle)
@@ -342,3 +319,7 @@ class WorldRig(GripperRig):
         put_object(self.model, self.data, planar_compose(self.g, self.pose() + np.asarray(delta, float)))
         self.forward()
         self.idle(0.1)
+
+
+#: The old name (deprecated): ``regrasp.Perturbation`` (this engine's features followed the fingers' friction).
+Perturbation = PlanarEnginePerturbation

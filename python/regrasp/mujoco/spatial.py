@@ -125,11 +125,12 @@ def add_pads3d(parent, scene, s0, vertices, friction_scale: float, pad: str):
 
 
 def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
-          contact: Contact = Contact(), pad: str = "point", world: bool = False):
+          contact: Contact = Contact(), pad: str = "point", world: bool = False, feature_scale: float | None = None):
     """The model of a 3-D execution, a ``mujoco.MjSpec`` (``.compile()`` it; ``.to_xml()`` is its
     MJCF): planner's view (pads fixed, features on driven 6-DoF bodies) or, with ``world``, the
     world's view (the pads on a driven 6-DoF gripper, features fixed where they are put: mocap
-    bodies). ``grip_scale`` is the controls' (:class:`SpatialExecution`), not the model's."""
+    bodies). ``grip_scale`` is the controls' (:class:`SpatialExecution`), not the model's;
+    ``feature_scale``: the features' friction factor (None: ``friction_scale``, the pads')."""
     s0 = np.asarray(start, float)
     v, t = scene.mesh()
     v, t = np.asarray(v, float), np.asarray(t, int)
@@ -141,7 +142,7 @@ def build(scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, ma
         _, _, fr = scene.pusher_spec(p)
         body = (spec.worldbody.add_body(name=f"feature_{p}", mocap=True, pos=PARK + [0.1 * i, 0, 0]) if world
                 else add_driven_body(spec.worldbody, f"feature_{p}", spatial=True))
-        add_feature_geoms(body, scene, p, fr * friction_scale)
+        add_feature_geoms(body, scene, p, fr * (friction_scale if feature_scale is None else feature_scale))
     add_grip_motors(spec)
     return spec
 
@@ -160,10 +161,11 @@ class SpatialExecution(Rig):
     where it is fixed in the world's view (:attr:`F`)."""
 
     def __init__(self, scene, start, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
-                 contact: Contact = Contact(), pad: str = "point", view: str = "world"):
+                 contact: Contact = Contact(), pad: str = "point", view: str = "world", feature_scale: float | None = None):
         _check_options(pad, view)
         self.scene, self.view, self.world = scene, view, view == "world"
-        spec = build(scene, start, friction_scale, grip_scale, mass_scale, contact, pad, world=self.world)
+        spec = build(scene, start, friction_scale, grip_scale, mass_scale, contact, pad, world=self.world,
+                     feature_scale=feature_scale)
         super().__init__(spec, contact, scene.grip_force * grip_scale)
         self.gripper = Driver(self.model, "gripper") if self.world else None
         self.drivers = {} if self.world else {p: Driver(self.model, f"feature_{p}") for p in scene.pusher_names}
@@ -285,7 +287,7 @@ class SpatialExecution(Rig):
 
 def execute_plan3d(scene, plan, friction_scale: float = 1.0, grip_scale: float = 1.0, mass_scale: float = 1.0,
                    contact: Contact = Contact(), settle: float = 0.2, pad: str = "point", view: str = "world",
-                   feedback: bool = False, max_replans: int = 10, seed: int = 0) -> dict:
+                   feedback: bool = False, max_replans: int = 10, seed: int = 0, feature_scale: float | None = None) -> dict:
     """Executes a 3-D plan (a ``regrasp.Plan`` or its dict) in MuJoCo; returns the final pose, the
     error to the goal (position, angle), success, the object's pose in the grasp after each step
     and the re-plans made.
@@ -306,5 +308,5 @@ def execute_plan3d(scene, plan, friction_scale: float = 1.0, grip_scale: float =
 
     _check_options(pad, view)
     path = check_plan3d(scene, plan_dict(plan))
-    ex = SpatialExecution(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact, pad, view)
+    ex = SpatialExecution(scene, path[0]["pose"], friction_scale, grip_scale, mass_scale, contact, pad, view, feature_scale)
     return ex.run(path, settle, feedback, max_replans, seed)
