@@ -8,7 +8,7 @@ For each example and each limit surface (``true``, ``ellipsoid``) the pushes of
 rings (3 is the simulator's default: 36 points a pad; 8, `regrasp validate`'s: 216). Prints a
 markdown table: the agreement (strict, and counting an *ambiguous* push, where the object can
 also stay in the grasp, as agreeing whichever outcome the simulator picks: see
-``regrasp.sim.validation``), the disagreements by kind (predicted stick / simulated slip, and the reverse; and how
+``regrasp.mujoco.validation``), the disagreements by kind (predicted stick / simulated slip, and the reverse; and how
 many of them are *withdrawing* pushes, whose contact (a line pusher's middle) moves away from the
 object: the cone
 lets gravity make the object follow the pusher, the simulator finds the object held by the pads
@@ -26,7 +26,7 @@ import numpy as np
 
 from regrasp import examples
 from regrasp.scene.planar import Scene
-from regrasp.sim import validation as V
+from regrasp.mujoco import validation as V
 from regrasp.sim.quasistatic import support_kwargs
 
 

@@ -20,7 +20,7 @@ from regrasp.execution import world_motion  # noqa: E402
 from regrasp import Perturbation  # noqa: E402
 from regrasp.execution.arm import execute_arm  # noqa: E402
 from regrasp.execution.arm_loop import ArmPlant, control_arm, controller_scene  # noqa: E402
-from regrasp.workcell.default import default_workcell  # noqa: E402
+from regrasp.execution import default_workcell  # noqa: E402
 
 #: A perturbed world (finger and feature friction, grip force up 30 %, the mass down 30 %).
 STIFF = Perturbation(1.3, 1.3, 0.7, 1.3)
@@ -134,7 +134,7 @@ def test_the_plant_pushes_the_object_as_commanded():
     # the object: 0.07° measured)
     assert np.all(np.abs(q0 - plan.poses[0]) <= [1e-3, 1e-3, np.radians(0.1)])
     a, b = np.asarray(plan.poses[0]), np.asarray(plan.poses[1])
-    from regrasp.sim.quasistatic import body_twist
+    from regrasp.pose import body_twist
 
     T = 1.0
     arm.push(plan.pushers[1], body_twist(a, b) / T, T)

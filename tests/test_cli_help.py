@@ -84,7 +84,7 @@ def test_the_defaults_come_from_the_api():
     from regrasp import _core, bench
     from regrasp.reference.approx_error import approximation_report
     from regrasp.sim import quasistatic
-    from regrasp.sim.validation import validate
+    from regrasp.mujoco.validation import validate
 
     def api(fn, name):
         return inspect.signature(fn).parameters[name].default

@@ -13,7 +13,8 @@ from regrasp.execution import world_motion
 from regrasp.execution import collision as C
 from regrasp.execution.motion_check import PENETRATION_LIMIT
 from regrasp.execution.world_motion import GRIPPER_ENVELOPE, GRIPPER_RADIUS
-from regrasp.workcell import Workcell, default_workcell, shapes
+from regrasp.execution import default_workcell
+from regrasp.workcell import Workcell, shapes
 from regrasp.workcell.description import Feature
 from regrasp.workcell.shapes import EDGE_RADIUS, PLATE_DEPTH, TABLE_DEPTH
 

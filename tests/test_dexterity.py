@@ -14,6 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import regrasp
 from regrasp.dexterity.graph import Chain, Edge, GraspGraph
 from regrasp.dexterity.sequence import plan
 from regrasp.dexterity.slip import Body, simulate
@@ -625,15 +626,31 @@ def test_a_table_pivot_that_would_take_the_object_into_the_table_does_not_apply(
 
 def test_a_planned_repick_is_executed_towards_the_grasp_it_was_measured_for(tmp_path):
     # topple-repick from the box's g7 has two new grasps (g12 first); the plan to g6 must run the g6 one
+    import dataclasses
+
+    from regrasp.dexterity.graph import _object
     from regrasp.dexterity.objects import object_path
-    from regrasp.dexterity.sequence import execute
+    from regrasp.execution import World, execute
 
     g = graph_of([Edge("g7", "topple-repick", "g12", 20, {"g12": 20}, {"target": "g12"}),
                   Edge("g7", "topple-repick", "g6", 20, {"g6": 20}, {"target": "g6"})], ("g6", "g7", "g12"))
     s = plan(g, "g7", "g6")
     assert [(x.action, x.params) for x in s.steps] == [("topple-repick", {"target": "g6"})]
-    run = execute(str(object_path("box")), s)
-    assert run.outcomes == ("g6",) and run.success
+    with pytest.raises(regrasp.ArgumentError) as e:  # planned on a graph without its object file
+        execute(World(regrasp.load_scene(regrasp.examples.path("block-3d")), rig="arm"), s)
+    assert e.value.field == "plan"
+    s = dataclasses.replace(s, object=str(object_path("box")))
+    scene, tax, _ = _object(s.object)
+    for world, field in ((World(scene), "world.rig"), (World(regrasp.load_scene(regrasp.examples.path("block-3d")),
+                                                              rig="arm"), "world.scene")):
+        with pytest.raises(regrasp.ArgumentError) as e:
+            execute(world, s)
+        assert e.value.field == field
+    x = execute(World(scene, rig="arm"), s)  # the one executor runs a sequence of regrasp actions too
+    assert x.detail.outcomes == ("g6",) and x.success
+    assert x.steps == [{"action": "topple-repick", "from": "g7", "to": "g6", "reached": "g6"}]
+    name, d = tax.nearest(x.final_pose)  # judged against the goal grasp: the classification's own distance
+    assert name == "g6" and x.goal_error == pytest.approx([d], abs=1e-12)
 
 
 def run_cli(*args):

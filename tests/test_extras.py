@@ -78,7 +78,7 @@ def test_core_works_without_extras(blocker):
         s3 = regrasp.load_scene(examples.path("prism-3d"))   # a mesh, quaternions without scipy
         p3 = regrasp.plan(s3, seed=0)
         assert p3.found and s3.replay(p3)["success"]
-        import regrasp.bench, regrasp.cli, regrasp.control, regrasp.reference, regrasp.viz.viewer, regrasp.sim.validation
+        import regrasp.bench, regrasp.cli, regrasp.control, regrasp.reference, regrasp.viz.viewer, regrasp.mujoco.validation
         loaded = sorted(m for m in {OPTIONAL!r} if m in sys.modules)
         assert not loaded, loaded
         print("core ok")

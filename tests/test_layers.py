@@ -108,6 +108,56 @@ def test_the_circle_check_finds_a_circle(tmp_path):
     assert circles(graph(pkg)) == [["regrasp.a.x", "regrasp.a.y", "regrasp.b"]]
 
 
+#: The folders of python/regrasp from the bottom up (README "What is where"); a module imports
+#: only from its own stage or one below. The base modules are under every stage; drawing code
+#: takes data (it imports no stage); ``planning`` is the Plan (the plan file's type) and
+#: ``plan()``, which the scenes' ``plan``/``replay`` return and read.
+STAGES = (
+    ("errors", "fields", "files", "pose", "polygon", "extras", "progress", "_moved", "_core"),
+    ("viz",),
+    ("planning",),
+    ("scene", "examples"),
+    ("reference",),
+    ("sim",),
+    ("mujoco",),
+    ("control",),
+    ("workcell",),
+    ("robot",),
+    ("execution",),
+    ("dexterity",),
+    ("bench",),
+    ("cli", "__main__"),
+)
+
+
+def _stage(module: str) -> int:
+    parts = module.split(".")
+    if len(parts) == 1:  # the package's face re-exports every stage
+        return len(STAGES)
+    return next(i for i, s in enumerate(STAGES) if parts[1] in s)
+
+
+def upward(g: dict) -> list:
+    """(importer, imported) of every import of a later stage."""
+    return sorted((a, b) for a, bs in g.items() for b in bs if _stage(b) > _stage(a))
+
+
+def test_imports_only_go_down_the_pipeline():
+    folders = {p.name for p in PKG.iterdir() if p.is_dir() and p.name != "__pycache__"}
+    folders |= {p.stem for p in PKG.glob("*.py") if p.stem != "__init__"}
+    folders |= {p.name.split(".")[0] for p in PKG.glob("_core*")}
+    staged = {f for s in STAGES for f in s}
+    assert folders - staged == set(), "a folder or module of no stage: add it to STAGES (and README)"
+    assert upward(graph()) == []
+
+
+def test_the_order_check_finds_an_upward_import():
+    """Not vacuous: a scene importing the executor (inside a function) is found."""
+    g = {"regrasp.scene.planar": {"regrasp.pose", "regrasp.execution.execute"}, "regrasp.execution.execute":
+         {"regrasp.scene.planar"}}
+    assert upward(g) == [("regrasp.scene.planar", "regrasp.execution.execute")]
+
+
 def core_reach(root: Path = PKG) -> list:
     """(module, line) of every reach into the compiled core outside the doors: an attribute
     ``x._core`` (a scene's or a cone's core object), or an import of ``_core`` (outside the base

@@ -14,7 +14,7 @@ from regrasp import Perturbation
 from regrasp.mujoco.planar import execute_plan
 from regrasp.mujoco.model import SOFT, convex_pieces, creep
 from regrasp.mujoco.push import PushRig
-from regrasp.sim.validation import validate
+from regrasp.mujoco.validation import validate
 
 from .conftest import EXAMPLES
 

@@ -12,7 +12,7 @@ import pytest
 import regrasp
 from regrasp.errors import ExecutionError
 from regrasp.execution import pick_place as pp
-from regrasp.workcell import default_workcell
+from regrasp.execution import default_workcell
 
 from .conftest import pose_matrix as T, run_cli
 

@@ -175,7 +175,7 @@ def test_validate_json_and_agreement():
     assert out["limit_surface"] == "true" and out["rings"] == regrasp._core.validation_rings() == 8
     # with the motion cones' own limit surface as the pads (the ellipsoid), prediction and
     # simulation coincide
-    from regrasp.sim.validation import validate
+    from regrasp.mujoco.validation import validate
 
     scene = regrasp.Scene.load(EXAMPLES / "block-high-friction.toml")
     ls = validate(scene.with_limit_surface("ellipsoid"), 90, 1, support="limit_surface")
@@ -190,7 +190,7 @@ def test_ambiguous_pushes_are_those_where_the_object_can_also_stay():
     into the object (checked here by hand from the scene's pushers); block-xztheta's corner point
     pusher has many, and the simulator mostly lets the contact open there. Counting either
     outcome as agreeing, xztheta reaches issue 17's 99% against the 8-ring pads."""
-    from regrasp.sim.validation import samples, validate
+    from regrasp.mujoco.validation import samples, validate
 
     scene = regrasp.Scene.load(EXAMPLES / "block-xztheta.toml")
     rows = samples(scene, 600, 0)
@@ -213,7 +213,7 @@ def test_plans_make_no_ambiguous_push(name):
     """The planner's steps push into the object: none is a push where the object could as well
     stay in the grasp (deterministic seeds; the twist of a step from its two poses)."""
     from regrasp.planning.plan import plan
-    from regrasp.sim.validation import static_alternative
+    from regrasp.mujoco.validation import static_alternative
 
     scene = regrasp.Scene.load(EXAMPLES / f"{name}.toml")
     steps = 0

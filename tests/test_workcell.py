@@ -12,7 +12,8 @@ from hypothesis import strategies as st
 import regrasp
 from regrasp import ArgumentError, SceneError
 from regrasp.execution.assignment import assign, pusher_contact
-from regrasp.workcell import Feature, Workcell, bundled, default_workcell
+from regrasp.execution import default_workcell
+from regrasp.workcell import Feature, Workcell, bundled
 from regrasp.workcell.description import BOUNDS
 
 from .conftest import rotation_matrix as rot

@@ -16,7 +16,8 @@ from regrasp.execution.assignment import MAX_TILT
 from regrasp.execution.motion_check import PENETRATION_LIMIT, edge_points, object_points
 from regrasp.execution.trajectory import LABELS
 from regrasp.execution.world_motion import SLIDE_GAP
-from regrasp.workcell import Table, Workcell, default_workcell
+from regrasp.execution import default_workcell
+from regrasp.workcell import Table, Workcell
 from regrasp.workcell.description import Feature, Robot
 
 from .conftest import rotation_matrix as rot, pose_matrix as T

@@ -107,7 +107,7 @@ def test_workcell_page_carries_every_feature_and_its_geometry():
 
 def test_workcell_in_hand_holds_the_object_at_its_start_above_the_table():
     s = regrasp.load_scene(regrasp.examples.path("pivot-3d"))
-    wc = regrasp.workcell.default_workcell(s)
+    wc = regrasp.execution.default_workcell(s)
     d = data_of(workcell_html(wc, s))
     G, O = d["samples"]["gripper"][0], d["samples"]["object"][0]
     start = np.asarray(s.task[0], float)

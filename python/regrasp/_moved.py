@@ -15,7 +15,9 @@ import warnings
 MOVED = {
     "scene3d": "scene.spatial",
     "quasistatic": "sim.quasistatic",
-    "validation": "sim.validation",
+    "validation": "mujoco.validation",
+    "sim.validation": "mujoco.validation",
+    "workcell.default": "execution.layout",
     "mncp_reference": "reference.mncp",
     "report": "reference.approx_error",
     "mujoco_model": "mujoco.model",
@@ -43,6 +45,21 @@ class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
     def exec_module(self, module):
         pass
+
+
+def attribute_aliases(package: str, moved: dict):
+    """A module ``__getattr__`` for ``package``'s names that moved: name → module (under
+    ``regrasp``) that holds it now; each use warns."""
+
+    def __getattr__(name: str):
+        if name not in moved:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}")
+        new = "regrasp." + moved[name]
+        warnings.warn(f"`{package}.{name}` moved to `{new}.{name}`; the old path will be removed", DeprecationWarning,
+                      stacklevel=2)
+        return getattr(importlib.import_module(new), name)
+
+    return __getattr__
 
 
 def install() -> None:

@@ -144,6 +144,35 @@ def planar_rotate(theta: float, v) -> np.ndarray:
 # --- twists ------------------------------------------------------------------------------------
 
 
+def body_twist(a, b) -> np.ndarray:
+    """Planar: the constant body twist taking pose ``a`` to pose ``b`` in unit time (planar log map)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    c, s = np.cos(a[2]), np.sin(a[2])
+    d = np.array([c * (b[0] - a[0]) + s * (b[1] - a[1]), -s * (b[0] - a[0]) + c * (b[1] - a[1])])
+    w = b[2] - a[2]
+    if abs(w) < 1e-9:
+        return np.array([d[0], d[1], w])
+    # inverse of V(w) = [[sin w / w, −(1−cos w)/w], [(1−cos w)/w, sin w / w]]
+    A, B = np.sin(w) / w, (1 - np.cos(w)) / w
+    det = A * A + B * B
+    lin = np.array([A * d[0] + B * d[1], -B * d[0] + A * d[1]]) / det
+    return np.array([lin[0], lin[1], w])
+
+
+def integrate_pose(q, u, t: float) -> np.ndarray:
+    """Planar: the pose reached from ``q`` after moving for ``t`` s with constant body twist ``u``."""
+    q, u = np.asarray(q, float), np.asarray(u, float)
+    w = u[2] * t
+    lin = u[:2] * t
+    if abs(w) < 1e-9:
+        a, b = 1 - w * w / 6, w / 2
+    else:
+        a, b = np.sin(w) / w, (1 - np.cos(w)) / w
+    d = np.array([a * lin[0] - b * lin[1], b * lin[0] + a * lin[1]])
+    c, s = np.cos(q[2]), np.sin(q[2])
+    return np.array([q[0] + c * d[0] - s * d[1], q[1] + s * d[0] + c * d[1], q[2] + w])
+
+
 def twist_in(rel, u) -> list:
     """Body twist ``u`` (m/s, rad/s) of a frame B expressed in frame A, where the pose ``rel`` =
     A⁻¹B (m, unit quaternion) (the adjoint): ``[R v + p × (R ω), R ω]``."""

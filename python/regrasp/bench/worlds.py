@@ -56,7 +56,7 @@ def run_world_motion(reps: int = 5, examples=WORLD_MOTION_EXAMPLES) -> dict:
     from ..execution import world_motion
     from ..planning.plan import plan
     from ..scene import load_scene
-    from ..workcell import default_workcell
+    from ..execution.layout import default_workcell
 
     out = {}
     for name in examples:

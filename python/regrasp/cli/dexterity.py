@@ -67,23 +67,27 @@ def cmd_grasp_graph(a) -> int:
 
 def cmd_regrasp_sequence(a) -> int:
     from ..dexterity.graph import GraspGraph
-    from ..dexterity.sequence import execute, plan
+    from ..dexterity.sequence import plan
 
     check_count(a, "runs", 1, MAX_TRIALS)
     graph = GraspGraph.load(a.graph)
     seq = plan(graph, a.source, a.target, a.objective)
     out = {"sequence": seq.to_dict()}
     if a.execute:
-        from ..dexterity.graph import Settings, perturbations
+        from ..dexterity.graph import Settings, _object, perturbations
+        from ..execution.execute import World, execute
 
         if not Path(str(graph.object.get("file", ""))).is_file():
             raise ArgumentError(f"invalid `object.file`: the graph's object file {graph.object.get('file')!r} is not "
                                 "there to execute on", "object.file")
         spread = {k: graph.settings[k] for k in ("spread", "shift", "turn") if isinstance(graph.settings.get(k), (int, float))}
-        runs = [execute(graph.object["file"], seq, p) for p in
+        world = World(_object(str(graph.object["file"]))[0], rig="arm")
+        runs = [execute(world, seq, perturbation=p) if seq.steps else None for p in
                 perturbations(Settings(trials=a.runs, seed=a.seed, **spread), f"sequence/{a.source}/{a.target}")]
-        out["runs"] = [r.to_dict() for r in runs]
-        out["measured"] = sum(r.success for r in runs) / len(runs)
+        runs = [{"outcomes": [], "success": True, "goal_error": [0.0]} if r is None else
+                {**r.detail.to_dict(), "goal_error": r.goal_error.tolist()} for r in runs]
+        out["runs"] = runs
+        out["measured"] = sum(r["success"] for r in runs) / len(runs)
     if a.json:
         print(json.dumps(out, allow_nan=False))
     else:

@@ -7,7 +7,7 @@ import json
 import numpy as np
 
 from .. import progress
-from ..scene.settings import quasistatic_defaults, validation_rings
+from ..scene.settings import DT, quasistatic_defaults, validation_rings
 from ..errors import ArgumentError
 from ..files import Outputs
 from ..planning.plan import POSE_SIZE, Plan
@@ -17,7 +17,7 @@ from . import (CANNOT, FIGURE_SUFFIXES, MAX_DURATION, MAX_PUSHES, MAX_STEPS, MAX
 
 
 def cmd_validate(a) -> int:
-    from ..sim.validation import format_validation, validate
+    from ..mujoco.validation import format_validation, validate
 
     check_count(a, "pushes", 1, MAX_PUSHES)
     check_count(a, "workers", 1, MAX_WORKERS)
@@ -153,7 +153,7 @@ def _push_report(scene, a, twist, tr: dict) -> int:
 
 def _check_push(a) -> None:
     """--duration, --dt (positive, at most MAX_STEPS steps) and --plot, before any work."""
-    from ..sim.quasistatic import push_dt
+    from ..scene.settings import push_dt
 
     check_number(a, "duration", 0.0, MAX_DURATION, what="duration [s]", lo_open=True)
     a.dt = push_dt(a.duration, a.dt)
@@ -189,7 +189,7 @@ def cmd_push(a) -> int:
 def add_parsers(sub) -> None:
     from ..scene.spatial import Scene3D
     from ..sim import quasistatic
-    from ..sim.validation import validate
+    from ..mujoco.validation import validate
 
     v = add_command(sub, "validate", "motion-cone predictions against the simulators (planar scenes)",
                     "regrasp validate block-low-friction.toml --pushes 500 --engines quasistatic,mujoco",
@@ -236,7 +236,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--twist", required=True,
                    help="pusher body twist vx,vz,omega, object frame at the start (3-D: vx,vy,vz,wx,wy,wz)")
     p.add_argument("--duration", type=float, default=1.0, help="duration of the push [s]")
-    p.add_argument("--dt", type=float, help=f"time step [s], at most --duration (default: min({quasistatic.DT}, --duration))")
+    p.add_argument("--dt", type=float, help=f"time step [s], at most --duration (default: min({DT}, --duration))")
     p.add_argument("--plot", metavar="PNG", help="planar: object motion and contact forces")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(p)

@@ -42,10 +42,10 @@ def cmd_pick_place(a) -> int:
     success = True
     executed = None
     if not a.plan_only:
-        from ..execution.pick_place import execute_pick_place
+        from ..execution.execute import World, execute
 
-        executed = execute_pick_place(scene, r)
-        err, success = executed.place_error, executed.success
+        executed = execute(World(scene, rig="arm"), r)
+        err, success = tuple(executed.goal_error), executed.success
     out = {"success": bool(success), "pick_grasp": rounded(r.pick.in_hand), "place_grasp": rounded(r.place.in_hand),
            "place_error": rounded(err), "switch_overs": int(r.switch_overs),
            "planning_time_s": round(r.planning_time, 4), "executed": executed is not None,

@@ -18,7 +18,8 @@ import numpy as np
 from .. import progress
 from ..errors import ArgumentError, RegraspError, check_seed
 from ..mujoco.model import plan_dict
-from ..sim.quasistatic import body_twist, simulate_push
+from ..pose import body_twist
+from ..sim.quasistatic import simulate_push
 from ..scene.perturbation import Perturbation
 from ..scene.planar import Scene
 from ..scene.settings import mpc_defaults

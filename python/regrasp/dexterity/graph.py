@@ -357,6 +357,7 @@ def run_edge(job: tuple) -> Edge:
     :func:`continuations`, each run starting where the action ``before`` (its grasp, name and
     params) ends and moving to this one's start as a sequence does (:class:`~.trial.Runner`'s
     lead-in)."""
+    from ..execution.execute import World, execute
     from .actions import action
     from .trial import REFUSED, Runner
 
@@ -369,7 +370,8 @@ def run_edge(job: tuple) -> Edge:
     if chain:
         source, name, before = chain[1]
         lead_in = (action(name).setup(obj, tax.grasp(source), before).path.poses[-1], obj.grip)
-    runner = Runner(scene, tax, grasp, setup, robot, lead_in)
+    runner = Runner(scene, tax, grasp, setup, robot, lead_in, action_name)
+    world = World(scene, rig="arm", robot=robot)
     outcomes: dict = {}
     runs: list = []
     if chain:
@@ -378,7 +380,7 @@ def run_edge(job: tuple) -> Edge:
         worlds = perturbations(settings, "/".join([grasp_name, action_name, *(str(v) for v in params.values())]))
     for i, p in enumerate(worlds):
         try:
-            r = runner.run(p)
+            r = execute(world, runner, perturbation=p).detail  # the one executor: a trial judged on its task
             outcome, pose = r.outcome, r.pose
         except ArgumentError as e:
             if i == 0 and not chain:  # the arm cannot do the action here at all (IK in the nominal world): no edge
@@ -438,7 +440,7 @@ def edges_to_measure(obj, settings: Settings, clear: dict | None = None) -> list
 def _each(run, jobs: list, workers: int, ray_address, take) -> None:
     """``take(run(job))`` for every job, in any order, over ``workers`` processes or Ray."""
     if ray_address is not None:
-        from ..sim.validation import ray_init
+        from ..mujoco.validation import ray_init
 
         ray = ray_init(ray_address, workers)
         remote = ray.remote(run)

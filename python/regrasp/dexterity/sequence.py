@@ -20,7 +20,8 @@ import numpy as np
 from ..errors import ArgumentError
 from ..extras import need
 from .graph import GraspGraph
-from .trial import REFUSED, TRANSFER_SETTLE, transfer
+from .taxonomy import grasp_distance
+from .trial import REFUSED, TRANSFER_SETTLE, execution, transfer
 
 OBJECTIVES = ("reliable", "expected")
 
@@ -54,18 +55,42 @@ class Sequence:
     """A planned sequence: its ``steps``, the predicted ``probability`` that it all succeeds (the
     product of the steps' p), the ``expected_actions`` (Σ 1/p) and the ``independent``
     probability (the product of the steps' ``alone``: as if each action started from its
-    grasp's own pose)."""
+    grasp's own pose); ``object``: the object file it was planned for (the graph's), which
+    :meth:`run_in` runs it on."""
 
     steps: tuple
     probability: float
     expected_actions: float
     independent: float | None = None
+    object: str | None = None
 
     def to_dict(self) -> dict:
         """The sequence as JSON (``regrasp regrasp-sequence --json``)."""
         return {"steps": [s.to_dict() for s in self.steps], "probability": self.probability,
                 "expected_actions": self.expected_actions,
                 "independent": self.probability if self.independent is None else self.independent}
+
+    def run_in(self, world, loop: str, perturbation, observe=None):
+        """The sequence run by :func:`regrasp.execution.execute` in ``world`` (the arm, open loop,
+        ``world.scene`` the object's scene): an :class:`~regrasp.execution.Execution` whose task
+        is the last step's grasp — ``goal_error`` ``[d]``, the distance [m] of the final in-hand
+        pose from that grasp (:func:`~.taxonomy.grasp_distance`), success when every step reached
+        its target; ``steps`` the per-step records, ``detail`` the :class:`SequenceRun`."""
+        from ..execution.execute import check_hand_world
+
+        check_hand_world(world, loop, perturbation, "a sequence of regrasp actions")
+        if self.object is None:
+            raise ArgumentError("invalid `plan`: a sequence without its object file (plan it from a grasp graph)",
+                                "plan")
+        if not self.steps:
+            raise ArgumentError("invalid `plan`: an empty sequence (its start is its goal): nothing to run", "plan")
+        _check_scene(world.scene, self.object)
+        run, final, tax = _run(self.object, self, perturbation, world.robot, observe)
+        final = tax.grasp(self.steps[0].source).pose if final is None else final  # the arm could not start
+        err = [grasp_distance(tax.vertices, final, tax.grasp(self.steps[-1].target).pose)]
+        return execution(world, loop, perturbation, final, err, run.success, [{"action": s.action, "from": s.source, "to": s.target,
+                                        "reached": run.outcomes[i] if i < len(run.outcomes) else None}
+                                       for i, s in enumerate(self.steps)], run)
 
 
 def states(graph: GraspGraph):
@@ -112,8 +137,9 @@ def plan(graph: GraspGraph, start: str, goal: str, objective: str = "reliable") 
                                 f"(grasps: {', '.join(graph.node_names)})", field_)
     if objective not in OBJECTIVES:
         raise ArgumentError(f"invalid `objective`: {objective!r} (known: {', '.join(OBJECTIVES)})", "objective")
+    obj = (graph.object.get("file") or None) if isinstance(graph.object, dict) else None
     if start == goal:
-        return Sequence((), 1.0, 0.0, 1.0)
+        return Sequence((), 1.0, 0.0, 1.0, obj)
     G = states(graph)
     end = ("goal", goal)
     G.add_edges_from(((s, end) for s in list(G.nodes) if s[1] == goal), p=1.0, end=True)
@@ -128,7 +154,7 @@ def plan(graph: GraspGraph, start: str, goal: str, objective: str = "reliable") 
                        G[u][v]["params"], bool(G[u][v]["chained"]), float(G[u][v]["alone"]))
                   for u, v in zip(nodes, nodes[1:]))
     return Sequence(steps, float(np.prod([s.p for s in steps])), float(sum(1 / s.p for s in steps)),
-                    float(np.prod([s.alone for s in steps])))
+                    float(np.prod([s.alone for s in steps])), obj)
 
 
 @dataclass(frozen=True)
@@ -150,22 +176,29 @@ def execute(path, sequence: Sequence, perturbation=None, robot: str | None = Non
     start (:func:`~.trial.transfer`, grip firm); each action set up for the grasp the plan expects
     there (with its measured parameters: a re-pick's target). Stops at the first step that misses
     its target; a step the arm cannot reach from where the last one left it (IK) ends the run as
-    ``refused``."""
+    ``refused``. (``regrasp.execution.execute(World(scene, rig="arm"), sequence)`` runs it too,
+    with the result every rig gives.)"""
+    from ..scene.perturbation import Perturbation
+
+    if not sequence.steps:
+        return SequenceRun((), True)
+    return _run(str(path), sequence, perturbation or Perturbation(), robot, observe)[0]
+
+
+def _run(path: str, sequence: Sequence, p, robot, observe) -> tuple:
+    """(:class:`SequenceRun`, the final in-hand pose (None when the arm could not start), the
+    taxonomy) of ``sequence`` run on the object file ``path`` in the world ``p``."""
     from .actions import action
     from .graph import _object
     from .trial import classify
-    from ..scene.perturbation import Perturbation
     from .world import HandWorld, constant, solve_path
 
     scene, tax, obj = _object(str(path))
-    if not sequence.steps:
-        return SequenceRun((), True)
-    p = perturbation or Perturbation()
     first = action(sequence.steps[0].action).setup(obj, tax.grasp(sequence.steps[0].source), sequence.steps[0].params)
     try:
         world = HandWorld(scene, tax.grasp(sequence.steps[0].source).pose, first.start, p, robot)
     except ArgumentError:  # no IK for the start: the run fails there
-        return SequenceRun((REFUSED,), False)
+        return SequenceRun((REFUSED,), False), None, tax
     outcomes = []
     for i, step in enumerate(sequence.steps):
         setup = first if i == 0 else action(step.action).setup(obj, tax.grasp(step.source), step.params)
@@ -175,10 +208,20 @@ def execute(path, sequence: Sequence, perturbation=None, robot: str | None = Non
                 world.follow(move, q_move, constant(obj.grip), TRANSFER_SETTLE, observe)
             q = solve_path(world.robot, setup.path, world.robot.q)
         except ArgumentError:  # the arm cannot go on from where the last action left it (IK)
-            return SequenceRun((*outcomes, REFUSED), False)
+            return SequenceRun((*outcomes, REFUSED), False), world.in_hand(), tax
         world.follow(setup.path, q, setup.grip, setup.settle, observe)
         outcome = classify(world, tax)[0]
         outcomes.append(outcome)
         if outcome != step.target:
-            return SequenceRun(tuple(outcomes), False)
-    return SequenceRun(tuple(outcomes), True)
+            return SequenceRun(tuple(outcomes), False), world.in_hand(), tax
+    return SequenceRun(tuple(outcomes), True), world.in_hand(), tax
+
+
+def _check_scene(scene, path: str) -> None:
+    """An ArgumentError naming ``world.scene`` unless ``scene`` is the object file ``path``'s."""
+    from .graph import _object
+
+    own = _object(str(path))[0]
+    if getattr(scene, "name", None) != own.name:
+        raise ArgumentError(f"invalid `world.scene`: the object's scene {own.name!r} (got "
+                            f"{getattr(scene, 'name', type(scene).__name__)!r})", "world.scene")

@@ -17,7 +17,7 @@ from typing import Optional
 import numpy as np
 
 from ..errors import ArgumentError
-from .taxonomy import CLASSIFICATION_TOLERANCE as TOLERANCE, classification_tolerance as tolerance
+from .taxonomy import CLASSIFICATION_TOLERANCE as TOLERANCE, classification_tolerance as tolerance, grasp_distance
 from ..scene.perturbation import Perturbation
 from .world import HandPath, HandWorld, constant, hand_pose, solve_path
 
@@ -86,9 +86,10 @@ class Runner:
     ``lead_in`` (a TCP pose (7,), a grip force [N]) each trial starts with the hand there (where
     the action before it ended) and moves to the action's start by :func:`transfer` at that grip."""
 
-    def __init__(self, scene, taxonomy, grasp, setup, robot: str | None = None, lead_in: tuple | None = None):
+    def __init__(self, scene, taxonomy, grasp, setup, robot: str | None = None, lead_in: tuple | None = None,
+                 action: str | None = None):
         self.scene, self.taxonomy, self.grasp, self.setup, self.robot = scene, taxonomy, grasp, setup, robot
-        self.lead_in = lead_in
+        self.lead_in, self.action = lead_in, action
         self._world: Optional[HandWorld] = None
         self.q: Optional[np.ndarray] = None
         self.move: Optional[tuple] = None
@@ -114,3 +115,43 @@ class Runner:
         w.follow(self.setup.path, self.q, self.setup.grip, self.setup.settle, observe)
         outcome, dist, pose = classify(w, self.taxonomy)
         return TrialResult(outcome, dist, pose, time.perf_counter() - t0)
+
+    def run_in(self, world, loop: str, perturbation: Perturbation, observe=None):
+        """One trial run by :func:`regrasp.execution.execute` in ``world`` (the arm, open loop, the
+        runner's scene and robot): an :class:`~regrasp.execution.Execution` judged against the
+        action's task — its intended grasp (success: the trial reached it); without one, the
+        model's predicted in-hand pose (success: held within the classification tolerance of it)
+        or, predicted to drop, the drop (success: dropped; ``goal_error`` empty).
+        ``goal_error`` ``[d]``: the distance [m] of the final in-hand pose from the task's pose
+        (:func:`~.taxonomy.grasp_distance`); ``detail`` the :class:`TrialResult`."""
+        from ..execution.execute import check_hand_world
+
+        check_hand_world(world, loop, perturbation, "a regrasp action")
+        if world.scene is not self.scene and getattr(world.scene, "name", None) != self.scene.name:
+            raise ArgumentError(f"invalid `world.scene`: the runner's scene {self.scene.name!r}", "world.scene")
+        if world.robot is not None and world.robot != self.robot:
+            raise ArgumentError(f"invalid `world.robot`: the runner's robot {self.robot!r}", "world.robot")
+        r = self.run(perturbation, observe)
+        final = self._world.in_hand()
+        s = self.setup
+        goal = self.taxonomy.grasp(s.intended).pose if s.intended is not None else s.predicted
+        err = np.zeros(0) if goal is None else np.array([grasp_distance(self.taxonomy.vertices, final, goal)])
+        if s.intended is not None:
+            ok = r.outcome == s.intended
+        elif goal is not None:
+            ok = r.outcome not in (DROPPED, UNSTABLE, REFUSED) and err[0] <= tolerance(self.taxonomy)
+        else:
+            ok = r.outcome == DROPPED
+        step = {"action": self.action, "from": self.grasp.name, "to": s.intended, "reached": r.outcome}
+        return execution(world, loop, perturbation, final, err, ok, [step], r)
+
+
+def execution(world, loop, perturbation, final, err, success: bool, steps: list, detail):
+    """The :class:`~regrasp.execution.Execution` of a run of regrasp actions that left the object
+    at in-hand pose ``final`` (m, unit quaternion) ``err`` [m] from its task's pose, ``success``
+    or not, with its per-step records ``steps`` and the runner's own ``detail``."""
+    from ..execution.execute import Execution
+
+    err = np.asarray(err, float)
+    return Execution(bool(success), err, err.copy(), bool(success), np.asarray(final, float), world, loop,
+                     perturbation, detail=detail, steps=steps)

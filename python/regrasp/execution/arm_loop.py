@@ -194,7 +194,7 @@ class ArmPlant:
         n = max(1, math.ceil(duration / self.timing.sample_period - 1e-9))
         s = duration * np.arange(1, n + 1) / n
         if self.scene.dimension == 2:
-            from ..sim.quasistatic import integrate_pose
+            from ..pose import integrate_pose
 
             Os = [self._spatial(integrate_pose(q, tw, t)) for t in s]
         else:
@@ -281,7 +281,7 @@ def control_arm(scene, plan, workcell=None, scales: Perturbation = Perturbation(
 
 def _check_features(scene, plan, workcell) -> None:
     """ExecutionError naming each pusher of ``plan`` that no feature of the workcell serves."""
-    from ..workcell.default import default_workcell
+    from .layout import default_workcell
 
     wc = default_workcell(scene) if workcell is None else workcell
     try:
@@ -295,7 +295,7 @@ def controller_scene(scene, plan, workcell=None):
     re-planning: the plan's and those a feature serves
     (:func:`~regrasp.execution.assignment.assign`) at every pose of the plan; ``scene`` itself when it needs none removed
     or has no source text to rebuild from."""
-    from ..workcell.default import default_workcell
+    from .layout import default_workcell
 
     wc = default_workcell(scene) if workcell is None else workcell
     poses = np.asarray(plan.poses, float)

@@ -6,6 +6,7 @@ loop, in a perturbed world (:class:`~regrasp.Perturbation`), with one result,
     from regrasp.execution import World, execute
     run = execute(World(scene, rig="arm"), plan, perturbation=Perturbation(0.9, 1.1, 1.0, 1.0))
     run.success, run.goal_error, run.plan_end_error, run.max_creep, run.trajectory
+    run = execute(World(scene, rig="arm"), pick_place(scene))   # a pick-regrasp-place: its task is the place
 
 Success is judged against the **task** (the scene's goal and tolerance, :meth:`Scene.goal_error`);
 the error to the plan's last pose is reported beside it (a plan may end off the task's goal when
@@ -23,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import pose as P
-from ..errors import ArgumentError
+from ..errors import ArgumentError, InternalError
 from ..planning.plan import Plan, as_plan
 from ..scene.perturbation import Perturbation
 from ..workcell.description import Workcell
@@ -84,7 +85,8 @@ class Execution:
     (the arm's joint trajectory, the free gripper's world motion); ``motion``: the gripper rigs'
     :class:`~regrasp.execution.world_motion.WorldMotion`; ``refused``: ``(push, feature, why)``
     of each contact the arm could not follow (another served the push); ``detail``: the rig's
-    own result."""
+    own result; ``steps``: a sequence of regrasp actions' per-step records (action, from, to,
+    the grasp reached)."""
 
     success: bool
     goal_error: np.ndarray
@@ -105,6 +107,7 @@ class Execution:
     motion: object = field(default=None, repr=False)
     refused: list = field(default_factory=list)
     detail: object = field(default=None, repr=False)
+    steps: list = field(default_factory=list)
 
     def to_json(self) -> dict:
         """The run's numbers as a JSON-ready dict."""
@@ -112,6 +115,8 @@ class Execution:
                "goal_error": self.goal_error.tolist(), "plan_end_error": self.plan_end_error.tolist(),
                "at_plan_end": bool(self.at_plan_end), "final_pose": self.final_pose.tolist(), "replans": self.replans,
                "pushes": self.pushes}
+        if self.steps:
+            out["steps"] = self.steps
         for k in ("duration", "max_creep", "max_creep_angle"):
             if getattr(self, k) is not None:
                 out[k] = float(getattr(self, k))
@@ -120,7 +125,10 @@ class Execution:
 
 def execute(world: World, plan, *, loop: str = "open", perturbation: Perturbation | None = None,
             observe=None) -> Execution:
-    """Runs ``plan`` (a :class:`~regrasp.Plan` or its dict) in ``world``, ``loop`` open (the plan
+    """Runs ``plan`` (a :class:`~regrasp.Plan` or its dict; with the arm also a planned
+    pick-regrasp-place, :func:`_pick_place`, or regrasp actions: a
+    :class:`~regrasp.dexterity.sequence.Sequence` or one action's
+    :class:`~regrasp.dexterity.trial.Runner`, which run themselves: ``plan.run_in``) in ``world``, ``loop`` open (the plan
     as made) or closed (the planar MPC of thesis §5.2, or re-planning from the measured pose in
     3-D), in the world ``perturbation`` (default: nominal). ``observe(robot)``: called every
     control period of the arm (e.g. a video recorder). ArgumentError naming the field when the
@@ -133,6 +141,16 @@ def execute(world: World, plan, *, loop: str = "open", perturbation: Perturbatio
     if not isinstance(pert, Perturbation):
         raise ArgumentError(f"invalid `perturbation`: a regrasp.Perturbation (got {type(pert).__name__})", "perturbation")
     scene = world.scene
+    from .pick_place import PickPlace
+
+    if isinstance(plan, PickPlace):
+        return _pick_place(world, scene, plan, loop, pert, observe)
+    run_in = getattr(plan, "run_in", None)
+    if callable(run_in):  # a plan of a later stage (regrasp actions: regrasp.dexterity) runs itself here
+        out = run_in(world, loop, pert, observe)
+        if not isinstance(out, Execution):
+            raise InternalError(f"{type(plan).__name__}.run_in returned {type(out).__name__}, not an Execution")
+        return out
     plan = as_plan(plan, scene)
     run = _RUNNERS[world.rig](world, scene, plan, loop, pert, observe)
     return _judged(world, scene, plan, loop, pert, run)
@@ -241,6 +259,50 @@ def _arm(world, scene, plan, loop, pert, observe) -> dict:
     return {"final": r.in_hand[-1], "poses": r.in_hand, "detail": r, "duration": r.duration,
             "creep": (r.max_creep, r.max_creep_angle), "tracking": r.tracking, "motion": am.motion,
             "trajectory": r.trajectory, "refused": list(am.refused)}
+
+
+def check_hand_world(world: World, loop: str, pert: Perturbation, what: str) -> None:
+    """What a run of regrasp actions (the arm holding the object by its hand, thesis §1.1.1)
+    needs: the arm rig, open loop, its own world (the table and the post: no workcell, no
+    options) and no moved start; an ArgumentError naming the field otherwise."""
+    if world.rig != "arm":
+        raise ArgumentError(f"invalid `world.rig`: {what} runs with the arm", "world.rig")
+    if loop != "open":
+        raise ArgumentError(f"invalid `loop`: {what} runs open loop", "loop")
+    if world.workcell is not None or world.options:
+        raise ArgumentError(f"invalid `world.workcell`: {what} runs in its object's own world (the table and the "
+                            "post; no workcell or options)", "world.workcell")
+    if pert.pose is not None or any(pert.shift) or pert.turn:
+        raise ArgumentError(f"invalid `perturbation`: {what} starts at its first grasp (no shift, turn or pose)",
+                            "perturbation.shift")
+
+
+def _pick_place(world, scene, r, loop, pert, observe) -> Execution:
+    """A planned pick-regrasp-place (:class:`~regrasp.execution.pick_place.PickPlace`) executed by
+    the arm in its own workcell; its task is the place: ``goal_error`` = ``plan_end_error`` =
+    ``[position (m), angle (rad)]`` of the object's final world pose from the place pose, success
+    within :data:`~regrasp.execution.pick_place.PLACE_TOLERANCE`."""
+    from .pick_place import execute_pick_place
+
+    if world.rig != "arm":
+        raise ArgumentError("invalid `world.rig`: a pick-regrasp-place runs with the arm", "world.rig")
+    if loop != "open":
+        raise ArgumentError("invalid `loop`: a pick-regrasp-place runs open loop", "loop")
+    if world.options or world.robot is not None:
+        raise ArgumentError("invalid `world.options`: a pick-regrasp-place takes its settings from its planning "
+                            "(pick_place)", "world.options")
+    if world.workcell is not None and world.workcell is not r.motion.workcell:
+        raise ArgumentError("invalid `world.workcell`: a pick-regrasp-place runs in the workcell it was planned "
+                            "in (leave it out)", "world.workcell")
+    if r.scene != scene.name:
+        raise ArgumentError(f"invalid `plan`: a pick-regrasp-place of {r.scene!r}, not of {scene.name!r}", "plan")
+    if pert.pose is not None or any(pert.shift) or pert.turn:
+        raise ArgumentError("invalid `perturbation`: a pick-regrasp-place starts from its pick pose (no shift, "
+                            "turn or pose)", "perturbation.shift")
+    x = execute_pick_place(scene, r, pert, observe=observe)
+    err = np.asarray(x.place_error, float)
+    return Execution(bool(x.success), err, err.copy(), bool(x.success), np.asarray(x.final_pose, float), world, loop,
+                     pert, x.duration, tracking=x.tracking, motion=r.motion, trajectory=r.arm, detail=x)
 
 
 _RUNNERS = {"planner": _planner, "free-gripper": _free_gripper, "arm": _arm}

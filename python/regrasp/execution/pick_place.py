@@ -40,7 +40,7 @@ import numpy as np
 from .. import pose as P
 from ..errors import ArgumentError, ExecutionError, RegraspError
 from ..extras import need
-from ..workcell.default import default_workcell
+from .layout import default_workcell
 from ..workcell.description import Workcell
 from .assignment import MAX_TILT
 from .arm_loop import with_pushers
@@ -380,7 +380,7 @@ def check_place(place, field_: str = "place") -> np.ndarray:
 def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, depth: float = 0.0, seed: int = 0,
                timing: Timing = Timing()) -> PickPlace:
     """Plans a pick-regrasp-place of ``scene``'s object in ``workcell`` (default: the scene's
-    :func:`~regrasp.workcell.default_workcell`): from ``pick`` (the object's world pose on the
+    :func:`~regrasp.execution.default_workcell`): from ``pick`` (the object's world pose on the
     table, m, unit quaternion; default :func:`default_poses`) to ``place`` (likewise); ``depth`` [m]: how much higher than
     :data:`FINGER_CLEARANCE` the fingers must stay above the table at the place (a pocket, a
     crowded shelf); ``seed`` of the planner. Returns the :class:`PickPlace` of the cheapest usable pair (see the module's

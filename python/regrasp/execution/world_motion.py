@@ -46,7 +46,7 @@ import numpy as np
 
 from .. import pose as P
 from ..errors import ArgumentError, ExecutionError
-from ..workcell.default import default_workcell
+from .layout import default_workcell
 from ..workcell.description import CLEARANCE, Workcell
 from ..workcell.shapes import EDGE_RADIUS
 from .assignment import MAX_TILT, Assignment, candidates
@@ -469,7 +469,7 @@ def _retreat(S: _Samples, L: _Layout, a: Assignment, Oh=None):
 def world_motion(scene, plan, workcell: Workcell | None = None, timing: Timing = Timing(), start=None,
                  max_tilt: float = MAX_TILT, envelope: float = GRIPPER_ENVELOPE, exclude=()) -> WorldMotion:
     """The gripper's world motion executing ``plan`` (a :class:`~regrasp.Plan` of ``scene``) in
-    ``workcell`` (default: :func:`~regrasp.workcell.default_workcell` of the scene), timed by
+    ``workcell`` (default: :func:`~regrasp.execution.default_workcell` of the scene), timed by
     ``timing``; ``start``: the gripper's world pose (m, unit quaternion) to begin from (default:
     above the first push's pre-contact pose, at the safe height); ``max_tilt`` [rad]: the most a
     push may turn the plan's gravity from the world's (default

@@ -26,9 +26,9 @@ from ..errors import ArgumentError
 from ..scene.perturbation import PlanarEnginePerturbation, Perturbation as _Perturbation
 from ..scene.planar import Scene
 from ..fields import check_number
-from ..sim.quasistatic import Replay, body_twist, integrate_pose
+from ..sim.quasistatic import Replay
 from .push import MAX_DURATION
-from ..pose import planar_compose, planar_inverse, planar_quat, planar_rotate
+from ..pose import body_twist, integrate_pose, planar_compose, planar_inverse, planar_quat, planar_rotate
 from .model import (Contact, Driver, Rig, add_driven_body, add_feature, add_grip_motors, add_object, add_planar_pads,
                     plan_dict, planar_pose, planar_spec, put_object)
 

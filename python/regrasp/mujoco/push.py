@@ -16,8 +16,7 @@ from ..fields import check_name, check_number, check_vector
 
 #: the longest push :func:`simulate_push` simulates [s] (MuJoCo steps of 0.5 ms: a bound on its time)
 MAX_DURATION = 60.0
-from ..sim.quasistatic import integrate_pose
-from ..pose import planar_compose, planar_inverse, planar_rotate
+from ..pose import integrate_pose, planar_compose, planar_inverse, planar_rotate
 from .model import (FEATURE_RADIUS, Contact, Driver, Rig, add_driven_body, add_feature_geom, add_grip_motors,
                     add_object, add_planar_pads, planar_pose, planar_spec, put_object)
 

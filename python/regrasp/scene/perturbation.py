@@ -129,7 +129,7 @@ class PlanarEnginePerturbation:
     fingers and, unless ``pusher_friction`` is given, features; gives a :class:`Perturbation`
     (with a DeprecationWarning)."""
 
-    def __new__(cls, friction: float = 1.0, grip: float = 1.0, mass: float = 1.0,
+    def __new__(cls, friction: float = 1.0, grip: float = 1.0, mass: float = 1.0,  # type: ignore[misc]
                 pusher_friction: float | None = None) -> Perturbation:
         _deprecated("regrasp.mujoco.planar.Perturbation")
         return Perturbation(friction, grip, mass, friction if pusher_friction is None else pusher_friction)
@@ -146,7 +146,7 @@ class ArmScales:
     friction unless ``feature_friction`` is given; gives a :class:`Perturbation` (with a
     DeprecationWarning)."""
 
-    def __new__(cls, finger_friction: float = 1.0, grip: float = 1.0, mass: float = 1.0,
+    def __new__(cls, finger_friction: float = 1.0, grip: float = 1.0, mass: float = 1.0,  # type: ignore[misc]
                 feature_friction: float = 1.0) -> Perturbation:
         _deprecated("regrasp.execution.arm.Scales")
         return Perturbation(finger_friction, grip, mass, feature_friction)
@@ -157,7 +157,8 @@ class HandPerturbation:
     ``turn`` [rad], ``pose`` (m, unit quaternion); gives a :class:`Perturbation` (with a
     DeprecationWarning)."""
 
-    def __new__(cls, friction: float = 1.0, grip: float = 1.0, mass: float = 1.0, shift: tuple = (0.0, 0.0, 0.0),
+    def __new__(cls, friction: float = 1.0, grip: float = 1.0, mass: float = 1.0,  # type: ignore[misc]
+                shift: tuple = (0.0, 0.0, 0.0),
                 turn: float = 0.0, pose: tuple | None = None) -> Perturbation:
         _deprecated("regrasp.dexterity.world.Perturbation")
         return Perturbation(friction, grip, mass, 1.0, shift, turn, pose)

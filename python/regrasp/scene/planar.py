@@ -417,7 +417,7 @@ class Scene:
         """Whether each push (rows of ``poses`` (n, 3) (m, m, rad) and body ``twists`` (n, 3)
         (m/s, m/s, rad/s)) of ``pusher``
         sticks in the quasi-static simulator: (sticks, object twists, residuals, errors) (see
-        :mod:`regrasp.sim.validation`)."""
+        :mod:`regrasp.mujoco.validation`)."""
         return self._core.push_outcomes(poses, pusher, twists, support, rings, points, merge_fingers)
     pad = core_property("pad", 'The finger pad: ``("circle", radius, radius)`` or ``("rectangle", width, '
                                'height)`` [m]; '

@@ -31,6 +31,16 @@ def limit_surface_default() -> str:
     return str(_core.limit_surface_default())
 
 
+#: Time step of simulated pushes and plan replays [s] (``regrasp push --dt``, ``regrasp simulate --dt``).
+DT = 0.05
+
+
+def push_dt(duration: float, dt: float | None = None) -> float:
+    """The time step [s] of a push of ``duration`` [s]: ``dt`` when given, else min(:data:`DT`,
+    ``duration``) (a short push is one step)."""
+    return min(DT, duration) if dt is None else dt
+
+
 def core_build() -> tuple[str, str]:
     """The core's version and the file name of its compiled extension."""
     return str(_core.__version__), Path(_core.__file__).name

@@ -145,7 +145,7 @@ class Scene3D:
         """The pusher moves with constant body ``twist`` (m/s, rad/s) for ``duration`` [s] > 0 in steps
         of ``dt`` [s] > 0 (quasi-static time stepping; default min(0.05 s, ``duration``), as the planar
         :func:`~regrasp.sim.quasistatic.simulate_push`)."""
-        from ..sim.quasistatic import push_dt
+        from .settings import push_dt
 
         duration = check_number(duration, "duration")
         dt = push_dt(duration, None if dt is None else check_number(dt, "dt"))

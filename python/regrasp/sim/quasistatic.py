@@ -15,14 +15,13 @@ import numpy as np
 from ..errors import ArgumentError
 from ..planning.plan import as_plan
 from ..scene.planar import Scene
-from ..scene.settings import quasistatic_defaults
+from ..scene.settings import DT, push_dt, quasistatic_defaults  # noqa: F401 (DT: its home until 0.2)
+from ..pose import body_twist, integrate_pose  # noqa: F401 (their home until 0.2)
 from ..fields import check_count, check_flag, check_name, check_number, check_vector
 
 #: The simulator's defaults, stated once in the Rust core (``quasistatic::Options``).
 DEFAULTS = quasistatic_defaults()
 SPEED = DEFAULTS["speed"]  # m/s, the thesis' pushing speed
-#: time step of simulated pushes and plan replays [s] (``regrasp push --dt``, ``regrasp simulate --dt``)
-DT = 0.05
 
 
 def support_kwargs(support: str | None = None, rings: int | None = None, points: int | None = None,
@@ -50,12 +49,6 @@ def problem(scene: Scene, pose, pusher: str | None = None, h: float | None = Non
                                            kw["points"], kw["merge_fingers"], h, SPEED)
 
 
-def push_dt(duration: float, dt: float | None = None) -> float:
-    """The time step [s] of a push of ``duration`` [s]: ``dt`` when given, else min(:data:`DT`,
-    ``duration``) (a short push is one step)."""
-    return min(DT, duration) if dt is None else dt
-
-
 def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: float | None = None, **support) -> dict:
     """Explicit time stepping of one push from ``pose`` (m, m, rad): the pusher moves with
     constant body ``twist`` (m/s, m/s, rad/s) for ``duration`` [s] in steps of ``dt`` [s]
@@ -68,21 +61,6 @@ def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, dt: f
 
 
 # --- plans -------------------------------------------------------------------------------------
-
-def body_twist(a, b) -> np.ndarray:
-    """Constant body twist taking pose ``a`` to pose ``b`` in unit time (planar log map)."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    c, s = np.cos(a[2]), np.sin(a[2])
-    d = np.array([c * (b[0] - a[0]) + s * (b[1] - a[1]), -s * (b[0] - a[0]) + c * (b[1] - a[1])])
-    w = b[2] - a[2]
-    if abs(w) < 1e-9:
-        return np.array([d[0], d[1], w])
-    # inverse of V(w) = [[sin w / w, −(1−cos w)/w], [(1−cos w)/w, sin w / w]]
-    A, B = np.sin(w) / w, (1 - np.cos(w)) / w
-    det = A * A + B * B
-    lin = np.array([A * d[0] + B * d[1], -B * d[0] + A * d[1]]) / det
-    return np.array([lin[0], lin[1], w])
-
 
 @dataclass
 class Replay:
@@ -140,17 +118,3 @@ def replay_plan(scene: Scene, plan, speed: float = SPEED, dt: float = DT, **supp
     err, ok = scene.goal_error(q, None if scene.task is not None else path[-1]["pose"])
     return Replay("quasistatic", q, err, ok, max_slip, np.array(ts),
                   np.array(qs), np.array(planned), steps)
-
-
-def integrate_pose(q, u, t: float) -> np.ndarray:
-    """Pose reached from ``q`` after moving for ``t`` s with constant body twist ``u``."""
-    q, u = np.asarray(q, float), np.asarray(u, float)
-    w = u[2] * t
-    lin = u[:2] * t
-    if abs(w) < 1e-9:
-        a, b = 1 - w * w / 6, w / 2
-    else:
-        a, b = np.sin(w) / w, (1 - np.cos(w)) / w
-    d = np.array([a * lin[0] - b * lin[1], b * lin[0] + a * lin[1]])
-    c, s = np.cos(q[2]), np.sin(q[2])
-    return np.array([q[0] + c * d[0] - s * d[1], q[1] + s * d[0] + c * d[1], q[2] + w])

@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 
 from .. import progress
+from ..pose import body_twist, integrate_pose
 from ..extras import need
+from ..errors import ArgumentError
 from ..files import atomic_write
-from ..planning.plan import as_plan
-from ..scene.planar import MotionCone
 
 
 def pyplot():
@@ -29,7 +29,17 @@ def _lambda(A, Js, wg, p):
     return (-b + np.sqrt(b * b - 4 * a * c)) / (2 * a)
 
 
-def boundary_samples(cone: MotionCone, n: int = 40):
+def checked_plan(plan, scene):
+    """``plan`` (a :class:`~regrasp.Plan`: the drawings take data, they read no file) checked
+    against ``scene``."""
+    if not callable(getattr(plan, "check_for", None)):
+        raise ArgumentError(f"invalid `plan`: a regrasp.Plan (Plan.load reads a file, Plan.from_json a dict; got "
+                            f"{type(plan).__name__})", "plan")
+    plan.check_for(scene, "plan")
+    return plan
+
+
+def boundary_samples(cone, n: int = 40):
     """Points on the boundary of the exact cone: for each boundary fan of the pusher's friction
     cone, pusher wrench directions p(t), the balancing wrench w_g + lambda p (object frame) and
     the twist ray. Returns a list of (wrenches (n, 3), twists (n, 3)) per fan."""
@@ -51,7 +61,7 @@ def boundary_samples(cone: MotionCone, n: int = 40):
     return out
 
 
-def plot_motion_cone(cone: MotionCone, path, title: str | None = None) -> Path:
+def plot_motion_cone(cone, path, title: str | None = None) -> Path:
     """Two 3-D panels: (left) wrench space: the limit surface, the pusher's friction cone shifted
     by gravity and their intersection (the wrench set); (right) twist space: the exact, curved
     motion cone, its polyhedral approximation and the gravity-free cone; beside them a chart of
@@ -92,7 +102,7 @@ def _label3d(ax, labels, title: str) -> None:
     ax.legend(loc="upper left", fontsize=8)
 
 
-def _wrench_panel(ax, cone: MotionCone, samples) -> None:
+def _wrench_panel(ax, cone, samples) -> None:
     """Wrench space: the limit surface, the pusher's cone shifted by gravity, the wrench set."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
@@ -123,7 +133,7 @@ def _wrench_panel(ax, cone: MotionCone, samples) -> None:
     _label3d(ax, ("f_x [N]", "f_z [N]", "tau_com / L [N]"), "wrench space: limit surface, pusher cone + gravity")
 
 
-def _twist_panel(ax, cone: MotionCone, samples) -> None:
+def _twist_panel(ax, cone, samples) -> None:
     """Twist space (metric [COM velocity, L omega]): the exact cone, its polyhedral
     approximation and the gravity-free cone."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
@@ -149,7 +159,7 @@ def _twist_panel(ax, cone: MotionCone, samples) -> None:
     _label3d(ax, ("v_com,x [m/s]", "v_com,z [m/s]", "L omega [m/s]"), "twist space: motion cone (unit twists)")
 
 
-def _ray_chart(ax, cone: MotionCone, samples) -> None:
+def _ray_chart(ax, cone, samples) -> None:
     """A chart of ray directions: angles about the cone's axis (twist space)."""
     Tm = cone.scene.metric_twist
     G, GF = Tm(cone.generators), Tm(cone.gravity_free_generators)
@@ -323,7 +333,7 @@ def plot_plan(scene, plan, path) -> Path:
     plt = pyplot()
     from matplotlib.patches import Circle, Polygon
 
-    plan = as_plan(plan, scene)
+    plan = checked_plan(plan, scene)
     names = scene.pusher_names
     color = {n: PUSHER_COLORS[i % len(PUSHER_COLORS)] for i, n in enumerate(names)}
     poses = plan.poses
@@ -378,11 +388,9 @@ def animate_plan(scene, plan, path, frames_per_step: int = 6, fps: int = 15) -> 
     from matplotlib.animation import FuncAnimation, PillowWriter
     from matplotlib.patches import Circle, Polygon
 
-    from ..sim.quasistatic import body_twist, integrate_pose
-
     names = scene.pusher_names
     color = {n: PUSHER_COLORS[i % len(PUSHER_COLORS)] for i, n in enumerate(names)}
-    plan = as_plan(plan, scene)
+    plan = checked_plan(plan, scene)
     poses, pushers = plan.poses, plan.pushers
     frames = []
     for i in range(1, len(poses)):

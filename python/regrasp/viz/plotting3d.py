@@ -7,16 +7,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..planning.plan import as_plan
 from ..pose import quat_rotate, slerp, tangents
-from .plotting import _save, pyplot, save_animation
+from .plotting import _save, checked_plan, pyplot, save_animation
 
 
 def _plan3d(scene, plan):
     """The prelude of the 3-D figures: the object's mesh (vertices [m] in the object frame,
     triangles), the plan checked against ``scene`` and its poses (m, unit quaternion) as an array."""
     v, t = scene.surface()
-    plan = as_plan(plan, scene)
+    plan = checked_plan(plan, scene)
     return np.asarray(v, float), np.asarray(t, int), plan, np.asarray(plan.poses, float)
 
 

@@ -5,14 +5,18 @@ table top for planes and pushers from below), a ledge (a horizontal edge high ab
 that pushes downward, so a pusher that pushes the object along the scene's gravity needs no
 tilt), a rod (a short vertical bar pushing towards the robot: side pushers need no tilt on it,
 and it passes between the fingers) and a plate (a small face, just large enough for the scene's largest patch pusher, so an
-object pivoting on a patch does not swing into a larger face)."""
+object pivoting on a patch does not swing into a larger face).
+
+The layout is made for the assignment of features to pushers (:mod:`.assignment`), so it lives
+beside it; a :class:`~regrasp.workcell.Workcell` itself is a description (before 0.2:
+``regrasp.workcell.default``)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from ..errors import ArgumentError
-from .description import Feature, ObjectStart, Robot, Table, Workcell
+from ..workcell.description import Feature, ObjectStart, Robot, Table, Workcell
 
 #: The default layout, stated once: table top height [m], table size [m] and centre [m] (world
 #: x-y), the robot (a UR5e at the world origin on the table top), the block's centre [m] (world
@@ -126,8 +130,8 @@ def default_workcell(scene) -> Workcell:
 def _start_pose(scene) -> np.ndarray:
     """The object's pose in the grasp at the task's start (identity without a task)."""
     t = scene.task
-    if t is not None:  # a planar Task, a 3-D (start, goal, tolerance)
-        return np.asarray(t.start if hasattr(t, "start") else t[0], float)
+    if t is not None:  # the one Task type of both scenes
+        return np.asarray(t.start, float)
     return np.zeros(3) if scene.dimension == 2 else np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
 
 
@@ -136,7 +140,7 @@ def _inclines(scene, cell: Workcell, friction: float) -> tuple:
     contact of ``cell`` serves within ``MAX_TILT`` at the task's start."""
     from .. import pose as P
     from ..errors import ExecutionError
-    from ..execution.assignment import candidates, gravity_in_gripper, pusher_contact
+    from .assignment import candidates, gravity_in_gripper, pusher_contact
 
     start, g = _start_pose(scene), gravity_in_gripper(scene)
     R = P.quat_matrix(P.turn_onto(g, [0.0, 0.0, -1.0]))  # the gripper frame with the scene's gravity down

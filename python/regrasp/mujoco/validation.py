@@ -32,7 +32,7 @@ import numpy as np
 from .. import progress as bars
 from ..errors import ArgumentError, RegraspError, check_seed
 from ..extras import need
-from .quasistatic import SPEED, support_kwargs
+from ..sim.quasistatic import SPEED, support_kwargs
 from ..scene.planar import Scene
 from ..scene.settings import validation_rings
 from ..fields import check_count
@@ -155,7 +155,7 @@ def samples(scene: Scene, pushes: int, seed: int, progress: bool = False) -> lis
 
 def _mujoco_chunk(scene: Scene, chunk: list) -> list:
     """MuJoCo outcomes of a chunk of (index, pusher, pose, twist); None where the run failed."""
-    from ..mujoco.push import PushRig
+    from .push import PushRig
 
     rigs, out = {}, []
     for i, pusher, pose, u in chunk:
