@@ -116,15 +116,18 @@ def test_the_arm_open_and_closed_loop(planar):
     pytest.importorskip("mink")
     from regrasp.execution.arm import arm_motion, execute_arm
     from regrasp.execution.arm_loop import ArmLoopResult
+    from regrasp.execution.execute import arm_motion_of
 
     scene, plan = planar
     pert = Perturbation(0.95, 1.05, 1.0, 1.0)
-    run = execute(World(scene, rig="arm"), plan, perturbation=pert)
-    am = arm_motion(scene, plan, scales=pert)
+    world = World(scene, rig="arm")
+    run = execute(world, plan, perturbation=pert)
+    am = arm_motion(scene, plan)  # the robot is sent the nominal world's trajectory: the perturbation is unknown to it
     ref = execute_arm(scene, plan, am.motion, scales=pert, trajectory=am.trajectory)
     assert np.allclose(run.detail.in_hand, ref.in_hand, atol=1e-9) and run.tracking is not None
     assert run.trajectory.robot == ref.trajectory.robot and run.max_creep == ref.max_creep
     assert run.success == scene.goal_error(run.final_pose)[1]
+    assert arm_motion_of(world, plan) is arm_motion_of(world, plan) and len(world._motions) == 1  # solved once
     c = execute(World(scene, rig="arm"), plan, loop="closed", perturbation=Perturbation(shift=(0.0005, 0.0, 0.0)))
     assert isinstance(c.detail, ArmLoopResult) and np.allclose(c.final_pose, c.detail.final)
     assert c.success == scene.goal_error(c.final_pose)[1] and c.loop == "closed"

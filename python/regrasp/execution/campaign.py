@@ -2,7 +2,8 @@
 once (its default planner settings, seed 0), turned into a world motion in its default workcell
 and into the arm's joint trajectory (IK once), then executed ``runs`` times in MuJoCo with the
 finger friction, the features' friction, the grip force and the object's mass each drawn
-uniformly within ±``spread`` of nominal (:class:`~regrasp.execution.arm.Scales`). With
+uniformly within ±``spread`` of nominal (:class:`~regrasp.Perturbation`), each run through
+:func:`~regrasp.execution.execute` and judged against the task. With
 ``closed_loop``, each run has the arm in the loop instead (the MPC for planar scenes,
 re-planning in 3-D; :mod:`~regrasp.execution.arm_loop`). The README's table is printed by
 ``scripts/arm-statistics.py``."""
@@ -19,8 +20,9 @@ from ..scene.perturbation import Perturbation
 
 @dataclass
 class Outcome:
-    """One example's runs: ``name``; ``runs`` executed; ``successes``; per run the goal error
-    (``errors``, planar ``[x, z, theta]`` or 3-D ``[position, angle]``), ``max_creep`` [m];
+    """One example's runs: ``name``; ``runs`` executed; ``successes`` (within the task's
+    tolerance of its goal, :func:`~regrasp.execution.execute`); per run the goal error against
+    the task (``errors``, planar ``[x, z, theta]`` or 3-D ``[position, angle]``), ``max_creep`` [m];
     ``refused``: why the example could not be executed (no plan, no feature, the arm), else
     None; ``seconds`` of wall time; ``failures``: why runs stopped early (the arm refused to go
     on in a perturbed world; each counts as a failed run)."""
@@ -57,8 +59,7 @@ def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: boo
 
     import regrasp
 
-    from .arm import arm_motion, execute_arm
-    from .arm_loop import control_arm
+    from .execute import World, arm_motion_of, execute
 
     t0 = time.perf_counter()
     out = Outcome(name)
@@ -68,26 +69,24 @@ def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: boo
         return out
     try:
         plan = regrasp.plan(scene, seed=0)
-        am = None if closed_loop else arm_motion(scene, plan)
+        world = World(scene, rig="arm")
+        if not closed_loop:
+            arm_motion_of(world, plan)  # solved once, here: an arm that cannot do the plan refuses the example
     except RegraspError as e:
         out.refused = f"{type(e).__name__}: {e}"
         out.seconds = time.perf_counter() - t0
         return out
     for scales in draws(runs, spread, seed):
         try:
-            if closed_loop:
-                r = control_arm(scene, plan, scales=scales)
-                creep = float("nan")
-            else:
-                r = execute_arm(scene, plan, am.motion, scales=scales, trajectory=am.trajectory)
-                creep = r.max_creep
+            r = execute(world, plan, loop="closed" if closed_loop else "open", perturbation=scales)
         except RegraspError as e:  # the arm could not go on in this world: a failed run
             out.failures.append(f"{type(e).__name__}: {e}")
             out.runs += 1
             continue
         out.runs += 1
         out.successes += int(r.success)
-        out.errors.append([float(x) for x in r.goal_error])
-        out.max_creep.append(creep)
+        e = r.goal_error  # against the task; 3-D as [position, angle]
+        out.errors.append([float(x) for x in (e if scene.dimension == 2 else (np.linalg.norm(e[:3]), e[3]))])
+        out.max_creep.append(float("nan") if r.max_creep is None else r.max_creep)
     out.seconds = time.perf_counter() - t0
     return out

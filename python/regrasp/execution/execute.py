@@ -51,6 +51,8 @@ class World:
     workcell: Workcell | None = None
     robot: str | None = None
     options: dict = field(default_factory=dict)
+    #: the arm's world motion and joint trajectory of each plan run here (:func:`arm_motion_of`)
+    _motions: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         if getattr(self.scene, "dimension", None) not in (2, 3):
@@ -250,10 +252,9 @@ def _arm(world, scene, plan, loop, pert, observe) -> dict:
             "workcell": world.workcell, "scales": pert, "robot": world.robot,
             "start_error": np.zeros(3) if se is None else se}))
         return {"final": r.final, "detail": r, "duration": r.duration, "replans": r.replans}
-    from .arm import arm_motion, execute_arm
+    from .arm import execute_arm
 
-    am = arm_motion(scene, plan, **_options(world, arm_motion, {"workcell": world.workcell, "robot": world.robot,
-                                                                "scales": pert}))
+    am = arm_motion_of(world, plan)
     start = None if se is None else np.asarray(plan.poses[0], float) + se
     r = execute_arm(scene, plan, am.motion, world.robot, pert, observe=observe, trajectory=am.trajectory, start=start)
     return {"final": r.in_hand[-1], "poses": r.in_hand, "detail": r, "duration": r.duration,
@@ -263,8 +264,9 @@ def _arm(world, scene, plan, loop, pert, observe) -> dict:
 
 def check_hand_world(world: World, loop: str, pert: Perturbation, what: str) -> None:
     """What a run of regrasp actions (the arm holding the object by its hand, thesis §1.1.1)
-    needs: the arm rig, open loop, its own world (the table and the post: no workcell, no
-    options) and no moved start; an ArgumentError naming the field otherwise."""
+    needs: the arm rig, open loop and its own world (the table and the post: no workcell, no
+    options; the perturbation's shift, turn or pose move the object in the hand at the start);
+    an ArgumentError naming the field otherwise."""
     if world.rig != "arm":
         raise ArgumentError(f"invalid `world.rig`: {what} runs with the arm", "world.rig")
     if loop != "open":
@@ -272,9 +274,6 @@ def check_hand_world(world: World, loop: str, pert: Perturbation, what: str) -> 
     if world.workcell is not None or world.options:
         raise ArgumentError(f"invalid `world.workcell`: {what} runs in its object's own world (the table and the "
                             "post; no workcell or options)", "world.workcell")
-    if pert.pose is not None or any(pert.shift) or pert.turn:
-        raise ArgumentError(f"invalid `perturbation`: {what} starts at its first grasp (no shift, turn or pose)",
-                            "perturbation.shift")
 
 
 def _pick_place(world, scene, r, loop, pert, observe) -> Execution:
@@ -303,6 +302,22 @@ def _pick_place(world, scene, r, loop, pert, observe) -> Execution:
     err = np.asarray(x.place_error, float)
     return Execution(bool(x.success), err, err.copy(), bool(x.success), np.asarray(x.final_pose, float), world, loop,
                      pert, x.duration, tracking=x.tracking, motion=r.motion, trajectory=r.arm, detail=x)
+
+
+def arm_motion_of(world: World, plan):
+    """The arm's :class:`~regrasp.execution.arm.ArmMotion` of ``plan`` in ``world`` (its world
+    motion in the workcell and joint trajectory, IK solved in the nominal world: the robot is
+    sent one trajectory, a perturbation is the world's, unknown to it), solved once per world and
+    plan; an ExecutionError when the arm cannot do the plan."""
+    from .arm import arm_motion
+
+    plan = as_plan(plan, world.scene)
+    hit = world._motions.get(id(plan))
+    if hit is None or hit[0] is not plan:  # the plan is kept with it: its id stays its own
+        am = arm_motion(world.scene, plan, **_options(world, arm_motion, {
+            "workcell": world.workcell, "robot": world.robot, "scales": Perturbation()}))
+        world._motions[id(plan)] = hit = (plan, am)
+    return hit[1]
 
 
 _RUNNERS = {"planner": _planner, "free-gripper": _free_gripper, "arm": _arm}
