@@ -125,3 +125,16 @@ def pose_matrix(pose):
     m = np.eye(4)
     m[:3, :3], m[:3, 3] = rotation_matrix(pose[3:]), pose[:3]
     return m
+
+
+_PLANS: dict = {}
+
+
+def plan_of(name: str) -> tuple:
+    """(scene, plan) of bundled example ``name``, planned once per test process (seed 0)."""
+    import regrasp
+
+    if name not in _PLANS:
+        scene = regrasp.load_scene(regrasp.examples.path(name))
+        _PLANS[name] = (scene, regrasp.plan(scene, seed=0))
+    return _PLANS[name]

@@ -18,18 +18,9 @@ from regrasp.workcell import Workcell, shapes
 from regrasp.workcell.description import Feature
 from regrasp.workcell.shapes import EDGE_RADIUS, PLATE_DEPTH, TABLE_DEPTH
 
-from .conftest import rotation_matrix as rot
+from .conftest import plan_of, rotation_matrix as rot
 
 mujoco = pytest.importorskip("mujoco")
-
-PLANS: dict = {}
-
-
-def plan_of(name):
-    if name not in PLANS:
-        scene = regrasp.load_scene(regrasp.examples.path(name))
-        PLANS[name] = (scene, regrasp.plan(scene, seed=0))
-    return PLANS[name]
 
 
 def task_examples():
@@ -250,7 +241,7 @@ def test_an_object_moved_beyond_a_bodys_plane_never_collides_with_it(name, which
     if np.linalg.norm(u) < 0.1 or np.linalg.norm(axis) < 0.1:
         return
     u, axis = u / np.linalg.norm(u), axis / np.linalg.norm(axis)
-    scene, _ = plan_of(name) if name in PLANS else (regrasp.load_scene(regrasp.examples.path(name)), None)
+    scene = regrasp.load_scene(regrasp.examples.path(name))
     cell = default_workcell(scene)
     cell = Workcell(cell.name, cell.table, cell.features + (
         Feature("post", "corner", [0.7, -0.25, 0.85, 1, 0, 0, 0], 0.5, index=3),), cell.robot)

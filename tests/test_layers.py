@@ -96,15 +96,20 @@ def test_no_import_circle():
     assert circles(graph()) == []
 
 
+def package(root: Path, files: dict) -> Path:
+    """A package ``regrasp`` under ``root`` of ``files`` (path → text), with its ``__init__``s."""
+    pkg = root / "regrasp"
+    for rel, text in {"__init__.py": "", **files}.items():
+        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / rel).parent.joinpath("__init__.py").touch()
+        (pkg / rel).write_text(text)
+    return pkg
+
+
 def test_the_circle_check_finds_a_circle(tmp_path):
     """Not vacuous: a circle through an import written inside a function is found."""
-    pkg = tmp_path / "regrasp"
-    (pkg / "a").mkdir(parents=True)
-    (pkg / "__init__.py").write_text("")
-    (pkg / "a" / "__init__.py").write_text("")
-    (pkg / "a" / "x.py").write_text("from .y import f\n")
-    (pkg / "a" / "y.py").write_text("def f():\n    from ..b import g\n")
-    (pkg / "b.py").write_text("def g():\n    from .a.x import f\n")
+    pkg = package(tmp_path, {"a/x.py": "from .y import f\n", "a/y.py": "def f():\n    from ..b import g\n",
+                             "b.py": "def g():\n    from .a.x import f\n"})
     assert circles(graph(pkg)) == [["regrasp.a.x", "regrasp.a.y", "regrasp.b"]]
 
 
@@ -181,12 +186,9 @@ def test_the_scene_is_the_one_door_to_the_core():
 
 
 def test_the_door_check_finds_a_reach(tmp_path):
-    pkg = tmp_path / "regrasp"
-    (pkg / "execution").mkdir(parents=True)
-    (pkg / "__init__.py").write_text("")
-    (pkg / "execution" / "arm.py").write_text("def f(scene):\n    return scene._core.grip_force\n")
-    (pkg / "execution" / "loop.py").write_text("from .. import _core\n\ndef g():\n    from .._core import Mpc\n")
-    (pkg / "pose.py").write_text("from . import _core\n")  # a base module may
+    pkg = package(tmp_path, {"execution/arm.py": "def f(scene):\n    return scene._core.grip_force\n",
+                             "execution/loop.py": "from .. import _core\n\ndef g():\n    from .._core import Mpc\n",
+                             "pose.py": "from . import _core\n"})  # a base module may
     assert sorted(core_reach(pkg)) == [("regrasp.execution.arm", 2), ("regrasp.execution.loop", 1),
                                        ("regrasp.execution.loop", 4)]
 

@@ -20,17 +20,9 @@ from regrasp.execution import default_workcell
 from regrasp.workcell import Table, Workcell
 from regrasp.workcell.description import Feature, Robot
 
-from .conftest import rotation_matrix as rot, pose_matrix as T
+from .conftest import plan_of, rotation_matrix as rot, pose_matrix as T
 
 EXAMPLE_WORKCELL = regrasp.examples.ROOT / "workcells" / "workcell-ur5e.toml"
-PLANS: dict = {}
-
-
-def plan_of(name):
-    if name not in PLANS:
-        scene = regrasp.load_scene(regrasp.examples.path(name))
-        PLANS[name] = (scene, regrasp.plan(scene, seed=0))
-    return PLANS[name]
 
 
 def T_planar(q):
