@@ -14,7 +14,8 @@ import numpy as np
 import regrasp
 from regrasp import Perturbation
 from regrasp.mujoco.planar import execute_plan
-from regrasp.mujoco.model import SOFT, creep
+from regrasp.mujoco.model import SOFT
+from regrasp.mujoco.world import creep
 from regrasp.viz.plotting import plot_replay
 from regrasp.sim.quasistatic import replay_plan
 

@@ -12,7 +12,8 @@ import pytest
 import regrasp
 from regrasp import Perturbation
 from regrasp.mujoco.planar import execute_plan
-from regrasp.mujoco.model import SOFT, convex_pieces, creep
+from regrasp.mujoco.model import SOFT, convex_pieces
+from regrasp.mujoco.world import creep
 from regrasp.mujoco.push import PushRig
 from regrasp.mujoco.validation import validate
 

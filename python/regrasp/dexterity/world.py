@@ -151,23 +151,17 @@ class HandWorld:
 
     def __init__(self, scene, grasp, hand, perturbation: _Perturbation = _Perturbation(), robot: str | None = None,
                  q=None):
-        from ..execution.arm import GRIP_PERIOD, grasp_of
-        from ..mujoco.spatial import add_object3d
+        from ..execution.arm import GRIP_PERIOD, OBJECT_RGBA, grasp_of
+        from ..mujoco.world import Layout, build as build_world
         from ..robot.model import DEFAULT_ROBOT, build
         from ..robot.pads import Pads
 
         self.scene, self.grasp, self.grip_period = scene, np.asarray(grasp, float), GRIP_PERIOD
         width, _ = grasp_of(scene, self.grasp)  # a turn about the grasp axis or a shift across it keeps it
-        v, t = scene.mesh()
-        mesh = (np.asarray(v, float), np.asarray(t, int))
+        world = Layout(scene, np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]), "robot", object_rgba=OBJECT_RGBA)
 
-        def add(spec):
-            from ..execution.arm import OBJECT_RGBA
-
-            add_object3d(spec, scene, np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]), mesh, 1.0)
-            for g in spec.body("object").geoms:
-                g.rgba = OBJECT_RGBA
-            add_post(spec)
+        def add(spec):  # the object (put in the hand by reset) and the post, around the robot
+            build_world(world, spec=spec, extra=add_post)
 
         try:
             self.robot = build(robot or DEFAULT_ROBOT, pads=Pads.of_scene(scene),
@@ -376,20 +370,19 @@ def hand_clearances(scene, grasps, robot: str | None = None) -> dict:
     object would go into the 2F-85's links above the pads (a wide object held deep) cannot be
     taken: the grasp graph leaves it out. One robot model per grasp width."""
     from ..execution.arm import clearance, grasp_of
-    from ..mujoco.spatial import add_object3d
+    from ..mujoco.world import Layout, build as build_world
     from ..robot.grip import close_fingers
     from ..robot.model import DEFAULT_ROBOT, build
     from ..robot.pads import Pads
 
-    v, t = scene.mesh()
-    mesh = (np.asarray(v, float), np.asarray(t, int))
+    world = Layout(scene, np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]), "robot")
     models: dict = {}
     out = {}
     for g in grasps:
         width = round(grasp_of(scene, g.pose)[0], 9)
         if width not in models:
             r = build(robot or DEFAULT_ROBOT, pads=Pads.of_scene(scene), pad_friction=float(scene.pad_friction),
-                      grasp_width=width, add=lambda spec: add_object3d(spec, scene, np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]), mesh, 1.0))
+                      grasp_width=width, add=lambda spec: build_world(world, spec=spec))
             close_fingers(r)
             models[width] = r
         r = models[width]

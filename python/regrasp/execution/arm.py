@@ -5,7 +5,7 @@ holding the object against the workcell's fixed features.
 
 The model: the robot (its base at the workcell's ``robot.base``, no table of its own), the
 table and every feature as fixed geoms colliding with the object and the robot
-(:func:`~regrasp.execution.free_gripper.add_workcell_geoms`), and the object on a free joint
+(:func:`~regrasp.mujoco.world.add_workcell_geoms`), and the object on a free joint
 (:func:`regrasp.mujoco.model.add_object`: the planar scene's lamina, 12 mm thick; a 3-D scene's
 mesh). The pads are the 2F-85's, a grid of point contacts of the scene's pad shape
 (:meth:`~regrasp.robot.pads.Pads.of_scene`) with the scene's finger friction; the limit surface
@@ -122,28 +122,19 @@ def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Pe
     friction (``pads``: another :class:`~regrasp.robot.pads.Pads`, e.g. the old single-contact
     model :func:`~regrasp.robot.pads.single_contact`); returns (robot, the object's body id, its
     geom ids, the TCP in the gripper frame)."""
-    from ..mujoco.model import add_object
+    from ..mujoco.world import Layout, build as build_world
     from ..robot.grip import close_fingers
     from ..robot.model import build, robot_name
     from ..robot.pads import Pads
-    from .free_gripper import add_workcell_geoms
 
     wc = motion.workcell
     name = robot_name(robot if robot is not None else wc.robot.name)
     width, centre = grasp_of(scene, motion.in_hand[0])
-    scaled = _scaled_workcell(wc, scales.feature_friction)
+    start = np.zeros(3) if scene.dimension == 2 else motion.object[0]
+    world = Layout(scene, start, "robot", workcell=wc, perturbation=scales, object_rgba=OBJECT_RGBA)
 
-    def add(spec):
-        add_workcell_geoms(spec, scaled)
-        if scene.dimension == 2:
-            add_object(spec, scene, [0.0, 0.0, 0.0], mass_scale=scales.mass)
-        else:
-            from ..mujoco.spatial import add_object3d
-
-            v, t = scene.mesh()
-            add_object3d(spec, scene, motion.object[0], (np.asarray(v, float), np.asarray(t, int)), scales.mass)
-        for g in spec.body("object").geoms:
-            g.rgba = OBJECT_RGBA
+    def add(spec):  # the world around the robot: the workcell's features at their (perturbed) friction, the object
+        build_world(world, spec=spec)
 
     try:
         r = build(name, base_pose=wc.robot.base, table=None, pads=Pads.of_scene(scene) if pads is None else pads,
@@ -158,16 +149,6 @@ def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Pe
     body = m.body("object").id
     geoms = [g for g in range(m.ngeom) if m.geom_bodyid[g] == body]
     return r, body, geoms, np.array([0.0, centre, 0.0, 1.0, 0.0, 0.0, 0.0])
-
-
-def _scaled_workcell(wc, k: float):
-    """``wc`` with every feature's and the table's friction times ``k``."""
-    if k == 1.0:
-        return wc
-    from dataclasses import replace
-
-    return replace(wc, table=replace(wc.table, friction=wc.table.friction * k),
-                   features=tuple(replace(f, friction=f.friction * k) for f in wc.features))
 
 
 def where(motion: WorldMotion, i: int) -> str:

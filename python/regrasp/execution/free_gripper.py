@@ -55,52 +55,29 @@ class FreeGripperResult:
     object: np.ndarray
 
 
-def add_workcell_geoms(spec, workcell: Workcell):
-    """The table and every feature of ``workcell`` as fixed geoms of ``spec``'s world body, their
-    physical bodies (:func:`regrasp.workcell.shapes.shapes`), colliding with the object (and a
-    robot's collision geoms)."""
-    from ..mujoco.model import FEATURE_BITS, add_geom
-    from ..workcell.shapes import shapes
-
-    for s in shapes(workcell):
-        add_geom(spec.worldbody, s.kind, s.size, bits=FEATURE_BITS, condim=3, friction=[s.friction], name=s.name,
-                 pos=s.pose[:3], quat=s.pose[3:])
-
-
 def build(scene, motion: WorldMotion, workcell: Workcell | None = None):
     """The model (a ``mujoco.MjSpec``; see the module's doc) of ``motion`` executed for ``scene``
-    in ``workcell`` (default: the motion's)."""
+    in ``workcell`` (default: the motion's): the world (:func:`~regrasp.mujoco.world.build`) with
+    the pads on a driven 6-DoF gripper and, for each push on an edge, a capsule along it."""
     from ..mujoco import model as M
+    from ..mujoco.world import Layout, build as build_world
 
     workcell = motion.workcell if workcell is None else workcell
-    if scene.dimension == 2:
-        g = scene.gravity[1]
-    else:
-        g = float(np.linalg.norm(scene.gravity))
-    spec = M.new_spec(f"{scene.name}-free-gripper", [0.0, 0.0, -g], M.Contact())
-    add_workcell_geoms(spec, workcell)
     names = {f.name for f in workcell.features}
     lengths = {c.name: c.length for c in workcell.contacts()}
-    for a in motion.assignments:
-        if ".edges[" in a.feature and a.feature.split(".")[0] in names and a.feature in lengths:
-            x = P.quat_rotate(a.frame[3:], [lengths[a.feature] / 2, 0.0, 0])
-            c = a.frame[:3] - P.quat_rotate(a.frame[3:], [0.0, 0, 1]) * FEATURE_RADIUS
-            mu = workcell.feature(a.feature.split(".")[0]).friction
-            M.add_geom(spec.worldbody, "capsule", [FEATURE_RADIUS], M.FEATURE_BITS, [mu], name=f"{a.feature}-push{a.index}",
-                       fromto=np.r_[c - x, c + x], condim=3)
-    gripper = M.add_driven_body(spec.worldbody, "gripper", spatial=True)
-    if scene.dimension == 2:
-        M.add_object(spec, scene, [0.0, 0.0, 0.0])
-        M.add_planar_pads(gripper, scene)
-    else:
-        from ..mujoco.spatial import add_object3d, add_pads3d
 
-        v, t = scene.mesh()
-        v, t = np.asarray(v, float), np.asarray(t, int)
-        add_object3d(spec, scene, motion.in_hand[0], (v, t), 1.0)
-        add_pads3d(gripper, scene, motion.in_hand[0], v, 1.0, "point")
-    M.add_grip_motors(spec)
-    return spec
+    def edges(spec):
+        for a in motion.assignments:
+            if ".edges[" in a.feature and a.feature.split(".")[0] in names and a.feature in lengths:
+                x = P.quat_rotate(a.frame[3:], [lengths[a.feature] / 2, 0.0, 0])
+                c = a.frame[:3] - P.quat_rotate(a.frame[3:], [0.0, 0, 1]) * FEATURE_RADIUS
+                mu = workcell.feature(a.feature.split(".")[0]).friction
+                M.add_geom(spec.worldbody, "capsule", [FEATURE_RADIUS], M.FEATURE_BITS, [mu],
+                           name=f"{a.feature}-push{a.index}", fromto=np.r_[c - x, c + x], condim=3)
+
+    start = np.zeros(3) if scene.dimension == 2 else motion.in_hand[0]
+    return build_world(Layout(scene, start, "gripper", spatial=True, workcell=workcell,
+                              name=f"{scene.name}-free-gripper"), M.Contact(), extra=edges)
 
 
 def _tolerance_error(scene, plan, q) -> tuple[np.ndarray, bool]:

@@ -1,7 +1,7 @@
-"""MuJoCo models of a grasp, built with ``mujoco.MjSpec``: the pieces that the planar execution
-(``planar``), the pushes in the planner's view (``push``) and the 3-D execution (``spatial``)
-share — the options and contact settings, the two force-driven pads, driven bodies and their
-:class:`Driver`, and :class:`Rig` (a compiled model with its data) — and the planar scene's own
+"""MuJoCo models of a grasp, built with ``mujoco.MjSpec``: the pieces that the one world
+builder (:mod:`.world`) assembles for every rig and that the runs share — the options and
+contact settings, the two force-driven pads, driven bodies and their :class:`Driver`, and
+:class:`Rig` (a compiled model with its data) — and the planar scene's own
 pieces: the object extruded from its outline (a non-convex outline as a union of convex pieces)
 and the pushers' features.
 
@@ -14,7 +14,7 @@ pyramidal cones admit less than the Coulomb disc), ``impratio`` 20 (stiffer fric
 normal constraints) and the no-slip post-processing solver (soft contact alone lets a pinched
 object creep under gravity, mujoco issue #3328); the pads' torsional friction coefficient is
 ``k μ_s`` (``k = 0.6 r``), so a pad contact's elliptic cone is the scene's ellipsoidal limit
-surface. ``creep()`` measures what happens without them.
+surface. :func:`regrasp.mujoco.world.creep` measures what happens without them.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import _moved
 from ..errors import ArgumentError
 from ..extras import need
 from ..polygon import cross, triangulate
@@ -397,17 +398,5 @@ class Rig:
         return any(c[i].geom1 in geoms or c[i].geom2 in geoms for i in range(self.data.ncon))
 
 
-def creep(scene: Scene, pose=None, duration: float = 2.0, contact: Contact = Contact()) -> float:
-    """How far [m] the object slides in the grasp while simply held for ``duration`` (no pusher):
-    rigid Coulomb friction holds it still; soft contact lets it creep."""
-    spec = planar_spec(scene, f"{scene.name}-held", contact)
-    add_object(spec, scene, scene.task.start if pose is None else pose)
-    add_planar_pads(spec.worldbody, scene)
-    add_grip_motors(spec)
-    rig = Rig(spec, contact, scene.grip_force)
-    for _ in range(int(0.1 / contact.timestep)):
-        rig.step()
-    start = planar_pose(rig.model, rig.data, "object")
-    for _ in range(int(duration / contact.timestep)):
-        rig.step()
-    return float(np.linalg.norm(planar_pose(rig.model, rig.data, "object")[:2] - start[:2]))
+#: ``regrasp.mujoco.model.creep`` (before 0.2): now :func:`regrasp.mujoco.world.creep`.
+__getattr__ = _moved.attribute_aliases(__name__, {"creep": "mujoco.world"})

@@ -29,11 +29,10 @@ from ..fields import check_number
 from ..sim.quasistatic import Replay
 from .push import MAX_DURATION
 from ..pose import body_twist, integrate_pose, planar_compose, planar_inverse, planar_quat, planar_rotate
-from .model import (Contact, Driver, Rig, add_driven_body, add_feature, add_grip_motors, add_object, add_planar_pads,
-                    plan_dict, planar_pose, planar_spec, put_object)
+from .model import Contact, Driver, Rig, plan_dict, planar_pose, put_object
+from .world import PARK, Layout, build as build_world
 
 GAP = 0.002  # m between the object and a feature when it is brought
-PARK = np.array([0.0, 5.0, 0.0])
 
 
 class Feature(NamedTuple):
@@ -58,13 +57,10 @@ def _segments(path: list) -> list:
 
 
 def _spec(scene: Scene, q0, pushers, perturb: _Perturbation, contact: Contact):
-    spec = planar_spec(scene, f"{scene.name}-execution", contact)
-    add_object(spec, scene, q0, mass_scale=perturb.mass)
-    add_planar_pads(add_driven_body(spec.worldbody, "gripper"), scene, friction_scale=perturb.finger_friction)
-    for p in pushers:
-        add_feature(spec, scene, p, f"feature_{p}", perturb.feature_friction, PARK)
-    add_grip_motors(spec)
-    return spec
+    """The world (:func:`~.world.build`): the object at ``q0`` held by pads on a planar driven
+    gripper, the ``pushers``' features parked."""
+    return build_world(Layout(scene, q0, "gripper", pushers=tuple(pushers), perturbation=perturb,
+                              name=f"{scene.name}-execution"), contact)
 
 
 def build(scene: Scene, plan, perturb: _Perturbation = _Perturbation(), contact: Contact = Contact()):

@@ -17,8 +17,8 @@ from ..fields import check_name, check_number, check_vector
 #: the longest push :func:`simulate_push` simulates [s] (MuJoCo steps of 0.5 ms: a bound on its time)
 MAX_DURATION = 60.0
 from ..pose import integrate_pose, planar_compose, planar_inverse, planar_rotate
-from .model import (FEATURE_RADIUS, Contact, Driver, Rig, add_driven_body, add_feature_geom, add_grip_motors,
-                    add_object, add_planar_pads, planar_pose, planar_spec, put_object)
+from .model import FEATURE_RADIUS, Contact, Driver, Rig, planar_pose, put_object
+from .world import Layout, build as build_world
 
 Settings = Contact  # kept for callers of the first version
 
@@ -26,12 +26,8 @@ Settings = Contact  # kept for callers of the first version
 def _spec(scene: Scene, pusher: str, contact: Contact):
     """The object at the origin held by pads fixed in the world, the pusher's feature on a driven
     body whose frame is the pusher frame."""
-    spec = planar_spec(scene, f"{scene.name}-push-{pusher}", contact)
-    add_object(spec, scene, np.zeros(3))
-    add_planar_pads(spec.worldbody, scene)
-    add_feature_geom(add_driven_body(spec.worldbody, "pusher"), scene, pusher)
-    add_grip_motors(spec)
-    return spec
+    return build_world(Layout(scene, np.zeros(3), "fixed", pushers=(pusher,), features="driven",
+                              name=f"{scene.name}-push-{pusher}"), contact)
 
 
 class PushRig(Rig):
@@ -40,7 +36,7 @@ class PushRig(Rig):
     def __init__(self, scene: Scene, pusher: str, contact: Contact = Contact()):
         super().__init__(_spec(scene, pusher, contact), contact, scene.grip_force)
         self.scene, self.pusher = scene, pusher
-        self.driver = Driver(self.model, "pusher")
+        self.driver = Driver(self.model, f"feature_{pusher}")
 
     def reset(self, pose):
         """Resets the simulation with the object at ``pose`` ``[x, z, theta]`` (m, m, rad)."""
