@@ -17,7 +17,8 @@ import numpy as np
 def trial(s, wc, rng, k: int, spread: float) -> dict:
     from regrasp.errors import RegraspError
     from regrasp.execution import pick_place as pp
-    from regrasp.execution.arm import Scales
+    from regrasp import Perturbation
+    from regrasp.execution import World, execute
 
     xy = np.array(pp.DEFAULT_PICK) + rng.uniform(-0.05, 0.05, 2)
     pick = pp.table_pose(s, wc, xy, 0.0, rng.uniform(-0.3, 0.3))
@@ -27,14 +28,15 @@ def trial(s, wc, rng, k: int, spread: float) -> dict:
         r = pp.pick_place(s, wc, place=place, pick=pick, seed=k)
     except RegraspError as e:
         return dict(k=k, friction=f, planned=False, success=False, why=str(e)[:300])
-    x = pp.execute_pick_place(s, r, Scales(finger_friction=f, feature_friction=f))
+    run = execute(World(s, rig="arm"), r, perturbation=Perturbation(finger_friction=f, feature_friction=f))
+    x = run.detail
     return dict(k=k, friction=f, planned=True, planning_time_s=r.planning_time, switch_overs=r.switch_overs,
-                success=bool(x.success), held=bool(x.held), place_error=[float(x.place_error[0]), float(x.place_error[1])])
+                success=bool(run.success), held=bool(x.held), place_error=[float(e) for e in run.goal_error])
 
 
 def main() -> int:
     import regrasp
-    from regrasp.workcell import default_workcell
+    from regrasp.execution import default_workcell
 
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("names", nargs="+", help="bundled planar examples")

@@ -18,7 +18,8 @@ from regrasp.control import loop
 from regrasp.mujoco import push as mj_push
 from regrasp.planning import plan as planning
 from regrasp.reference import approx_error
-from regrasp.sim import quasistatic, validation
+from regrasp.mujoco import validation
+from regrasp.sim import quasistatic
 
 from .harness import fuzz_settings, run
 from .strategies import BAD_SCALARS, EXAMPLES, Weird, bad_values
