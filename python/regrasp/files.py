@@ -22,7 +22,12 @@ from typing import Callable, Iterable, Mapping, Optional
 from .errors import ArgumentError
 
 __all__ = ["as_path", "atomic_write", "write_text", "temp_path", "check_writable", "refuse_overwrite_input", "Outputs",
-           "same_file"]
+           "same_file", "read_text", "MAX_FILE_BYTES"]
+
+#: The most any input file may hold [bytes] (a scene, a plan, a workcell, a grasp graph, an
+#: object file): a larger one — or an endless stream such as /dev/zero — is refused after
+#: reading this much, naming the field.
+MAX_FILE_BYTES = 64 * 2**20
 
 
 def as_path(v, name: str) -> Path:
@@ -35,6 +40,26 @@ def as_path(v, name: str) -> Path:
     if "\0" in v:
         raise ArgumentError(f"invalid `{name}`: a file path without NUL characters", name)
     return Path(v)
+
+
+def read_text(path, field: str, limit: Optional[int] = None) -> str:
+    """The UTF-8 text of the file at ``path``, read at most ``limit`` bytes (default
+    :data:`MAX_FILE_BYTES`): an ArgumentError naming ``field`` when it cannot be read, is not
+    text, or holds more (nothing more is read)."""
+    limit = MAX_FILE_BYTES if limit is None else limit
+    p = as_path(path, field)
+    try:
+        with open(p, "rb") as f:
+            data = f.read(limit + 1)
+    except OSError as e:
+        raise ArgumentError(f"invalid `{field}`: cannot read {p}: {e.strerror or e}", field) from None
+    if len(data) > limit:
+        raise ArgumentError(f"invalid `{field}`: {p} holds more than {limit} bytes (the most an input file may hold)",
+                            field)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ArgumentError(f"invalid `{field}`: {p} is not UTF-8 text ({e.reason} at byte {e.start})", field) from None
 
 
 def same_file(a, b) -> bool:

@@ -250,12 +250,15 @@ class GraspGraph:
     @classmethod
     def load(cls, path) -> "GraspGraph":
         """The graph file ``path``; an ArgumentError naming the field of a bad file."""
+        from ..files import read_text
+
+        text = read_text(path, "graph")
         try:
-            d = json.loads(Path(path).read_text(encoding="utf-8"))
-        except OSError as e:
-            raise ArgumentError(f"cannot read the grasp graph {str(path)!r}: {e.strerror}", "graph") from None
-        except (json.JSONDecodeError, UnicodeDecodeError) as e:
+            d = json.loads(text)
+        except json.JSONDecodeError as e:
             raise ArgumentError(f"invalid grasp graph {str(path)!r}: not JSON ({e})", "graph") from None
+        except RecursionError:
+            raise ArgumentError(f"invalid grasp graph {str(path)!r}: nested too deeply", "graph") from None
         return cls.from_dict(d)
 
     @classmethod

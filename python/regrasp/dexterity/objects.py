@@ -63,12 +63,13 @@ def load_object(path):
 
     if isinstance(path, str) and path in OBJECTS:
         path = object_path(path)
+    from ..files import read_text
+
     path = Path(path)
     try:
-        text = path.read_text()
-    except OSError as e:
-        raise ArgumentError(f"invalid `object`: cannot read {str(path)!r}: {e.strerror}; the bundled objects: "
-                            f"{', '.join(OBJECTS)}", "object") from None
+        text = read_text(path, "object")
+    except ArgumentError as e:
+        raise ArgumentError(f"{e}; the bundled objects: {', '.join(OBJECTS)}", "object") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import ArgumentError, check_seed
-from ..files import as_path, same_file as _same_file, write_text
+from ..files import as_path, read_text, same_file as _same_file, write_text
 
 #: the keys of a plan file, in the order they are written (docs/plan-file.md), by dimension
 KEYS = {
@@ -258,10 +258,9 @@ class Plan:
     def load(cls, path, scene=None) -> "Plan":
         """Reads a plan file (see :meth:`from_json`); errors name the field (``plan.path[3].pose``)."""
         p = as_path(path, "plan")
+        text = read_text(p, "plan")
         try:
-            d = json.loads(p.read_text())
-        except (OSError, UnicodeDecodeError) as e:
-            raise ArgumentError(f"invalid `plan`: cannot read {p}: {e}", "plan") from e
+            d = json.loads(text)
         except ValueError as e:
             raise ArgumentError(f"invalid `plan`: {p} is not JSON: {e}", "plan") from e
         except RecursionError as e:

@@ -9,18 +9,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ArgumentError
-from ..files import as_path
+from ..files import as_path, read_text
 
 
 def read_scene_file(path) -> tuple[Path, str]:
     """The path and text of a scene file; an :class:`ArgumentError` naming ``path`` when it
     cannot be read."""
     p = as_path(path, "path")
-    try:
-        return p, p.read_text()
-    except (OSError, UnicodeDecodeError) as e:
-        raise ArgumentError(f"invalid `path`: cannot read {p}: {e}", "path") from e
+    return p, read_text(p, "path")
 
 
 def is_3d_text(text: str) -> bool:

@@ -404,11 +404,9 @@ def from_toml(text: str) -> Workcell:
 
 def load(path) -> Workcell:
     """The workcell of the TOML file at ``path``; ArgumentError when it cannot be read."""
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError, TypeError, ValueError) as e:
-        raise ArgumentError(f"invalid `workcell`: cannot read {str(path)!r}: {e}", "workcell") from None
-    return from_toml(text)
+    from ..files import read_text
+
+    return from_toml(read_text(path, "workcell"))
 
 
 def bundled(name: str = "workcell-ur5e") -> Path:
