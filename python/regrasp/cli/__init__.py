@@ -460,6 +460,14 @@ def _quiet_stdout() -> None:
         pass
 
 
+def _open_closed_streams() -> None:
+    """A standard stream the command was started without (``>&-``: Python sets it to None)
+    becomes /dev/null, so that nothing written to it fails."""
+    for name in ("stdout", "stderr"):
+        if getattr(sys, name) is None:
+            setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))  # noqa: SIM115 (lives as long as the process)
+
+
 def _say(message: str) -> None:
     try:
         progress.note(f"regrasp: {message}")
@@ -510,7 +518,9 @@ def commands(ap: argparse.ArgumentParser) -> list[str]:
 def main(argv=None) -> int:
     """The `regrasp` command; returns its exit status (docs/cli.md). Ctrl-C: 130, after
     "regrasp: interrupted" (outputs are written atomically: nothing half-done is left); a closed
-    standard output (``| head``): 141, quietly."""
+    standard output (``| head``): 141, quietly. Started with standard output or error closed
+    (``>&-``), what would go there is discarded; the command runs and its status stands."""
+    _open_closed_streams()
     try:
         argv = sys.argv[1:] if argv is None else list(argv)
         ap = build_parser()
