@@ -88,3 +88,27 @@ def test_ctrl_c_stops_parallel_and_slow_validation_within_a_second(tmp_path, arg
     status, err, took = interrupt(["validate", scene, "--pushes", "2000" if args else "100000", *args], 4.0, tmp_path)
     assert status == 130 and err.strip().endswith("regrasp: interrupted") and "Traceback" not in err, err
     assert took < 1.0, f"validation went on {took:.1f} s after Ctrl-C"
+
+
+def test_sigterm_stops_like_ctrl_c_with_143_and_leaves_no_temporary_file(tmp_path, top_only):
+    """SIGTERM (a job scheduler, `kill`) while planning with an animation and a plan file to
+    write: exit 143, `regrasp: terminated`, no output and no temporary file left."""
+    out, gif = tmp_path / "o.json", tmp_path / "a.gif"
+    p = subprocess.Popen([sys.executable, "-m", "regrasp.cli", "plan", str(top_only), "--goal", FAR, "--time-limit",
+                          "30", "--out", str(out), "--animate", str(gif)], cwd=tmp_path, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(1.5)
+        assert p.poll() is None, f"it ended before the signal: {p.communicate()}"
+        p.send_signal(signal.SIGTERM)
+        t0 = time.perf_counter()
+        _, err = p.communicate(timeout=120)
+        took = time.perf_counter() - t0
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+    assert p.returncode == 143 and err.strip() == "regrasp: terminated" and "Traceback" not in err, err
+    assert took < 3.0, f"planning went on {took:.1f} s after SIGTERM"
+    assert not out.exists() and not gif.exists()
+    assert [q.name for q in tmp_path.iterdir() if ".tmp" in q.name] == []

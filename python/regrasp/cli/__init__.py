@@ -14,7 +14,9 @@ import argparse
 import inspect
 import os
 import re
+import signal
 import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +32,16 @@ from ..scene.settings import core_build, limit_surface_default, mpc_defaults
 
 
 #: exit statuses (docs/cli.md): 130 = 128 + SIGINT, 141 = 128 + SIGPIPE (the shell's convention)
-OK, CANNOT, INVALID, INTERRUPTED, BROKEN_PIPE = 0, 1, 2, 130, 141
+OK, CANNOT, INVALID, INTERRUPTED, BROKEN_PIPE, TERMINATED = 0, 1, 2, 130, 141, 143
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the command is, so that it stops as on Ctrl-C: outputs uncommitted,
+    temporary files removed, worker processes stopped."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
 
 #: upper bounds of the count options (docs/cli.md): larger values are invalid input, not hours of work
 MAX_PUSHES = 100_000
@@ -518,9 +529,11 @@ def commands(ap: argparse.ArgumentParser) -> list[str]:
 def main(argv=None) -> int:
     """The `regrasp` command; returns its exit status (docs/cli.md). Ctrl-C: 130, after
     "regrasp: interrupted" (outputs are written atomically: nothing half-done is left); a closed
-    standard output (``| head``): 141, quietly. Started with standard output or error closed
+    standard output (``| head``): 141, quietly; SIGTERM: 143, after "regrasp: terminated", as Ctrl-C. Started with standard output or error closed
     (``>&-``), what would go there is discarded; the command runs and its status stands."""
     _open_closed_streams()
+    main_thread = threading.current_thread() is threading.main_thread()
+    old = signal.signal(signal.SIGTERM, _on_sigterm) if main_thread else None
     try:
         argv = sys.argv[1:] if argv is None else list(argv)
         ap = build_parser()
@@ -534,12 +547,18 @@ def main(argv=None) -> int:
             _say(message)
         sys.stdout.flush()
         return status
+    except Terminated:
+        _say("terminated")
+        return TERMINATED
     except KeyboardInterrupt:
         _say("interrupted")
         return INTERRUPTED
     except BrokenPipeError:
         _quiet_stdout()
         return BROKEN_PIPE
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL if old is None else old)
 
 
 if __name__ == "__main__":

@@ -314,7 +314,10 @@ class GraspGraph:
 
 
 def _ignore_sigint() -> None:
+    """A pool worker's signals: Ctrl-C is the parent's to handle; SIGTERM (the pool's terminate)
+    ends it at once (not the command's SIGTERM handler, inherited by a fork)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 _CACHE: dict = {}

@@ -173,7 +173,10 @@ def _mujoco_job(job: tuple) -> list:
 
 
 def _ignore_sigint() -> None:
+    """A pool worker's signals: Ctrl-C is the parent's to handle; SIGTERM (the pool's terminate)
+    ends it at once (not the command's SIGTERM handler, inherited by a fork)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _check_reachable(address: str, timeout: float = 5.0) -> None:
