@@ -363,7 +363,8 @@ def run_edge(job: tuple) -> Edge:
     :func:`continuations`, each run starting where the action ``before`` (its grasp, name and
     params) ends and moving to this one's start as a sequence does (:class:`~.trial.Runner`'s
     lead-in)."""
-    from ..execution.execute import World, execute
+    from ..execution.execute import World, check_hand_world, execute
+    from ..scene.perturbation import Perturbation
     from .actions import action
     from .trial import REFUSED, Runner
 
@@ -378,6 +379,7 @@ def run_edge(job: tuple) -> Edge:
         lead_in = (action(name).setup(obj, tax.grasp(source), before).path.poses[-1], obj.grip)
     runner = Runner(scene, tax, grasp, setup, robot, lead_in, action_name)
     world = World(scene, rig="arm", robot=robot)
+    check_hand_world(world, "open", Perturbation(), "a regrasp action")  # here: below, an ArgumentError is the arm's
     outcomes: dict = {}
     runs: list = []
     if chain:

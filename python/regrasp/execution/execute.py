@@ -287,9 +287,10 @@ def _pick_place(world, scene, r, loop, pert, observe) -> Execution:
         raise ArgumentError("invalid `world.rig`: a pick-regrasp-place runs with the arm", "world.rig")
     if loop != "open":
         raise ArgumentError("invalid `loop`: a pick-regrasp-place runs open loop", "loop")
-    if world.options or world.robot is not None:
-        raise ArgumentError("invalid `world.options`: a pick-regrasp-place takes its settings from its planning "
-                            "(pick_place)", "world.options")
+    for k in ("options", "robot"):
+        if getattr(world, k):
+            raise ArgumentError(f"invalid `world.{k}`: a pick-regrasp-place takes its settings from its planning "
+                                "(pick_place)", f"world.{k}")
     if world.workcell is not None and world.workcell is not r.motion.workcell:
         raise ArgumentError("invalid `world.workcell`: a pick-regrasp-place runs in the workcell it was planned "
                             "in (leave it out)", "world.workcell")

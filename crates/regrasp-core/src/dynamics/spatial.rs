@@ -299,7 +299,7 @@ mod tests {
         // the ball off its pads: a pad touches only where the ball's extreme point is on it
         let off = Isometry3::from_parts(Translation3::new(0.0, 0.0, 0.007), UnitQuaternion::identity());
         assert!(ball.pad_contacts(&off).iter().all(|c| c.is_empty()));
-        assert!(!crate::planning::spatial::pads_on(&ball, &off) && crate::planning::spatial::pads_on(&ball, &q));
+        assert!(!ball.pads_on(&off) && ball.pads_on(&q));
     }
 
     /// The floor moving under the held ball rolls it: the ball turns about the grasp axis by

@@ -244,7 +244,7 @@ pub fn hold_ratio3(scene: &Scene3, pose: &Isometry3<f64>) -> Option<f64> {
     use crate::dynamics::mncp::{FrictionLaw, NormalLaw};
     use clarabel::algebra::CscMatrix;
     use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
-    if !crate::planning::spatial::pads_on(scene, pose) {
+    if !scene.pads_on(pose) {
         return None;
     }
     let p = crate::dynamics::spatial::problem(scene, pose, None, 1.0, 0.01).ok()?;

@@ -68,13 +68,6 @@ fn key(l: f64, q: &Isometry3<f64>) -> [f64; 7] {
     [q.translation.x, q.translation.y, q.translation.z, s * r.w, s * r.i, s * r.j, s * r.k]
 }
 
-/// Whether both pads touch the object at `q` (a face: at least 6 of the pad's 8 ring points on
-/// it; an edge or a vertex: itself).
-pub fn pads_on(scene: &Scene3, q: &Isometry3<f64>) -> bool {
-    let pads = scene.pad_contacts(q);
-    pads.iter().all(|p| !p.is_empty() && (p.len() >= 6 || p.len() <= 2))
-}
-
 /// The motion (body twist, object frame at `q`) of pusher `p` that makes the object follow `u`
 /// where they touch: a rigid pusher moves with `u` (it sticks); a plane rolls the object — it
 /// translates with the velocity of the object's contact point and turns only about its own
@@ -115,7 +108,7 @@ pub fn step_feasible(scene: &Scene3, q: &Isometry3<f64>, u: &Twist6, p: usize, c
     let settings = mncp::Settings::default();
     for k in 0..=n {
         let qk = if k == 0 { *q } else { integrate(q, u, k as f64 / n as f64) };
-        if !pads_on(scene, &qk) {
+        if !scene.pads_on(&qk) {
             return false;
         }
         if k == n {
@@ -143,7 +136,7 @@ pub fn simulate_step(scene: &Scene3, q: &Isometry3<f64>, u: &Twist6, p: usize, n
             return None;
         }
         let qk = crate::scene::spatial::pose_from_array("pose", &tr.pose[k]).ok()?;
-        if !pads_on(scene, &qk) {
+        if !scene.pads_on(&qk) {
             return None;
         }
     }
@@ -371,7 +364,7 @@ pub fn plan3(scene: &Scene3, start: Option<Isometry3<f64>>, goal: Option<Isometr
     let start = start.unwrap_or(scene.start);
     let goal = goal.unwrap_or(scene.goal);
     for (name, q) in [("start", &start), ("goal", &goal)] {
-        if !pads_on(scene, q) {
+        if !scene.pads_on(q) {
             return Err(Error::arg(name, "the finger pads do not both touch the object there"));
         }
     }

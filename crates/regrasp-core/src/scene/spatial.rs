@@ -378,6 +378,12 @@ impl Scene3 {
         })
     }
 
+    /// Whether both pads touch the object at `pose` (a face: at least 6 of the pad's 8 ring points
+    /// on it; an edge or a vertex: itself).
+    pub fn pads_on(&self, pose: &Isometry3<f64>) -> bool {
+        self.pad_contacts(pose).iter().all(|p| !p.is_empty() && (p.len() >= 6 || p.len() <= 2))
+    }
+
     /// Contact points (object frame) of the two pads (left: +Y, right: −Y) at pose `pose`: the
     /// object's extreme points along ±Y of the gripper; a face parallel to the pad gives the
     /// pad's ring of points that lie on the face (a patch), an edge or a vertex gives itself.
