@@ -15,7 +15,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import regrasp
+from regrasp.dexterity.actions import ACTIONS
 from regrasp.dexterity.graph import Chain, Edge, GraspGraph
+from regrasp.fields import MAX_GRAPH_NODES
 from regrasp.dexterity.sequence import plan
 from regrasp.dexterity.slip import Body, simulate
 from regrasp.errors import ArgumentError, SceneError
@@ -68,7 +70,8 @@ def test_a_hanging_object_breaks_away_from_the_turning_hand_at_the_limit_surface
 
 def graph_of(edges, names=("g0", "g1", "g2", "g3")):
     nodes = [{"name": n} for n in names]
-    return GraspGraph({"name": "t", "file": ""}, nodes, edges, [], {})
+    return GraspGraph({"name": "t", "file": ""}, nodes, edges, [ACTIONS[a].to_dict() for a in sorted({e.action for e in edges})],
+                      {})
 
 
 def edge(a, b, action, hits, trials=20, **more):
@@ -101,6 +104,23 @@ def test_the_graph_file_round_trips(tmp_path):
     (lambda d: d["edges"][0].update(outcomes={"g1": 25, "dropped": -5}), "edges[0].outcomes"),
     (lambda d: d["edges"][0].update(outcomes={"g1": 15, "g9": 5}), "edges[0].outcomes"),
     (lambda d: d["edges"][0].update(trials=20.9), "edges[0].trials"),
+    # nonsense a file could hold (issue 44): unknown actions, rates outside [0, 1], NaN settings, ...
+    (lambda d: d["edges"][0].update(action="levitate"), "edges[0].action"),
+    (lambda d: d.update(actions=[{"name": "levitate"}]), "actions[0]"),
+    (lambda d: d.update(actions=["gravity-slide"]), "actions[0]"),
+    (lambda d: d["edges"][0].update(success_rate=5), "edges[0].success_rate"),
+    (lambda d: d["edges"][0].update(success_rate=float("nan")), "edges[0].success_rate"),
+    (lambda d: d["edges"][0].update(success_rate=0.5), "edges[0].success_rate"),
+    (lambda d: d["settings"].update(spread=float("nan")), "settings.spread"),
+    (lambda d: d["settings"].update(spread=3), "settings.spread"),
+    (lambda d: d["settings"].update(trials=0), "settings.trials"),
+    (lambda d: d["settings"].update(actions=["levitate"]), "settings.actions"),
+    (lambda d: d["settings"].update(warp=1), "settings.warp"),
+    (lambda d: d.update(version=True), "version"),
+    (lambda d: d["nodes"].append({"name": "g0"}), "nodes[4].name"),
+    (lambda d: d.update(seconds=-1), "seconds"),
+    (lambda d: d["edges"][0].update(seconds=float("inf")), "edges[0].seconds"),
+    (lambda d: d.update(nodes=[{"name": f"n{i}"} for i in range(MAX_GRAPH_NODES + 1)]), "nodes"),
 ])
 def test_a_bad_graph_file_names_its_field(tmp_path, change, field):
     d = graph_of([edge("g0", "g1", "gravity-slide", 15)]).to_dict()

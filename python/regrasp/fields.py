@@ -19,6 +19,19 @@ from .errors import ArgumentError, SceneError
 #: The bound the core puts on the magnitude of every number argument (1e9).
 MAX_MAGNITUDE = _core.MAX_MAGNITUDE
 
+#: The input limits, stated once in the core (``crates/regrasp-core/src/scene/bounds.rs``) and
+#: listed in docs/guarantees.md ("Limits"): what one input may hold, by name.
+LIMITS = {k: int(v) if float(v).is_integer() else float(v) for k, v in _core.LIMITS.items()}
+MAX_FILE_BYTES = LIMITS["file_bytes"]  # bytes of one input file
+MAX_NESTING = LIMITS["nesting"]  # arrays and tables/objects nested in a TOML or JSON file
+MAX_PLAN_STEPS = LIMITS["plan_steps"]  # steps of a plan
+MAX_WORKCELL_FEATURES = LIMITS["workcell_features"]  # fixed features of a workcell
+MAX_GRAPH_NODES = LIMITS["graph_nodes"]  # grasps of a grasp graph
+MAX_GRAPH_EDGES = LIMITS["graph_edges"]  # regrasp actions of a grasp graph
+MAX_TRAJECTORY_SAMPLES = LIMITS["trajectory_samples"]  # samples of a trajectory file
+MAX_COORDINATE = LIMITS["coordinate"]  # m, any position's coordinate
+MAX_ANGLE = LIMITS["angle"]  # rad, any angle of a pose
+
 
 def check_array(x, name: str) -> np.ndarray:
     """``x`` as a float array, or an ArgumentError naming ``name`` (text, ragged lists, objects
@@ -152,6 +165,12 @@ class FieldCheck:
             got = f"{len(x)} numbers" if isinstance(x, (list, tuple)) else x
             raise self.fail(where, f"expected {n} numbers{' ' + what if what else ''}", got)
         return np.array([self.number(v, f"{where}[{i}]", lo, hi, unit) for i, v in enumerate(x)], float)
+
+    def count(self, items, where: str, most: int, what: str) -> None:
+        """At most ``most`` ``items`` (the input limit of ``what``, e.g. ``"features"``)."""
+        if len(items) > most:
+            raise SceneError(f"{self.file} field `{where}`: has {len(items)} {what}; at most {most} are allowed "
+                             "(docs/guarantees.md, Limits)", where)
 
     def keys(self, d, keys, where: str) -> None:
         """``d``: an object with exactly the (required) ``keys``, the unknown one named first."""

@@ -11,23 +11,33 @@ several outputs this way and renames them only when every one was written.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
+import re
 import signal
 import stat
 import threading
+import tomllib
 import uuid
 from pathlib import Path
 from typing import Callable, Iterable, Mapping, Optional
 
+import numpy as np
+
 from .errors import ArgumentError
+from .fields import MAX_FILE_BYTES, MAX_NESTING
 
 __all__ = ["as_path", "atomic_write", "write_text", "temp_path", "check_writable", "refuse_overwrite_input", "Outputs",
-           "same_file", "read_text", "MAX_FILE_BYTES"]
+           "same_file", "read_text", "parse_json", "parse_toml", "nesting", "MAX_FILE_BYTES"]
 
-#: The most any input file may hold [bytes] (a scene, a plan, a workcell, a grasp graph, an
-#: object file): a larger one — or an endless stream such as /dev/zero — is refused after
-#: reading this much, naming the field.
-MAX_FILE_BYTES = 64 * 2**20
+# MAX_FILE_BYTES (the core's, regrasp.fields): the most any input file may hold; a larger one —
+# or an endless stream such as /dev/zero — is refused after reading this much, naming the field.
+# MAX_NESTING: the deepest nesting of arrays and tables a TOML or JSON input may have.
+
+#: what cannot hold a bracket that counts: strings and comments (TOML) / strings (JSON)
+_TOML_INERT = re.compile(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'|#[^\n]*')
+_JSON_INERT = re.compile(r'"(?:[^"\\]|\\.)*"')
+_BRACKETS = re.compile(r"[\[\]{}]")
 
 
 def as_path(v, name: str) -> Path:
@@ -60,6 +70,68 @@ def read_text(path, field: str, limit: Optional[int] = None) -> str:
         return data.decode("utf-8")
     except UnicodeDecodeError as e:
         raise ArgumentError(f"invalid `{field}`: {p} is not UTF-8 text ({e.reason} at byte {e.start})", field) from None
+
+
+def nesting(text: str, toml: bool = False) -> int:
+    """The deepest nesting of arrays and tables/objects in TOML or JSON ``text``, counted over its
+    brackets outside strings (and comments) without parsing it: a parser would recurse."""
+    marks = _BRACKETS.findall((_TOML_INERT if toml else _JSON_INERT).sub("", text))
+    if not marks:
+        return 0
+    steps = np.fromiter((1 if m in "[{" else -1 for m in marks), dtype=np.int64, count=len(marks))
+    return int(np.cumsum(steps).max())
+
+
+def _depth(value) -> int:
+    """The nesting depth of a parsed value (lists and dicts), without recursion."""
+    deepest, stack = 0, [(value, 0)]
+    while stack:
+        v, d = stack.pop()
+        if isinstance(v, dict):
+            v = list(v.values())
+        if isinstance(v, list):
+            deepest = max(deepest, d + 1)
+            stack.extend((x, d + 1) for x in v if isinstance(x, (list, dict)))
+    return deepest
+
+
+#: why a TOML or JSON input is refused when it nests too deeply
+TOO_DEEP = f"nested more than {MAX_NESTING} arrays or tables deep (the most an input file may nest)"
+
+
+def _no_constant(c: str):
+    raise ValueError(f"{c} is not allowed (JSON has no NaN or Infinity)")
+
+
+def _parse(text: str, field: str, fail, toml: bool, constants: bool = True):
+    kind = "TOML" if toml else "JSON"
+    if not isinstance(text, str):
+        raise ArgumentError(f"invalid `text`: the {kind} text, a str (got {type(text).__name__})", "text")
+    too_deep = TOO_DEEP
+    fail = fail or (lambda why: ArgumentError(f"invalid `{field}`: {why}", field))
+    if nesting(text, toml) > MAX_NESTING:
+        raise fail(too_deep)
+    try:
+        v = tomllib.loads(text) if toml else json.loads(text, parse_constant=None if constants else _no_constant)
+    except (tomllib.TOMLDecodeError, ValueError) as e:
+        raise fail(f"not {kind}: {e}") from None
+    except RecursionError:
+        raise fail(too_deep) from None
+    if _depth(v) > MAX_NESTING:
+        raise fail(too_deep)
+    return v
+
+
+def parse_json(text: str, field: str, fail: Optional[Callable[[str], Exception]] = None, constants: bool = True):
+    """The value of JSON ``text``. When it is not JSON (or, without ``constants``, holds NaN or
+    Infinity), or nests deeper than :data:`MAX_NESTING` (refused before parsing), the error
+    ``fail(why)`` (default: an ArgumentError naming ``field``)."""
+    return _parse(text, field, fail, toml=False, constants=constants)
+
+
+def parse_toml(text: str, field: str, fail: Optional[Callable[[str], Exception]] = None) -> dict:
+    """The table of TOML ``text``; errors as :func:`parse_json`."""
+    return _parse(text, field, fail, toml=True)
 
 
 def same_file(a, b) -> bool:

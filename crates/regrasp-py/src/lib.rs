@@ -39,6 +39,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(pose::se3_compose, m)?)?;
     m.add_function(wrap_pyfunction!(pose::se3_inverse, m)?)?;
     m.add("MAX_MAGNITUDE", convert::MAX_MAGNITUDE)?;
+    let limits = pyo3::types::PyDict::new(m.py());
+    for (name, v) in regrasp::scene::bounds::LIMITS {
+        limits.set_item(name, v)?;
+    }
+    m.add("LIMITS", limits)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

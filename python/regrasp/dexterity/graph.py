@@ -27,7 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ArgumentError
-from ..files import write_text
+from ..fields import MAX_GRAPH_EDGES, MAX_GRAPH_NODES
+from ..files import parse_json, read_text, write_text
 from .. import progress as bars
 
 FORMAT, VERSION = "regrasp-grasp-graph", 1
@@ -131,11 +132,58 @@ class Edge:
         detail = d.get("detail", {})
         if not isinstance(detail, dict):
             raise ArgumentError(f"invalid `{f}.detail`: an object", f"{f}.detail")
-        seconds = d.get("seconds", 0.0)
-        if not isinstance(seconds, (int, float)) or isinstance(seconds, bool):
-            raise ArgumentError(f"invalid `{f}.seconds`: a number", f"{f}.seconds")
+        seconds = _seconds(d.get("seconds", 0.0), f"{f}.seconds")
         runs = _runs(d.get("runs", []), f"{f}.runs", d["trials"], out)
-        return cls(d["from"], d["action"], d.get("to"), d["trials"], dict(out), dict(detail), float(seconds), runs)
+        return cls(d["from"], d["action"], d.get("to"), d["trials"], dict(out), dict(detail), seconds, runs)
+
+    def check_rate(self, rate, f: str) -> None:
+        """A file's ``success_rate`` of this edge (None: not given) is its outcomes' share that
+        reached ``to``, in [0, 1]; else an ArgumentError naming ``f``."""
+        if rate is not None and not (_is_number(rate) and 0 <= rate <= 1 and abs(rate - self.success_rate) <= 1e-9):
+            raise ArgumentError(f"invalid `{f}`: the share of `trials` that reached `to`, in [0, 1] "
+                                f"({self.success_rate:g} by its outcomes; got {rate!r:.40})", f)
+
+
+def _is_number(x) -> bool:
+    """Whether ``x`` is a finite JSON number (not a bool)."""
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and bool(np.isfinite(x))
+
+
+def _seconds(v, f: str) -> float:
+    """A wall time [s] of a graph file: a finite number >= 0; else an ArgumentError naming ``f``."""
+    if not (_is_number(v) and v >= 0):
+        raise ArgumentError(f"invalid `{f}`: seconds, a finite number >= 0 (got {v!r:.40})", f)
+    return float(v)
+
+
+def _known_actions() -> set:
+    """The names of the regrasp actions."""
+    from .actions import ACTIONS
+
+    return set(ACTIONS)
+
+
+def _settings(s: dict, known: set) -> dict:
+    """A graph file's ``settings`` (those of :class:`Settings`), each value checked; an
+    ArgumentError naming ``settings.KEY``."""
+    whole = lambda v, lo: isinstance(v, int) and not isinstance(v, bool) and v >= lo  # noqa: E731
+    checks = {"trials": (lambda v: whole(v, 1), "a whole number >= 1"),
+              "seed": (lambda v: whole(v, 0), "a whole number >= 0"),
+              "spread": (lambda v: _is_number(v) and 0 <= v < 1, "a share in [0, 1)"),
+              "shift": (lambda v: _is_number(v) and 0 <= v <= 1, "metres in [0, 1]"),
+              "turn": (lambda v: _is_number(v) and 0 <= v <= np.pi, "radians in [0, pi]"),
+              "actions": (lambda v: v is None or (isinstance(v, list) and all(a in known for a in v if isinstance(a, str))
+                                                  and all(isinstance(a, str) for a in v)),
+                          "null or a list of regrasp actions"),
+              "chain": (lambda v: isinstance(v, bool), "true or false")}
+    for k, v in s.items():
+        if k not in checks:
+            raise ArgumentError(f"invalid `settings.{k}`: unknown setting (the settings: {', '.join(checks)})",
+                                f"settings.{k}")
+        ok, what = checks[k]
+        if not ok(v):
+            raise ArgumentError(f"invalid `settings.{k}`: {what} (got {v!r:.40})", f"settings.{k}")
+    return dict(s)
 
 
 def _numbers(v, n: int, positive: bool = False) -> bool:
@@ -250,15 +298,8 @@ class GraspGraph:
     @classmethod
     def load(cls, path) -> "GraspGraph":
         """The graph file ``path``; an ArgumentError naming the field of a bad file."""
-        from ..files import read_text
-
-        text = read_text(path, "graph")
-        try:
-            d = json.loads(text)
-        except json.JSONDecodeError as e:
-            raise ArgumentError(f"invalid grasp graph {str(path)!r}: not JSON ({e})", "graph") from None
-        except RecursionError:
-            raise ArgumentError(f"invalid grasp graph {str(path)!r}: nested too deeply", "graph") from None
+        d = parse_json(read_text(path, "graph"), "graph",
+                       lambda why: ArgumentError(f"invalid grasp graph {str(path)!r}: {why}", "graph"))
         return cls.from_dict(d)
 
     @classmethod
@@ -266,26 +307,44 @@ class GraspGraph:
         """The graph of a graph file's JSON ``d``; an ArgumentError naming the field of a bad one."""
         if not isinstance(d, dict) or d.get("format") != FORMAT:
             raise ArgumentError(f"invalid `format`: a grasp graph file has \"format\": \"{FORMAT}\"", "format")
-        if d.get("version") != VERSION:
+        if isinstance(d.get("version"), bool) or d.get("version") != VERSION:
             raise ArgumentError(f"invalid `version`: {d.get('version')!r} (this regrasp reads version {VERSION})", "version")
         for key, kind in (("object", dict), ("nodes", list), ("edges", list), ("actions", list), ("settings", dict)):
             if key not in d:
                 raise ArgumentError(f"invalid `{key}`: is required", key)
             if not isinstance(d[key], kind):
                 raise ArgumentError(f"invalid `{key}`: a JSON {'object' if kind is dict else 'array'}", key)
-        if not all(isinstance(n, dict) and isinstance(n.get("name"), str) for n in d["nodes"]):
-            raise ArgumentError("invalid `nodes`: a list of grasps, each with a `name` (a string)", "nodes")
+        for key, most in (("nodes", MAX_GRAPH_NODES), ("edges", MAX_GRAPH_EDGES)):
+            if len(d[key]) > most:
+                raise ArgumentError(f"invalid `{key}`: has {len(d[key])}; at most {most} are allowed "
+                                    "(docs/guarantees.md, Limits)", key)
+        if not all(isinstance(n, dict) and isinstance(n.get("name"), str) and n["name"].strip() for n in d["nodes"]):
+            raise ArgumentError("invalid `nodes`: a list of grasps, each with a `name` (a non-blank string)", "nodes")
+        names = [n["name"] for n in d["nodes"]]
+        for i, n in enumerate(names):
+            if n in names[:i]:
+                raise ArgumentError(f"invalid `nodes[{i}].name`: repeats nodes[{names.index(n)}].name ({n!r})",
+                                    f"nodes[{i}].name")
+        known = _known_actions()
+        for i, a in enumerate(d["actions"]):
+            if not (isinstance(a, dict) and a.get("name") in known):
+                raise ArgumentError(f"invalid `actions[{i}]`: a regrasp action, {{\"name\": one of "
+                                    f"{', '.join(sorted(known))}, ...}} (got {a!r:.60})", f"actions[{i}]")
+        measured = [a["name"] for a in d["actions"]]
+        settings = _settings(d["settings"], known)
         if not isinstance(d["object"].get("file", ""), str) or not isinstance(d["object"].get("name", ""), str):
             raise ArgumentError("invalid `object`: its `name` and `file` are strings", "object")
-        seconds = d.get("seconds", 0.0)
-        if not isinstance(seconds, (int, float)) or isinstance(seconds, bool):
-            raise ArgumentError("invalid `seconds`: a number", "seconds")
-        names = [n["name"] for n in d["nodes"]]
+        seconds = _seconds(d.get("seconds", 0.0), "seconds")
         edges = [Edge.from_dict(e, i, names) for i, e in enumerate(d["edges"])]
+        for i, e in enumerate(edges):
+            if e.action not in measured:
+                raise ArgumentError(f"invalid `edges[{i}].action`: {e.action!r:.40} is not one of the graph's `actions` "
+                                    f"({', '.join(measured)})", f"edges[{i}].action")
         for i, e in enumerate(edges):
             for key, v in (("from", e.source), ("to", e.target)):
                 if v is not None and v not in names:
                     raise ArgumentError(f"invalid `edges[{i}].{key}`: {v!r} is not a node", f"edges[{i}].{key}")
+            e.check_rate(d["edges"][i].get("success_rate"), f"edges[{i}].success_rate")
         if not isinstance(d.get("chained", []), list):
             raise ArgumentError("invalid `chained`: a JSON array", "chained")
         chained = [Chain.from_dict(c, i, edges, names) for i, c in enumerate(d.get("chained", []))]
@@ -294,8 +353,7 @@ class GraspGraph:
             i = next(k for k, p in enumerate(pairs) if p in pairs[:k])
             raise ArgumentError(f"invalid `chained[{i}]`: a second chain of edge {pairs[i][1]} after edge "
                                 f"{pairs[i][0]}", f"chained[{i}]")
-        return cls(dict(d["object"]), list(d["nodes"]), edges, list(d["actions"]), dict(d["settings"]), float(seconds),
-                   chained)
+        return cls(dict(d["object"]), list(d["nodes"]), edges, list(d["actions"]), settings, seconds, chained)
 
     @property
     def node_names(self) -> list:

@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ArgumentError, SceneError
-from ..fields import FieldCheck
+from ..fields import MAX_ANGLE, MAX_COORDINATE, MAX_TRAJECTORY_SAMPLES, FieldCheck
+from ..files import parse_json
 
 #: Sample labels, in the order a push meets them (a world motion's and its trajectory's).
 LABELS = ("start", "transfer", "approach", "push", "retreat")
@@ -30,13 +31,16 @@ SAMPLE_KEYS = ("t", "q", "gripper_pose", "grip_force", "label", "push")
 ASSIGNMENT_KEYS = ("pusher", "feature", "first", "last", "frame", "tilt", "penetration")
 
 
+MAX_SECONDS = 1e6  # s, the latest time of a sample (11.6 days)
+MAX_FORCE = 1e6  # N, the largest grip force (the core's largest normal force)
+
 _CHECK = FieldCheck("trajectory")
 _fail, _number, _integer, _name, _vector, _keys = (_CHECK.fail, _CHECK.number, _CHECK.integer, _CHECK.name,
                                                    _CHECK.vector, _CHECK.keys)
 
 
 def _pose(x, where: str) -> np.ndarray:
-    p = _vector(x, 7, where)
+    p = _vector(x, 7, where, -MAX_COORDINATE, MAX_COORDINATE, "m")
     if abs(np.linalg.norm(p[3:]) - 1) > UNIT_TOL:
         raise _fail(where, f"the quaternion [qw, qx, qy, qz] must have unit norm (within {UNIT_TOL:g})",
                     float(np.linalg.norm(p[3:])))
@@ -152,23 +156,15 @@ class Trajectory:
         """The trajectory of the file's JSON text (SceneError ``(json)`` for a syntax error)."""
         if not isinstance(text, str):
             raise ArgumentError(f"invalid `text`: the trajectory file's text, a str (got {type(text).__name__})", "text")
-        try:
-            d = json.loads(text, parse_constant=lambda c: (_ for _ in ()).throw(ValueError(f"{c} is not allowed")))
-        except ValueError as e:
-            raise SceneError(f"trajectory file: not valid JSON: {e}", "(json)") from None
-        return _from_dict(d)
+        return _from_dict(parse_json(text, "(json)", lambda why: SceneError(f"trajectory file: {why}", "(json)"),
+                                     constants=False))
 
     @classmethod
     def load(cls, path) -> "Trajectory":
         """The trajectory file at ``path``; ArgumentError when it cannot be read."""
-        from ..files import as_path
+        from ..files import read_text
 
-        p = as_path(path, "path")
-        try:
-            text = p.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as e:
-            raise ArgumentError(f"invalid `path`: cannot read {str(p)!r}: {e}", "path") from None
-        return cls.from_json(text)
+        return cls.from_json(read_text(path, "path"))
 
 
 def _from_dict(d) -> Trajectory:
@@ -200,20 +196,22 @@ def _from_dict(d) -> Trajectory:
         last = _integer(a["last"], f"{w}.last", first + 1, 10**9)
         records.append(PushRecord(_name(a["pusher"], f"{w}.pusher"), _name(a["feature"], f"{w}.feature"), first, last,
                                   _pose(a["frame"], f"{w}.frame"), _number(a["tilt"], f"{w}.tilt", 0.0, math.pi),
-                                  _number(a["penetration"], f"{w}.penetration", 0.0)))
+                                  _number(a["penetration"], f"{w}.penetration", 0.0, 1.0, "m")))
     S = d["samples"]
     if not isinstance(S, list) or not S:
         raise _fail("samples", "must be a non-empty list", S)
+    _CHECK.count(S, "samples", MAX_TRAJECTORY_SAMPLES, "samples")
+    _CHECK.count(A, "assignments", len(S), "assignments (at most one per sample)")
     t, q, g, f, lab, push = [], [], [], [], [], []
     for i, s in enumerate(S):
         w = f"samples[{i}]"
         _keys(s, SAMPLE_KEYS, w)
-        t.append(_number(s["t"], f"{w}.t", 0.0))
+        t.append(_number(s["t"], f"{w}.t", 0.0, MAX_SECONDS, "s"))
         if i and t[-1] <= t[-2]:
             raise _fail(f"{w}.t", f"times must increase strictly (samples[{i - 1}].t is {t[-2]!r})", s["t"])
-        q.append(_vector(s["q"], len(joints), f"{w}.q"))
+        q.append(_vector(s["q"], len(joints), f"{w}.q", -MAX_ANGLE, MAX_ANGLE, "rad"))
         g.append(_pose(s["gripper_pose"], f"{w}.gripper_pose"))
-        f.append(_number(s["grip_force"], f"{w}.grip_force", 0.0))
+        f.append(_number(s["grip_force"], f"{w}.grip_force", 0.0, MAX_FORCE, "N"))
         if s["label"] not in LABELS:
             raise _fail(f"{w}.label", f"must be one of {', '.join(LABELS)}", s["label"])
         lab.append(s["label"])

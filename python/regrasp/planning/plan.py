@@ -19,7 +19,8 @@ import numpy as np
 
 from .. import _core
 from ..errors import ArgumentError, check_seed
-from ..files import as_path, read_text, same_file as _same_file, write_text
+from ..fields import MAX_ANGLE, MAX_COORDINATE, MAX_PLAN_STEPS
+from ..files import as_path, parse_json, read_text, same_file as _same_file, write_text
 
 #: the keys of a plan file, in the order they are written (docs/plan-file.md), by dimension
 KEYS = {
@@ -69,8 +70,22 @@ def _numbers(v, n: int, where: str, what: str) -> np.ndarray:
 
 def _pose(v, dim: int, where: str) -> np.ndarray:
     q = _numbers(v, POSE_SIZE[dim], where, f"{POSE_SIZE[dim]} finite numbers {POSE_TEXT[dim]}")
-    if dim == 3 and np.linalg.norm(q[3:]) < 1e-9:
-        raise ArgumentError(f"invalid `{where}`: the quaternion [qw, qx, qy, qz] is zero", where)
+    return check_pose(q, dim, where)
+
+
+def check_pose(q: np.ndarray, dim: int, where: str) -> np.ndarray:
+    """Pose ``q`` of a plan when it is physical: positions within ``MAX_COORDINATE`` (m) of the
+    origin, a planar angle within ``MAX_ANGLE`` (rad), a 3-D quaternion neither zero nor huge;
+    else an ArgumentError naming ``where``."""
+    n = 2 if dim == 2 else 3
+    if np.max(np.abs(q[:n])) > MAX_COORDINATE:
+        raise ArgumentError(f"invalid `{where}`: positions must be within {MAX_COORDINATE:g} m of the origin "
+                            f"(got {q.tolist()})", where)
+    if dim == 2 and abs(q[2]) > MAX_ANGLE:
+        raise ArgumentError(f"invalid `{where}`: the angle must be within {MAX_ANGLE:g} rad (got {q[2]:g})", where)
+    if dim == 3 and not 1e-9 <= np.linalg.norm(q[3:]) <= 1e6:
+        raise ArgumentError(f"invalid `{where}`: the quaternion [qw, qx, qy, qz] must have a norm in [1e-9, 1e6] "
+                            f"(got {q[3:].tolist()})", where)
     return q
 
 
@@ -244,6 +259,9 @@ class Plan:
         path = d.get("path")
         if not isinstance(path, list) or not path:
             raise ArgumentError(f"invalid `{name}.path`: a non-empty list of {{pose, pusher}} entries", f"{name}.path")
+        if len(path) - 1 > MAX_PLAN_STEPS:
+            raise ArgumentError(f"invalid `{name}.path`: has {len(path) - 1} steps; at most {MAX_PLAN_STEPS} are allowed "
+                                "(docs/guarantees.md, Limits)", f"{name}.path")
         dim = _dimension_of(path, scene, name)
         poses, pushers, twists = zip(*(_entry(k, i, dim, name) for i, k in enumerate(path)))
         stats = {k: _summary_value(d[k], k, f"{name}.{k}") for k in KEYS[dim] if k != "path" and d.get(k) is not None}
@@ -258,13 +276,8 @@ class Plan:
     def load(cls, path, scene=None) -> "Plan":
         """Reads a plan file (see :meth:`from_json`); errors name the field (``plan.path[3].pose``)."""
         p = as_path(path, "plan")
-        text = read_text(p, "plan")
-        try:
-            d = json.loads(text)
-        except ValueError as e:
-            raise ArgumentError(f"invalid `plan`: {p} is not JSON: {e}", "plan") from e
-        except RecursionError as e:
-            raise ArgumentError(f"invalid `plan`: {p} is nested too deeply", "plan") from e
+        d = parse_json(read_text(p, "plan"), "plan",
+                       lambda why: ArgumentError(f"invalid `plan`: {p}: {why}", "plan"))
         if not isinstance(d, dict):
             raise ArgumentError(f"invalid `plan`: {p} is not a plan file: a JSON object with a `path` "
                                 f"(got a JSON {_json_type(d)})", "plan")

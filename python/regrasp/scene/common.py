@@ -3,13 +3,13 @@ read-only properties that hand a value of the Rust core through."""
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..files import as_path, read_text
+from ..errors import SceneError
+from ..files import TOO_DEEP, as_path, parse_toml, read_text
 
 
 def read_scene_file(path) -> tuple[Path, str]:
@@ -24,9 +24,15 @@ def is_3d_text(text: str) -> bool:
     3-D loader checks that it is 3). Text that is not TOML counts as planar, whose loader then
     names the error."""
     try:
-        return "dimension" in tomllib.loads(text)
-    except tomllib.TOMLDecodeError:
+        d = parse_toml(text, "(toml)", lambda why: SceneError(f"scene field `(toml)`: {why}", "(toml)")
+                       if why == TOO_DEEP else _NotToml())
+    except _NotToml:
         return False
+    return "dimension" in d
+
+
+class _NotToml(Exception):
+    """Scene text that is not TOML (the loader names the error)."""
 
 
 def core_property(name: str, doc: str | None = None, wrap=None) -> property:

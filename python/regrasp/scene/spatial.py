@@ -5,7 +5,6 @@ documented in ``crates/regrasp-core/src/scene3d.rs`` and the README."""
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import Optional
 
@@ -15,6 +14,7 @@ from .. import _core
 from ..errors import ArgumentError, RegraspError, SceneError, check_seed
 from ..planning.plan import Plan, as_plan
 from ..pose import quat_angle, twist_between, twist_in
+from ..files import parse_toml
 from .common import Task, core_property, read_scene_file
 from ..fields import check_flag, check_name, check_number, check_vector
 
@@ -209,9 +209,10 @@ def _check_mesh_file(text: str, base) -> None:
     """A missing ``object.mesh`` file is a SceneError naming the folder its path is relative to
     (a copied scene file without its meshes); the core reports every other mesh fault."""
     try:
-        mesh = tomllib.loads(text).get("object", {}).get("mesh")
-    except tomllib.TOMLDecodeError:
-        return  # the core reports the syntax error with its line
+        obj = parse_toml(text, "(toml)").get("object")
+    except ArgumentError:
+        return  # the core reports the syntax error with its line (is_3d_text: a too deep one)
+    mesh = obj.get("mesh") if isinstance(obj, dict) else None
     if not isinstance(mesh, str) or not mesh.strip():
         return
     folder = Path(base or ".").absolute()

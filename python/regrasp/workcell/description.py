@@ -15,7 +15,6 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,7 +22,8 @@ import numpy as np
 
 from .. import pose as P
 from ..errors import ArgumentError, SceneError
-from ..fields import FieldCheck
+from ..fields import MAX_WORKCELL_FEATURES, FieldCheck
+from ..files import parse_toml
 
 #: The bounds of a workcell file's numbers (inclusive), stated once: (low, high, unit).
 BOUNDS = {
@@ -239,11 +239,28 @@ class Workcell:
         if self.description is not None and not isinstance(self.description, str):
             raise _fail("description", "must be a string", self.description)
         object.__setattr__(self, "features", tuple(self.features))
+        _CHECK.count(self.features, "features", MAX_WORKCELL_FEATURES, "features")
+        self._check_start()
         seen: dict = {}
         for i, f in enumerate(self.features):
             if f.name in seen:
                 raise _fail(f"features[{i}].name", f"repeats features[{seen[f.name]}].name", f.name)
             seen[f.name] = i
+
+    def _check_start(self) -> None:
+        """An object starting on the table starts on it: its origin above the table top (by at most
+        the largest object size, 10 m) and over the table's rectangle."""
+        if self.object.on != "table":
+            return
+        p, t = self.object.pose, self.table
+        if not t.height < p[2] <= t.height + BOUNDS["size"][1]:
+            raise _fail("object.pose[2]", f"must be above the table top ({t.height:g} m) by at most "
+                        f"{BOUNDS['size'][1]:g} m: the object starts on the table", float(p[2]))
+        off = np.abs(p[:2] - t.center) - t.size / 2
+        if np.any(off > 1e-9):
+            k = int(np.argmax(off))
+            raise _fail(f"object.pose[{k}]", f"must lie over the table (its centre {t.center.tolist()}, size "
+                        f"{t.size.tolist()} m): the object starts on the table", float(p[k]))
 
     def __eq__(self, other) -> bool:
         """Workcells are equal when their files are (:meth:`to_dict`)."""
@@ -381,6 +398,7 @@ def from_dict(d) -> Workcell:
     fs = d.get("features", [])
     if not isinstance(fs, list):
         raise SceneError(f"workcell field `features`: must be an array of tables (got {fs!r:.60})", "features")
+    _CHECK.count(fs, "features", MAX_WORKCELL_FEATURES, "features")
     features = []
     for i, f in enumerate(fs):
         _table(f, f"features[{i}]", "features[]")
@@ -395,11 +413,7 @@ def from_toml(text: str) -> Workcell:
     """The workcell of a TOML text; SceneError naming the field (``(toml)`` for a syntax error)."""
     if not isinstance(text, str):
         raise ArgumentError(f"invalid `text`: the workcell file's text, a str (got {type(text).__name__})", "text")
-    try:
-        d = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise SceneError(f"workcell field `(toml)`: {e}", "(toml)") from None
-    return from_dict(d)
+    return from_dict(parse_toml(text, "(toml)", lambda why: SceneError(f"workcell field `(toml)`: {why}", "(toml)")))
 
 
 def load(path) -> Workcell:

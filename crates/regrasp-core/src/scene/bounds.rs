@@ -83,6 +83,55 @@ pub const MAX_PUSHER_POINTS: usize = 1_000;
 /// Most pushers in a scene.
 pub const MAX_PUSHERS: usize = 1_000;
 
+/// The most bytes one input file may hold (a scene, a mesh, a plan, a workcell, a grasp graph, a
+/// trajectory, an object file): a larger one, or an endless stream, is refused after this much.
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+/// The deepest nesting of arrays and tables (objects) in a TOML or JSON input.
+pub const MAX_NESTING: usize = 32;
+/// The most steps (poses after the start) of a plan file or a plan given to execute.
+pub const MAX_PLAN_STEPS: usize = 10_000;
+/// The most fixed features of a workcell.
+pub const MAX_WORKCELL_FEATURES: usize = 256;
+/// The most nodes (grasps) and edges (regrasp actions) of a grasp graph file.
+pub const MAX_GRAPH_NODES: usize = 10_000;
+pub const MAX_GRAPH_EDGES: usize = 100_000;
+/// The most samples of a trajectory file.
+pub const MAX_TRAJECTORY_SAMPLES: usize = 1_000_000;
+
+/// The input limits by name, for the bindings and the docs (`docs/guarantees.md`, "Limits").
+pub const LIMITS: [(&str, f64); 15] = [
+    ("file_bytes", MAX_FILE_BYTES as f64),
+    ("nesting", MAX_NESTING as f64),
+    ("plan_steps", MAX_PLAN_STEPS as f64),
+    ("workcell_features", MAX_WORKCELL_FEATURES as f64),
+    ("graph_nodes", MAX_GRAPH_NODES as f64),
+    ("graph_edges", MAX_GRAPH_EDGES as f64),
+    ("trajectory_samples", MAX_TRAJECTORY_SAMPLES as f64),
+    ("outline_vertices", MAX_OUTLINE_VERTICES as f64),
+    ("mesh_vertices", MAX_MESH_VERTICES as f64),
+    ("mesh_triangles", MAX_MESH_TRIANGLES as f64),
+    ("mesh_parts", MAX_MESH_PARTS as f64),
+    ("pusher_points", MAX_PUSHER_POINTS as f64),
+    ("pushers", MAX_PUSHERS as f64),
+    ("coordinate", COORD.hi),
+    ("angle", ANGLE.hi),
+];
+
+/// The UTF-8 text of the file at `path`, read at most [`MAX_FILE_BYTES`]: an error naming
+/// `field` (a scene error when `scene`, else an argument error) when it cannot be read, holds
+/// more, or is not text.
+pub fn read_file(path: &std::path::Path, field: &str, scene: bool) -> Result<String> {
+    use std::io::Read;
+    let fail = |m: String| if scene { Error::scene(field, m) } else { Error::arg(field, m) };
+    let f = std::fs::File::open(path).map_err(|e| fail(format!("cannot read {}: {e}", path.display())))?;
+    let mut data = Vec::new();
+    f.take(MAX_FILE_BYTES + 1).read_to_end(&mut data).map_err(|e| fail(format!("cannot read {}: {e}", path.display())))?;
+    if data.len() as u64 > MAX_FILE_BYTES {
+        return Err(fail(format!("{} holds more than {MAX_FILE_BYTES} bytes (the most an input file may hold)", path.display())));
+    }
+    String::from_utf8(data).map_err(|e| fail(format!("{} is not UTF-8 text (at byte {})", path.display(), e.utf8_error().valid_up_to())))
+}
+
 /// How far a pusher point may lie from the object's boundary [m] and still be taken as on it
 /// (then moved onto it, with a note): scene files are measured and rounded to 0.1 mm.
 pub const SNAP_DISTANCE: f64 = 1e-4;
@@ -93,4 +142,31 @@ pub fn count(field: &str, n: usize, max: usize, what: &str) -> Result<()> {
         return Err(Error::scene(field, format!("has {n} {what}; at most {max} are allowed")));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_endless_file_is_refused_after_the_limit() {
+        let e = read_file(std::path::Path::new("/dev/zero"), "object.mesh", true).unwrap_err();
+        assert!(e.to_string().contains("object.mesh") && e.to_string().contains("more than"), "{e}");
+    }
+
+    #[test]
+    fn a_file_that_is_not_text_is_refused_naming_the_field() {
+        let p = std::env::temp_dir().join(format!("regrasp-bounds-{}.obj", std::process::id()));
+        std::fs::write(&p, [0xffu8, 0xfe, 0]).unwrap();
+        let e = read_file(&p, "path", false).unwrap_err();
+        std::fs::remove_file(&p).ok();
+        assert!(e.to_string().contains("path") && e.to_string().contains("UTF-8"), "{e}");
+    }
+
+    #[test]
+    fn a_deeply_nested_scene_is_a_scene_error() {
+        let deep = format!("name = \"x\"\nextra = {}1{}\n", "[".repeat(5000), "]".repeat(5000));
+        assert!(crate::scene::planar::Scene::from_toml_str(&deep).is_err());
+        assert!(crate::scene::spatial::Scene3::from_toml_str(&format!("dimension = 3\n{deep}"), None).is_err());
+    }
 }

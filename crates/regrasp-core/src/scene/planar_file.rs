@@ -214,8 +214,7 @@ impl Scene {
     }
 
     pub fn load(path: &std::path::Path) -> Result<Scene> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::arg("path", format!("cannot read {}: {e}", path.display())))?;
+        let text = bounds::read_file(path, "path", false)?;
         Self::from_toml_str(&text)
     }
 

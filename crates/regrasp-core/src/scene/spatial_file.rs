@@ -177,7 +177,7 @@ impl Scene3 {
     }
 
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::arg("path", format!("cannot read {}: {e}", path.display())))?;
+        let text = bounds::read_file(path, "path", false)?;
         Self::from_toml_str(&text, path.parent())
     }
 }
@@ -224,8 +224,7 @@ fn shape(obj: &RawObject, base: Option<&Path>) -> Result<Solid> {
         "mesh" => {
             let file = req("object.mesh", obj.mesh.clone())?;
             let path = base.map(|b| b.join(&file)).unwrap_or_else(|| file.clone().into());
-            let text = std::fs::read_to_string(&path)
-                .map_err(|e| Error::scene("object.mesh", format!("cannot read {}: {e}", path.display())))?;
+            let text = bounds::read_file(&path, "object.mesh", true)?;
             let (m, parts) = parts(&text)?;
             let size = m.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
             if bounds::SIZE.check("object.mesh", size).is_err() {
