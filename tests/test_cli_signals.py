@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+import types
 from pathlib import Path
 
 import pytest
@@ -112,3 +113,36 @@ def test_sigterm_stops_like_ctrl_c_with_143_and_leaves_no_temporary_file(tmp_pat
     assert took < 3.0, f"planning went on {took:.1f} s after SIGTERM"
     assert not out.exists() and not gif.exists()
     assert [q.name for q in tmp_path.iterdir() if ".tmp" in q.name] == []
+
+
+def test_a_stop_that_comes_back_as_another_error_is_still_the_stop(monkeypatch, capsys):
+    """Ctrl-C inside a compiled solver may surface as another exception (the QP solver of the
+    arm's IK: "Buffer dtype mismatch"): 130, "interrupted", not an internal error (issue 44)."""
+    import os
+
+    from regrasp import cli
+
+    def solver_interrupted(args):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(1.0)
+        except KeyboardInterrupt:
+            raise ValueError("Buffer dtype mismatch, expected 'double' but got 'long'") from None
+        return 0
+
+    run = cli._run
+    monkeypatch.setattr(cli, "_run", lambda args: run(types.SimpleNamespace(fn=solver_interrupted, cmd=args.cmd)))
+    assert cli.main(["examples"]) == 130
+    err = capsys.readouterr().err
+    assert err.strip() == "regrasp: interrupted" and "internal error" not in err, err
+
+
+@pytest.mark.parametrize("after", [2.0, 3.5])
+def test_ctrl_c_during_the_arms_inverse_kinematics_exits_130(tmp_path, after):
+    plan = tmp_path / "plan.json"
+    subprocess.run([sys.executable, "-m", "regrasp.cli", "plan", str(EXAMPLES / "block-low-friction.toml"), "--seed", "0",
+                    "--out", str(plan), "-q"], check=True, cwd=tmp_path, capture_output=True)
+    status, err, took = interrupt(["execute", EXAMPLES / "block-low-friction.toml", "--plan", plan, "--robot",
+                                   "ur5e-2f85", "-q"], after, tmp_path)
+    assert status == 130 and err.strip().endswith("regrasp: interrupted") and "internal error" not in err, err
+    assert took < 3.0, f"the arm went on {took:.1f} s after Ctrl-C"

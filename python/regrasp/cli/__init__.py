@@ -40,8 +40,27 @@ class Terminated(KeyboardInterrupt):
     temporary files removed, worker processes stopped."""
 
 
+#: the signal that asked the command to stop (SIGINT or SIGTERM), or None
+_STOPPED: list = []
+
+
 def _on_sigterm(signum, frame):
+    _STOPPED.append(signum)
     raise Terminated()
+
+
+def _on_sigint(signum, frame):
+    _STOPPED.append(signum)
+    raise KeyboardInterrupt()
+
+
+def _stopped() -> KeyboardInterrupt | None:
+    """The interrupt to raise when a signal asked the command to stop: an exception raised inside
+    a compiled solver by the signal may come back as another one (a QP solver's "Buffer dtype
+    mismatch"); it is the stop, not an internal error."""
+    if not _STOPPED:
+        return None
+    return Terminated() if _STOPPED[-1] == signal.SIGTERM else KeyboardInterrupt()
 
 #: upper bounds of the count options (docs/cli.md): larger values are invalid input, not hours of work
 MAX_PUSHES = 100_000
@@ -454,7 +473,11 @@ def _run(args) -> tuple[int, str | None]:
 
 
 def _unexpected(e: Exception) -> tuple[int, str]:
-    """Any other exception: a one-line internal error (exit 1); REGRASP_TRACEBACK=1 re-raises it."""
+    """Any other exception: a one-line internal error (exit 1); REGRASP_TRACEBACK=1 re-raises it.
+    After Ctrl-C or SIGTERM: the stop (:func:`_stopped`)."""
+    stop = _stopped()
+    if stop is not None:
+        raise stop from e
     if os.environ.get("REGRASP_TRACEBACK"):
         raise e
     return CANNOT, _internal(e)
@@ -533,7 +556,10 @@ def main(argv=None) -> int:
     (``>&-``), what would go there is discarded; the command runs and its status stands."""
     _open_closed_streams()
     main_thread = threading.current_thread() is threading.main_thread()
+    _STOPPED.clear()
     old = signal.signal(signal.SIGTERM, _on_sigterm) if main_thread else None
+    old_int = signal.signal(signal.SIGINT, _on_sigint) if main_thread and \
+        signal.getsignal(signal.SIGINT) is signal.default_int_handler else None
     try:
         argv = sys.argv[1:] if argv is None else list(argv)
         ap = build_parser()
@@ -543,6 +569,9 @@ def main(argv=None) -> int:
             ap.error(f"a COMMAND is required: one of {', '.join(commands(ap))} (`regrasp --help` says what each does)")
         progress.set_quiet(args.quiet)
         status, message = _run(args)
+        stop = _stopped()  # a stop turned into an error by the code it interrupted is still the stop
+        if stop is not None and status != OK:
+            raise stop
         if message is not None:
             _say(message)
         sys.stdout.flush()
@@ -559,6 +588,8 @@ def main(argv=None) -> int:
     finally:
         if main_thread:
             signal.signal(signal.SIGTERM, signal.SIG_DFL if old is None else old)
+            if old_int is not None:
+                signal.signal(signal.SIGINT, old_int)
 
 
 if __name__ == "__main__":

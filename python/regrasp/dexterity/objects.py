@@ -10,11 +10,11 @@ near its ends for the gravity pivots."""
 
 from __future__ import annotations
 
-import tomllib
 from importlib.resources import files
 from pathlib import Path
 
 from ..errors import ArgumentError, SceneError
+from ..files import parse_toml, read_text
 
 OBJECTS = ("prism", "cylinder", "box", "bar")  # examples/objects/NAME.toml
 STILL_TASK = "\n[task]\nstart = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]\ngoal = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]\n" \
@@ -35,13 +35,15 @@ def _placeholder(data: dict, base: Path) -> str:
         elif obj.get("shape") == "sphere":
             point = [float(obj["radius"]), 0.0, 0.0]
         else:
-            rows = [x.split()[1:4] for x in (base / obj["mesh"]).read_text().splitlines() if x.startswith("v ")]
+            rows = [x.split()[1:4] for x in read_text(base / obj["mesh"], "object.mesh").splitlines()
+                    if x.startswith("v ")]
             vertices = [[float(c) for c in r] for r in rows]
             point = vertices[0]
             centre = [sum(v[k] for v in vertices) / len(vertices) for k in range(3)]
             normal = [c - p for c, p in zip(centre, point)]  # into the object (towards its vertices' centroid)
             return _pusher(point, normal)
-    except (KeyError, TypeError, ValueError, IndexError, OSError, StopIteration, ZeroDivisionError):
+    except (KeyError, TypeError, ValueError, IndexError, OSError, StopIteration, ZeroDivisionError, ArgumentError,
+            AttributeError):
         return ""  # the loader names what is wrong with the object table
     return _pusher(point, [-c for c in point])  # into the object (a box or sphere about its origin)
 
@@ -63,17 +65,12 @@ def load_object(path):
 
     if isinstance(path, str) and path in OBJECTS:
         path = object_path(path)
-    from ..files import read_text
-
     path = Path(path)
     try:
         text = read_text(path, "object")
     except ArgumentError as e:
         raise ArgumentError(f"{e}; the bundled objects: {', '.join(OBJECTS)}", "object") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise SceneError(f"scene field `(toml)`: {e}", "(toml)") from None
+    data = parse_toml(text, "(toml)", lambda why: SceneError(f"scene field `(toml)`: {why}", "(toml)"))
     if data.get("dimension") != 3:
         raise SceneError("scene field `dimension`: the grasp graph needs a 3-D scene (`dimension = 3`)", "dimension")
     if not data.get("pushers"):

@@ -283,11 +283,28 @@ class Plan:
                                 f"(got a JSON {_json_type(d)})", "plan")
         return cls.from_json(d, scene)
 
+    def check_limits(self, name: str = "plan") -> None:
+        """Whether the plan is one a world can run: at most ``MAX_PLAN_STEPS`` steps, every pose
+        finite and physical (:func:`check_pose`); ArgumentError naming the field."""
+        q = np.asarray(self.poses, float)
+        if q.ndim != 2 or q.shape[1] != POSE_SIZE.get(self.dimension, -1) or not len(q):
+            raise ArgumentError(f"invalid `{name}.path`: poses of {POSE_SIZE.get(self.dimension)} numbers "
+                                f"(got shape {q.shape})", f"{name}.path")
+        if len(q) - 1 > MAX_PLAN_STEPS:
+            raise ArgumentError(f"invalid `{name}.path`: has {len(q) - 1} steps; at most {MAX_PLAN_STEPS} are allowed "
+                                "(docs/guarantees.md, Limits)", f"{name}.path")
+        for i, row in enumerate(q):
+            if not np.all(np.isfinite(row)):
+                raise ArgumentError(f"invalid `{name}.path[{i}].pose`: finite numbers (got {row.tolist()})",
+                                    f"{name}.path[{i}].pose")
+            check_pose(row, self.dimension, f"{name}.path[{i}].pose")
+
     def check_for(self, scene, name: str = "plan") -> None:
         """Whether the plan is for ``scene``: its dimension, its pushers; a plane pusher's 3-D step
         needs its pusher twist (a plane only rolls the object). ArgumentError naming the field."""
         if not all(hasattr(scene, a) for a in ("dimension", "pusher_names", "_core")):
             raise ArgumentError(f"invalid `scene`: a regrasp Scene or Scene3D (got {type(scene).__name__})", "scene")
+        self.check_limits(name)
         if scene.dimension != self.dimension:
             kind = {2: "a planar", 3: "a 3-D"}
             n = POSE_SIZE[scene.dimension]

@@ -89,7 +89,7 @@ pub const MAX_FILE_BYTES: u64 = 64 << 20;
 /// The deepest nesting of arrays and tables (objects) in a TOML or JSON input.
 pub const MAX_NESTING: usize = 32;
 /// The most steps (poses after the start) of a plan file or a plan given to execute.
-pub const MAX_PLAN_STEPS: usize = 10_000;
+pub const MAX_PLAN_STEPS: usize = 1_000;
 /// The most fixed features of a workcell.
 pub const MAX_WORKCELL_FEATURES: usize = 256;
 /// The most nodes (grasps) and edges (regrasp actions) of a grasp graph file.

@@ -105,18 +105,19 @@ def post_scene(obj: ObjectModel, start, goal, force: float, friction: float = PO
     its pads at ``force`` [N] each, gravity along the hand's −x, the post's face a plane pusher
     (``friction``, by default the post's) pushing towards the palm (+z), the task from in-hand
     pose ``start`` to ``goal`` (1 mm, 1°)."""
-    import tomllib
-
+    from ...files import parse_toml, read_text
     from ...scene.spatial import Scene3D
     from ...workcell.file import toml_value
 
     path = getattr(obj.scene, "path", None)
     if path is None:
         raise ArgumentError("invalid `scene`: a post push needs the object's scene file (load it from a file)", "scene")
+    why = lambda e: ArgumentError(f"invalid `scene`: cannot read the object's scene file {str(path)!r}: {e}", "scene")  # noqa: E731
     try:
-        data = tomllib.loads(Path(path).read_text())
-    except (OSError, tomllib.TOMLDecodeError) as e:
-        raise ArgumentError(f"invalid `scene`: cannot read the object's scene file {str(path)!r}: {e}", "scene") from None
+        text = read_text(path, "scene")
+    except ArgumentError as e:
+        raise why(e) from None
+    data = parse_toml(text, "scene", why)
     lines = ["dimension = 3", 'name = "post-push"']
     for table, values in (("object", data.get("object", {})), ("grasp", dict(data.get("grasp", {}), force=float(force)))):
         lines += ["", f"[{table}]"]
