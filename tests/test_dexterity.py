@@ -17,6 +17,8 @@ from hypothesis import strategies as st
 import regrasp
 from regrasp.dexterity.actions import ACTIONS
 from regrasp.dexterity.graph import Chain, Edge, GraspGraph
+from regrasp.dexterity.objects import load_object
+from regrasp.dexterity.taxonomy import taxonomy_of
 from regrasp.fields import MAX_GRAPH_NODES
 from regrasp.dexterity.sequence import plan
 from regrasp.dexterity.slip import Body, simulate
@@ -69,7 +71,8 @@ def test_a_hanging_object_breaks_away_from_the_turning_hand_at_the_limit_surface
 
 
 def graph_of(edges, names=("g0", "g1", "g2", "g3")):
-    nodes = [{"name": n} for n in names]
+    grasps = taxonomy_of(load_object("box")).grasps
+    nodes = [dict(grasps[i].to_dict(), name=n) for i, n in enumerate(names)]
     return GraspGraph({"name": "t", "file": ""}, nodes, edges, [ACTIONS[a].to_dict() for a in sorted({e.action for e in edges})],
                       {})
 
@@ -121,6 +124,10 @@ def test_the_graph_file_round_trips(tmp_path):
     (lambda d: d.update(seconds=-1), "seconds"),
     (lambda d: d["edges"][0].update(seconds=float("inf")), "edges[0].seconds"),
     (lambda d: d.update(nodes=[{"name": f"n{i}"} for i in range(MAX_GRAPH_NODES + 1)]), "nodes"),
+    (lambda d: d["nodes"][1].update(width=float("nan")), "nodes[1].width"),
+    (lambda d: d["nodes"][1].update(pose=[1e308, 0, 0, 1, 0, 0, 0]), "nodes[1].pose"),
+    (lambda d: d["nodes"][1].pop("label"), "nodes[1].label"),
+    (lambda d: d["nodes"][1].update(clearance=-11), "nodes[1].clearance"),
 ])
 def test_a_bad_graph_file_names_its_field(tmp_path, change, field):
     d = graph_of([edge("g0", "g1", "gravity-slide", 15)]).to_dict()

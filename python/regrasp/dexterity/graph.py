@@ -149,6 +149,22 @@ def _is_number(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool) and bool(np.isfinite(x))
 
 
+def _node(n: dict, f: str) -> None:
+    """A graph file's node ``f``: a grasp (:meth:`~regrasp.dexterity.taxonomy.Grasp.from_dict`)
+    with its hand's signed ``clearance`` [m] (< 0: the hand collides) and whether it ``fits``; an ArgumentError naming the
+    node's field."""
+    from .taxonomy import Grasp
+
+    try:
+        Grasp.from_dict(n)
+    except ArgumentError as e:
+        raise ArgumentError(str(e).replace(f"`{e.field}`", f"`{f}.{e.field}`", 1), f"{f}.{e.field}") from None
+    if "clearance" in n and not (_is_number(n["clearance"]) and abs(n["clearance"]) <= 10):
+        raise ArgumentError(f"invalid `{f}.clearance`: metres in [-10, 10] (got {n['clearance']!r:.40})", f"{f}.clearance")
+    if "fits" in n and not isinstance(n["fits"], bool):
+        raise ArgumentError(f"invalid `{f}.fits`: true or false (got {n['fits']!r:.40})", f"{f}.fits")
+
+
 def _seconds(v, f: str) -> float:
     """A wall time [s] of a graph file: a finite number >= 0; else an ArgumentError naming ``f``."""
     if not (_is_number(v) and v >= 0):
@@ -325,6 +341,8 @@ class GraspGraph:
             if n in names[:i]:
                 raise ArgumentError(f"invalid `nodes[{i}].name`: repeats nodes[{names.index(n)}].name ({n!r})",
                                     f"nodes[{i}].name")
+        for i, n in enumerate(d["nodes"]):
+            _node(n, f"nodes[{i}]")
         known = _known_actions()
         for i, a in enumerate(d["actions"]):
             if not (isinstance(a, dict) and a.get("name") in known):

@@ -109,7 +109,7 @@ class Grasp:
         if not isinstance(d, dict):
             raise ArgumentError(f"invalid `grasp`: a dict (got {type(d).__name__})", "grasp")
         return cls(_field(d, "name", _text), _field(d, "label", _text), _field(d, "faces", _faces),
-                   _field(d, "angle", _real), _field(d, "offset", _real), _field(d, "width", _real),
+                   _field(d, "angle", _angle), _field(d, "offset", _length), _field(d, "width", _width),
                    _field(d, "pose", _pose), _field(d, "holds", _flag), _field(d, "margin", _real),
                    _field(d, "torsion_k", _real), _field(d, "patch_area", _real),
                    _field(d, "lateral", _real) if "lateral" in d else 0.0)
@@ -515,6 +515,30 @@ def _real(v) -> float:
     return float(v)
 
 
+def _length(v) -> float:
+    """A length or offset [m] within the largest object size (10 m)."""
+    x = _real(v)
+    if abs(x) > 10.0:
+        raise ValueError(v)
+    return x
+
+
+def _width(v) -> float:
+    """A grasp width [m], > 0 and at most 10 m."""
+    x = _length(v)
+    if x <= 0:
+        raise ValueError(v)
+    return x
+
+
+def _angle(v) -> float:
+    """An angle [rad] within a turn either way."""
+    x = _real(v)
+    if abs(x) > 2 * np.pi:
+        raise ValueError(v)
+    return x
+
+
 def _flag(v) -> bool:
     if not isinstance(v, bool):
         raise TypeError(type(v).__name__)
@@ -529,7 +553,7 @@ def _faces(v) -> tuple:
 
 def _pose(v) -> np.ndarray:
     q = np.array([_real(x) for x in v])
-    if q.shape != (7,) or abs(np.linalg.norm(q[3:]) - 1) > 1e-6:
+    if q.shape != (7,) or abs(np.linalg.norm(q[3:]) - 1) > 1e-6 or np.max(np.abs(q[:3])) > 10.0:
         raise ValueError(v)
     return q
 
