@@ -315,7 +315,7 @@ class GraspGraph:
     def load(cls, path) -> "GraspGraph":
         """The graph file ``path``; an ArgumentError naming the field of a bad file."""
         d = parse_json(read_text(path, "graph"), "graph",
-                       lambda why: ArgumentError(f"invalid grasp graph {str(path)!r}: {why}", "graph"))
+                       lambda why: ArgumentError(f"invalid `graph`: {str(path)!r}: {why}", "graph"))
         return cls.from_dict(d)
 
     @classmethod
