@@ -3,10 +3,12 @@ the closed exception set (SceneError/ArgumentError naming a field, GraspError)."
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import faulthandler
 import math
 import os
+import resource
 import signal
 import time
 import traceback
@@ -24,7 +26,49 @@ LONG = os.environ.get("REGRASP_FUZZ", "short") == "long"
 #: seconds one case may take before it counts as a hang
 TIMEOUT = float(os.environ.get("REGRASP_FUZZ_TIMEOUT", "10"))
 #: outcome kinds that are failures
-BAD = ("panic", "hang", "nan", "out_of_set", "no_field", "accepted", "wrong_field", "traceback", "exit_status")
+BAD = ("panic", "hang", "nan", "out_of_set", "no_field", "accepted", "wrong_field", "traceback", "exit_status",
+       "internal", "clobbered", "temp_left", "memory")
+
+
+#: bytes of data a case may add to the process (RLIMIT_DATA; a subprocess gets this much in all):
+#: an unbounded read fails the case ("memory") instead of the machine
+MEMORY = int(float(os.environ.get("REGRASP_FUZZ_MEMORY_GB", "8")) * 2**30)
+#: peak resident memory [bytes] over which the long profile counts a "memory" outcome
+PEAK = int(float(os.environ.get("REGRASP_FUZZ_PEAK_GB", "2")) * 2**30)
+
+
+def _data_bytes() -> int:
+    """The process's data segment now (VmData) [bytes]."""
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("VmData:"):
+                return int(line.split()[1]) * 1024
+    return 0
+
+
+@contextlib.contextmanager
+def memory_limit(extra: int | None = None):
+    """At most ``extra`` (default :data:`MEMORY`) more bytes of data while the block runs."""
+    soft, hard = resource.getrlimit(resource.RLIMIT_DATA)
+    limit = _data_bytes() + (MEMORY if extra is None else extra)
+    if hard != resource.RLIM_INFINITY:
+        limit = min(limit, hard)
+    resource.setrlimit(resource.RLIMIT_DATA, (limit, hard))
+    try:
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_DATA, (soft, hard))
+
+
+def limit_child() -> None:
+    """A subprocess's ``preexec_fn``: at most :data:`MEMORY` bytes of data in all."""
+    resource.setrlimit(resource.RLIMIT_DATA, (MEMORY, resource.getrlimit(resource.RLIMIT_DATA)[1]))
+
+
+def peak_bytes() -> dict:
+    """Peak resident memory [bytes] of this process and of its largest finished child."""
+    return {"self": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+            "children": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024}
 
 
 settings.register_profile(
@@ -70,8 +114,13 @@ class Recorder:
             raise AssertionError(f"[{kind}] {family}: {what}\n{detail}")
 
     def summary(self) -> dict:
+        peak = peak_bytes()
+        if max(peak.values()) > PEAK and not self.bad.get("memory"):
+            self.bad["memory"] += 1
+            self.examples["memory"].append({"family": "session", "case": "peak resident memory",
+                                            "detail": f"{peak} bytes, over {PEAK}"})
         return {"profile": "long" if LONG else "short", "cases": dict(self.cases),
-                "bad": {k: self.bad.get(k, 0) for k in BAD}, "examples": dict(self.examples)}
+                "bad": {k: self.bad.get(k, 0) for k in BAD}, "examples": dict(self.examples), "peak_bytes": peak}
 
 
 RECORDER = Recorder()
@@ -139,6 +188,8 @@ def judge_exception(e: BaseException, family: str, what: str) -> None:
         pass
     elif isinstance(e, KeyboardInterrupt):
         raise e
+    elif isinstance(e, MemoryError):
+        RECORDER.fail("memory", family, what, f"ran out of its {MEMORY} bytes: an unbounded read?\n{tb}")
     else:
         RECORDER.fail("out_of_set", family, what, tb)
 
@@ -167,7 +218,8 @@ def run(family: str, what: str, fn, timeout: float | None = None, reject: list |
     faulthandler.dump_traceback_later(3 * limit + 5, exit=False)
     t0 = time.monotonic()
     try:
-        out = fn()
+        with memory_limit():
+            out = fn()
     except BaseException as e:  # noqa: BLE001 - judging every outcome is the point
         signal.setitimer(signal.ITIMER_REAL, 0)
         judge_exception(e, family, what)

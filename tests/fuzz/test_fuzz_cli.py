@@ -12,6 +12,7 @@ import io
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -97,14 +98,17 @@ def run_main(argv: list) -> tuple[int, str, str]:
     return status, out.getvalue(), err.getvalue()
 
 
-def judge(family: str, argv: list, result, must: str | None, out_path: str | None) -> None:
-    """Exit status, message and outputs of one run (``must``: the option that is certainly bad)."""
+def judge(family: str, argv: list, result, must: str | None, out_path: str | None, outputs=()) -> None:
+    """Exit status, message and outputs of one run (``must``: the option that is certainly bad;
+    ``outputs``: files the run may write, each checked for NaN/inf when written)."""
     what = "regrasp " + " ".join(argv)
     if result is None:  # an exception escaped main: already recorded by run()
         return
     status, out, err = result
     if "Traceback" in err or "Traceback" in out:
         RECORDER.fail("traceback", family, what, err)
+    if "internal error" in err:
+        RECORDER.fail("internal", family, what, err)
     if status not in (0, 1, 2):
         RECORDER.fail("exit_status", family, what, f"exit {status}\n{err}")
     if must is not None:
@@ -116,13 +120,30 @@ def judge(family: str, argv: list, result, must: str | None, out_path: str | Non
         RECORDER.fail("no_field", family, what, "exit 2 with nothing on stderr")
     if status != 0 and out_path and Path(out_path).read_text() != SENTINEL:
         RECORDER.fail("clobbered", family, what, f"exit {status} but {out_path} was replaced")
-    if status == 0 and "--json" in argv and out.strip():
-        try:
-            bad = non_finite(json.loads(out))
-        except json.JSONDecodeError as e:
-            bad = f"not JSON: {e}"
+    if "--json" in argv and out.strip():  # whatever the status: a JSON answer has no NaN
+        bad = text_non_finite(out, json_text=status == 0)
         if bad:
             RECORDER.fail("nan", family, what, f"printed JSON: {bad}")
+    for f in [out_path, *outputs]:
+        if f and Path(f).is_file() and Path(f).stat().st_size and Path(f).read_text(errors="replace") != SENTINEL:
+            bad = text_non_finite(Path(f).read_text(errors="replace"), json_text=f.endswith(".json"))
+            if bad:
+                RECORDER.fail("nan", family, what, f"{f}: {bad}")
+
+
+_NON_FINITE = re.compile(r"\b(NaN|-?Infinity|nan|-?inf)\b")
+
+
+def text_non_finite(text: str, json_text: bool) -> str | None:
+    """Where an output holds NaN or inf: its JSON's path (``json_text``: it must be JSON), else
+    the first NaN/Infinity token in the text."""
+    if json_text:
+        try:
+            return non_finite(json.loads(text))
+        except json.JSONDecodeError as e:
+            return f"not JSON: {e}"
+    m = _NON_FINITE.search(text)
+    return None if m is None else f"{m.group(0)!r} at {m.start()}: {text[max(0, m.start() - 60):m.end() + 20]!r}"
 
 
 @st.composite

@@ -121,6 +121,14 @@ fn bad_parts_are_errors_naming_the_field() {
     let open = up.replace("f 5 6 8 7\n", "") + &foot(-0.02);
     let m = mesh_error(with_obj(&open, "open"));
     assert!(m.contains("part 0 (`o upright`): the mesh is not closed"), "{m}");
+    // a coordinate that is not finite, or too far, and more vertices than a mesh may have: named
+    for (bad, what) in [("nan", "finite"), ("inf", "finite"), ("1e300", "within 100 m")] {
+        let m = mesh_error(with_obj(&(up.replacen("v -0.012", &format!("v {bad}"), 1) + &foot(-0.02)), "coordinate"));
+        assert!(m.contains(what) && m.contains("line 2"), "{m}");
+    }
+    let unused: String = (0..regrasp::scene::bounds::MAX_MESH_VERTICES).map(|k| format!("v 0 0 {}\n", k as f64 * 1e-6)).collect();
+    let m = mesh_error(with_obj(&(up.clone() + &foot(-0.02) + &unused), "many"));
+    assert!(m.contains("more than 5000 vertices"), "{m}");
     // a pusher point in the notch's air is not on the surface
     let text = std::fs::read_to_string(examples().join("bracket-pivot-3d.toml")).unwrap();
     let bad = text.replace("points = [[-0.008, -0.005, -0.04], [0.036, -0.005, -0.04]", "points = [[0.026, 0.0, -0.005], [0.036, -0.005, -0.04]");
@@ -183,5 +191,5 @@ fn parts_are_bounded_together() {
         first += 200;
     }
     let m = mesh_error(with_obj(&obj, "many"));
-    assert!(m.contains("vertices in all its parts"), "{m}");
+    assert!(m.contains("more than 5000 vertices"), "{m}");
 }

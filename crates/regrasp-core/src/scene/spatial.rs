@@ -451,6 +451,12 @@ fn read_obj(text: &str) -> std::result::Result<(Vec<V3>, Vec<(String, Vec<[usize
                 if c.len() != 3 {
                     return Err(format!("line {}: a vertex needs 3 coordinates", ln + 1));
                 }
+                if let Some(x) = c.iter().find(|x| !(x.is_finite() && x.abs() <= bounds::COORD.hi)) {
+                    return Err(format!("line {}: a coordinate must be finite and within {} m (got {x})", ln + 1, bounds::COORD.hi));
+                }
+                if v.len() == bounds::MAX_MESH_VERTICES {
+                    return Err(format!("line {}: more than {} vertices (the most a mesh may have)", ln + 1, bounds::MAX_MESH_VERTICES));
+                }
                 v.push(V3::new(c[0], c[1], c[2]));
             }
             Some(kw @ ("o" | "g")) => {
