@@ -25,7 +25,8 @@ from hypothesis import strategies as st
 import regrasp
 from regrasp import cli
 
-from .harness import RECORDER, fuzz_settings, non_finite, run
+from . import harness
+from .harness import fuzz_settings, non_finite, run
 from .strategies import EXAMPLES
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -106,29 +107,29 @@ def judge(family: str, argv: list, result, must: str | None, out_path: str | Non
         return
     status, out, err = result
     if "Traceback" in err or "Traceback" in out:
-        RECORDER.fail("traceback", family, what, err)
+        harness.RECORDER.fail("traceback", family, what, err)
     if "internal error" in err:
-        RECORDER.fail("internal", family, what, err)
+        harness.RECORDER.fail("internal", family, what, err)
     if status not in (0, 1, 2):
-        RECORDER.fail("exit_status", family, what, f"exit {status}\n{err}")
+        harness.RECORDER.fail("exit_status", family, what, f"exit {status}\n{err}")
     if must is not None:
         if status != 2:
-            RECORDER.fail("accepted", family, what, f"exit {status} for a bad {must}\n{err}")
+            harness.RECORDER.fail("accepted", family, what, f"exit {status} for a bad {must}\n{err}")
         elif must not in err:
-            RECORDER.fail("wrong_field", family, what, f"stderr does not name {must}:\n{err}")
+            harness.RECORDER.fail("wrong_field", family, what, f"stderr does not name {must}:\n{err}")
     if status == 2 and not err.strip():
-        RECORDER.fail("no_field", family, what, "exit 2 with nothing on stderr")
+        harness.RECORDER.fail("no_field", family, what, "exit 2 with nothing on stderr")
     if status != 0 and out_path and Path(out_path).read_text() != SENTINEL:
-        RECORDER.fail("clobbered", family, what, f"exit {status} but {out_path} was replaced")
+        harness.RECORDER.fail("clobbered", family, what, f"exit {status} but {out_path} was replaced")
     if "--json" in argv and out.strip():  # whatever the status: a JSON answer has no NaN
         bad = text_non_finite(out, json_text=status == 0)
         if bad:
-            RECORDER.fail("nan", family, what, f"printed JSON: {bad}")
+            harness.RECORDER.fail("nan", family, what, f"printed JSON: {bad}")
     for f in [out_path, *outputs]:
         if f and Path(f).is_file() and Path(f).stat().st_size and Path(f).read_text(errors="replace") != SENTINEL:
             bad = text_non_finite(Path(f).read_text(errors="replace"), json_text=f.endswith(".json"))
             if bad:
-                RECORDER.fail("nan", family, what, f"{f}: {bad}")
+                harness.RECORDER.fail("nan", family, what, f"{f}: {bad}")
 
 
 _NON_FINITE = re.compile(r"\b(NaN|-?Infinity|nan|-?inf)\b")
@@ -240,7 +241,7 @@ def test_unwritable_output(argv, which, tmp_path_factory):
           files["out"] if files["out"] in argv else None)
     for k, before in scene_before.items():
         if Path(files[k]).read_bytes() != before:
-            RECORDER.fail("clobbered", "cli.output", what, f"the input {files[k]} was overwritten")
+            harness.RECORDER.fail("clobbered", "cli.output", what, f"the input {files[k]} was overwritten")
 
 
 CONFLICTS = [
@@ -300,13 +301,13 @@ def test_real_process_no_traceback(argv, tail, status, tmp_path):
     files["bad"] = str(tmp_path / "list.json")
     argv = fill(argv, files)
     what = "regrasp " + " ".join(argv) + tail
-    RECORDER.case("cli.process")
+    harness.RECORDER.case("cli.process")
     try:
         p = _regrasp(argv, timeout=60, shell_tail=tail)
     except subprocess.TimeoutExpired:
-        RECORDER.fail("hang", "cli.process", what, "ran past 60 s")
+        harness.RECORDER.fail("hang", "cli.process", what, "ran past 60 s")
         return
     if "Traceback" in p.stderr or "Error" in p.stderr.split(":")[0]:
-        RECORDER.fail("traceback", "cli.process", what, p.stderr)
+        harness.RECORDER.fail("traceback", "cli.process", what, p.stderr)
     if status is not None and p.returncode != status:
-        RECORDER.fail("exit_status", "cli.process", what, f"exit {p.returncode}, expected {status}\n{p.stderr}")
+        harness.RECORDER.fail("exit_status", "cli.process", what, f"exit {p.returncode}, expected {status}\n{p.stderr}")

@@ -27,7 +27,8 @@ from regrasp.dexterity.graph import GraspGraph
 from regrasp.execution.trajectory import Trajectory
 from regrasp.workcell import Workcell
 
-from .harness import RECORDER, fuzz_settings, limit_child, run
+from . import harness
+from .harness import fuzz_settings, limit_child, run
 from .strategies import EXAMPLES
 from .test_fuzz_cli import SENTINEL, judge, run_main, text_non_finite
 from .world_files import KINDS, MESH, MESH_SCENE, graph_base, mutated_file, mutated_mesh, plan_base, workcell_base
@@ -64,7 +65,7 @@ def _load(kind: str, path: Path):
             "graph": GraspGraph.load, "trajectory": Trajectory.load}[kind](path)
 
 
-@fuzz_settings(15, 2500)
+@fuzz_settings(15, 8000)
 @given(kind=st.sampled_from(sorted(KINDS)), data=st.data())
 def test_mutated_world_files(kind, data, tmp_path_factory):
     text, what, must = data.draw(mutated_file(kind))
@@ -73,7 +74,7 @@ def test_mutated_world_files(kind, data, tmp_path_factory):
     run(f"world.{kind}", f"{kind}: {what}", lambda: _use(kind, _load(kind, path)), timeout=30, reject=must or None)
 
 
-@fuzz_settings(8, 800)
+@fuzz_settings(8, 1500)
 @given(case=mutated_mesh())
 def test_mutated_meshes(case, tmp_path_factory):
     text, what, must = case
@@ -164,7 +165,7 @@ def _fill(argv: list, files: dict) -> list:
     return [a.format(**files) for a in argv]
 
 
-@fuzz_settings(12, 600)
+@fuzz_settings(12, 1000)
 @given(case=world_invocation())
 def test_world_commands_with_bad_input(case, tmp_path_factory):
     name, argv, must = case
@@ -173,14 +174,14 @@ def test_world_commands_with_bad_input(case, tmp_path_factory):
     r = run(f"cli.{name}", "regrasp " + " ".join(argv), lambda: run_main(argv), timeout=60)
     judge(f"cli.{name}", argv, r, must, files["out"] if files["out"] in argv else None, outputs=[files["traj"]])
     if r is not None and r[0] != 0 and Path(files["traj"]).read_text() != SENTINEL:
-        RECORDER.fail("clobbered", f"cli.{name}", " ".join(argv), "a failed run replaced the trajectory file")
+        harness.RECORDER.fail("clobbered", f"cli.{name}", " ".join(argv), "a failed run replaced the trajectory file")
     _no_temporary_files(f"cli.{name}", " ".join(argv), files["base"])
 
 
 def _no_temporary_files(family: str, what: str, folder: str) -> None:
     left = [p.name for p in Path(folder).rglob(".*tmp*")]
     if left:
-        RECORDER.fail("temp_left", family, what, f"temporary files left behind: {left}")
+        harness.RECORDER.fail("temp_left", family, what, f"temporary files left behind: {left}")
 
 
 @st.composite
@@ -211,9 +212,9 @@ def test_valid_world_runs_succeed_with_finite_outputs(argv, tmp_path_factory):
     r = run("cli.valid-run", what, lambda: run_main(argv), timeout=60)
     judge("cli.valid-run", argv, r, None, None, outputs=[files["traj"]])
     if r is not None and r[0] not in (0, 1):
-        RECORDER.fail("exit_status", "cli.valid-run", what, f"a valid run exited {r[0]}: {r[2]}")
+        harness.RECORDER.fail("exit_status", "cli.valid-run", what, f"a valid run exited {r[0]}: {r[2]}")
     if r is not None and r[0] == 0 and "--trajectory" in argv and Path(files["traj"]).read_text() == SENTINEL:
-        RECORDER.fail("exit_status", "cli.valid-run", what, "exit 0 without writing the trajectory")
+        harness.RECORDER.fail("exit_status", "cli.valid-run", what, "exit 0 without writing the trajectory")
 
 
 @fuzz_settings(3, 60)
@@ -226,7 +227,7 @@ def test_valid_sequences_succeed_with_finite_outputs(ab, objective, tmp_path_fac
     r = run("cli.valid-sequence", "regrasp " + " ".join(argv), lambda: run_main(argv))
     judge("cli.valid-sequence", argv, r, None, None)
     if r is not None and r[0] != 0:
-        RECORDER.fail("exit_status", "cli.valid-sequence", " ".join(argv), f"exit {r[0]}: {r[2]}")
+        harness.RECORDER.fail("exit_status", "cli.valid-sequence", " ".join(argv), f"exit {r[0]}: {r[2]}")
 
 
 # --- real processes: SIGTERM and closed streams -------------------------------------------------
@@ -257,7 +258,7 @@ def test_sigterm_at_any_moment(argv, after, tmp_path_factory):
     files = _files(tmp_path_factory.mktemp("term"))
     argv = _fill(argv, files)
     what = f"regrasp {' '.join(argv)} + SIGTERM after {after:.2f} s"
-    RECORDER.case("process.sigterm")
+    harness.RECORDER.case("process.sigterm")
     p = _process(argv, cwd=files["base"])
     time.sleep(after)
     p.send_signal(signal.SIGTERM)
@@ -266,24 +267,24 @@ def test_sigterm_at_any_moment(argv, after, tmp_path_factory):
     except subprocess.TimeoutExpired:
         os.killpg(p.pid, signal.SIGKILL)
         p.communicate()
-        RECORDER.fail("hang", "process.sigterm", what, "still running 30 s after SIGTERM")
+        harness.RECORDER.fail("hang", "process.sigterm", what, "still running 30 s after SIGTERM")
         return
     if "Traceback" in err or "internal error" in err:
-        RECORDER.fail("traceback", "process.sigterm", what, err)
+        harness.RECORDER.fail("traceback", "process.sigterm", what, err)
     stopped = err.strip().endswith("regrasp: terminated")
     if p.returncode == 143 and not stopped:
-        RECORDER.fail("exit_status", "process.sigterm", what, f"143 but stderr {err!r}")
+        harness.RECORDER.fail("exit_status", "process.sigterm", what, f"143 but stderr {err!r}")
     # -15: the signal came before the command set its handler (Python still importing) or after
     # it restored the default one (the interpreter ending): the default action ends it, 143 to
     # the shell; its outputs are then untouched or complete
     if p.returncode not in (0, 1, 143, -signal.SIGTERM):
-        RECORDER.fail("exit_status", "process.sigterm", what, f"exit {p.returncode}\n{err}")
+        harness.RECORDER.fail("exit_status", "process.sigterm", what, f"exit {p.returncode}\n{err}")
     for k in ("out", "traj"):
         text = Path(files[k]).read_text(errors="replace")
         if stopped and text != SENTINEL:
-            RECORDER.fail("clobbered", "process.sigterm", what, f"terminated, but {files[k]} was written")
+            harness.RECORDER.fail("clobbered", "process.sigterm", what, f"terminated, but {files[k]} was written")
         elif text != SENTINEL and text_non_finite(text, json_text=True):
-            RECORDER.fail("nan", "process.sigterm", what, f"{files[k]} (incomplete?): {text_non_finite(text, True)}")
+            harness.RECORDER.fail("nan", "process.sigterm", what, f"{files[k]} (incomplete?): {text_non_finite(text, True)}")
     _no_temporary_files("process.sigterm", what, files["base"])
 
 
@@ -302,17 +303,17 @@ def test_closed_streams(argv, tail, tmp_path):
     files = _files(tmp_path)
     argv = _fill(argv, files)
     what = f"regrasp {' '.join(argv)}{tail}"
-    RECORDER.case("process.streams")
+    harness.RECORDER.case("process.streams")
     p = _process(argv, tail, cwd=tmp_path)
     try:
         _, err = p.communicate(timeout=60)
     except subprocess.TimeoutExpired:
         os.killpg(p.pid, signal.SIGKILL)
-        RECORDER.fail("hang", "process.streams", what, "ran past 60 s")
+        harness.RECORDER.fail("hang", "process.streams", what, "ran past 60 s")
         return
     if "Traceback" in err or "internal error" in err:
-        RECORDER.fail("traceback", "process.streams", what, err)
+        harness.RECORDER.fail("traceback", "process.streams", what, err)
     if p.returncode not in (0, 1, 2):
-        RECORDER.fail("exit_status", "process.streams", what, f"exit {p.returncode}\n{err}")
+        harness.RECORDER.fail("exit_status", "process.streams", what, f"exit {p.returncode}\n{err}")
     if "/dev/zero" in argv and p.returncode != 2:
-        RECORDER.fail("accepted", "process.streams", what, f"exit {p.returncode} for --plan /dev/zero")
+        harness.RECORDER.fail("accepted", "process.streams", what, f"exit {p.returncode} for --plan /dev/zero")

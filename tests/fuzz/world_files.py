@@ -132,7 +132,7 @@ def mutated_file(draw, kind: str):
         new = draw(st.sampled_from(REPLACEMENTS))
         _parent(d, p)[p[-1]] = new
         hostile = isinstance(new, float) and not math.isfinite(new) and _types(v) == "number"
-        retyped = _types(new) != _types(v) and not (_types(new) == "null" and field in nullable)
+        retyped = _types(new) != _types(v) and field not in nullable  # a nullable field takes null or a value
         certain = (hostile or retyped) and not _free(field, free)
         if fmt == "toml" and new is None:  # TOML has no null: the key is dropped
             del _parent(d, p)[p[-1]]
@@ -165,6 +165,8 @@ def mutated_file(draw, kind: str):
             return text[: len(text) // 2] + "\udcff\udcfe\x00", "binary", []
         what = "unchanged"
     must = [prefix + field.split(".")[0].split("[")[0]] if certain else []
+    if certain and kind == "trajectory" and op == "replace" and isinstance(new, float) and not math.isfinite(new):
+        must.append(PARSE_FIELD[kind])  # NaN and Infinity are not JSON: the trajectory reader refuses the text
     return text_of(d, fmt), what, must
 
 

@@ -500,6 +500,9 @@ def edges_to_measure(obj, settings: Settings, clear: dict | None = None) -> list
     from .actions import ACTIONS
 
     names = list(ACTIONS) if settings.actions is None else list(settings.actions)
+    if not names:
+        raise ArgumentError(f"invalid `actions`: name at least one action (None: all; known: {', '.join(ACTIONS)})",
+                            "actions")
     for n in names:
         if n not in ACTIONS:
             raise ArgumentError(f"invalid `actions`: unknown action {n!r} (known: {', '.join(ACTIONS)})", "actions")
