@@ -182,3 +182,9 @@ def test_nesting_at_the_limit_is_read_and_one_deeper_is_refused(tmp_path):
                         ("a" + ".a" * (MAX_NESTING + 1) + " = 1", parse_toml)):  # dotted keys: depth after parsing
         with pytest.raises(ArgumentError, match="nested more than"):
             parse(text, "x")
+
+
+@pytest.mark.parametrize("place, field", [("0.45,-0.2,-5,1,0,0,0", "place"),  # 5 m under the table
+                                          ("50,0,0.8,1,0,0,0", "place")])  # beside it
+def test_a_place_off_the_table_is_refused(place, field):
+    refused(regrasp_cli("pick-place", SCENE, "--place", place, "--plan-only"), field)

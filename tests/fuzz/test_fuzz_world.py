@@ -250,18 +250,25 @@ SIGTERM_CASES = [
 ]
 
 
+#: the signal -> (the status after it, the last line on stderr)
+STOPS = {signal.SIGTERM: (143, "regrasp: terminated"), signal.SIGINT: (130, "regrasp: interrupted")}
+
+
 @fuzz_settings(3, 60)
-@given(argv=st.sampled_from(SIGTERM_CASES), after=st.floats(0.8, 4.0))
-def test_sigterm_at_any_moment(argv, after, tmp_path_factory):
-    """SIGTERM at a random moment: exit 143 with "regrasp: terminated" (or the run's own status when
-    it had finished), no traceback, the outputs as they were or complete, no temporary file."""
+@given(argv=st.sampled_from(SIGTERM_CASES), after=st.floats(0.8, 4.0), sig=st.sampled_from(sorted(STOPS)))
+def test_sigterm_at_any_moment(argv, after, sig, tmp_path_factory):
+    """SIGTERM (or Ctrl-C's SIGINT) at a random moment — planning, MuJoCo, the arm's world, a
+    process pool: exit 143 with "regrasp: terminated" (130, "interrupted"), or the run's own
+    status when it had finished; no traceback, the outputs as they were or complete, no temporary
+    file, no worker left."""
+    status, line = STOPS[sig]
     files = _files(tmp_path_factory.mktemp("term"))
     argv = _fill(argv, files)
-    what = f"regrasp {' '.join(argv)} + SIGTERM after {after:.2f} s"
+    what = f"regrasp {' '.join(argv)} + {signal.Signals(sig).name} after {after:.2f} s"
     harness.RECORDER.case("process.sigterm")
     p = _process(argv, cwd=files["base"])
     time.sleep(after)
-    p.send_signal(signal.SIGTERM)
+    p.send_signal(sig)
     try:
         out, err = p.communicate(timeout=30)
     except subprocess.TimeoutExpired:
@@ -271,21 +278,41 @@ def test_sigterm_at_any_moment(argv, after, tmp_path_factory):
         return
     if "Traceback" in err or "internal error" in err:
         harness.RECORDER.fail("traceback", "process.sigterm", what, err)
-    stopped = err.strip().endswith("regrasp: terminated")
-    if p.returncode == 143 and not stopped:
-        harness.RECORDER.fail("exit_status", "process.sigterm", what, f"143 but stderr {err!r}")
-    # -15: the signal came before the command set its handler (Python still importing) or after
-    # it restored the default one (the interpreter ending): the default action ends it, 143 to
-    # the shell; its outputs are then untouched or complete
-    if p.returncode not in (0, 1, 143, -signal.SIGTERM):
+    stopped = err.strip().endswith(line)
+    if p.returncode == status and not stopped:
+        harness.RECORDER.fail("exit_status", "process.sigterm", what, f"{status} but stderr {err!r}")
+    # -15 (SIGTERM) or 130 without the line (SIGINT, Python's own KeyboardInterrupt exit): the
+    # signal came before the command set its handler (Python still importing) or after it
+    # restored the default one (the interpreter ending); its outputs are then untouched or complete
+    if p.returncode not in (0, 1, status, -sig) or (p.returncode == status and "Traceback" in err):
         harness.RECORDER.fail("exit_status", "process.sigterm", what, f"exit {p.returncode}\n{err}")
     for k in ("out", "traj"):
         text = Path(files[k]).read_text(errors="replace")
         if stopped and text != SENTINEL:
-            harness.RECORDER.fail("clobbered", "process.sigterm", what, f"terminated, but {files[k]} was written")
+            harness.RECORDER.fail("clobbered", "process.sigterm", what, f"stopped, but {files[k]} was written")
         elif text != SENTINEL and text_non_finite(text, json_text=True):
             harness.RECORDER.fail("nan", "process.sigterm", what, f"{files[k]} (incomplete?): {text_non_finite(text, True)}")
     _no_temporary_files("process.sigterm", what, files["base"])
+    _no_workers_left("process.sigterm", what, p.pid)
+
+
+def _no_workers_left(family: str, what: str, pid: int) -> None:
+    """No process of the stopped command's session (its pool workers) outlives it by a second."""
+    deadline = time.monotonic() + 1.0
+    while time.monotonic() < deadline:
+        left = [d for d in os.listdir("/proc") if d.isdigit() and _session(int(d)) == pid]
+        if not left:
+            return
+        time.sleep(0.1)
+    harness.RECORDER.fail("hang", family, what, f"processes of its session still running: {left}")
+
+
+def _session(pid: int) -> int | None:
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return int(f.read().rsplit(")", 1)[1].split()[3])  # state, ppid, pgrp, session
+    except (OSError, ValueError, IndexError):
+        return None
 
 
 STREAM_CASES = [

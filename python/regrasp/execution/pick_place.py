@@ -368,12 +368,17 @@ def reachable(robot, avoid, tcp, G) -> np.ndarray | None:
         return None
 
 
-def check_place(place, field_: str = "place") -> np.ndarray:
-    """``place`` as a pose ``[x, y, z, qw, qx, qy, qz]`` (m, quaternion normalised); ArgumentError
-    naming ``field_`` otherwise."""
+def check_place(place, field_: str = "place", table=None) -> np.ndarray:
+    """``place`` as a pose ``[x, y, z, qw, qx, qy, qz]`` (m, quaternion normalised), with ``table``
+    (a workcell's) on it (:meth:`~regrasp.workcell.Table.off`); ArgumentError naming ``field_``
+    otherwise."""
     a = np.asarray(place, float) if isinstance(place, (list, tuple, np.ndarray)) else None
     if a is None or a.shape != (7,) or not np.all(np.isfinite(a)) or np.linalg.norm(a[3:]) < 1e-6:
         raise ArgumentError(f"invalid `{field_}`: a pose x,y,z,qw,qx,qy,qz (m, quaternion) (got {place!r:.80})", field_)
+    off = None if table is None else table.off(a)
+    if off is not None:
+        raise ArgumentError(f"invalid `{field_}`: the object's pose on the table: [{off[0]}] {off[1]} (got "
+                            f"{a[off[0]]:g})", field_)
     return np.r_[a[:3], a[3:] / np.linalg.norm(a[3:])]
 
 
@@ -393,8 +398,8 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
     if not isinstance(workcell, Workcell):
         raise ArgumentError(f"invalid `workcell`: a Workcell (got {type(workcell).__name__})", "workcell")
     d_pick, d_place = default_poses(scene, workcell)
-    pick_pose = d_pick if pick is None else check_place(pick, "pick")
-    place_pose = d_place if place is None else check_place(place)
+    pick_pose = d_pick if pick is None else check_place(pick, "pick", workcell.table)
+    place_pose = d_place if place is None else check_place(place, "place", workcell.table)
     if isinstance(depth, bool) or not isinstance(depth, (int, float)) or not (0 <= depth < 1):
         raise ArgumentError(f"invalid `depth`: a height in [0, 1) m (got {depth!r:.40})", "depth")
     start, goal = spots(scene)

@@ -96,6 +96,20 @@ class Table:
         object.__setattr__(self, "center", check_numbers(self.center, 2, "table.center", "coordinate"))
 
 
+    def off(self, pose) -> tuple[int, str] | None:
+        """Why an object's origin at world ``pose`` (m) is not on the table — (the pose's index at
+        fault, what it must be) — or None: it lies over the table's rectangle and above its top by
+        at most the largest object size (10 m)."""
+        p, most = np.asarray(pose, float), BOUNDS["size"][1]
+        if not self.height < p[2] <= self.height + most:
+            return 2, f"must be above the table top ({self.height:g} m) by at most {most:g} m"
+        off = np.abs(p[:2] - self.center) - self.size / 2
+        if np.any(off > 1e-9):
+            return int(np.argmax(off)), (f"must lie over the table (its centre {self.center.tolist()}, size "
+                                         f"{self.size.tolist()} m)")
+        return None
+
+
 @dataclass(frozen=True, eq=False)
 class Feature:
     """A fixed feature in the world frame: ``kind`` ``"edge"`` (a segment of ``length`` [m] along
@@ -248,19 +262,13 @@ class Workcell:
             seen[f.name] = i
 
     def _check_start(self) -> None:
-        """An object starting on the table starts on it: its origin above the table top (by at most
-        the largest object size, 10 m) and over the table's rectangle."""
+        """An object starting on the table starts on it (:meth:`Table.off`)."""
         if self.object.on != "table":
             return
-        p, t = self.object.pose, self.table
-        if not t.height < p[2] <= t.height + BOUNDS["size"][1]:
-            raise _fail("object.pose[2]", f"must be above the table top ({t.height:g} m) by at most "
-                        f"{BOUNDS['size'][1]:g} m: the object starts on the table", float(p[2]))
-        off = np.abs(p[:2] - t.center) - t.size / 2
-        if np.any(off > 1e-9):
-            k = int(np.argmax(off))
-            raise _fail(f"object.pose[{k}]", f"must lie over the table (its centre {t.center.tolist()}, size "
-                        f"{t.size.tolist()} m): the object starts on the table", float(p[k]))
+        off = self.table.off(self.object.pose)
+        if off is not None:
+            k, why = off
+            raise _fail(f"object.pose[{k}]", f"{why}: the object starts on the table", float(self.object.pose[k]))
 
     def __eq__(self, other) -> bool:
         """Workcells are equal when their files are (:meth:`to_dict`)."""
