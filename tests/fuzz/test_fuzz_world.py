@@ -55,8 +55,15 @@ def _use(kind: str, value):
     if kind == "graph":
         from regrasp.dexterity.sequence import plan
 
-        names = value.node_names
-        return [plan(value, a, b) for a in names[:2] for b in names[:3] if a != b]
+        found = []
+        for a in value.node_names[:2]:
+            for b in value.node_names[:3]:
+                try:
+                    found.append(plan(value, a, b))
+                except regrasp.ArgumentError as e:  # no measured sequence between them: a valid answer
+                    if e.field != "to":
+                        raise
+        return found
     return Trajectory.from_json(value.to_json()).to_json()
 
 
@@ -65,7 +72,7 @@ def _load(kind: str, path: Path):
             "graph": GraspGraph.load, "trajectory": Trajectory.load}[kind](path)
 
 
-@fuzz_settings(15, 8000)
+@fuzz_settings(15, 9500)
 @given(kind=st.sampled_from(sorted(KINDS)), data=st.data())
 def test_mutated_world_files(kind, data, tmp_path_factory):
     text, what, must = data.draw(mutated_file(kind))
@@ -308,9 +315,12 @@ def _no_workers_left(family: str, what: str, pid: int) -> None:
 
 
 def _session(pid: int) -> int | None:
+    """The session of a live process ``pid`` (None for a zombie, which has ended: an init that
+    does not reap, as in some containers, leaves them)."""
     try:
         with open(f"/proc/{pid}/stat") as f:
-            return int(f.read().rsplit(")", 1)[1].split()[3])  # state, ppid, pgrp, session
+            state, _, _, session = f.read().rsplit(")", 1)[1].split()[:4]
+        return None if state in "ZX" else int(session)
     except (OSError, ValueError, IndexError):
         return None
 

@@ -18,6 +18,7 @@ from hypothesis import strategies as st
 
 import regrasp
 from regrasp.fields import LIMITS, MAX_NESTING
+from regrasp.planning.plan import KEYS as PLAN_KEYS
 from regrasp.workcell import Workcell, bundled
 
 from .strategies import EXAMPLES, HOSTILE_NUMBERS, _parent, dotted, leaves, to_toml
@@ -84,12 +85,13 @@ def trajectory_base() -> str:
 #: paths that may be null, whether unknown keys are refused, the prefix of every field named)
 KINDS = {
     "workcell": (workcell_base, "toml", ("description",), (), True, ""),
-    "plan": (plan_base, "json", ("scene", "stop_reason", "propagation", "path[0].pusher"), ("path[0].pusher",),
+    "plan": (plan_base, "json", ("scene", "stop_reason", "propagation", "path[0].pusher"),
+             ("path[0].pusher",) + tuple(k for k in PLAN_KEYS[2] if k != "path"),  # null: not known
              False, "plan."),
     "graph": (graph_base, "json", ("object.", "edges[0].detail", "edges[1].detail", "actions[0].summary",
                                    "actions[0].resource", "actions[1].summary", "actions[1].resource",
                                    "settings.actions", "chained"),
-              ("edges[0].to", "edges[1].to", "edges[0].runs[1].pose", "edges[0].runs[0].pose", "edges[0].runs[2].pose",
+              ("edges[0].to", "edges[1].to", "edges[0].success_rate", "edges[1].success_rate", "edges[0].runs[1].pose", "edges[0].runs[0].pose", "edges[0].runs[2].pose",
                "settings.actions"), False, ""),
     "trajectory": (trajectory_base, "json", (), ("robot",) + tuple(f"samples[{i}].push" for i in range(12)), True, ""),
 }

@@ -55,6 +55,9 @@ def _start_error(scene, a, plan=None):
     if scene.dimension != 2:
         raise ArgumentError("invalid `--start-error`: planar scenes only", "--start-error")
     se = floats(a.start_error, 3, "--start-error")
+    if np.max(np.abs(se[:2])) > 1.0 or abs(se[2]) > np.pi:
+        raise ArgumentError(f"invalid `--start-error`: a perturbation of the start, at most 1 m and pi rad (got "
+                            f"{a.start_error})", "--start-error")
     if plan is not None and not scene.admissible(np.asarray(plan.poses[0], float) + se):
         raise ArgumentError("invalid `--start-error`: from the plan's start it puts the pad off the object",
                             "--start-error")

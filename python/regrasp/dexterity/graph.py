@@ -17,6 +17,7 @@ docs/grasp-graph.md."""
 from __future__ import annotations
 
 import json
+import math
 import multiprocessing
 import signal
 import time
@@ -145,8 +146,13 @@ class Edge:
 
 
 def _is_number(x) -> bool:
-    """Whether ``x`` is a finite JSON number (not a bool)."""
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and bool(np.isfinite(x))
+    """Whether ``x`` is a finite JSON number (not a bool; an integer too large for a float is not)."""
+    if not isinstance(x, (int, float)) or isinstance(x, bool):
+        return False
+    try:
+        return math.isfinite(float(x))
+    except OverflowError:
+        return False
 
 
 def _node(n: dict, f: str) -> None:
@@ -204,9 +210,7 @@ def _settings(s: dict, known: set) -> dict:
 
 def _numbers(v, n: int, positive: bool = False) -> bool:
     """Whether ``v`` is a list of ``n`` finite numbers (> 0 with ``positive``)."""
-    return isinstance(v, list) and len(v) == n and all(
-        isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) and (x > 0 or not positive)
-        for x in v)
+    return isinstance(v, list) and len(v) == n and all(_is_number(x) and (x > 0 or not positive) for x in v)
 
 
 def _runs(runs, f: str, trials: int, outcomes: dict) -> list:
