@@ -111,6 +111,8 @@ def test_the_graph_file_round_trips(tmp_path):
     (lambda d: d["edges"][0].update(action="levitate"), "edges[0].action"),
     (lambda d: d.update(actions=[{"name": "levitate"}]), "actions[0]"),
     (lambda d: d.update(actions=["gravity-slide"]), "actions[0]"),
+    (lambda d: d["actions"][0].update(name=[1e300]), "actions[0]"),  # not a name (found by the fuzz suite)
+    (lambda d: d.update(seconds=10**400), "seconds"),  # too large for a float
     (lambda d: d["edges"][0].update(success_rate=5), "edges[0].success_rate"),
     (lambda d: d["edges"][0].update(success_rate=float("nan")), "edges[0].success_rate"),
     (lambda d: d["edges"][0].update(success_rate=0.5), "edges[0].success_rate"),

@@ -349,7 +349,7 @@ class GraspGraph:
             _node(n, f"nodes[{i}]")
         known = _known_actions()
         for i, a in enumerate(d["actions"]):
-            if not (isinstance(a, dict) and a.get("name") in known):
+            if not (isinstance(a, dict) and isinstance(a.get("name"), str) and a["name"] in known):
                 raise ArgumentError(f"invalid `actions[{i}]`: a regrasp action, {{\"name\": one of "
                                     f"{', '.join(sorted(known))}, ...}} (got {a!r:.60})", f"actions[{i}]")
         measured = [a["name"] for a in d["actions"]]
