@@ -30,11 +30,13 @@ __all__ = [
     "se3_compose",
     "se3_inverse",
     "MAX_MAGNITUDE",
+    "LIMITS",
     "__version__",
 ]
 
 __version__: str
 MAX_MAGNITUDE: float
+LIMITS: dict[str, float]
 
 _Floats = NDArray[np.float64]
 _Bools = NDArray[np.bool_]

@@ -17,7 +17,6 @@ docs/grasp-graph.md."""
 from __future__ import annotations
 
 import json
-import math
 import multiprocessing
 import signal
 import time
@@ -29,6 +28,7 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..fields import MAX_GRAPH_EDGES, MAX_GRAPH_NODES
+from .graph_values import is_number, known_actions, check_node, check_seconds, check_settings
 from ..files import parse_json, read_text, write_text
 from .. import progress as bars
 
@@ -133,84 +133,21 @@ class Edge:
         detail = d.get("detail", {})
         if not isinstance(detail, dict):
             raise ArgumentError(f"invalid `{f}.detail`: an object", f"{f}.detail")
-        seconds = _seconds(d.get("seconds", 0.0), f"{f}.seconds")
+        seconds = check_seconds(d.get("seconds", 0.0), f"{f}.seconds")
         runs = _runs(d.get("runs", []), f"{f}.runs", d["trials"], out)
         return cls(d["from"], d["action"], d.get("to"), d["trials"], dict(out), dict(detail), seconds, runs)
 
     def check_rate(self, rate, f: str) -> None:
         """A file's ``success_rate`` of this edge (None: not given) is its outcomes' share that
         reached ``to``, in [0, 1]; else an ArgumentError naming ``f``."""
-        if rate is not None and not (_is_number(rate) and 0 <= rate <= 1 and abs(rate - self.success_rate) <= 1e-9):
+        if rate is not None and not (is_number(rate) and 0 <= rate <= 1 and abs(rate - self.success_rate) <= 1e-9):
             raise ArgumentError(f"invalid `{f}`: the share of `trials` that reached `to`, in [0, 1] "
                                 f"({self.success_rate:g} by its outcomes; got {rate!r:.40})", f)
 
 
-def _is_number(x) -> bool:
-    """Whether ``x`` is a finite JSON number (not a bool; an integer too large for a float is not)."""
-    if not isinstance(x, (int, float)) or isinstance(x, bool):
-        return False
-    try:
-        return math.isfinite(float(x))
-    except OverflowError:
-        return False
-
-
-def _node(n: dict, f: str) -> None:
-    """A graph file's node ``f``: a grasp (:meth:`~regrasp.dexterity.taxonomy.Grasp.from_dict`)
-    with its hand's signed ``clearance`` [m] (< 0: the hand collides) and whether it ``fits``; an ArgumentError naming the
-    node's field."""
-    from .taxonomy import Grasp
-
-    try:
-        Grasp.from_dict(n)
-    except ArgumentError as e:
-        raise ArgumentError(str(e).replace(f"`{e.field}`", f"`{f}.{e.field}`", 1), f"{f}.{e.field}") from None
-    if "clearance" in n and not (_is_number(n["clearance"]) and abs(n["clearance"]) <= 10):
-        raise ArgumentError(f"invalid `{f}.clearance`: metres in [-10, 10] (got {n['clearance']!r:.40})", f"{f}.clearance")
-    if "fits" in n and not isinstance(n["fits"], bool):
-        raise ArgumentError(f"invalid `{f}.fits`: true or false (got {n['fits']!r:.40})", f"{f}.fits")
-
-
-def _seconds(v, f: str) -> float:
-    """A wall time [s] of a graph file: a finite number >= 0; else an ArgumentError naming ``f``."""
-    if not (_is_number(v) and v >= 0):
-        raise ArgumentError(f"invalid `{f}`: seconds, a finite number >= 0 (got {v!r:.40})", f)
-    return float(v)
-
-
-def _known_actions() -> set:
-    """The names of the regrasp actions."""
-    from .actions import ACTIONS
-
-    return set(ACTIONS)
-
-
-def _settings(s: dict, known: set) -> dict:
-    """A graph file's ``settings`` (those of :class:`Settings`), each value checked; an
-    ArgumentError naming ``settings.KEY``."""
-    whole = lambda v, lo: isinstance(v, int) and not isinstance(v, bool) and v >= lo  # noqa: E731
-    checks = {"trials": (lambda v: whole(v, 1), "a whole number >= 1"),
-              "seed": (lambda v: whole(v, 0), "a whole number >= 0"),
-              "spread": (lambda v: _is_number(v) and 0 <= v < 1, "a share in [0, 1)"),
-              "shift": (lambda v: _is_number(v) and 0 <= v <= 1, "metres in [0, 1]"),
-              "turn": (lambda v: _is_number(v) and 0 <= v <= np.pi, "radians in [0, pi]"),
-              "actions": (lambda v: v is None or (isinstance(v, list) and all(a in known for a in v if isinstance(a, str))
-                                                  and all(isinstance(a, str) for a in v)),
-                          "null or a list of regrasp actions"),
-              "chain": (lambda v: isinstance(v, bool), "true or false")}
-    for k, v in s.items():
-        if k not in checks:
-            raise ArgumentError(f"invalid `settings.{k}`: unknown setting (the settings: {', '.join(checks)})",
-                                f"settings.{k}")
-        ok, what = checks[k]
-        if not ok(v):
-            raise ArgumentError(f"invalid `settings.{k}`: {what} (got {v!r:.40})", f"settings.{k}")
-    return dict(s)
-
-
 def _numbers(v, n: int, positive: bool = False) -> bool:
     """Whether ``v`` is a list of ``n`` finite numbers (> 0 with ``positive``)."""
-    return isinstance(v, list) and len(v) == n and all(_is_number(x) and (x > 0 or not positive) for x in v)
+    return isinstance(v, list) and len(v) == n and all(is_number(x) and (x > 0 or not positive) for x in v)
 
 
 def _runs(runs, f: str, trials: int, outcomes: dict) -> list:
@@ -346,17 +283,17 @@ class GraspGraph:
                 raise ArgumentError(f"invalid `nodes[{i}].name`: repeats nodes[{names.index(n)}].name ({n!r})",
                                     f"nodes[{i}].name")
         for i, n in enumerate(d["nodes"]):
-            _node(n, f"nodes[{i}]")
-        known = _known_actions()
+            check_node(n, f"nodes[{i}]")
+        known = known_actions()
         for i, a in enumerate(d["actions"]):
             if not (isinstance(a, dict) and isinstance(a.get("name"), str) and a["name"] in known):
                 raise ArgumentError(f"invalid `actions[{i}]`: a regrasp action, {{\"name\": one of "
                                     f"{', '.join(sorted(known))}, ...}} (got {a!r:.60})", f"actions[{i}]")
         measured = [a["name"] for a in d["actions"]]
-        settings = _settings(d["settings"], known)
+        settings = check_settings(d["settings"], known)
         if not isinstance(d["object"].get("file", ""), str) or not isinstance(d["object"].get("name", ""), str):
             raise ArgumentError("invalid `object`: its `name` and `file` are strings", "object")
-        seconds = _seconds(d.get("seconds", 0.0), "seconds")
+        seconds = check_seconds(d.get("seconds", 0.0), "seconds")
         edges = [Edge.from_dict(e, i, names) for i, e in enumerate(d["edges"])]
         for i, e in enumerate(edges):
             if e.action not in measured:
