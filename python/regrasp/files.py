@@ -75,11 +75,11 @@ def read_text(path, field: str, limit: Optional[int] = None) -> str:
 def nesting(text: str, toml: bool = False) -> int:
     """The deepest nesting of arrays and tables/objects in TOML or JSON ``text``, counted over its
     brackets outside strings (and comments) without parsing it: a parser would recurse."""
-    marks = _BRACKETS.findall((_TOML_INERT if toml else _JSON_INERT).sub("", text))
-    if not marks:
+    marks = np.frombuffer("".join(_BRACKETS.findall((_TOML_INERT if toml else _JSON_INERT).sub("", text)))
+                          .encode("ascii"), dtype=np.uint8)
+    if not marks.size:
         return 0
-    steps = np.fromiter((1 if m in "[{" else -1 for m in marks), dtype=np.int64, count=len(marks))
-    return int(np.cumsum(steps).max())
+    return int(np.cumsum(np.where((marks == ord("[")) | (marks == ord("{")), 1, -1)).max())
 
 
 def _depth(value) -> int:
@@ -107,18 +107,17 @@ def _parse(text: str, field: str, fail, toml: bool, constants: bool = True):
     kind = "TOML" if toml else "JSON"
     if not isinstance(text, str):
         raise ArgumentError(f"invalid `text`: the {kind} text, a str (got {type(text).__name__})", "text")
-    too_deep = TOO_DEEP
     fail = fail or (lambda why: ArgumentError(f"invalid `{field}`: {why}", field))
     if nesting(text, toml) > MAX_NESTING:
-        raise fail(too_deep)
+        raise fail(TOO_DEEP)
     try:
         v = tomllib.loads(text) if toml else json.loads(text, parse_constant=None if constants else _no_constant)
     except (tomllib.TOMLDecodeError, ValueError) as e:
         raise fail(f"not {kind}: {e}") from None
     except RecursionError:
-        raise fail(too_deep) from None
+        raise fail(TOO_DEEP) from None
     if _depth(v) > MAX_NESTING:
-        raise fail(too_deep)
+        raise fail(TOO_DEEP)
     return v
 
 
