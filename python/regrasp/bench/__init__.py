@@ -17,6 +17,7 @@ from ..scene.planar import Scene
 from .cones import _cone_batch, _membership, _projection, _single_cone
 from .planners import run_hard_plans, run_limit_surface, run_plan3d, run_planner
 from .solvers import run_mncp, run_mncp_scaling, run_mpc
+from .startup import run_startup
 from .timing import _random_poses
 from .worlds import run_arm_steps, run_grasp_graph, run_ik, run_mujoco, run_world_motion
 
@@ -57,6 +58,7 @@ def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, sc
         ("arm IK", lambda: _unless_missing("the arm's inverse kinematics", run_ik)),
         ("arm steps", lambda: _unless_missing("MuJoCo's speed with the arm", run_arm_steps)),
         ("grasp graph", lambda: _unless_missing("the grasp graph (MuJoCo, the arm)", run_grasp_graph)),
+        ("CLI start", lambda: run_startup(reps)),
     ]
     results = {}
     with progress.bar(len(benchmarks), "bench", unit="benchmark") as bar:

@@ -426,8 +426,31 @@ def add_quiet(p, default=False) -> None:
                    help="no progress bars on stderr (bars are shown only when stderr is a terminal)")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from . import cones, control, dexterity, dynamics, examples, execution, pick_place, planning, tools
+#: each command and its group, the module ``cli/<group>.py`` that adds its parser, in the order of
+#: `regrasp --help`; only the chosen command's group is imported (the CLI starts in about the time of
+#: `import regrasp`: the groups' help reads the defaults of the modules that do the work)
+GROUPS = {"plan": "planning", "cone": "cones", "approx-error": "cones", "validate": "dynamics",
+          "simulate": "dynamics", "push": "dynamics", "control": "control", "execute": "execution",
+          "pick-place": "pick_place", "grasp-graph": "dexterity", "regrasp-sequence": "dexterity",
+          "bench": "tools", "demo": "tools", "examples": "examples"}
+#: the options of `regrasp` itself (before COMMAND): none takes a value
+GLOBAL_FLAGS = ("-v", "--verbose", "-q", "--quiet", "--version")
+
+
+def chosen(argv: list) -> str | None:
+    """The command that ``argv`` names (its first word that is not a global flag); "" when it has
+    global flags only (``--version``, or no command); None for an unknown command or `regrasp`'s
+    own help asked for before it (then every group's parser is built)."""
+    for token in argv:
+        if token not in GLOBAL_FLAGS:
+            return token if token in GROUPS else None
+    return ""
+
+
+def build_parser(cmd: str | None = None) -> argparse.ArgumentParser:
+    """`regrasp`'s parser: with the parsers of ``cmd``'s group only when ``cmd`` is a command (the
+    other groups are not imported), none when it is "" (see :func:`chosen`), else every command's."""
+    import importlib
 
     ap = Parser(prog="regrasp", description="In-hand regrasps by prehensile pushing: motion cones, planning, "
                 "simulation and control (`regrasp COMMAND --help` for each command).",
@@ -437,9 +460,10 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("-v", "--verbose", action="store_true", help="print the scenes' notes on stderr")
     add_quiet(ap)
     sub = ap.add_subparsers(dest="cmd", metavar="COMMAND", parser_class=Parser)
-    for group in (planning, cones, dynamics, control, execution, pick_place, dexterity, tools, examples):
-        group.add_parsers(sub)
-    ap.description += f"\nCOMMAND: one of {{{','.join(sub.choices)}}}."
+    groups = [GROUPS[cmd]] if cmd in GROUPS else [] if cmd == "" else list(dict.fromkeys(GROUPS.values()))
+    for group in groups:
+        importlib.import_module(f"{__name__}.{group}").add_parsers(sub)
+    ap.description += f"\nCOMMAND: one of {{{','.join(GROUPS)}}}."
     for p in sub.choices.values():
         add_quiet(p, argparse.SUPPRESS)
     return ap
@@ -543,12 +567,6 @@ def _scene_help(ap: argparse.ArgumentParser, argv: list) -> None:
         return
 
 
-def commands(ap: argparse.ArgumentParser) -> list[str]:
-    """The command names of parser ``ap`` (`regrasp`'s), in the order of its help."""
-    sub = next(a for a in ap._actions if isinstance(a, argparse._SubParsersAction))
-    return list(sub.choices)
-
-
 def main(argv=None) -> int:
     """The `regrasp` command; returns its exit status (docs/cli.md). Ctrl-C: 130, after
     "regrasp: interrupted" (outputs are written atomically: nothing half-done is left); a closed
@@ -562,11 +580,11 @@ def main(argv=None) -> int:
         signal.getsignal(signal.SIGINT) is signal.default_int_handler else None
     try:
         argv = sys.argv[1:] if argv is None else list(argv)
-        ap = build_parser()
+        ap = build_parser(chosen(argv))
         _scene_help(ap, argv)
         args = ap.parse_args(argv)
         if args.cmd is None:
-            ap.error(f"a COMMAND is required: one of {', '.join(commands(ap))} (`regrasp --help` says what each does)")
+            ap.error(f"a COMMAND is required: one of {', '.join(GROUPS)} (`regrasp --help` says what each does)")
         progress.set_quiet(args.quiet)
         status, message = _run(args)
         stop = _stopped()  # a stop turned into an error by the code it interrupted is still the stop
