@@ -43,10 +43,11 @@ $(ALL_DEPS): $(DEMO_DEPS)
 
 setup: $(ALL_DEPS)
 
-# The extension again only when a Rust source changed since it was built.
+# The extension again only when a Rust source changed since it was built (checked again here: a
+# first setup has just built it).
 $(EXT): $(RUST_SRC) | $(DEMO_DEPS)
-	@$(STAGE) "Rust extension ($(PROFILE))" $(LOGS)/build.log $(DEVELOP) --skip-install
-	@touch $@
+	@if [ ! -e $@ ] || [ -n "$$(find $(RUST_SRC) -newer $@)" ]; then \
+		$(STAGE) "Rust extension ($(PROFILE))" $(LOGS)/build.log $(DEVELOP) --skip-install && touch $@; fi
 
 build: $(EXT)
 
