@@ -18,9 +18,10 @@
 //! cannot rest there ([`cannot_hold`]). So is a goal whose pad centre lies, beyond its
 //! tolerance, in a direction no push can move the pad's centre: when the pushers' friction cones
 //! and gravity over the planner's turn range all push it within less than a half-plane
-//! ([`blocked`], [`one_way`]).
+//! ([`blocked`], [`one_way`]), or, with gravity weighed against the pads' friction, when no push
+//! can move it along the goal's direction at any pose ([`never_along`]).
 
-use crate::mechanics::geometry::Vec2;
+use crate::mechanics::geometry::{Vec2, Vec3};
 use crate::scene::planar::Support;
 use crate::scene::Scene;
 use crate::scene::spatial::Scene3;
@@ -200,33 +201,133 @@ pub fn blocked(scene: &Scene, turn: [f64; 2]) -> Option<(f64, f64)> {
 /// gravity the turn does not matter and the answer holds for every plan; with it, a plan turning
 /// the object further (gravity then pulls another way in the object's frame) is not excluded.
 pub fn one_way(scene: &Scene, start: &[f64; 3], goal: &[f64; 3], tol: &[f64; 3], turn: [f64; 2]) -> Option<String> {
-    let (mid, half) = blocked(scene, turn)?;
     let (cs, _) = scene.pad_disc(start)?;
     let (cg, _) = scene.pad_disc(goal)?;
     let delta = cg - cs;
-    // the blocked direction closest to Δ: its angle clamped into the arc
-    let off = (delta.y.atan2(delta.x) - mid + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-    let a = mid + off.clamp(-half, half);
-    let d = Vec2::new(a.cos(), a.sin());
     let shift = tol[0].hypot(tol[1]);
     let slack = shift + (goal[0].hypot(goal[1]) + shift) * tol[2];
-    let need = d.dot(&delta);
-    let within = if gravity_in_plane(scene) {
-        format!(
-            " while the object's turn in the grasp stays within {:.3}..{:.3} rad (the planner's range, the start's and the goal's \
-             turns widened by theta_margin: widen it to consider larger turns, which let gravity pull another way)",
-            turn[0], turn[1]
-        )
-    } else {
-        String::new()
+    let within = |any_turn: bool| {
+        if !gravity_in_plane(scene) {
+            String::new()
+        } else if any_turn {
+            " at any turn in the grasp (the object's weight, against the pads' friction, cannot turn the pushes' forces that far)".to_string()
+        } else {
+            format!(
+                " while the object's turn in the grasp stays within {:.3}..{:.3} rad (the planner's range, the start's and the goal's \
+                 turns widened by theta_margin: widen it to consider larger turns, which let gravity pull another way)",
+                turn[0], turn[1]
+            )
+        }
     };
-    (need > slack + 1e-9).then(|| {
+    let say = |d: Vec2, any_turn: bool| {
         format!(
-            "no push can move the pad's centre along ({:.3}, {:.3}) in the object's frame{within} (the pushers' friction cones and \
+            "no push can move the pad's centre along ({:.3}, {:.3}) in the object's frame{} (the pushers' friction cones and \
              gravity all push it the other way), and the goal needs {:.2} mm of it (the goal tolerance reaches {:.2} mm)",
-            d.x + 0.0, d.y + 0.0, 1e3 * need, 1e3 * slack
+            d.x + 0.0, d.y + 0.0, within(any_turn), 1e3 * d.dot(&delta), 1e3 * slack
         )
-    })
+    };
+    if let Some((mid, half)) = blocked(scene, turn) {
+        // the blocked direction closest to Δ: its angle clamped into the arc
+        let off = (delta.y.atan2(delta.x) - mid + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        let a = mid + off.clamp(-half, half);
+        let d = Vec2::new(a.cos(), a.sin());
+        if d.dot(&delta) > slack + 1e-9 {
+            return Some(say(d, false));
+        }
+    }
+    // gravity weighed against the pads' friction: along Δ, then turned from it by up to 60°
+    if !(delta.norm() > slack + 1e-9) {
+        return None;
+    }
+    let along = delta.y.atan2(delta.x);
+    for (k, any_turn) in [(0, true), (0, false), (1, false), (-1, false), (2, false), (-2, false), (3, false), (-3, false)] {
+        let a = along + k as f64 * std::f64::consts::PI / 9.0;
+        let d = Vec2::new(a.cos(), a.sin());
+        let range = if any_turn { [-std::f64::consts::PI, std::f64::consts::PI] } else { turn };
+        if d.dot(&delta) > slack + 1e-9 && never_along(scene, &d, range) {
+            return Some(say(d, any_turn));
+        }
+    }
+    None
+}
+
+/// The turn grid of [`never_along`] [rad]: between neighbouring turns the load is bounded by its
+/// Lipschitz constant.
+pub const TURN_STEP: f64 = 0.005;
+
+/// Whether no push can move the pad's centre along the unit direction `d` (object frame) at any
+/// turn within `turn` (rad), gravity weighed against the pads' friction; false when that is not
+/// shown (or the pad is not isotropic: disc pads only).
+///
+/// The pad's centre moves along `−f` (`f = f_g + f_p`, the force on the object; an isotropic pad
+/// without force–moment coupling), and only while the load `w_g + t·p` is on the limit surface
+/// (`‖·‖ = 1`, the grasp's norm at the pad's centre `c`; `‖w_g‖ < 1` where it holds). With every
+/// pusher edge `eᵢ = (fᵢ, mᵢ)` having `d·fᵢ > 0`, write pushes as `p = Σλᵢêᵢ`, `êᵢ = eᵢ/(d·fᵢ)`,
+/// `Σλᵢ = 1`: `d·f` grows along the ray and is 0 at `t₀ = g = max(0, −d·f_g)`, so the pad moves
+/// along `d` only if the ray leaves the surface before `t₀`, i.e. `‖w_g + g·p‖ > 1`. That norm
+/// is convex in `λ` (largest at an edge) and in `c` (largest at a vertex of the pad centres'
+/// region, [`pad_region`]); over the turn it is checked every [`TURN_STEP`] with the margin its
+/// Lipschitz constant allows (`|f_g|` times the norm's force and moment gains and the arms).
+pub fn never_along(scene: &Scene, d: &Vec2, turn: [f64; 2]) -> bool {
+    let Support::Grasp(g) = &scene.support else { return false };
+    let b = &g.limit_surface.b;
+    let isotropic = match &g.exact {
+        Some(e) => e.region().axisymmetric(),
+        None => (b[(0, 0)] - b[(1, 1)]).abs() <= 1e-12 * b[(0, 0)].abs() && b[(0, 1)] == 0.0 && b[(0, 2)] == 0.0 && b[(1, 2)] == 0.0,
+    };
+    if !isotropic || !turn.iter().all(|t| t.is_finite()) || turn[1] < turn[0] {
+        return false;
+    }
+    let Some((_, r)) = scene.pad_disc(&[0.0; 3]) else { return false };
+    let mut edges: Vec<Vec3> = Vec::new();
+    for p in &scene.pushers {
+        for e in p.contact.edge_wrenches() {
+            let s = d.x * e.wrench.x + d.y * e.wrench.y;
+            if !(s > 1e-12 * e.wrench.xy().norm()) {
+                return false; // this edge alone moves the pad's centre along d (or across it)
+            }
+            edges.push(e.wrench / s);
+        }
+    }
+    let corners: Vec<Vec2> = match pad_region(scene, r, LineJoin::Bevel) {
+        Some(region) => region.0.iter().flat_map(|p| p.exterior().0.iter().map(|c| Vec2::new(c.x, c.y))).collect(),
+        None => scene.outline.vertices().to_vec(),
+    };
+    let f0 = scene.frame(&[0.0; 3]);
+    // the norm of a wrench given at the object's origin, at frame `f`'s pad centre
+    let load = |f: &crate::cones::motion_cone::SupportFrame, w: &Vec3| {
+        let u = f.js_inv.tr_mul(w);
+        match &f.exact {
+            Some((surface, s)) => surface.gauge(&(u / *s)),
+            None => u.dot(&(f.a * u)).sqrt(),
+        }
+    };
+    let (nf, nm) = (load(&f0, &Vec3::new(1.0, 0.0, 0.0)), load(&f0, &Vec3::new(0.0, 0.0, 1.0)));
+    let weight = f0.gravity.xy().norm();
+    let n = ((turn[1] - turn[0]) / TURN_STEP).ceil().max(1.0) as usize;
+    let step = (turn[1] - turn[0]) / n as f64;
+    let cross = |a: &Vec2, b: &Vec3| a.x * b.y - a.y * b.x;
+    for c in &corners {
+        // the load's Lipschitz constant in the turn, per edge: |f_g| (nf (1 + |f̂|) + nm (|com − c| + |m̂ − c × f̂|))
+        let lip: Vec<f64> = edges
+            .iter()
+            .map(|e| weight * (nf * (1.0 + e.xy().norm()) + nm * ((scene.com - c).norm() + (e.z - cross(c, e)).abs())))
+            .collect();
+        for k in 0..=n {
+            let th = turn[0] + step * k as f64;
+            let (sn, cs) = th.sin_cos();
+            // the pose whose pad centre is c at turn θ: c = −Rᵀ(θ) t
+            let t = -Vec2::new(cs * c.x - sn * c.y, sn * c.x + cs * c.y);
+            let f = scene.frame(&[t.x, t.y, th]);
+            let gd = (-d.dot(&f.gravity.xy())).max(0.0);
+            for (e, l) in edges.iter().zip(&lip) {
+                if load(&f, &(f.gravity + e * gd)) + 0.5 * step * l > 1.0 {
+                    return false;
+                }
+            }
+        }
+    }
+    true
 }
 
 /// Whether gravity pulls in the object's plane (it then depends on the turn).
