@@ -146,3 +146,25 @@ def test_ctrl_c_during_the_arms_inverse_kinematics_exits_130(tmp_path, after):
                                    "ur5e-2f85", "-q"], after, tmp_path)
     assert status == 130 and err.strip().endswith("regrasp: interrupted") and "internal error" not in err, err
     assert took < 3.0, f"the arm went on {took:.1f} s after Ctrl-C"
+
+
+def test_ctrl_c_during_an_import_that_runs_python_from_c_still_exits_130(tmp_path):
+    """A Ctrl-C inside an import whose extension runs Python code itself (PyRun_*, as MuJoCo's
+    bindings do while they load) is marked by CPython as unhandled for good: the process would
+    end killed by SIGINT (-2) whatever `regrasp` returned. The stop waits for the import's end
+    (regrasp.cli.stopping): 130, "interrupted"."""
+    (tmp_path / "slowmod.py").write_text(
+        "import ctypes\nctypes.pythonapi.PyRun_SimpleString(b'import time\\nfor _ in range(30): time.sleep(0.05)\\n')\n")
+    code = (f"import sys, importlib\nsys.path.insert(0, {str(tmp_path)!r})\nfrom regrasp import cli\n"
+            "def slow(args):\n    importlib.import_module('slowmod')\n    import time\n    time.sleep(3)\n    return 0\n"
+            "run = cli._run\ncli._run = lambda args: run(type('A', (), {'fn': staticmethod(slow), 'cmd': args.cmd})())\n"
+            "sys.exit(cli.main(['examples']))\n")
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(1.0)  # inside the import's 1.5 s of Python run from C
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=30)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert p.returncode == 130 and err.strip().endswith("regrasp: interrupted"), (p.returncode, err)

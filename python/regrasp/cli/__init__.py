@@ -5,7 +5,9 @@ missing optional dependency: the extra to install is named), 2 invalid input, 13
 
 One module per command group: ``cones`` (cone, approx-error), ``planning`` (plan), ``dynamics``
 (validate, simulate, push), ``control`` (control), ``tools`` (bench, demo), ``examples`` (examples). Each has
-``add_parsers(sub)``; this module assembles them and holds what they share.
+``add_parsers(sub)``; this module assembles them (only the chosen command's group is imported:
+:data:`GROUPS`) and holds what they share. How a command stops on Ctrl-C and SIGTERM:
+:mod:`regrasp.cli.stopping`.
 """
 
 from __future__ import annotations
@@ -14,9 +16,7 @@ import argparse
 import inspect
 import os
 import re
-import signal
 import sys
-import threading
 from pathlib import Path
 
 import numpy as np
@@ -29,38 +29,12 @@ from ..planning.plan import Plan, planner_defaults
 from ..scene import load_scene
 from ..scene.planar import Scene
 from ..scene.settings import core_build, limit_surface_default, mpc_defaults
+from .stopping import Terminated, install, restore, stopped as _stopped
 
 
 #: exit statuses (docs/cli.md): 130 = 128 + SIGINT, 141 = 128 + SIGPIPE (the shell's convention)
 OK, CANNOT, INVALID, INTERRUPTED, BROKEN_PIPE, TERMINATED = 0, 1, 2, 130, 141, 143
 
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised where the command is, so that it stops as on Ctrl-C: outputs uncommitted,
-    temporary files removed, worker processes stopped."""
-
-
-#: the signal that asked the command to stop (SIGINT or SIGTERM), or None
-_STOPPED: list = []
-
-
-def _on_sigterm(signum, frame):
-    _STOPPED.append(signum)
-    raise Terminated()
-
-
-def _on_sigint(signum, frame):
-    _STOPPED.append(signum)
-    raise KeyboardInterrupt()
-
-
-def _stopped() -> KeyboardInterrupt | None:
-    """The interrupt to raise when a signal asked the command to stop: an exception raised inside
-    a compiled solver by the signal may come back as another one (a QP solver's "Buffer dtype
-    mismatch"); it is the stop, not an internal error."""
-    if not _STOPPED:
-        return None
-    return Terminated() if _STOPPED[-1] == signal.SIGTERM else KeyboardInterrupt()
 
 #: upper bounds of the count options (docs/cli.md): larger values are invalid input, not hours of work
 MAX_PUSHES = 100_000
@@ -573,11 +547,7 @@ def main(argv=None) -> int:
     standard output (``| head``): 141, quietly; SIGTERM: 143, after "regrasp: terminated", as Ctrl-C. Started with standard output or error closed
     (``>&-``), what would go there is discarded; the command runs and its status stands."""
     _open_closed_streams()
-    main_thread = threading.current_thread() is threading.main_thread()
-    _STOPPED.clear()
-    old = signal.signal(signal.SIGTERM, _on_sigterm) if main_thread else None
-    old_int = signal.signal(signal.SIGINT, _on_sigint) if main_thread and \
-        signal.getsignal(signal.SIGINT) is signal.default_int_handler else None
+    saved = install()
     try:
         argv = sys.argv[1:] if argv is None else list(argv)
         ap = build_parser(chosen(argv))
@@ -604,10 +574,7 @@ def main(argv=None) -> int:
         _quiet_stdout()
         return BROKEN_PIPE
     finally:
-        if main_thread:
-            signal.signal(signal.SIGTERM, signal.SIG_DFL if old is None else old)
-            if old_int is not None:
-                signal.signal(signal.SIGINT, old_int)
+        restore(saved)
 
 
 if __name__ == "__main__":
