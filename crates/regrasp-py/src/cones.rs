@@ -199,8 +199,9 @@ pub type Classified<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>
 /// `Scene.project_many`'s result: projections (n, 3) and status (n,).
 pub type Projected<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>);
 
-/// Entries of a batch computed between two interrupt checks.
-const CHUNK: usize = 1024;
+/// Entries of a batch computed between two interrupt checks (each chunk spread over the core's
+/// threads in pieces of [`regrasp::cones::batch`]'s own chunk; a few ms of work at most).
+const CHUNK: usize = 16_384;
 
 /// `f` on the ranges of `0..n`, [`CHUNK`] entries each, checking for an interrupt before each.
 fn chunked(n: usize, mut f: impl FnMut(std::ops::Range<usize>)) -> regrasp::Result<()> {
@@ -220,7 +221,8 @@ pub fn generators_many<'py>(py: Python<'py>, scene: &Scene, poses: &Arg<'py>, na
     let mut st = vec![Status::Ok; n];
     let (g, s) = (k * 3, &mut st);
     interruptible(py, || chunked(q.len(), |r| batches::generators_into(scene, &q[r.clone()], i, gravity_free, &mut out[r.start * g..r.end * g], &mut s[r])))?;
-    let g = Array3::from_shape_fn((n, k, 3), |(a, b, c)| out[(a * k + b) * 3 + c]);
+    // the buffer is the array's memory, row-major (n, k, 3): no copy
+    let g = Array3::from_shape_vec((n, k, 3), out).map_err(|e| to_py(regrasp::Error::arg("poses", format!("generators: {e}"))))?;
     Ok((g.into_pyarray(py), status_array(py, &st)))
 }
 

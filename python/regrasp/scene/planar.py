@@ -19,7 +19,7 @@ from .. import _core
 from ..errors import ArgumentError, SceneError
 from ..fields import check_array as _array, check_flag as _flag, check_name as _name
 from ..fields import check_number as _number, check_rows as _rows, check_twists as _twists
-from ..fields import check_vec_or_rows as _vec_or_rows, check_vector as _vec
+from ..fields import check_vec_or_rows as _vec_or_rows, check_vector as _vec, plain_numbers
 from .common import Task, core_property, read_scene_file
 
 ArrayLike = Sequence[float] | np.ndarray
@@ -541,7 +541,7 @@ class Scene:
     def motion_cone(self, pose, pusher: str, check_hold: bool = True) -> MotionCone:
         """The motion cone of ``pusher`` at ``pose`` ``[x, z, theta]`` (m, m, rad). Raises GraspError
         when the grasp cannot hold the object there (pass ``check_hold=False`` for gravity-free and grip-force queries)."""
-        q = list(_vec(pose, 3, "pose"))
+        q = plain_numbers(pose, 3) or list(_vec(pose, 3, "pose"))
         return MotionCone(self._core.motion_cone(q, _name(pusher, "pusher"), _flag(check_hold, "check_hold")), self)
 
     def gravity_free_cone(self, pose, pusher: str) -> GravityFreeCone:
