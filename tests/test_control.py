@@ -184,3 +184,30 @@ def test_simulate_cli_3d_rejects_planar_flags(tmp_path):
     assert r.returncode == 2 and "scale-grip" in r.stderr
     r = subprocess.run(cli + ["--dt", "0.05", "--json"], capture_output=True, text=True)
     assert r.returncode == 0 and json.loads(r.stdout)["success"], r.stderr
+
+
+@pytest.mark.parametrize("horizon", [5, 20, 40])
+def test_mpc_qp_optimum_matches_the_condensed_qp_solved_by_scipy(horizon):
+    """The MPC's sparse QP (poses kept as variables, step_qp.rs) reaches the optimum of the same
+    QP written independently in condensed form (regrasp.bench.solvers.mpc_qp_condensed) and
+    solved by SLSQP: its cost no higher, its constraints met."""
+    pytest.importorskip("scipy")
+    from regrasp.bench.solvers import _mpc_qp_scipy, mpc_qp_condensed
+    from regrasp.scene.settings import mpc_defaults
+
+    s = load("t-shape")
+    p = regrasp.plan(s, seed=0)
+    settings = {**mpc_defaults(), "horizon": horizon}
+    m = s.mpc(p.poses.tolist(), p.pushers, horizon=horizon)
+    q = (p.poses[0] + [0.0005, -0.0005, 0.01]).tolist()
+    steps, ok = m.solve_qp(q, 0)
+    knots = np.asarray(m.knots)
+    targets = [knots[min(1 + i, len(knots) - 1)] for i in range(len(steps))]
+    P, c, T, offs, sizes = mpc_qp_condensed(s, q, steps, targets, settings)
+    ours = np.concatenate([st_["weights"] for st_ in steps]) / settings["speed"]
+    ref = _mpc_qp_scipy(s, q, steps, targets, settings) / settings["speed"]
+    cost = lambda a: 0.5 * a @ P @ a + c @ a  # noqa: E731
+    assert ok and np.all(ours >= 0)
+    for i in range(len(sizes)):
+        assert np.linalg.norm(ours[offs[i]:offs[i] + sizes[i]] @ T[i]) <= 1 + 1e-6
+    assert cost(ours) <= cost(ref) + 1e-6 * max(1.0, abs(cost(ref))), (cost(ours), cost(ref))

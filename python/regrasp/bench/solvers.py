@@ -82,11 +82,13 @@ def run_mncp_scaling(points=SCALING_POINTS, reps: int = 5) -> dict:
     }}
 
 
-def _mpc_qp_scipy(scene: Scene, q, steps, targets, settings: dict):
-    """The MPC's QP (see crates/regrasp-core/src/control/mpc.rs) solved by scipy's SLSQP: the
-    baseline; ``settings`` the MPC's (``mpc_defaults()``)."""
-    minimize = need("scipy.optimize", "reference").minimize
-
+def mpc_qp_condensed(scene: Scene, q, steps, targets, settings: dict):
+    """The MPC's QP (crates/regrasp-core/src/control/step_qp.rs) in its condensed form, written
+    independently with the poses eliminated: ``(P, c, speed_rows, offs, sizes)`` with the cost
+    ``½αᵀPα + cᵀα`` over the weights α (units of v_max) and step i's speed bound
+    ``‖α[offs[i]:offs[i] + sizes[i]] @ speed_rows[i]‖ ≤ 1`` (and ``α ≥ 0``, each step's weights summing to
+    at most 10); ``settings`` the MPC's
+    (``mpc_defaults()``), ``targets`` the reference knots."""
     speed, dt = settings["speed"], settings["dt"]
     stage, terminal, effort = settings["stage_weight"], settings["terminal_weight"], settings["effort_weight"]
     L = scene.length
@@ -114,11 +116,21 @@ def _mpc_qp_scipy(scene: Scene, q, steps, targets, settings: dict):
         e0 = q0 - np.array([t[0], t[1], L * t[2]]) / ds
         P += 2 * w * M.T @ M
         c += 2 * w * M.T @ e0
+    return P, c, T, offs, sizes
+
+
+def _mpc_qp_scipy(scene: Scene, q, steps, targets, settings: dict):
+    """The MPC's QP (:func:`mpc_qp_condensed`) solved by scipy's SLSQP: the baseline."""
+    minimize = need("scipy.optimize", "reference").minimize
+    P, c, T, offs, sizes = mpc_qp_condensed(scene, q, steps, targets, settings)
+    n = len(c)
     cons = [{"type": "ineq", "fun": (lambda a, i=i: 1.0 - np.sum((a[offs[i]:offs[i] + sizes[i]] @ T[i]) ** 2))}
-            for i in range(len(gens)) if sizes[i]]
+            for i in range(len(sizes)) if sizes[i]]
+    cons += [{"type": "ineq", "fun": (lambda a, i=i: 10.0 - np.sum(a[offs[i]:offs[i] + sizes[i]]))}
+             for i in range(len(sizes)) if sizes[i]]  # the weights of a step sum to at most 10
     r = minimize(lambda a: 0.5 * a @ P @ a + c @ a, np.zeros(n), jac=lambda a: P @ a + c, bounds=[(0, 10)] * n,
                  constraints=cons, method="SLSQP", options={"ftol": 1e-10, "maxiter": 200})
-    return r.x * speed
+    return r.x * settings["speed"]
 
 
 def run_mpc(reps: int = 200) -> dict:

@@ -13,7 +13,7 @@
 //! after it, `R(θ)` turns body twists into pose rates, `S = diag(1, 1, L)` and `‖·‖` the twist
 //! metric (the speed bound is a second-order cone: wide cones' opposite generators cannot add
 //! up to a fast twist that goes nowhere).
-//! The positions are eliminated, so the QP has only the non-negative weights (clarabel).
+//! The QP keeps the poses after each step as variables (banded: [`crate::control::step_qp`], clarabel).
 //! The first step's twist `G₁α₁` is checked with the exact test at `q₁` and projected into the
 //! exact cone (with a margin) when the polyhedral approximation overshoots it; and since the
 //! polyhedral approximation can also miss directions of the exact cone, each step's generators
@@ -25,7 +25,7 @@
 //! planner is called from the measured pose.
 
 use crate::error::{Error, Result};
-use crate::mechanics::geometry::{rot, Vec2, Vec3};
+use crate::mechanics::geometry::Vec3;
 use crate::cones::motion_cone::project_with_margin_on;
 use crate::dynamics::planar::integrate;
 use crate::cones::robust::generators;
@@ -33,9 +33,8 @@ use crate::scene::planar::Scene;
 use crate::planning::planar::{self as trrt, PlanarSettings};
 use crate::planning::trrt::SearchSettings;
 use crate::pose::planar::body_twist;
-use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
-use nalgebra::{DMatrix, DVector};
+use crate::control::step_qp::{self, Weights};
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus};
 use std::time::Instant;
 
 /// Controller settings.
@@ -334,72 +333,6 @@ impl Mpc {
         steps
     }
 
-    /// The tracking cost `½ αᵀPα + cᵀα` over the generator weights (offsets `offs`, counts
-    /// `sizes`): per step the pose error after the step (stage or terminal weight, positions and
-    /// `L θ` in units of one step) plus the effort `Σ α²`.
-    fn cost(&self, q: &[f64; 3], steps: &[(usize, Vec<Vec3>, [f64; 3], f64)], offs: &[usize], sizes: &[usize]) -> (DMatrix<f64>, DVector<f64>) {
-        let s = &self.settings;
-        let ds = s.speed * s.dt;
-        let l = self.scene.length;
-        let n: usize = sizes.iter().sum();
-        // columns: pose change (in units of one step, metric-scaled) per unit weight (α/v_max)
-        let mut b = DMatrix::<f64>::zeros(3, n);
-        for (i, (_, gens, _, th)) in steps.iter().enumerate() {
-            let r = rot(*th);
-            for (k, g) in gens.iter().enumerate() {
-                let d = r * Vec2::new(g.x, g.y);
-                // pose rate of the unit twist × v_max × δt, in steps: [dx, dz, L dθ] / ds
-                let col = Vec3::new(d.x, d.y, l * g.z) * (s.speed * s.dt / ds);
-                b.set_column(offs[i] + k, &DVector::from_row_slice(col.as_slice()));
-            }
-        }
-        let mut p_mat = DMatrix::<f64>::identity(n, n) * (2.0 * s.effort_weight);
-        let mut c = DVector::<f64>::zeros(n);
-        let q0 = Vec3::new(q[0], q[1], l * q[2]) / ds;
-        for (i, (_, _, target, _)) in steps.iter().enumerate() {
-            let w = if i + 1 == steps.len() { s.terminal_weight } else { s.stage_weight };
-            let upto = offs[i] + sizes[i];
-            let m = b.columns(0, upto).into_owned();
-            let e0 = q0 - Vec3::new(target[0], target[1], l * target[2]) / ds;
-            let mut pv = p_mat.view_mut((0, 0), (upto, upto));
-            pv += m.transpose() * &m * (2.0 * w);
-            let mut cv = c.rows_mut(0, upto);
-            cv += m.transpose() * DVector::from_row_slice(e0.as_slice()) * (2.0 * w);
-        }
-        (p_mat, c)
-    }
-
-    /// The constraints `A α + s = b, s ∈ K`: `−α ≤ 0`; `Σ αᵢ ≤ 10` per step (bounded weights);
-    /// `‖Σₖ αᵢₖ S gᵢₖ‖ ≤ 1` per step (the twist's speed in the metric at most v_max: a
-    /// second-order cone).
-    fn constraints(&self, steps: &[(usize, Vec<Vec3>, [f64; 3], f64)], offs: &[usize], sizes: &[usize]) -> (CscMatrix<f64>, Vec<f64>, Vec<SupportedConeT<f64>>) {
-        let metric = self.scene.metric();
-        let (n, h) = (sizes.iter().sum::<usize>(), steps.len());
-        let rows = n + h + 4 * h;
-        let mut a = vec![vec![0.0; n]; rows];
-        let mut bvec = vec![0.0; rows];
-        for k in 0..n {
-            a[k][k] = -1.0;
-        }
-        for (i, (_, gens, _, _)) in steps.iter().enumerate() {
-            for k in 0..sizes[i] {
-                a[n + i][offs[i] + k] = 1.0;
-            }
-            bvec[n + i] = 10.0;
-            let r0 = n + h + 4 * i;
-            bvec[r0] = 1.0;
-            for (k, g) in gens.iter().enumerate() {
-                let t = metric.twist(g);
-                for d in 0..3 {
-                    a[r0 + 1 + d][offs[i] + k] = -t[d];
-                }
-            }
-        }
-        let mut cones = vec![SupportedConeT::NonnegativeConeT(n + h)];
-        cones.extend(std::iter::repeat_n(SupportedConeT::SecondOrderConeT(4), h));
-        (CscMatrix::from(&a), bvec, cones)
-    }
-
     /// The QP from pose `q` with reference knots after `j`: non-negative weights of each
     /// horizon step's generators minimizing the tracking cost under the speed bound (clarabel).
     pub fn solve_qp(&self, q: &[f64; 3], j: usize) -> Result<QpSolution> {
@@ -414,12 +347,11 @@ impl Mpc {
             return Ok(QpSolution { steps: steps.into_iter().map(|(p, g, _, _)| (p, g, Vec::new())).collect(), status_ok: false });
         }
         let offs: Vec<usize> = sizes.iter().scan(0, |acc, &k| { let o = *acc; *acc += k; Some(o) }).collect();
-        let (p_mat, c) = self.cost(q, &steps, &offs, &sizes);
-        let (a, bvec, cones) = self.constraints(&steps, &offs, &sizes);
-        let upper: Vec<Vec<f64>> = (0..n).map(|r| (0..n).map(|cc| if cc >= r { p_mat[(r, cc)] } else { 0.0 }).collect()).collect();
-        let p = CscMatrix::from(&upper);
+        let s = &self.settings;
+        let weights = Weights { stage: s.stage_weight, terminal: s.terminal_weight, effort: s.effort_weight };
+        let qp = step_qp::build(q, &steps, &offs, &sizes, weights, s.speed * s.dt, self.scene.length, &self.scene.metric());
         let settings = DefaultSettings { verbose: false, ..DefaultSettings::default() };
-        let mut solver = DefaultSolver::new(&p, c.as_slice(), &a, &bvec, &cones, settings)
+        let mut solver = DefaultSolver::new(&qp.p, &qp.c, &qp.a, &qp.b, &qp.cones, settings)
             .map_err(|e| Error::arg("mpc", format!("QP setup failed: {e:?}")))?;
         solver.solve();
         let ok = matches!(solver.solution.status, SolverStatus::Solved | SolverStatus::AlmostSolved);
