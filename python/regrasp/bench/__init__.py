@@ -16,7 +16,7 @@ from ..reference import cones as reference
 from ..scene.planar import Scene
 from .cones import _cone_batch, _membership, _projection, _single_cone
 from .planners import run_hard_plans, run_limit_surface, run_plan3d, run_planner
-from .solvers import run_mncp, run_mncp_scaling, run_mpc
+from .solvers import run_mncp, run_mncp_scaling, run_mpc, run_mpc_horizons
 from .startup import run_startup
 from .timing import _random_poses
 from .worlds import run_arm_steps, run_grasp_graph, run_ik, run_mujoco, run_world_motion
@@ -53,6 +53,7 @@ def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, sc
         ("limit surfaces", run_limit_surface),
         ("MuJoCo", lambda: _unless_missing("MuJoCo's speed", run_mujoco)),
         ("MPC", lambda: _unless_missing("the MPC step against SciPy", run_mpc)),
+        ("MPC horizons", lambda: run_mpc_horizons(max(3, reps))),
         ("3-D planner", run_plan3d),
         ("world motion", run_world_motion),
         ("arm IK", lambda: _unless_missing("the arm's inverse kinematics", run_ik)),

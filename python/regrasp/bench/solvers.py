@@ -162,3 +162,39 @@ def run_mpc(reps: int = 200) -> dict:
             "baseline": "the same QP alone (generators given) with scipy SLSQP",
         }
     return out
+
+
+#: the horizons of :func:`run_mpc_horizons` and issue 45's targets: H = 20 within 1 ms, the
+#: step's cost growing at most as H^1.3 from the shortest to the longest
+MPC_HORIZONS, MPC_TARGETS = (5, 10, 20, 40, 80), (1e-3, 1.3)
+
+
+def run_mpc_horizons(reps: int = 15, horizons=MPC_HORIZONS) -> dict:
+    """The MPC tracking the T-shape's seed-0 plan at each horizon: one controller, ``reps`` steps
+    from poses 0.5 mm and 10 mrad off successive knots (as in a control loop: each step's horizon
+    shares all but one knot's cone with the last); the median CPU time of a step [s] and the
+    growth exponent between the first and the last horizon. No baseline solver (the targets,
+    :data:`MPC_TARGETS`)."""
+    from ..planning.plan import plan
+
+    scene = Scene.load(bundled.path("t-shape"))
+    p = plan(scene, seed=0)
+    poses = p.poses.tolist()
+    out, times = {}, {}
+    for h in horizons:
+        m = scene.mpc(poses, p.pushers, horizon=h)
+        knots = np.asarray(m.knots)
+        runs = []
+        for k in range(reps):
+            q = (knots[min(k, len(knots) - 1)] + [0.0005, -0.0005, 0.01]).tolist()
+            t0 = time.process_time()
+            m.step(q)
+            runs.append(time.process_time() - t0)
+        times[h] = float(np.median(runs))
+    growth = float(np.log(times[horizons[-1]] / times[horizons[0]]) / np.log(horizons[-1] / horizons[0]))
+    for h in horizons:
+        out[f"mpc_step_h{h}"] = {"median_s": times[h], "baseline_median_s": None, "ratio": None,
+                                 "baseline": f"none: CPU time; target H=20 <= {MPC_TARGETS[0] * 1e3:g} ms, growth "
+                                             f"H^{growth:.2f} from H={horizons[0]} to {horizons[-1]} (target <= "
+                                             f"H^{MPC_TARGETS[1]})", "growth": growth}
+    return out
