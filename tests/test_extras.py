@@ -196,7 +196,7 @@ def _no_nan(constant: str):
 def test_bench_json_without_reference_is_valid_json(blocker):
     """`regrasp bench --json` with the baselines' extras missing prints valid JSON (no NaN):
     a skipped baseline has None as its time and ratio. Made small: fewer cones, one seed, one
-    example of each planner."""
+    example of each planner, two seeds of the limit surfaces' comparison."""
     code = textwrap.dedent('''
         import sys
         from regrasp import bench
@@ -208,6 +208,8 @@ def test_bench_json_without_reference_is_valid_json(blocker):
         bench.run_planner = lambda: planner(seeds=1, time_limit=5.0, examples=("block-high-friction",))
         bench.run_plan3d = lambda: plan3d(seeds=1, examples=("offset-3d",))
         bench.run_world_motion = lambda: wm(reps=1, examples=("block-low-friction",))
+        ls = bench.run_limit_surface
+        bench.run_limit_surface = lambda: ls(seeds=2, time_limit=5.0, examples=("block-high-friction",))
         sys.exit(regrasp.cli.main(["bench", "--quick", "--json"]))
     ''')
     r = run(blocker, ["-c", code], ("casadi", "scipy", "mujoco"))
@@ -216,7 +218,7 @@ def test_bench_json_without_reference_is_valid_json(blocker):
     skipped = res["plan3d_offset-3d"]
     assert skipped["baseline_median_s"] is None and skipped["ratio"] is None, skipped
     assert "regrasp[reference]" in skipped["baseline"]
-    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_", "mujoco_", "ik_", "arm_")) for k in res), sorted(res)
-    assert res["world_motion_block-low-friction"]["median_s"] > 0  # needs no extra
+    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_step_", "mujoco_", "ik_", "arm_")) for k in res), sorted(res)
+    assert res["world_motion_block-low-friction"]["median_s"] > 0 and res["mpc_horizon_20"]["median_s"] > 0  # need no extra
     assert res["cli_start_version"]["ratio"] > 0 and res["cli_start_plan_t_shape"]["baseline_median_s"] > 0
     assert res["hard_neck-unreachable"]["unreachable"] == 1 and res["hard_neck-unreachable"]["median_s"] < 1.0

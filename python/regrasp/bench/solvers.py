@@ -193,7 +193,7 @@ def run_mpc_horizons(reps: int = 15, horizons=MPC_HORIZONS) -> dict:
         times[h] = float(np.median(runs))
     growth = float(np.log(times[horizons[-1]] / times[horizons[0]]) / np.log(horizons[-1] / horizons[0]))
     for h in horizons:
-        out[f"mpc_step_h{h}"] = {"median_s": times[h], "baseline_median_s": None, "ratio": None,
+        out[f"mpc_horizon_{h}"] = {"median_s": times[h], "baseline_median_s": None, "ratio": None,
                                  "baseline": f"none: CPU time; target H=20 <= {MPC_TARGETS[0] * 1e3:g} ms, growth "
                                              f"H^{growth:.2f} from H={horizons[0]} to {horizons[-1]} (target <= "
                                              f"H^{MPC_TARGETS[1]})", "growth": growth}
