@@ -168,3 +168,25 @@ def test_ctrl_c_during_an_import_that_runs_python_from_c_still_exits_130(tmp_pat
         if p.poll() is None:
             p.kill()
     assert p.returncode == 130 and err.strip().endswith("regrasp: interrupted"), (p.returncode, err)
+
+
+def _ray_processes() -> set:
+    out = subprocess.run(["pgrep", "-f", "raylet|gcs_server|ray::"], capture_output=True, text=True).stdout
+    return set(out.split())
+
+
+@pytest.mark.parametrize("after", [1.5, 4.0])  # while the local cluster starts, and while it works
+def test_ctrl_c_during_validation_on_ray_exits_130_and_leaves_no_ray_process(tmp_path, after):
+    """Ctrl-C while `validate --ray local` starts its cluster (or runs on it): 130, and none of
+    the cluster's processes outlives the command (a Ctrl-C cut into ray.init used to leave its
+    agents running: the start is a section the stop waits for, regrasp.interrupts)."""
+    pytest.importorskip("ray")
+    before = _ray_processes()
+    status, err, took = interrupt(["validate", EXAMPLES / "t-shape.toml", "--pushes", "2000", "--engines", "mujoco",
+                                   "--ray", "local"], after, tmp_path)
+    assert status == 130 and err.strip().endswith("regrasp: interrupted") and "Traceback" not in err, err
+    assert took < 30.0, f"the command went on {took:.1f} s after Ctrl-C"
+    deadline = time.time() + 10.0
+    while (left := _ray_processes() - before) and time.time() < deadline:
+        time.sleep(0.5)
+    assert not left, subprocess.run(["ps", "-o", "pid,cmd", "-p", ",".join(left)], capture_output=True, text=True).stdout

@@ -118,7 +118,7 @@ def test_the_circle_check_finds_a_circle(tmp_path):
 #: takes data (it imports no stage); ``planning`` is the Plan (the plan file's type) and
 #: ``plan()``, which the scenes' ``plan``/``replay`` return and read.
 STAGES = (
-    ("errors", "fields", "files", "pose", "polygon", "extras", "progress", "_moved", "_core"),
+    ("errors", "fields", "files", "pose", "polygon", "extras", "progress", "interrupts", "_moved", "_core"),
     ("viz",),
     ("planning",),
     ("scene", "examples"),

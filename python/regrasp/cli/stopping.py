@@ -2,8 +2,9 @@
 (KeyboardInterrupt, or :class:`Terminated`), so that outputs stay uncommitted, temporary files are
 removed and worker processes stopped; `regrasp` then exits 130 or 143 (docs/cli.md).
 
-A signal that arrives while a module is being imported waits for the import's end (it is sent
-again every :data:`RESEND` seconds until then): an exception raised inside an import can pass
+A signal that arrives while a module is being imported, or inside a section that must not be cut
+(:func:`regrasp.interrupts.deferred`: starting a local Ray cluster), waits for its end (it is sent
+again every :data:`RESEND` seconds until then). An exception raised inside an import can pass
 through an extension module's own run of Python code (``PyRun_*``, e.g. while MuJoCo's bindings
 load), which CPython marks as an unhandled Ctrl-C for good; the interpreter would then end by
 killing itself with SIGINT whatever status the command returned.
@@ -14,6 +15,8 @@ from __future__ import annotations
 import os
 import signal
 import threading
+
+from ..interrupts import deferring
 
 #: seconds after which a signal deferred by an import is sent again
 RESEND = 0.05
@@ -45,7 +48,7 @@ def _send_again(signum: int) -> None:
 def on_signal(signum, frame):
     """The handler of SIGINT and SIGTERM while a command runs."""
     STOPPED.append(signum)
-    if _importing(frame):
+    if _importing(frame) or deferring():
         timer = threading.Timer(RESEND, _send_again, (signum,))
         timer.daemon = True
         timer.start()

@@ -32,6 +32,7 @@ import numpy as np
 from .. import progress as bars
 from ..errors import ArgumentError, RegraspError, check_seed
 from ..extras import need
+from ..interrupts import deferred
 from ..sim.quasistatic import SPEED, support_kwargs
 from ..scene.planar import Scene
 from ..scene.settings import validation_rings
@@ -198,8 +199,9 @@ def ray_init(address: str, workers: int):
     ray = need("ray", "ray")
     if not ray.is_initialized():
         _check_reachable(address)
-        ray.init(address=None if address == "local" else address, include_dashboard=False,
-                 log_to_driver=False, num_cpus=workers if address == "local" else None)
+        with deferred():  # a Ctrl-C half-way through would leave the cluster's agents running
+            ray.init(address=None if address == "local" else address, include_dashboard=False,
+                     log_to_driver=False, num_cpus=workers if address == "local" else None)
     return ray
 
 
