@@ -9,6 +9,7 @@ Rust core, which bounds every number by ``MAX_MAGNITUDE``."""
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,6 +58,17 @@ def check_finite(a: np.ndarray, name: str) -> np.ndarray:
     if a.size and np.max(np.abs(a)) > MAX_MAGNITUDE:
         raise ArgumentError(f"invalid `{name}`: components must be at most {MAX_MAGNITUDE:g} in magnitude", name)
     return a
+
+
+def finite_number(x) -> bool:
+    """Whether ``x`` is a real number (not a bool) that is finite as a float: an integer too
+    large for one (a file's 10^400) is not."""
+    if not isinstance(x, numbers.Real) or isinstance(x, (bool, np.bool_)):
+        return False
+    try:
+        return math.isfinite(float(x))
+    except OverflowError:
+        return False
 
 
 def plain_numbers(x, n: int) -> list | None:

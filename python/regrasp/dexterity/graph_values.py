@@ -4,21 +4,11 @@ Each fault is an ArgumentError naming the field (``settings.spread``, ``nodes[3]
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
 from ..errors import ArgumentError
-
-
-def is_number(x) -> bool:
-    """Whether ``x`` is a finite JSON number (not a bool; an integer too large for a float is not)."""
-    if not isinstance(x, (int, float)) or isinstance(x, bool):
-        return False
-    try:
-        return math.isfinite(float(x))
-    except OverflowError:
-        return False
+from ..fields import finite_number as is_number
 
 
 def check_node(n: dict, f: str) -> None:

@@ -9,7 +9,6 @@ of plan files and :meth:`Plan.from_json` of plan dicts, both checking every fiel
 from __future__ import annotations
 
 import json
-import math
 import numbers
 import weakref
 from dataclasses import dataclass, field
@@ -20,7 +19,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import ArgumentError, check_seed
-from ..fields import MAX_ANGLE, MAX_COORDINATE, MAX_PLAN_STEPS
+from ..fields import MAX_ANGLE, MAX_COORDINATE, MAX_PLAN_STEPS, finite_number
 from ..files import as_path, parse_json, read_text, same_file as _same_file, write_text
 
 #: the keys of a plan file, in the order they are written (docs/plan-file.md), by dimension
@@ -56,21 +55,9 @@ def planner_defaults(dimension: int) -> dict:
 
 # --- checking plan values ----------------------------------------------------------------------
 
-def _is_number(x) -> bool:
-    return isinstance(x, numbers.Real) and not isinstance(x, bool)
-
-
-def _finite(x) -> bool:
-    """Whether real number ``x`` is finite as a float (an integer too large for one is not)."""
-    try:
-        return math.isfinite(float(x))
-    except OverflowError:
-        return False
-
-
 def _numbers(v, n: int, where: str, what: str) -> np.ndarray:
     """``v`` as n finite numbers, or an ArgumentError naming ``where``."""
-    ok = isinstance(v, (list, tuple, np.ndarray)) and len(v) == n and all(_is_number(x) and _finite(x) for x in v)
+    ok = isinstance(v, (list, tuple, np.ndarray)) and len(v) == n and all(finite_number(x) for x in v)
     a = np.asarray(v, float) if ok else None
     if a is None or not np.all(np.isfinite(a)):
         raise ArgumentError(f"invalid `{where}`: {what} (got {v!r})", where)
@@ -107,7 +94,7 @@ def _is_type(v, t: str) -> bool:
     if t == "int":
         return isinstance(v, numbers.Integral) and not isinstance(v, bool)
     if t == "float":
-        return _is_number(v) and _finite(v)
+        return finite_number(v)
     return isinstance(v, list) and all(_is_type(x, "float") for x in v)  # float[]
 
 
