@@ -75,7 +75,10 @@ fn pads_touch_the_ls_faces_and_not_the_notch() {
 
 /// The bracket's scene with its OBJ replaced by `obj` (written next to a copy of the scene).
 fn with_obj(obj: &str, tag: &str) -> regrasp::Result<Scene3> {
-    let dir = std::env::temp_dir().join(format!("regrasp-nonconvex-{tag}-{}", std::process::id()));
+    // a folder of its own per call: the tests run in parallel threads of one process
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("regrasp-nonconvex-{tag}-{}-{call}", std::process::id()));
     std::fs::create_dir_all(dir.join("meshes")).unwrap();
     std::fs::write(dir.join("meshes/bracket.obj"), obj).unwrap();
     let text = std::fs::read_to_string(examples().join("bracket-pivot-3d.toml")).unwrap();
@@ -190,6 +193,6 @@ fn parts_are_bounded_together() {
         }
         first += 200;
     }
-    let m = mesh_error(with_obj(&obj, "many"));
+    let m = mesh_error(with_obj(&obj, "parts"));
     assert!(m.contains("more than 5000 vertices"), "{m}");
 }
