@@ -133,3 +133,16 @@ fn a_heavier_object_is_not_certified_where_gravity_can_win() {
     let s = Scene::from_toml_str(&text).unwrap();
     assert!(!never_along(&s, &Vec2::new(0.0, 1.0), [-std::f64::consts::PI, std::f64::consts::PI]));
 }
+
+#[test]
+fn a_huge_turn_range_is_not_shown_rather_than_worked_through() {
+    // more poses than MAX_POSES: "not shown" at once, no overflow of the count
+    let s = weighed();
+    let t0 = Instant::now();
+    assert!(!never_along(&s, &Vec2::new(0.0, 1.0), [-1e300, 1e300]));
+    assert!(!never_along(&s, &Vec2::new(0.0, 1.0), [-1e4, 1e4]));
+    assert!(!never_along(&s, &Vec2::new(0.0, 1.0), [f64::NAN, 0.0]));
+    assert!(t0.elapsed().as_secs_f64() < 0.1);
+    // within the budget it is shown
+    assert!(never_along(&s, &Vec2::new(0.0, 1.0), [-0.5, 0.5]));
+}

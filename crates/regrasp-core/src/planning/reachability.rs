@@ -240,11 +240,12 @@ pub fn one_way(scene: &Scene, start: &[f64; 3], goal: &[f64; 3], tol: &[f64; 3],
         return None;
     }
     let along = delta.y.atan2(delta.x);
+    let corners = pad_corners(scene)?;
     for (k, any_turn) in [(0, true), (0, false), (1, false), (-1, false), (2, false), (-2, false), (3, false), (-3, false)] {
         let a = along + k as f64 * std::f64::consts::PI / 9.0;
         let d = Vec2::new(a.cos(), a.sin());
         let range = if any_turn { [-std::f64::consts::PI, std::f64::consts::PI] } else { turn };
-        if d.dot(&delta) > slack + 1e-9 && never_along(scene, &d, range) {
+        if d.dot(&delta) > slack + 1e-9 && never_along_from(scene, &d, range, &corners) {
             return Some(say(d, any_turn));
         }
     }
@@ -254,6 +255,25 @@ pub fn one_way(scene: &Scene, start: &[f64; 3], goal: &[f64; 3], tol: &[f64; 3],
 /// The turn grid of [`never_along`] [rad]: between neighbouring turns the load is bounded by its
 /// Lipschitz constant.
 pub const TURN_STEP: f64 = 0.005;
+
+/// The most poses (corners × turns) [`never_along`] evaluates; beyond it the answer is "not
+/// shown" (a few tenths of a second of work at most before the search).
+pub const MAX_POSES: usize = 200_000;
+
+/// The vertices of the convex hull of the pad centres' region ([`pad_region`], or the outline
+/// when it is too large to erode): a convex function of the pad's centre is largest at one.
+fn pad_corners(scene: &Scene) -> Option<Vec<Vec2>> {
+    use geo::ConvexHull;
+    let (_, r) = scene.pad_disc(&[0.0; 3])?;
+    let hull = match pad_region(scene, r, LineJoin::Bevel) {
+        Some(region) => region.convex_hull(),
+        None => {
+            let ring: Vec<(f64, f64)> = scene.outline.vertices().iter().map(|v| (v.x, v.y)).collect();
+            Polygon::new(LineString::from(ring), vec![]).convex_hull()
+        }
+    };
+    Some(hull.exterior().0.iter().map(|c| Vec2::new(c.x, c.y)).collect())
+}
 
 /// Whether no push can move the pad's centre along the unit direction `d` (object frame) at any
 /// turn within `turn` (rad), gravity weighed against the pads' friction; false when that is not
@@ -265,10 +285,15 @@ pub const TURN_STEP: f64 = 0.005;
 /// pusher edge `eᵢ = (fᵢ, mᵢ)` having `d·fᵢ > 0`, write pushes as `p = Σλᵢêᵢ`, `êᵢ = eᵢ/(d·fᵢ)`,
 /// `Σλᵢ = 1`: `d·f` grows along the ray and is 0 at `t₀ = g = max(0, −d·f_g)`, so the pad moves
 /// along `d` only if the ray leaves the surface before `t₀`, i.e. `‖w_g + g·p‖ > 1`. That norm
-/// is convex in `λ` (largest at an edge) and in `c` (largest at a vertex of the pad centres'
-/// region, [`pad_region`]); over the turn it is checked every [`TURN_STEP`] with the margin its
+/// is convex in `λ` (largest at an edge) and in `c` (largest at a vertex of the convex hull of the
+/// pad centres' region, [`pad_region`]); over the turn it is checked every [`TURN_STEP`] with the margin its
 /// Lipschitz constant allows (`|f_g|` times the norm's force and moment gains and the arms).
 pub fn never_along(scene: &Scene, d: &Vec2, turn: [f64; 2]) -> bool {
+    pad_corners(scene).is_some_and(|corners| never_along_from(scene, d, turn, &corners))
+}
+
+/// [`never_along`] over the pad centres' hull `corners`.
+fn never_along_from(scene: &Scene, d: &Vec2, turn: [f64; 2], corners: &[Vec2]) -> bool {
     let Support::Grasp(g) = &scene.support else { return false };
     let b = &g.limit_surface.b;
     let isotropic = match &g.exact {
@@ -278,7 +303,6 @@ pub fn never_along(scene: &Scene, d: &Vec2, turn: [f64; 2]) -> bool {
     if !isotropic || !turn.iter().all(|t| t.is_finite()) || turn[1] < turn[0] {
         return false;
     }
-    let Some((_, r)) = scene.pad_disc(&[0.0; 3]) else { return false };
     let mut edges: Vec<Vec3> = Vec::new();
     for p in &scene.pushers {
         for e in p.contact.edge_wrenches() {
@@ -289,10 +313,6 @@ pub fn never_along(scene: &Scene, d: &Vec2, turn: [f64; 2]) -> bool {
             edges.push(e.wrench / s);
         }
     }
-    let corners: Vec<Vec2> = match pad_region(scene, r, LineJoin::Bevel) {
-        Some(region) => region.0.iter().flat_map(|p| p.exterior().0.iter().map(|c| Vec2::new(c.x, c.y))).collect(),
-        None => scene.outline.vertices().to_vec(),
-    };
     let f0 = scene.frame(&[0.0; 3]);
     // the norm of a wrench given at the object's origin, at frame `f`'s pad centre
     let load = |f: &crate::cones::motion_cone::SupportFrame, w: &Vec3| {
@@ -304,10 +324,14 @@ pub fn never_along(scene: &Scene, d: &Vec2, turn: [f64; 2]) -> bool {
     };
     let (nf, nm) = (load(&f0, &Vec3::new(1.0, 0.0, 0.0)), load(&f0, &Vec3::new(0.0, 0.0, 1.0)));
     let weight = f0.gravity.xy().norm();
-    let n = ((turn[1] - turn[0]) / TURN_STEP).ceil().max(1.0) as usize;
+    let turns = ((turn[1] - turn[0]) / TURN_STEP).ceil().max(1.0);
+    if corners.len() as f64 * (turns + 1.0) > MAX_POSES as f64 {
+        return false; // checked as floats: a huge turn range must not overflow the count
+    }
+    let n = turns as usize;
     let step = (turn[1] - turn[0]) / n as f64;
     let cross = |a: &Vec2, b: &Vec3| a.x * b.y - a.y * b.x;
-    for c in &corners {
+    for c in corners {
         // the load's Lipschitz constant in the turn, per edge: |f_g| (nf (1 + |f̂|) + nm (|com − c| + |m̂ − c × f̂|))
         let lip: Vec<f64> = edges
             .iter()
