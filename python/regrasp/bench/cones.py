@@ -6,7 +6,7 @@ import numpy as np
 
 from ..reference import cones as reference
 from ..scene.planar import Scene
-from .timing import _median_time
+from .timing import _median_cpu, _median_time
 
 
 def _cone_batch(scene: Scene, pusher: str, params, poses, batch, reps: int, baseline_reps: int) -> dict:
@@ -18,6 +18,9 @@ def _cone_batch(scene: Scene, pusher: str, params, poses, batch, reps: int, base
     t_rust = _median_time(lambda: scene.motion_cones(poses, pusher), reps)
     t_loop = _median_time(lambda: [reference.generators_numpy(params, q) for q in poses], baseline_reps)
     t_vec = _median_time(lambda: reference.generators_numpy_batch(params, poses), reps)
+    # CPU time too: the batch spreads over threads, so its wall time flatters it on several cores
+    c_rust = _median_cpu(lambda: scene.motion_cones(poses, pusher), reps)
+    c_vec = _median_cpu(lambda: reference.generators_numpy_batch(params, poses), reps)
     return {
         f"cone_batch_{n}": {
             "median_s": t_rust,
@@ -31,8 +34,9 @@ def _cone_batch(scene: Scene, pusher: str, params, poses, batch, reps: int, base
             "median_s": t_rust,
             "baseline_median_s": t_vec,
             "ratio": t_vec / t_rust,
-            "baseline": "numpy, vectorized over poses (einsum)",
+            "baseline": f"numpy, vectorized over poses (einsum); in CPU time {c_vec / c_rust:.1f}x",
             "n": n,
+            "cpu_median_s": c_rust, "baseline_cpu_median_s": c_vec, "cpu_ratio": c_vec / c_rust,
             "max_abs_diff": float(np.abs(batch.generators - vec).max()),
         },
     }

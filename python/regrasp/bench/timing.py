@@ -18,6 +18,16 @@ def _median_time(fn, reps: int) -> float:
     return float(np.median(ts))
 
 
+def _median_cpu(fn, reps: int) -> float:
+    """The median CPU time of ``fn()`` [s]: this process's, every thread (rayon's too) counted."""
+    ts = []
+    for _ in range(reps):
+        t0 = time.process_time()
+        fn()
+        ts.append(time.process_time() - t0)
+    return float(np.median(ts))
+
+
 def _random_poses(scene: Scene, n: int, rng) -> np.ndarray:
     out = np.empty((0, 3))
     while len(out) < n:

@@ -1,5 +1,5 @@
-//! The QP of one MPC step ([`crate::control::mpc`]), sparse: the poses after each horizon step
-//! stay variables beside the generator weights, tied by the dynamics as equalities, so the KKT
+//! The QP of one MPC step ([`crate::control::mpc`]), sparse: the pose errors after each horizon
+//! step stay variables beside the generator weights, tied by the dynamics as equalities, so the KKT
 //! system is banded and clarabel's sparse factorisation costs O(H) per iteration (the condensed
 //! form, positions eliminated, has a dense Hessian: O(H²) to build and more to factor).
 //!
