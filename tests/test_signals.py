@@ -44,8 +44,13 @@ LONG = {
 
 def interrupted(call: str, wait: float = 1.0):
     """Runs `call` in a subprocess, sends SIGINT `wait` s after it starts: (seconds from SIGINT
-    to exit, return code, stderr)."""
-    code = PRELUDE + call + "\nprint('finished', flush=True)\n"
+    to the KeyboardInterrupt reaching Python, seconds from SIGINT to exit, return code, stdout,
+    stderr). The first is the stop; the second adds the interpreter's teardown, which a loaded
+    machine (cargo test beside pytest on 2 cores) can stretch past a second."""
+    body = "\n".join("    " + line for line in call.split("; "))
+    code = (PRELUDE + "import time\ntry:\n" + body + "\nexcept KeyboardInterrupt:\n"
+            "    print('caught', time.monotonic(), file=sys.stderr, flush=True)\n    raise\n"
+            "print('finished', flush=True)\n")
     p = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert p.stdout.readline().strip() == "started", p.stderr.read()
@@ -54,7 +59,10 @@ def interrupted(call: str, wait: float = 1.0):
         p.send_signal(signal.SIGINT)
         t0 = time.monotonic()
         out, err = p.communicate(timeout=30)
-        return time.monotonic() - t0, p.returncode, out, err
+        t_exit = time.monotonic()
+        caught = [float(line.split()[1]) for line in err.splitlines() if line.startswith("caught ")]
+        t_stop = caught[0] if caught else float("inf")
+        return t_stop - t0, t_exit - t0, p.returncode, out, err
     finally:
         if p.poll() is None:
             p.kill()
@@ -63,9 +71,10 @@ def interrupted(call: str, wait: float = 1.0):
 
 @pytest.mark.parametrize("name", list(LONG))
 def test_ctrl_c_stops_a_long_call_within_a_second(name):
-    dt, rc, out, err = interrupted(LONG[name])
+    dt, dt_exit, rc, out, err = interrupted(LONG[name])
     assert "KeyboardInterrupt" in err, (name, err[-2000:])
     assert "finished" not in out
     assert rc != 0
-    assert dt < 1.0, f"{name}: {dt:.2f} s from SIGINT to exit"
+    assert dt < 1.0, f"{name}: {dt:.2f} s from SIGINT to the KeyboardInterrupt"
+    assert dt_exit < 10.0, f"{name}: {dt_exit:.2f} s from SIGINT to exit"
     assert "PanicException" not in err and "panicked" not in err
