@@ -8,6 +8,7 @@ import json
 import numpy as np
 
 from ..errors import ArgumentError
+from ..execution.trajectory_formats import FORMATS as TRAJECTORY_FORMATS, format_of
 from ..planning.plan import Plan
 from . import (CANNOT, OK, add_command, add_scale_options, add_verbose, check_outputs, floats, load, refuse_flags,
                rounded, scales)
@@ -29,7 +30,16 @@ def _check(a) -> None:
     scales(a)
     if a.video and a.robot == FREE_GRIPPER:
         raise ArgumentError("invalid `--video`: the video shows the arm (not --robot free-gripper)", "--video")
-    check_outputs(a, {"trajectory": (".json",), "video": (".gif", ".mp4"), "html": (".html", ".htm")},
+    if a.plan_only:
+        refuse_flags(a, ("video", "closed_loop", "scale_friction", "scale_grip", "scale_mass", "start_error"),
+                     "with --plan-only", "nothing is simulated (leave out --plan-only to run it in MuJoCo)")
+    if a.format is not None and not a.trajectory:
+        raise ArgumentError("invalid `--format`: the format of --trajectory, which is not given", "--format")
+    if a.trajectory and a.robot == FREE_GRIPPER and format_of(a.trajectory, a.format) != "json":
+        raise ArgumentError(f"invalid `--trajectory`: {format_of(a.trajectory, a.format)} carries a robot's joints (a "
+                            "free gripper's trajectory is .json)", "--trajectory")
+    suffixes = None if a.format else tuple(e for exts in TRAJECTORY_FORMATS.values() for e in exts)
+    check_outputs(a, {"trajectory": suffixes, "video": (".gif", ".mp4"), "html": (".html", ".htm")},
                   [a.scene, a.plan, a.workcell])
 
 
@@ -138,6 +148,46 @@ def _closed_loop(scene, plan, a) -> int:
     return OK if run.success else CANNOT
 
 
+def _plan_only(scene, plan, a) -> int:
+    """`--plan-only`: the world motion and, with the arm, its IK and time parametrisation; no
+    simulation. Prints the trajectory's length, duration and joint rates against the limits."""
+    from ..execution.arm import arm_motion
+    from ..execution.world_motion import world_motion
+
+    if a.robot == FREE_GRIPPER:
+        motion, arm, refused = world_motion(scene, plan, _workcell(a)), None, []
+    else:
+        am = arm_motion(scene, plan, _workcell(a), a.robot)
+        motion, arm, refused = am.motion, am.trajectory, am.refused
+    tr = motion.to_trajectory(arm)
+    written = [tr.save(a.trajectory, a.format)] if a.trajectory else []
+    if a.html:
+        from ..viz.viewer import write_motion_html
+
+        written.append(write_motion_html(a.html, scene, motion))
+    out = dict(plan_only=True, robot=tr.robot or FREE_GRIPPER, workcell=motion.workcell.name, samples=len(tr),
+               duration_s=tr.duration, pushes=[{"pusher": p.pusher, "feature": p.feature, "tilt": p.tilt}
+                                               for p in motion.assignments],
+               refused=[dict(push=k, feature=f_, why=why) for k, f_, why in refused])
+    if arm is not None:
+        from ..robot.kinds import ROBOTS
+
+        kind = ROBOTS[arm.robot]
+        out["max_velocity_ratio"] = float(np.max(np.abs(arm.qd) / np.asarray(kind.velocity_limit)))
+        out["max_acceleration_ratio"] = float(np.max(np.abs(arm.qdd) / np.asarray(kind.acceleration_limit)))
+    if a.json:
+        print(json.dumps(out, allow_nan=False))
+    else:
+        rates = (f"; joint speeds up to {out['max_velocity_ratio']:.0%} and accelerations up to "
+                 f"{out['max_acceleration_ratio']:.0%} of the limits") if arm is not None else ""
+        print(f"{scene.name}: {out['robot']} in workcell {out['workcell']}, {len(motion.assignments)} pushes "
+              f"({', '.join(f'{p.pusher} on {p.feature}' for p in motion.assignments)}): a trajectory of "
+              f"{len(tr)} samples, {tr.duration:.1f} s{rates} (not simulated)")
+        for p in written:
+            print(f"wrote {p}")
+    return OK
+
+
 def cmd_execute(a) -> int:
     _check(a)
     scene = load(a.scene, a)
@@ -146,11 +196,13 @@ def cmd_execute(a) -> int:
     _start_error(scene, a, plan)
     if a.closed_loop:
         return _closed_loop(scene, plan, a)
+    if a.plan_only:
+        return _plan_only(scene, plan, a)
     out, motion, extra = (_free if a.robot == FREE_GRIPPER else _arm)(scene, plan, a)
     written = []
     if a.trajectory:
         arm = extra[0].trajectory if extra else None
-        written.append(motion.to_trajectory(arm).save(a.trajectory))
+        written.append(motion.to_trajectory(arm).save(a.trajectory, a.format))
     if a.video and extra and extra[1] is not None:
         written.append(extra[1].save(a.video))
     if a.html:
@@ -183,8 +235,12 @@ def add_parsers(sub) -> None:
                    "generated for the scene)")
     e.add_argument("--robot", metavar="NAME", help=f"the robot: one of {', '.join(_robots())} (default: the "
                    "workcell's)")
-    e.add_argument("--trajectory", metavar="TRAJ.json", help="write the timed joint trajectory "
-                   "(docs/trajectory-file.md)")
+    e.add_argument("--trajectory", metavar="TRAJ", help="write the timed joint trajectory, within the robot's "
+                   "joint limits: .json (ours), .yaml (a ROS 2 JointTrajectory) or .csv (docs/trajectory-file.md)")
+    e.add_argument("--format", choices=list(TRAJECTORY_FORMATS), help="the format of --trajectory (default: by "
+                   "its extension)")
+    e.add_argument("--plan-only", action="store_true", help="stop after the world motion, the IK and the time "
+                   "parametrisation: write the trajectory without simulating it")
     e.add_argument("--video", metavar="GIF|MP4", help="a video of the arm doing it (MuJoCo's renderer)")
     e.add_argument("--html", metavar="HTML", help="a browser view of the workcell and the world motion")
     add_scale_options(e, "the arm's world: ")

@@ -62,14 +62,18 @@ Scales = ArmScales
 @dataclass
 class ArmTrajectory:
     """The arm's joint-space trajectory of a world motion: ``robot`` (registry name),
-    ``joint_names``, per motion sample ``times`` (n,) [s] and ``q`` (n, 6) [rad]; ``tcp`` (7,)
-    the TCP's pose in regrasp's gripper frame (m, unit quaternion); ``grasp_width`` [m]."""
+    ``joint_names``, per motion sample ``times`` (n,) [s] (time-parametrised within the robot's
+    joint limits, never faster than the motion: :func:`~regrasp.execution.retime.retime`),
+    ``q`` (n, 6) [rad], ``qd`` (n, 6) [rad/s] and ``qdd`` (n, 6) [rad/s²]; ``tcp`` (7,) the TCP's
+    pose in regrasp's gripper frame (m, unit quaternion); ``grasp_width`` [m]."""
     robot: str
     joint_names: list
     times: np.ndarray
     q: np.ndarray
     tcp: np.ndarray
     grasp_width: float
+    qd: np.ndarray | None = None
+    qdd: np.ndarray | None = None
 
 
 @dataclass
@@ -273,8 +277,11 @@ def solve_arm(robot, motion: WorldMotion, tcp) -> ArmTrajectory:
         # the push it serves or leads to (the final transfer: the last push's)
         err.push = next((int(p) for p in motion.push[i:] if p >= 0), int(motion.push.max()))
         raise err from None
-    return ArmTrajectory(robot.name, [robot.kind.arm_joints[j] for j in range(len(robot.kind.arm_joints))],
-                         motion.times.copy(), q, np.asarray(tcp, float), robot.grasp_width)
+    from .retime import retime
+
+    timed = retime(motion.times, q, robot.kind.velocity_limit, robot.kind.acceleration_limit)
+    return ArmTrajectory(robot.name, list(robot.kind.arm_joints), motion.times[0] + timed.times, q,
+                         np.asarray(tcp, float), robot.grasp_width, timed.qd, timed.qdd)
 
 
 @dataclass
@@ -385,7 +392,7 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
         return P.compose(P.inverse(P.compose(r.tcp_pose(), untcp)), body_pose(d, body))
 
     def record(t: float) -> None:
-        while k[0] < len(motion.times) and t >= motion.times[k[0]] - 1e-9:
+        while k[0] < len(traj.times) and t >= traj.times[k[0]] - 1e-9:
             samples.append(in_hand())
             qs.append(r.q)
             k[0] += 1
@@ -399,7 +406,7 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
     H[-1] = in_hand()  # after settling
     creep, turn = _creep(motion, H)
     err, ok = _tolerance_error(scene, plan, H[-1])
-    return ArmResult(ok, err, creep, turn, float(d.time), tracking, traj, motion.times.copy(), H,
+    return ArmResult(ok, err, creep, turn, float(d.time), tracking, traj, np.array(traj.times, float), H,
                      motion.in_hand.copy(), np.array(qs))
 
 

@@ -530,7 +530,7 @@ def execute_pick_place(scene, r: PickPlace, scales=None, observe=None) -> PickPl
     scales = Perturbation() if scales is None else scales
     rob, body, geoms, tcp = build_robot(scene, r.motion, scales=scales)
     m, d = rob.model, rob.data
-    q, t = r.arm.q, r.motion.times
+    q, t = r.arm.q, r.arm.times
     rob.set_q(q[0])
     jq = m.jnt_qposadr[m.body_jntadr[body]]
     d.qpos[jq:jq + 7] = r.pick_pose

@@ -28,6 +28,10 @@ UNIT_TOL = 1e-6
 #: The keys of the file, of a sample and of an assignment (all required).
 KEYS = ("format", "version", "scene", "workcell", "robot", "joint_names", "samples", "assignments")
 SAMPLE_KEYS = ("t", "q", "gripper_pose", "grip_force", "label", "push")
+#: A robot's samples may also carry the joint velocities and accelerations (both, in every sample).
+MOTION_KEYS = ("qd", "qdd")
+#: The most a joint velocity [rad/s] or acceleration [rad/s²] may be in the file.
+MAX_RATE = 1e4
 ASSIGNMENT_KEYS = ("pusher", "feature", "first", "last", "frame", "tilt", "penetration")
 
 
@@ -70,7 +74,10 @@ class Trajectory:
     positions [rad]; ``gripper`` (n, 7) the gripper's world pose (m, unit quaternion);
     ``grip_force`` (n,) [N] per finger; ``labels`` (one of :data:`LABELS` each); ``push`` (n,)
     the push index (−1: none, ``null`` in the file); ``assignments``: a :class:`PushRecord` per
-    push. Checked on construction (SceneError naming the field)."""
+    push; with a robot, ``qd`` and ``qdd`` (n, len(joint_names)) the joint velocities [rad/s] and
+    accelerations [rad/s²] (None: not given). Checked on construction (SceneError naming the
+    field). :meth:`save` writes it as our JSON, a ROS 2 ``JointTrajectory`` or CSV
+    (:mod:`.trajectory_formats`)."""
     scene: str
     workcell: str
     robot: str | None
@@ -82,10 +89,12 @@ class Trajectory:
     labels: list
     push: np.ndarray
     assignments: list = field(default_factory=list)
+    qd: np.ndarray | None = None
+    qdd: np.ndarray | None = None
 
     def __post_init__(self):
         checked = _from_dict(self.to_dict(check=False))
-        for k in ("times", "q", "gripper", "grip_force", "push", "labels", "assignments", "joint_names"):
+        for k in ("times", "q", "gripper", "grip_force", "push", "labels", "assignments", "joint_names", "qd", "qdd"):
             setattr(self, k, getattr(checked, k))
 
     def __len__(self) -> int:
@@ -120,6 +129,9 @@ class Trajectory:
                     "grip_force": row(self.grip_force, i), "label": row(self.labels, i),
                     "push": None if row(self.push, i) is None or row(self.push, i) == -1 else row(self.push, i)}
                    for i in range(n)]
+        if self.qd is not None or self.qdd is not None:
+            for i, sample in enumerate(samples):
+                sample["qd"], sample["qdd"] = row(self.qd, i), row(self.qdd, i)
         return {"format": FORMAT, "version": VERSION, "scene": self.scene, "workcell": self.workcell,
                 "robot": self.robot, "joint_names": list(self.joint_names) if isinstance(self.joint_names,
                                                                                           (list, tuple)) else self.joint_names,
@@ -140,11 +152,16 @@ class Trajectory:
                 lines.append(f" {json.dumps(k)}: {json.dumps(v)}")
         return "{\n" + ",\n".join(lines) + "\n}"
 
-    def save(self, path) -> Path:
-        """Writes the file to ``path`` atomically (:func:`regrasp.files.write_text`)."""
+    def save(self, path, format: str | None = None) -> Path:
+        """Writes the trajectory to ``path`` atomically (:func:`regrasp.files.write_text`) in
+        ``format``: ``"json"`` (this file), ``"ros2"`` (a ``trajectory_msgs/JointTrajectory``
+        document, YAML) or ``"csv"``; by default chosen by the extension (``.json``, ``.yaml`` /
+        ``.yml``, ``.csv``). See :mod:`.trajectory_formats`."""
         from ..files import as_path, write_text
+        from .trajectory_formats import text_as
 
-        return write_text(as_path(path, "path"), self.to_json() + "\n")
+        path = as_path(path, "path")
+        return write_text(path, text_as(self, path, format))
 
     @classmethod
     def from_dict(cls, d) -> "Trajectory":
@@ -200,12 +217,18 @@ def _from_dict(d) -> Trajectory:
     S = d["samples"]
     if not isinstance(S, list) or not S:
         raise _fail("samples", "must be a non-empty list", S)
+    rates = isinstance(S[0], dict) and any(k in S[0] for k in MOTION_KEYS)
+    if rates and robot is None:
+        raise _fail("samples[0].qd", "joint velocities need a robot (robot is null)", S[0].get("qd"))
     _CHECK.count(S, "samples", MAX_TRAJECTORY_SAMPLES, "samples")
     _CHECK.count(A, "assignments", len(S), "assignments (at most one per sample)")
-    t, q, g, f, lab, push = [], [], [], [], [], []
+    t, q, g, f, lab, push, qd, qdd = [], [], [], [], [], [], [], []
     for i, s in enumerate(S):
         w = f"samples[{i}]"
-        _keys(s, SAMPLE_KEYS, w)
+        _keys(s, SAMPLE_KEYS + MOTION_KEYS if rates else SAMPLE_KEYS, w)
+        if rates:
+            qd.append(_vector(s["qd"], len(joints), f"{w}.qd", -MAX_RATE, MAX_RATE, "rad/s"))
+            qdd.append(_vector(s["qdd"], len(joints), f"{w}.qdd", -MAX_RATE, MAX_RATE, "rad/s²"))
         t.append(_number(s["t"], f"{w}.t", 0.0, MAX_SECONDS, "s"))
         if i and t[-1] <= t[-2]:
             raise _fail(f"{w}.t", f"times must increase strictly (samples[{i - 1}].t is {t[-2]!r})", s["t"])
@@ -222,4 +245,6 @@ def _from_dict(d) -> Trajectory:
     tr.scene, tr.workcell, tr.robot, tr.joint_names = scene, workcell, robot, joints
     tr.times, tr.q, tr.gripper = np.array(t), np.array(q, float).reshape(len(t), len(joints)), np.array(g)
     tr.grip_force, tr.labels, tr.push, tr.assignments = np.array(f), lab, np.array(push, int), records
+    tr.qd, tr.qdd = (np.array(qd, float).reshape(len(t), len(joints)), np.array(qdd, float).reshape(len(t), len(joints))) \
+        if rates else (None, None)
     return tr

@@ -159,18 +159,21 @@ class WorldMotion:
         """The motion as a :class:`~regrasp.execution.trajectory.Trajectory` for the trajectory
         file (docs/trajectory-file.md): of a free gripper (robot None, no joints), or with
         ``arm`` (an :class:`~regrasp.execution.arm.ArmTrajectory` of this motion) the robot's
-        name, joint names and joint positions [rad] per sample."""
+        name, joint names, and per sample the arm's times [s] (time-parametrised within its joint
+        limits) with its joint positions [rad], velocities [rad/s] and accelerations [rad/s²]."""
         from .trajectory import PushRecord, Trajectory
 
         if arm is not None and len(arm.q) != len(self.times):
             raise ArgumentError(f"invalid `arm`: {len(self.times)} samples of joint positions (got {len(arm.q)})", "arm")
         robot, names, q = (None, [], np.zeros((len(self.times), 0))) if arm is None else \
             (arm.robot, list(arm.joint_names), np.asarray(arm.q, float))
-        return Trajectory(self.scene or "scene", self.workcell.name, robot, names, self.times.copy(),
+        times = self.times.copy() if arm is None else np.array(arm.times, float)
+        qd, qdd = (None, None) if arm is None else (getattr(arm, "qd", None), getattr(arm, "qdd", None))
+        return Trajectory(self.scene or "scene", self.workcell.name, robot, names, times,
                           q, self.gripper.copy(), self.grip_force.copy(),
                           list(self.labels), self.push.copy(),
                           [PushRecord(a.pusher, a.feature, a.first, a.last, a.frame.copy(), a.tilt, d)
-                           for a, d in zip(self.assignments, self.penetration)])
+                           for a, d in zip(self.assignments, self.penetration)], qd, qdd)
 
     def to_dict(self) -> dict:
         """The motion as JSON-ready lists: per-sample arrays, and per push its pusher, feature,

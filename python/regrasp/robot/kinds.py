@@ -25,7 +25,9 @@ class RobotKind:
     bodies (left, right), driver tendon and joints, the gripper's base body, the arm's ``reach``
     [m] from its ``shoulder`` body to the flange (UR5e: 0.85 m, its data sheet); the ``mounted``
     bodies, which only turn about the base's axis (they stand where the robot is mounted: left out
-    of the clearance checks against the table it stands on, :attr:`Robot.clearance_geoms`)."""
+    of the clearance checks against the table it stands on, :attr:`Robot.clearance_geoms`); the
+    joints' ``velocity_limit`` [rad/s] and ``acceleration_limit`` [rad/s²], one per arm joint,
+    which the trajectory's time parametrisation keeps (:mod:`regrasp.execution.retime`)."""
 
     arm_file: str
     gripper_file: str
@@ -38,6 +40,8 @@ class RobotKind:
     reach: float
     shoulder: str
     mounted: tuple = ()
+    velocity_limit: tuple = ()
+    acceleration_limit: tuple = ()
 
 
 #: The robots by name (``--robot NAME``).
@@ -55,6 +59,10 @@ ROBOTS = {
         reach=0.85,
         shoulder="shoulder_link",
         mounted=("base", "shoulder_link"),
+        # UR5e data sheet: 180 °/s on every joint; URScript's `movej` default acceleration (1.4
+        # rad/s², the teach pendant's), well inside what the arm can do under the gripper's load
+        velocity_limit=(3.1416,) * 6,
+        acceleration_limit=(1.4,) * 6,
     ),
 }
 #: The default robot.
