@@ -218,7 +218,7 @@ def test_bench_json_without_reference_is_valid_json(blocker):
     skipped = res["plan3d_offset-3d"]
     assert skipped["baseline_median_s"] is None and skipped["ratio"] is None, skipped
     assert "regrasp[reference]" in skipped["baseline"]
-    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_step_", "mujoco_", "ik_", "arm_")) for k in res), sorted(res)
+    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_step_", "mujoco_", "ik_", "arm_", "plan_only_")) for k in res), sorted(res)
     assert res["world_motion_block-low-friction"]["median_s"] > 0 and res["mpc_horizon_20"]["median_s"] > 0  # need no extra
     assert res["cli_start_version"]["ratio"] > 0 and res["cli_start_plan_t_shape"]["baseline_median_s"] > 0
     assert res["hard_neck-unreachable"]["unreachable"] == 1 and res["hard_neck-unreachable"]["median_s"] < 1.0

@@ -147,3 +147,17 @@ def test_bad_requests_are_refused_before_any_work(tmp_path):
                        (["--plan-only", "--scale-mass", "1.1"], "--scale-mass")]:
         code, _, err = run_cli("execute", scene, "--plan", plan, *extra)
         assert code == 2 and opt in err and "Traceback" not in err, (extra, err)
+
+
+def test_the_documented_python_snippet_writes_a_joint_trajectory(tmp_path, monkeypatch):
+    import re
+    from pathlib import Path
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "trajectory-file.md").read_text()
+    code = re.findall(r"```python\n(.*?)```", doc.split("## Formats")[1], re.S)[0]
+    assert len(code.strip().splitlines()) <= 10
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "trajectory-file.md", "exec"), {})
+    doc = yaml.safe_load((tmp_path / "block-xztheta.yaml").read_text())
+    conforms(doc, SCHEMA)
+    assert len(doc["points"]) > 100

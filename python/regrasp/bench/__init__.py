@@ -19,7 +19,7 @@ from .planners import run_hard_plans, run_limit_surface, run_plan3d, run_planner
 from .solvers import run_mncp, run_mncp_scaling, run_mpc, run_mpc_horizons
 from .startup import run_startup
 from .timing import _random_poses
-from .worlds import run_arm_steps, run_grasp_graph, run_ik, run_mujoco, run_world_motion
+from .worlds import run_arm_steps, run_grasp_graph, run_ik, run_mujoco, run_plan_only, run_world_motion
 
 #: cones per batch, repetitions of the timed regrasp calls and of the slow baselines (``regrasp bench``)
 CONES, REPS, BASELINE_REPS = 100_000, 11, 3
@@ -58,6 +58,7 @@ def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, sc
         ("world motion", run_world_motion),
         ("arm IK", lambda: _unless_missing("the arm's inverse kinematics", run_ik)),
         ("arm steps", lambda: _unless_missing("MuJoCo's speed with the arm", run_arm_steps)),
+        ("plan only", lambda: _unless_missing("the trajectory without simulating (the arm)", run_plan_only)),
         ("grasp graph", lambda: _unless_missing("the grasp graph (MuJoCo, the arm)", run_grasp_graph)),
         ("CLI start", lambda: run_startup(reps)),
     ]

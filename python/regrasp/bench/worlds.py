@@ -162,3 +162,31 @@ def run_grasp_graph(trials: int = 3, name: str = "prism", workers: int = 1) -> d
                                   "baseline": f"a trial ({grasp} {act}) in a freshly compiled world with its IK; the "
                                               f"{name}'s whole graph: {len(g.edges)} edges, {n} trials in {build:.1f} s "
                                               f"with {workers} worker(s), {n / build:.2f} trials/s"}}
+
+
+def run_plan_only(reps: int = 3, name: str = "block-xztheta") -> dict:
+    """A trajectory a controller can load, without simulating (``regrasp execute --plan-only``:
+    the world motion, the arm's IK, the time parametrisation and the file written): the median
+    CPU time over ``reps`` [s] against the simulated execution of the same plan (once); issue
+    41's target is under 10 s."""
+    need("mujoco", "robot")
+    need("mink", "robot")
+    import tempfile
+    from pathlib import Path
+
+    from ..execution import World, execute
+    from ..execution.arm import arm_motion
+    from ..planning.plan import plan
+    from ..scene import load_scene
+    from .timing import _median_cpu
+
+    scene = load_scene(bundled.path(name))
+    p = plan(scene, seed=0)
+    with tempfile.TemporaryDirectory() as d:
+        def plan_only():
+            am = arm_motion(scene, p)
+            am.motion.to_trajectory(am.trajectory).save(Path(d) / "t.yaml")
+        t = _median_cpu(plan_only, reps)
+        base = _median_cpu(lambda: execute(World(scene, rig="arm"), p), 1)
+    return {f"plan_only_{name}": {"median_s": t, "baseline_median_s": base, "ratio": base / t,
+                                  "baseline": "the simulated execution (MuJoCo, the arm), CPU time; target < 10 s"}}
