@@ -129,7 +129,7 @@ def _calibration_rig(grasp_width: float, robot_name: str, pads, pad_friction: fl
     set_options(g, contact)
     g.option.gravity = [0, 0, 0]
     g.worldbody.add_geom(name="calibration_box", type=mujoco.mjtGeom.mjGEOM_BOX, size=[grasp_width / 2, 0.03, 0.035],
-                         pos=[0, 0, 0.16])
+                         pos=[0, 0, kind.calibration_height])
     m = g.compile()
     pad_geoms = tuple(tuple(i for i in range(m.ngeom) if m.geom_bodyid[i] == m.body(b).id and m.geom_contype[i])
                       for b in kind.pad_bodies)

@@ -12,7 +12,8 @@ from importlib.resources import files
 from ..errors import ArgumentError
 from ..extras import need
 from ..mujoco.model import Contact
-from .pads import add_pads
+from .pads import add_pads, face as pad_face
+from .parallel_gripper import ParallelGripper
 
 ARM_PREFIX, GRIPPER_PREFIX = "arm/", "gripper/"
 GRIP_RANGE = 20.0  # N, the grip actuator's force range (≈ 180 N per pad at a 40 mm grasp)
@@ -27,7 +28,11 @@ class RobotKind:
     bodies, which only turn about the base's axis (they stand where the robot is mounted: left out
     of the clearance checks against the table it stands on, :attr:`Robot.clearance_geoms`); the
     joints' ``velocity_limit`` [rad/s] and ``acceleration_limit`` [rad/s²], one per arm joint,
-    which the trajectory's time parametrisation keeps (:mod:`regrasp.execution.retime`)."""
+    which the trajectory's time parametrisation keeps (:mod:`regrasp.execution.retime`). A
+    ``gripper`` (:class:`~regrasp.robot.parallel_gripper.ParallelGripper`) builds the gripper from
+    its parameters instead of ``gripper_file``; ``opening`` [m] is the widest grasp, and
+    ``calibration_height`` [m] where along the base's z the grip's calibration box stands (at the
+    pads)."""
 
     arm_file: str
     gripper_file: str
@@ -42,6 +47,9 @@ class RobotKind:
     mounted: tuple = ()
     velocity_limit: tuple = ()
     acceleration_limit: tuple = ()
+    gripper: ParallelGripper | None = None
+    opening: float = 0.085
+    calibration_height: float = 0.16
 
 
 #: The robots by name (``--robot NAME``).
@@ -65,6 +73,11 @@ ROBOTS = {
         acceleration_limit=(1.4,) * 6,
     ),
 }
+_LONG_FINGERS = ParallelGripper()
+ROBOTS["ur5e-parallel"] = RobotKind(  # the UR5e with the parametric parallel gripper (the thesis' long fingers)
+    **{**ROBOTS["ur5e-2f85"].__dict__, "gripper_file": "", "gripper": _LONG_FINGERS, "opening": _LONG_FINGERS.stroke,
+       "calibration_height": _LONG_FINGERS.pad_height, "pad_bodies": ("left_pad", "right_pad"),
+       "driver_joints": ("right_finger_joint", "left_finger_joint")})
 #: The default robot.
 DEFAULT_ROBOT = "ur5e-2f85"
 #: Other names of the robots (a workcell file's ``robot.name``, e.g. ``"ur5e"``).
@@ -105,14 +118,21 @@ def gripper_spec(kind: RobotKind, pads: Pads, pad_friction: float):
     spring link, so a pad keeps its orientation; Menagerie's linkage otherwise lets the pads tilt
     under load and touch the object with their tips only)."""
     mujoco = need("mujoco", "robot")
-    g = mujoco.MjSpec.from_file(asset_path(kind.gripper_file))
+    if kind.gripper is not None:
+        from .parallel_gripper import spec
+
+        g = spec(kind.gripper)
+    else:
+        g = mujoco.MjSpec.from_file(asset_path(kind.gripper_file))
     for a in list(g.actuators):
         g.delete(a)
     g.add_actuator(name="grip", trntype=mujoco.mjtTrn.mjTRN_TENDON, target=kind.driver,
                    gainprm=[1.0] + [0] * 9, biasprm=[0] * 10, ctrlrange=[-GRIP_RANGE, GRIP_RANGE], ctrllimited=True,
                    forcerange=[-GRIP_RANGE, GRIP_RANGE], forcelimited=True)
     for b in kind.pad_bodies:
-        add_pads(g, g.body(b), pads, pad_friction)
+        add_pads(g, g.body(b), pads, pad_friction, kind.gripper.face if kind.gripper is not None else pad_face())
+    if kind.gripper is not None:
+        return g
     for side in ("left", "right"):  # parallel pinch: the pad keeps its orientation (follower = -spring link)
         g.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=f"{side}_follower_joint", name2=f"{side}_spring_link_joint",
                        data=[0, -1, 0, 0, 0] + [0] * 7, solref=[0.005, 1], solimp=[0.95, 0.99, 0.001, 0.5, 2])

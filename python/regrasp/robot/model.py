@@ -150,9 +150,9 @@ def build(name: str = DEFAULT_ROBOT, base_pose=(0, 0, 0, 1, 0, 0, 0), table: Opt
     name = robot_name(name)
     kind = ROBOTS[name]
     pose = check_pose(base_pose, "base_pose")
-    if not (is_number(grasp_width) and 0.0 < grasp_width < 0.085):
-        raise ArgumentError(f"invalid `grasp_width`: in (0, 0.085) m, the 2F-85's opening (got {grasp_width!r})",
-                            "grasp_width")
+    if not (is_number(grasp_width) and 0.0 < grasp_width < kind.opening):
+        raise ArgumentError(f"invalid `grasp_width`: in (0, {kind.opening:g}) m, the gripper's opening (got "
+                            f"{grasp_width!r})", "grasp_width")
     if not (is_number(pad_friction) and pad_friction > 0):
         raise ArgumentError(f"invalid `pad_friction`: a number > 0 (got {pad_friction!r})", "pad_friction")
     spec = robot_spec(kind, name, pose, table, pads, pad_friction, grasp_width, contact)

@@ -45,16 +45,16 @@ class Pads:
     solref: tuple = PAD_SOLREF
     torsion: float = 0.0
 
-    def points(self) -> np.ndarray:
+    def points(self, face: tuple = (HALF_WIDTH, LENGTH / 2)) -> np.ndarray:
         """The spheres' centres in the pad body's frame, shape (k, 3) [m] (k = columns · rows
-        without a ``shape``)."""
-        hx, hz = HALF_WIDTH, LENGTH / 2
+        without a ``shape``), on a ``face`` of half-width and half-length [m] centred at
+        ``z = LENGTH / 2`` (the 2F-85's whole face by default; a smaller gripper pad's)."""
+        hx, hz = float(face[0]), float(face[1])
         if self.torsion > 0:
             return np.array([[0.0, FACE_Y + self.radius, LENGTH / 2]])
         if self.shape is not None:
             kind, a, b = self.shape
-            hx, hz = (min(a, HALF_WIDTH), min(a, LENGTH / 2)) if kind == "circle" else \
-                (min(a / 2, HALF_WIDTH), min(b / 2, LENGTH / 2))
+            hx, hz = (min(a, hx), min(a, hz)) if kind == "circle" else (min(a / 2, hx), min(b / 2, hz))
         xs = np.linspace(-hx + self.radius, hx - self.radius, self.columns)
         zs = np.linspace(-hz + self.radius, hz - self.radius, self.rows)
         pts = np.array([[x, z] for z in zs for x in xs])
@@ -80,14 +80,20 @@ def single_contact(scene) -> "Pads":
     return Pads(1, 1, 0.001, None, TIP_SOLREF, float(k))
 
 
-def add_pads(spec, body, pads: Pads, friction: float) -> None:
+def face() -> tuple:
+    """The 2F-85 pad's face: (half-width, half-length) [m]."""
+    return (HALF_WIDTH, LENGTH / 2)
+
+
+def add_pads(spec, body, pads: Pads, friction: float, face: tuple = (HALF_WIDTH, LENGTH / 2)) -> None:
     """Replaces the contact geoms of pad ``body`` (an ``MjsBody`` of ``spec``) by ``pads``'s grid
-    of spheres with Coulomb friction ``friction`` and no torsional or rolling friction."""
+    of spheres on ``face`` (:meth:`Pads.points`) with Coulomb friction ``friction`` and no
+    torsional or rolling friction."""
     mujoco = need("mujoco", "robot")
     for g in list(body.geoms):
         if g.contype or g.conaffinity:
             spec.delete(g)
-    for i, p in enumerate(pads.points()):
+    for i, p in enumerate(pads.points(face)):
         body.add_geom(name=f"{body.name}_contact{i}", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[pads.radius, 0, 0],
                       pos=p, condim=4 if pads.torsion > 0 else 3, friction=[friction, pads.torsion * friction, 0],
                       priority=2, solref=pads.solref, solimp=PAD_SOLIMP,
