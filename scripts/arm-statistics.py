@@ -3,7 +3,7 @@
 example (or those named), ``--runs`` executions each with friction, grip force and mass drawn
 within ±``--spread``, ``--workers`` processes.
 
-    python scripts/arm-statistics.py --runs 20 --spread 0.1 --workers 2 [--json out.json] [NAME ...]
+    python scripts/arm-statistics.py --runs 20 --spread 0.1 --workers 2 [--robot NAME] [--json out.json] [NAME ...]
 """
 
 import argparse
@@ -39,14 +39,15 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--closed-loop", action="store_true", help="the arm in the loop (MPC / re-planning)")
+    ap.add_argument("--robot", help="the robot (regrasp.robot.kinds.ROBOTS; default: the workcell's)")
     ap.add_argument("--json", help="also write the outcomes here")
     a = ap.parse_args()
     names = a.names or regrasp.examples.names()
     loop = "closed loop" if a.closed_loop else "open loop"
-    print(f"| example | {loop}: success (±{a.spread:.0%}, {a.runs} runs) | median goal error | max creep [mm] | wall [s] |")
+    print(f"| example | {loop}{', ' + a.robot if a.robot else ''}: success (±{a.spread:.0%}, {a.runs} runs) | median goal error | max creep [mm] | wall [s] |")
     print("|---|---|---|---|---|", flush=True)
     with ProcessPoolExecutor(a.workers) as pool:  # a row as each example completes
-        jobs = [pool.submit(example, name, a.runs, a.spread, a.seed, a.closed_loop) for name in names]
+        jobs = [pool.submit(example, name, a.runs, a.spread, a.seed, a.closed_loop, a.robot) for name in names]
         for job in as_completed(jobs):
             print(row(job.result()), flush=True)
     outs = [job.result() for job in jobs]

@@ -51,10 +51,11 @@ def draws(runs: int, spread: float, seed: int):
     return out[:runs]
 
 
-def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: bool = False) -> Outcome:
+def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: bool = False,
+            robot: str | None = None) -> Outcome:
     """The :class:`Outcome` of bundled example ``name`` (see the module's doc); ``closed_loop``:
     each run with the arm in the loop (:func:`~regrasp.execution.arm_loop.control_arm`) instead
-    of the open-loop joint trajectory."""
+    of the open-loop joint trajectory; ``robot``: the robot (default: the workcell's)."""
     import time
 
     import regrasp
@@ -69,7 +70,7 @@ def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: boo
         return out
     try:
         plan = regrasp.plan(scene, seed=0)
-        world = World(scene, rig="arm")
+        world = World(scene, rig="arm", robot=robot)
         if not closed_loop:
             arm_motion_of(world, plan)  # solved once, here: an arm that cannot do the plan refuses the example
     except RegraspError as e:
