@@ -27,7 +27,7 @@ URDF_COMPILER = '<mujoco><compiler fusestatic="false" discardvisual="true" strip
 
 def arm_spec(kind, model_path: str):
     """The arm of robot kind ``kind`` (:class:`~regrasp.robot.kinds.RobotKind`) from its model file
-    ``model_path``, prepared as the module says. ArgumentError naming ``robot.arm.*`` when a named
+    ``model_path``, prepared as the module says. ArgumentError naming ``arm.*`` when a named
     body or joint is not in the model."""
     mujoco = need("mujoco", "robot")
     path = Path(model_path)
@@ -36,11 +36,13 @@ def arm_spec(kind, model_path: str):
     else:
         s = mujoco.MjSpec.from_file(str(path))
     for b in kind.remove:
-        body = _body(s, b, "robot.arm.remove")
+        body = _body(s, b, "arm.remove")
         s.delete(body)
-    if kind.flange_body:
+    if kind.flange_body:  # the robot file's flange replaces the model's own
+        if s.site(FLANGE_SITE) is not None:
+            s.delete(s.site(FLANGE_SITE))
         q = kind.flange_pose or (0, 0, 0, 1, 0, 0, 0)
-        _body(s, kind.flange_body, "robot.arm.flange").add_site(name=FLANGE_SITE, pos=list(q[:3]), quat=list(q[3:]))
+        _body(s, kind.flange_body, "arm.flange").add_site(name=FLANGE_SITE, pos=list(q[:3]), quat=list(q[3:]))
     joints = [_joint(s, j) for j in kind.arm_joints]
     if kind.armature:
         for j in joints:
@@ -59,7 +61,7 @@ def urdf_text(path: Path) -> str:
     """The URDF at ``path`` as MuJoCo should read it (see the module's doc)."""
     from ..files import read_text
 
-    text = read_text(path, "robot.arm.model")
+    text = read_text(path, "arm.model")
     text = re.sub(r"<visual\b.*?</visual>", "", text, flags=re.S)
 
     def package(m):
@@ -67,14 +69,14 @@ def urdf_text(path: Path) -> str:
         for folder in path.resolve().parents:
             if folder.name == name:
                 return str(folder / rest)
-        raise ArgumentError(f"invalid `robot.arm.model`: {path} names `package://{name}/…` but no folder {name!r} "
-                            "holds it", "robot.arm.model")
+        raise ArgumentError(f"invalid `arm.model`: {path} names `package://{name}/…` but no folder {name!r} "
+                            "holds it", "arm.model")
 
     text = re.sub(r"package://([^/\"']+)/([^\"']*)", package, text)
     text = re.sub(r'filename="(?!/)([^"]+)"', lambda m: f'filename="{(path.parent / m.group(1)).resolve()}"', text)
     text, n = re.subn(r"(<robot\b[^>]*>)", lambda m: m.group(1) + URDF_COMPILER, text, count=1)
     if not n:
-        raise ArgumentError(f"invalid `robot.arm.model`: {path} has no <robot> element (a URDF)", "robot.arm.model")
+        raise ArgumentError(f"invalid `arm.model`: {path} has no <robot> element (a URDF)", "arm.model")
     return text
 
 
@@ -88,5 +90,5 @@ def _body(s, name: str, field: str):
 def _joint(s, name: str):
     j = s.joint(name)
     if j is None:
-        raise ArgumentError(f"invalid `robot.arm.joints`: the arm's model has no joint {name!r}", "robot.arm.joints")
+        raise ArgumentError(f"invalid `arm.joints`: the arm's model has no joint {name!r}", "arm.joints")
     return j

@@ -2,7 +2,8 @@
 model (MJCF or URDF, which MuJoCo compiles; paths relative to the file), its joints, home, joint
 velocity and acceleration limits, where the gripper mounts, and the gripper: a bundled one by
 name or the parametric parallel gripper with its parameters. :func:`load` reads and checks it
-(a SceneError naming the field, ``arm.home[2]``) into a :class:`~regrasp.robot.kinds.RobotKind`;
+(a SceneError naming the field, ``arm.home[2]``; a model a Python package ships is
+``dist://DISTRIBUTION/PATH``) into a :class:`~regrasp.robot.kinds.RobotKind`;
 :func:`robot_name` takes a registry name or a robot file's path and registers the file's robot
 under its ``name``, so every part of regrasp that takes a robot by name takes it."""
 
@@ -26,6 +27,8 @@ ARM_OPTIONAL = ("flange_pose", "remove", "mounted", "kp", "kv", "armature")
 #: The bundled grippers by ``gripper.kind`` (the parametric one takes its parameters beside it).
 GRIPPERS = ("robotiq-2f85", "parallel")
 MAX_JOINTS = 16
+#: The prefix of a model path inside an installed Python distribution.
+DIST = "dist://"
 #: The position gains [N·m/rad, N·m·s/rad] of arm joints a model gives no actuator, by default.
 KP, KV = 2000.0, 400.0
 _LOADED: dict = {}
@@ -47,7 +50,7 @@ def from_dict(d, folder: Path, source: str = "") -> RobotKind:
     name = _name(d["name"], "name")
     a = d["arm"]
     _keys_subset(a, ARM_REQUIRED + ARM_OPTIONAL, ARM_REQUIRED, "arm")
-    model = folder / _name(a["model"], "arm.model")
+    model = model_path(_name(a["model"], "arm.model"), folder)
     if model.suffix.lower() not in (".xml", ".urdf") or not model.is_file():
         raise _fail("arm.model", "must be an MJCF (.xml) or URDF (.urdf) file that exists", str(model))
     joints = _names(a["joints"], "arm.joints")
@@ -72,6 +75,21 @@ def from_dict(d, folder: Path, source: str = "") -> RobotKind:
                      armature=_number(a.get("armature", 0.1), "arm.armature", 0.0, 100.0, "kg·m²"), source=source,
                      name=name)
     return _with_gripper(kind, d.get("gripper", {"kind": "parallel"}))
+
+
+def model_path(text: str, folder: Path) -> Path:
+    """A robot file's model path: ``dist://DISTRIBUTION/PATH`` (a file an installed Python
+    distribution ships, e.g. ``dist://example-robot-data/cmeel.prefix/…/panda.urdf``), or a path,
+    relative to the file's ``folder``."""
+    if not text.startswith(DIST):
+        return folder / text
+    import importlib.metadata
+
+    dist, _, rest = text[len(DIST):].partition("/")
+    try:
+        return Path(importlib.metadata.distribution(dist).locate_file(rest))
+    except importlib.metadata.PackageNotFoundError:
+        raise _fail("arm.model", f"names the Python distribution {dist!r}, which is not installed", text) from None
 
 
 def _with_gripper(kind: RobotKind, g) -> RobotKind:
