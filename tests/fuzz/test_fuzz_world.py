@@ -1,5 +1,5 @@
 """Fuzz: the world side (issue 44). Every world file kind (workcell, plan, grasp graph,
-trajectory, a scene's mesh) mutated and read through its loader, then used when it was
+trajectory, robot, a scene's mesh) mutated and read through its loader, then used when it was
 accepted; the world commands (execute, pick-place, grasp-graph, regrasp-sequence) with bad
 option values and bad files; generated valid runs that must succeed with finite outputs; SIGTERM
 at random moments and closed streams, in real processes. Each case: the closed error set with
@@ -64,10 +64,20 @@ def _use(kind: str, value):
                     if e.field != "to":
                         raise
         return found
+    if kind == "robot":  # compiled: its bodies and joints checked against the model
+        from regrasp.robot.model import build
+
+        r = build(str(value))
+        return {"tcp": r.tcp_pose(), "limits": r.joint_limits()}
     return Trajectory.from_json(value.to_json()).to_json()
 
 
 def _load(kind: str, path: Path):
+    if kind == "robot":
+        from regrasp.robot.robot_file import load
+
+        load(path)
+        return path
     return {"workcell": Workcell.load, "plan": lambda p: regrasp.Plan.load(p, _scene()),
             "graph": GraspGraph.load, "trajectory": Trajectory.load}[kind](path)
 

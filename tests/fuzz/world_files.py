@@ -1,5 +1,5 @@
 """The world side's files for the fuzz suite: a valid base of each kind (workcell, plan, grasp
-graph, trajectory, a mesh-object scene) and the strategies that mutate them — a leaf replaced
+graph, trajectory, robot, a mesh-object scene) and the strategies that mutate them — a leaf replaced
 by a hostile value or a value of another type, a key dropped or added, a list emptied or
 repeated past its limit, the text truncated, nested deeper than the limit or made binary.
 
@@ -81,6 +81,15 @@ def trajectory_base() -> str:
                                         "penetration": 0.001}]})
 
 
+def robot_base() -> str:
+    """The bundled UR5e with the 2F-85 as a robot file (its model from the package that ships it)."""
+    import tomllib
+
+    from ..test_robot_file import UR5E
+
+    return json.dumps(tomllib.loads(UR5E))
+
+
 #: kind -> (base JSON text, format of the file, paths (dotted, prefix) whose content is free-form,
 #: paths that may be null, whether unknown keys are refused, the prefix of every field named)
 KINDS = {
@@ -94,11 +103,12 @@ KINDS = {
               ("edges[0].to", "edges[1].to", "edges[0].success_rate", "edges[1].success_rate", "edges[0].runs[1].pose", "edges[0].runs[0].pose", "edges[0].runs[2].pose",
                "settings.actions"), False, ""),
     "trajectory": (trajectory_base, "json", (), ("robot",) + tuple(f"samples[{i}].push" for i in range(12)), True, ""),
+    "robot": (robot_base, "toml", (), (), True, ""),
 }
 
 
 #: the field that a file's syntax error (or too deep nesting) names
-PARSE_FIELD = {"workcell": "(toml)", "plan": "plan", "graph": "graph", "trajectory": "(json)"}
+PARSE_FIELD = {"workcell": "(toml)", "plan": "plan", "graph": "graph", "trajectory": "(json)", "robot": "(toml)"}
 #: kind -> (the list with a count limit, that limit)
 LIMITED = {"workcell": ("features", LIMITS["workcell_features"]), "plan": ("path", LIMITS["plan_steps"] + 1),
            "graph": ("nodes", LIMITS["graph_nodes"])}
