@@ -407,6 +407,23 @@ mod tests {
         assert!(checked > 150);
     }
 
+    /// Found by hypothesis (tests/test_quasistatic.py): no gravity, pusher friction 1, the pusher
+    /// sliding along the top edge while turning (one point pressing in, the other leaving); the
+    /// limit-surface pad. The IPOPT reference solves it (object twist ≈ (0, 0, −0.0068)).
+    #[test]
+    fn sliding_along_an_edge_without_gravity_converges() {
+        let s = Scene::from_json_str(
+            r#"{"name": "prop", "object": {"outline": [[-0.03125, -0.0234375], [0.03125, -0.0234375], [0.03125, 0.0234375], [-0.03125, 0.0234375]], "mass": 0.5, "com": [0.0, 0.0]}, "grasp": {"force": 5.0, "friction": 1.0, "pad_radius": 0.0078125}, "gravity": {"direction": [0.0, -1.0], "g": 0.0}, "pushers": [{"name": "p", "friction": 1.0, "points": [[0.025, 0.0234375], [-0.025, 0.0234375]], "normal": [0.0, -1.0]}], "task": {"start": [0.0, 0.0, 0.0], "goal": [0.0, 0.0, 0.0], "tolerance": [0.001, 0.001, 0.01]}}"#,
+        )
+        .unwrap();
+        let opts = Options { support: SupportModel::LimitSurface, ..Options::default() };
+        let u = Vec3::new(0.009998779321710066, 0.0, -0.006927921324405637);
+        let out = push_outcome(&s, &[0.0; 3], 0, &u, &opts).unwrap();
+        assert!(!out.sticks);
+        let v = &out.solution.twist;
+        assert!((v[2] + 0.0068).abs() < 2e-4 && v[0].abs() < 1e-4, "{v}");
+    }
+
     #[test]
     fn horizontal_push_drifts_down_under_gravity() {
         let s = block();

@@ -1,7 +1,8 @@
 //! The forward problem (thesis §3.2): the pusher's twist given, the object's twist and every
 //! contact force. The object moving with the pusher is decided exactly by the inverse problem;
 //! otherwise the semismooth Newton solver ([`super::newton`]) is tried from a few starts, exact,
-//! smoothed and with other projection steps, until one attempt meets every constraint.
+//! smoothed, with other projection steps and by continuation in the pusher's friction, until one
+//! attempt meets every constraint.
 
 use super::newton::Newton;
 use super::{finish, solve_inverse, FrictionLaw, Problem, Settings, Side, Solution};
@@ -55,9 +56,46 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
             }
         }
     }
+    // 5. Continuation in the pusher's friction: from a frictionless pusher (the easiest
+    //    problem) up to its own, each solve starting from the last one's solution.
+    if let Some(s) = friction_continuation(p, u, settings, &mut tries)? {
+        return Ok(s);
+    }
     crate::interrupt::check()?; // an interrupt that cut the last attempt short is not a failure to converge
     Err(tries.failure())
 }
+
+/// Step 5: the pusher's friction coefficients scaled by `CONTINUATION` in turn, each problem
+/// solved (smoothing Newton, then exact) from the previous one's solution; the last is `p`.
+fn friction_continuation(p: &Problem, u: &DVector<f64>, settings: &Settings, tries: &mut Attempts<'_>) -> Result<Option<Solution>> {
+    let mut x: Option<DVector<f64>> = None;
+    for scale in CONTINUATION {
+        crate::interrupt::check()?;
+        let mut q = p.clone();
+        for c in q.contacts.iter_mut().filter(|c| c.side == Side::Pusher) {
+            if let FrictionLaw::Coulomb(mu) = &mut c.friction {
+                *mu *= scale;
+            }
+        }
+        let nw = Newton::new(&q, u);
+        // from the last solution, exact Newton first (it is near); smoothing where that fails
+        let (xs, its) = match x.take() {
+            Some(x0) => match nw.solve(x0.clone(), 0.0, settings.tolerance, settings.max_iterations) {
+                (xs, r, its) if r <= settings.tolerance => (xs, its),
+                _ => smooth_then_exact(&nw, x0, 0.1, settings),
+            },
+            None => smooth_then_exact(&nw, nw.start(u), 0.1, settings),
+        };
+        if scale == 1.0 {
+            return Ok(tries.consider(&nw, &xs, its));
+        }
+        x = Some(xs);
+    }
+    Ok(None)
+}
+
+/// The pusher-friction scales of [`friction_continuation`] (the last is the problem's own).
+const CONTINUATION: [f64; 6] = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0];
 
 /// Step 1: the solution of the inverse problem at `V = U`, if it exists and is accepted (the
 /// object moving rigidly with the pusher).
