@@ -128,3 +128,47 @@ def test_an_edited_file_replaces_its_robot(tmp_path):
     p.write_text(UR5E.replace('kind = "robotiq-2f85"', 'kind = "parallel"\nfinger_length = 0.15'))
     robot_name(str(p))
     assert ROBOTS["my-ur5e"].gripper.finger_length == pytest.approx(0.15)
+
+
+def test_a_workcell_names_a_robot_file(tmp_path):
+    """A workcell's ``robot.name`` may be a robot file's path: the arm's joint trajectory is the
+    file's arm (six joints of its own naming) without --robot."""
+    import dataclasses
+
+    from regrasp.execution import default_workcell
+    from regrasp.execution.arm import arm_motion
+
+    scene = regrasp.load_scene(regrasp.examples.path("block-xztheta"))
+    plan = regrasp.plan(scene, seed=0)
+    wc = default_workcell(scene)
+    path = write(tmp_path, UR5E.replace('name = "my-ur5e"', 'name = "wc-ur5e"'))
+    wc = dataclasses.replace(wc, robot=dataclasses.replace(wc.robot, name=str(path)))
+    arm = arm_motion(scene, plan, wc)
+    assert arm.trajectory.q.shape[1] == 6 and arm.robot.name == "wc-ur5e"
+
+
+def test_the_documented_keys_are_the_readers():
+    """docs/robot-file.md's key tables list exactly the keys the reader takes."""
+    import re
+    from dataclasses import fields
+
+    from regrasp.robot import robot_file
+    from regrasp.robot.parallel_gripper import ParallelGripper
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "robot-file.md").read_text()
+    documented = set(re.findall(r"^\| `([a-z_.]+)` \|", doc, flags=re.M))
+    keys = {*robot_file.KEYS, *(f"arm.{k}" for k in robot_file.ARM_REQUIRED + robot_file.ARM_OPTIONAL),
+            "gripper.kind", *(f"gripper.{f.name}" for f in fields(ParallelGripper))}
+    assert documented == keys
+
+
+def test_a_bundled_robot_file_is_named_by_its_name():
+    from regrasp.robot.robot_file import bundled
+
+    files = bundled()
+    assert "panda-parallel" in files
+    for name, path in files.items():  # the stem is the file's name
+        assert load(path).name == name
+    with pytest.raises(ArgumentError) as e:
+        robot_name("no-such-robot")
+    assert e.value.field == "robot" and "panda-parallel" in str(e.value)

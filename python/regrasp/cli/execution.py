@@ -19,15 +19,16 @@ FREE_GRIPPER = "free-gripper"
 
 def _robots() -> list[str]:
     from ..robot.model import ALIASES, ROBOTS
+    from ..robot.robot_file import bundled
 
-    return [*ROBOTS, *ALIASES, FREE_GRIPPER]
+    return [*ROBOTS, *ALIASES, *(n for n in bundled() if n not in ROBOTS), FREE_GRIPPER]
 
 
 def _check(a) -> None:
     """The options of `regrasp execute`, before any work."""
-    if a.robot is not None and a.robot.lower().endswith(".toml"):
-        from ..robot.robot_file import robot_name
+    from ..robot.robot_file import bundled, robot_name
 
+    if a.robot is not None and (a.robot.lower().endswith(".toml") or a.robot in bundled()):
         a.robot = robot_name(a.robot)  # the robot file read and checked, its robot registered
     elif a.robot is not None and a.robot not in _robots():
         raise ArgumentError(f"invalid `--robot`: unknown robot {a.robot!r} (known: {', '.join(_robots())}; or a "

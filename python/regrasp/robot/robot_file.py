@@ -19,7 +19,7 @@ from . import kinds
 from .kinds import ROBOTS, RobotKind
 from .parallel_gripper import ParallelGripper
 
-_CHECK = FieldCheck("robot")
+_CHECK = FieldCheck("robot file")
 _fail, _number, _name, _vector, _keys = _CHECK.fail, _CHECK.number, _CHECK.name, _CHECK.vector, _CHECK.keys
 KEYS = ("name", "arm", "gripper")
 ARM_REQUIRED = ("model", "root", "flange", "joints", "home", "velocity_limit", "acceleration_limit", "shoulder", "reach")
@@ -137,11 +137,25 @@ def _names(x, where: str, empty: bool = False) -> tuple:
 
 def robot_name(name) -> str:
     """The registry name of robot ``name``: a bundled robot's name or alias
-    (:func:`regrasp.robot.kinds.robot_name`), or the path of a robot file (``.toml``), whose robot
-    is then registered under its ``name`` (a bundled robot's name is refused)."""
+    (:func:`regrasp.robot.kinds.robot_name`), a bundled robot file's name (:func:`bundled`), or
+    the path of a robot file (``.toml``), whose robot is then registered under its ``name`` (a
+    bundled robot's name is refused)."""
     if isinstance(name, (str, Path)) and str(name).lower().endswith(".toml"):
         return register(load(name))
-    return kinds.robot_name(name)
+    if isinstance(name, str) and name not in ROBOTS and name in bundled():
+        return register(load(bundled()[name]))
+    try:
+        return kinds.robot_name(name)
+    except ArgumentError as e:
+        raise ArgumentError(f"{e}, the bundled robot files ({', '.join(bundled())}) or a robot file's path "
+                            "(ROBOT.toml, docs/robot-file.md)", "robot") from None
+
+
+def bundled() -> dict:
+    """The bundled robot files (``regrasp/examples/robots``) by their robot's name (the file's
+    stem is its ``name``)."""
+    folder = Path(__file__).resolve().parents[1] / "examples" / "robots"
+    return {p.stem: p for p in sorted(folder.glob("*.toml"))}
 
 
 def register(kind: RobotKind) -> str:
