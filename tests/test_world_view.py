@@ -225,3 +225,116 @@ def test_repr_html_write_and_refusals(tmp_path):
     with pytest.raises(ArgumentError) as e:
         workcell_html("bench")
     assert e.value.field == "workcell"
+
+
+ARMS: dict = {}
+
+
+def arm_of(name, robot="ur5e-parallel"):
+    """The world motion the arm follows, its joint trajectory and the arm's drawing data."""
+    pytest.importorskip("mink")
+    from regrasp.execution.arm import arm_motion
+    from regrasp.robot.shapes import arm_view
+
+    if (name, robot) not in ARMS:
+        scene = regrasp.load_scene(regrasp.examples.path(name))
+        am = arm_motion(scene, regrasp.plan(scene, seed=0), robot=robot)
+        ARMS[name, robot] = scene, am, arm_view(am.robot, am.trajectory.q)
+    return ARMS[name, robot]
+
+
+def test_the_drawn_arm_follows_the_joint_trajectory():
+    """The drawn bodies' hulls are made of the bodies' own collision-geom points, and the page's
+    body poses are MuJoCo's kinematics: the palm carries the TCP rigidly (a fixed offset at every
+    kept sample) and ends where the world motion's gripper is."""
+    from regrasp import pose as P
+    from regrasp.robot.shapes import _geom_points, body_shapes
+
+    scene, am, view = arm_of("t-shape")
+    robot, mujoco = am.robot, pytest.importorskip("mujoco")
+    shapes = body_shapes(robot)
+    assert {"arm/shoulder_link", "arm/wrist_3_link", "gripper/base"} <= {s["name"] for s in shapes}
+    for s in shapes:  # every hull vertex is a point of the body's geoms
+        pts = np.vstack([_geom_points(robot.model, g, mujoco) for g in robot.robot_geoms
+                         if robot.model.geom_bodyid[g] == s["body"]])
+        v = np.asarray(s["vertices"])
+        assert np.min(np.linalg.norm(v[:, None] - pts[None], axis=2), axis=1).max() < 1e-4, s["name"]
+        assert outward(v, s["triangles"]), s["name"]
+    k = [b["name"] for b in view["bodies"]].index("gripper/base")
+    offsets = []
+    for f, i in enumerate(view["samples"][::25]):
+        palm = np.asarray(view["poses"][f * 25][k])
+        offsets.append(P.compose(P.inverse(palm), am.robot.tcp_pose(am.trajectory.q[i])))
+    assert np.ptp(np.asarray(offsets)[:, :3], axis=0).max() < 1e-4
+    assert view["samples"][-1] == len(am.motion.times) - 1 and len(view["samples"]) <= 601
+    page = data_of(motion_html(scene, am.motion, view))
+    assert page["arm"]["poses"] == view["poses"] and page["arm"]["robot"] == "ur5e-parallel"
+    with pytest.raises(ArgumentError) as e:
+        motion_html(scene, am.motion, {**view, "samples": view["samples"][:-1]})
+    assert e.value.field == "arm"
+
+
+@pytest.mark.skipif(NODE is None, reason="needs node to run the page's script")
+def test_page_script_puts_the_arm_where_its_samples_are(tmp_path):
+    scene, am, view = arm_of("t-shape")
+    f = write_motion_html(tmp_path / "m.html", scene, am.motion, view)
+    kept = view["samples"][::40]
+    times = [float(am.motion.times[i]) for i in kept]
+    out = json.loads(subprocess.run([NODE, str(ROOT / "tests" / "js" / "run_world_viewer.js"), str(f), json.dumps(times)],
+                                    capture_output=True, text=True, check=True).stdout)["frames"]
+    for fr, i in zip(out, kept):
+        k = int(np.searchsorted(am.motion.times, am.motion.times[i]))  # repeated times: the first
+        want = np.asarray(view["poses"][view["samples"].index(i)]) if k == i else None
+        got = np.asarray(fr["arm"])
+        assert fr["finite"] and got.shape == (len(view["bodies"]), 7)
+        if want is not None:
+            assert np.allclose(got[:, :3], want[:, :3], atol=1e-9)
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="needs Chromium (Debian package chromium)")
+@pytest.mark.parametrize("name, robot", [("t-shape", "ur5e-parallel"), ("block-xztheta", "ur5e-2f85")])
+def test_the_arm_gripper_and_object_are_inside_the_frame_in_chromium(name, robot, tmp_path):
+    """The world view with the arm in headless Chromium: no console error, and at every frame the
+    arm, the jaws and the object drawn inside the canvas; the screenshot holds the arm's colour."""
+    scene, am, view = arm_of(name, robot)
+    f = write_motion_html(tmp_path / "m.html", scene, am.motion, view)
+    out, console = chromium(tmp_path, f"file://{f}#selftest", (1000, 700), "--dump-dom")
+    assert not console, console
+    got = json.loads(html.unescape(re.search(r'<pre id="selftest">(.*?)</pre>', out, re.S).group(1)))
+    W, H = got["css"]
+    for fr in got["frames"]:
+        if fr.get("follow"):
+            continue
+        for kind in ("arm", "object", "jaw"):
+            x0, y0, x1, y1 = fr["boxes"][kind]
+            assert 0 <= x0 < x1 <= W and 0 <= y0 < y1 <= H, (kind, fr["t"], fr["boxes"][kind], (W, H))
+    shot = tmp_path / "shot.png"
+    chromium(tmp_path, f"file://{f}#t=0.5", (1000, 700), f"--screenshot={shot}")
+    import matplotlib.image as mpimg
+
+    px = (mpimg.imread(shot)[..., :3] * 255).astype(int)
+    r, g, b = px[..., 0], px[..., 1], px[..., 2]
+    arm = (b - r > 40) & (b - g > 25) & (b < 190)  # the arm's slate blue, shaded
+    assert arm.mean() > 0.01, arm.mean()
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="needs Chromium (Debian package chromium)")
+def test_a_link_to_a_moment_means_the_same_in_both_views(tmp_path):
+    """``#t=0.5`` is half-way in the world view as in the plan view; ``#t=50%`` too; the world
+    view also takes seconds (``#t=12.5s``)."""
+    from regrasp.viz.viewer import write_html
+
+    s, m = motion_of("t-shape")
+    f = write_motion_html(tmp_path / "m.html", s, m)
+    T = float(m.times[-1])
+    info = {}
+    for h in ("0.5", "50%", f"{T / 2:.4f}s", "0"):
+        out, console = chromium(tmp_path, f"file://{f}#t={h}", (900, 650), "--dump-dom")
+        info[h] = re.search(r'<span id="info">(.*?)</span>', out, re.S).group(1)
+    assert info["0.5"] == info["50%"] == info[f"{T / 2:.4f}s"] != info["0"]
+    assert f"t = {T / 2:.2f} s" in info["0.5"]
+    p = write_html(s, regrasp.plan(s, seed=0), tmp_path / "p.html")
+    plan_info = {h: re.search(r'<span id="info">(.*?)</span>', chromium(tmp_path, f"file://{p}#t={h}", (900, 650),
+                                                                        "--dump-dom")[0], re.S).group(1)
+                 for h in ("0.5", "50%", "0")}
+    assert plan_info["0.5"] == plan_info["50%"] != plan_info["0"]

@@ -4,6 +4,7 @@ MuJoCo, its timed joint trajectory exported."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 
@@ -154,6 +155,19 @@ def _closed_loop(scene, plan, a) -> int:
     return OK if run.success else CANNOT
 
 
+def _write_html(path, scene, motion, arm) -> Path:
+    """The world view of ``motion`` at ``path``, with the robot's bodies along the joint
+    trajectory ``arm`` (an ArmTrajectory; None: the gripper alone)."""
+    from ..viz.viewer import write_motion_html
+
+    view = None
+    if arm is not None:
+        from ..robot.shapes import trajectory_view
+
+        view = trajectory_view(arm.robot, motion.workcell.robot.base, arm.q)
+    return write_motion_html(path, scene, motion, view)
+
+
 def _plan_only(scene, plan, a) -> int:
     """`--plan-only`: the world motion and, with the arm, its IK and time parametrisation; no
     simulation. Prints the trajectory's length, duration and joint rates against the limits."""
@@ -168,9 +182,7 @@ def _plan_only(scene, plan, a) -> int:
     tr = motion.to_trajectory(arm)
     written = [tr.save(a.trajectory, a.format)] if a.trajectory else []
     if a.html:
-        from ..viz.viewer import write_motion_html
-
-        written.append(write_motion_html(a.html, scene, motion))
+        written.append(_write_html(a.html, scene, motion, arm))
     out = dict(plan_only=True, robot=tr.robot or FREE_GRIPPER, workcell=motion.workcell.name, samples=len(tr),
                duration_s=tr.duration, pushes=[{"pusher": p.pusher, "feature": p.feature, "tilt": p.tilt}
                                                for p in motion.assignments],
@@ -212,9 +224,7 @@ def cmd_execute(a) -> int:
     if a.video and extra and extra[1] is not None:
         written.append(extra[1].save(a.video))
     if a.html:
-        from ..viz.viewer import write_motion_html
-
-        written.append(write_motion_html(a.html, scene, motion))
+        written.append(_write_html(a.html, scene, motion, extra[0].trajectory if extra else None))
     out = {**out, "workcell": motion.workcell.name, "pushes": [
         {"pusher": p.pusher, "feature": p.feature, "tilt": p.tilt} for p in motion.assignments]}
     if a.json:

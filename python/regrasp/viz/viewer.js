@@ -164,8 +164,9 @@ function tick() {  // about 0.7 s a step at speed 1
   slider.value = (Number(slider.value) + per) % 1001; draw(); requestAnimationFrame(tick);
 }
 if (!D.jaws) for (const el of document.querySelectorAll ? document.querySelectorAll(".jaws") : []) el.style.display = "none";
-const at = typeof location !== "undefined" && /^#t=([0-9.]+)$/.exec(location.hash);  // a link to a point along the plan
-if (at) slider.value = Math.min(1000, 1000 * Number(at[1]));
+// a link to a point along the plan, as in the world view: #t=0.5 (half-way), #t=50% (the same)
+const at = typeof location !== "undefined" && /^#t=([0-9.]+)(%)?$/.exec(location.hash);
+if (at) slider.value = Math.min(1000, at[2] === "%" ? 10 * Number(at[1]) : 1000 * Number(at[1]));
 fit();
 window.regraspViewer = { draw, poseAt, probes, drawn: () => drawn, drawnAll: () => drawnAll, jawGap: () => jawGap,
                          setT: v => { slider.value = v; draw(); } };

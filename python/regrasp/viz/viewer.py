@@ -162,7 +162,7 @@ __STYLE_TAIL__</style></head><body>
 <div id="legend"><b>world frame</b> (drag: orbit, wheel: zoom)<br>
 <i style="background:#c8aa82"></i>table, <i style="background:#a0a5b4"></i>features<br>
 <i style="background:#e62828"></i>feature pushing<br>
-<i style="background:#ffb43c"></i>robot base<br>
+<i style="background:#ffb43c"></i>robot base<span class="arm">, <i style="background:#5f78a5"></i>arm</span><br>
 <span class="held"><i style="background:#9ebff0"></i>object, <i style="background:#6e6e78"></i>jaws<br></span>
 <span class="moving">gripper path: <span style="color:#888">transfer</span>, <span style="color:#1f77b4">approach</span>,
 <span style="color:#d62728">push</span>, <span style="color:#2ca02c">retreat</span><br></span>
@@ -214,35 +214,36 @@ def workcell_html(workcell, scene=None) -> str:
     return world_page(workcell_description_of(workcell, scene), workcell.name)
 
 
-def motion_description_of(scene, motion) -> dict:
+def motion_description_of(scene, motion, arm=None) -> dict:
     """The world view's data of ``motion`` (a :class:`~regrasp.execution.WorldMotion` of
-    ``scene``; None: without the object, the gripper as its axes; see
-    :func:`regrasp.viz.world_data.motion_description`)."""
+    ``scene``; None: without the object, the gripper as its axes) and the robot's bodies ``arm``
+    (:func:`regrasp.robot.shapes.arm_view`; see :func:`regrasp.viz.world_data.motion_description`)."""
     from .world_data import motion_description
 
     if not all(hasattr(motion, k) for k in ("workcell", "times", "gripper", "object", "assignments", "in_hand")):
         raise ArgumentError(f"invalid `motion`: a WorldMotion (got {type(motion).__name__})", "motion")
     if scene is None:
-        return motion_description(None, motion)
+        return motion_description(None, motion, arm)
     v = description(scene)
     if motion.scene and motion.scene != scene.name:
         raise ArgumentError(f"invalid `scene`: the motion is of scene `{motion.scene}` (got `{scene.name}`)", "scene")
-    return motion_description(v, motion)
+    return motion_description(v, motion, arm)
 
 
-def motion_html(scene, motion) -> str:
+def motion_html(scene, motion, arm=None) -> str:
     """The browser view (a self-contained HTML page, a str) of world motion ``motion`` of
     ``scene`` (None: without the object, the gripper as its axes): the workcell, the gripper
     holding the object animated along the motion's times [s]
     (time slider, play), the gripper's path coloured by label (transfer, approach, push,
-    retreat) and the feature of each push highlighted while it pushes."""
+    retreat), the feature of each push highlighted while it pushes, and with ``arm``
+    (:func:`regrasp.robot.shapes.arm_view`) the robot's arm and gripper."""
     name = scene.name if scene is not None else motion.scene or "motion"
-    return world_page(motion_description_of(scene, motion), f"{name} in {motion.workcell.name}")
+    return world_page(motion_description_of(scene, motion, arm), f"{name} in {motion.workcell.name}")
 
 
-def write_motion_html(path, scene, motion) -> Path:
-    """Writes :func:`motion_html` of ``scene`` and ``motion`` to ``path`` (atomically; its folder
-    created, once the page is made); returns the path."""
-    p, text = Path(path), motion_html(scene, motion)
+def write_motion_html(path, scene, motion, arm=None) -> Path:
+    """Writes :func:`motion_html` of ``scene``, ``motion`` and ``arm`` to ``path`` (atomically;
+    its folder created, once the page is made); returns the path."""
+    p, text = Path(path), motion_html(scene, motion, arm)
     p.parent.mkdir(parents=True, exist_ok=True)  # atomic_write does not create folders
     return write_text(p, text)

@@ -13,6 +13,7 @@ import itertools
 import numpy as np
 
 from .. import pose as P
+from ..errors import ArgumentError
 from .view_data import _outward, _world, feature_mesh, jaws
 
 #: The table's drawn slab thickness under its top [m] and its legs' side [m].
@@ -147,13 +148,42 @@ def _object(view):
     return {k: view[k] for k in ("vertices", "triangles", "marks", "edges", "size")}
 
 
-def motion_description(view, motion) -> dict:
+def arm_checked(arm, samples: int):
+    """The robot's drawing data ``arm`` (:func:`regrasp.robot.shapes.arm_view`: ``bodies`` with
+    ``vertices`` [m] and ``triangles``, ``samples`` the motion's sample indices kept, ``poses``
+    frames × bodies × 7) checked against a motion of ``samples`` samples; None stays None."""
+    if arm is None:
+        return None
+    ok = isinstance(arm, dict) and {"bodies", "samples", "poses"} <= set(arm)
+    if ok:
+        idx, poses = np.asarray(arm["samples"]), np.asarray(arm["poses"], float)
+        ok = (idx.ndim == 1 and len(idx) >= 1 and idx[0] == 0 and idx[-1] == samples - 1 and np.all(np.diff(idx) > 0)
+              and poses.shape == (len(idx), len(arm["bodies"]), 7) and bool(np.all(np.isfinite(poses))))
+    if not ok:
+        raise ArgumentError("invalid `arm`: the robot's bodies and their poses at the motion's samples "
+                            "(regrasp.robot.shapes.arm_view)", "arm")
+    return {k: arm[k] for k in ("robot", "bodies", "samples", "poses") if k in arm}
+
+
+def _arm_points(arm) -> np.ndarray:
+    """Every drawn body's vertices in the world at the first, middle and last kept frame [m]."""
+    poses = np.asarray(arm["poses"], float)
+    out = [np.zeros((0, 3))]
+    for f in {0, len(poses) // 2, len(poses) - 1}:
+        for b, body in enumerate(arm["bodies"]):
+            out.append(P.transform(poses[f, b], np.asarray(body["vertices"], float)))
+    return np.vstack(out)
+
+
+def motion_description(view, motion, arm=None) -> dict:
     """The world view's data of ``motion`` (a :class:`~regrasp.execution.WorldMotion`) of the
     scene whose page data is ``view`` (None: no object, the gripper drawn as its axes): the workcell (:func:`workcell_description`), the object's
     mesh, the gripper (:func:`gripper_description`), the samples (``times`` [s], ``gripper`` and
     ``object`` world poses (m, unit quaternion), ``labels``, ``push``) and per push its pusher,
     contact (``feature``), owning feature (``body``), contact kind, ``frame`` (m, unit
-    quaternion), edge ``length`` [m], face ``extent`` [m] and path indices."""
+    quaternion), edge ``length`` [m], face ``extent`` [m] and path indices; ``arm``: the robot's
+    bodies along the motion (:func:`arm_checked`; None: the gripper alone). The framing holds the
+    workcell, the gripper's path with the object around it, and the arm."""
     d = workcell_description(motion.workcell)
     owners = contact_owners(motion.workcell)
     contacts = {c.name: c for c in motion.workcell.contacts()}
@@ -168,8 +198,13 @@ def motion_description(view, motion) -> dict:
              samples={"times": np.asarray(motion.times, float).tolist(), "gripper": np.asarray(motion.gripper, float).tolist(),
                       "object": np.asarray(motion.object, float).tolist(), "labels": list(motion.labels),
                       "push": np.asarray(motion.push, int).tolist()},
-             pushes=pushes)
-    return _framed(d, np.asarray(motion.gripper, float)[:, :3])
+             pushes=pushes, arm=arm_checked(arm, len(motion.times)))
+    path = np.asarray(motion.gripper, float)[:, :3]
+    reach = 1.5 * float(view["size"]) if view else 0.05  # the object and the jaws about the path
+    pts = [path, path + reach, path - reach]
+    if d["arm"] is not None:
+        pts.append(_arm_points(d["arm"]))
+    return _framed(d, np.vstack(pts))
 
 
 def _framed(d: dict, pts) -> dict:
