@@ -61,12 +61,14 @@ def main() -> int:
     for name in a.names:
         rng = np.random.default_rng(a.seed)
         draws = [draw(rng, a.spread) for _ in range(a.trials)]
-        with ProcessPoolExecutor(a.workers) as pool:
-            rows = list(pool.map(trial, *zip(*[(name, a.robot, k, *d) for k, d in enumerate(draws)])))
-        if a.json:
-            with open(a.json, "a") as f:
-                for r in rows:
-                    f.write(json.dumps({"name": name, **r}) + "\n")
+        rows = []
+        with ProcessPoolExecutor(a.workers) as pool:  # each trial written as it ends, in order
+            for r in pool.map(trial, *zip(*[(name, a.robot, k, *d) for k, d in enumerate(draws)])):
+                rows.append(r)
+                print(f"{name} trial {r['k']}: {'placed' if r['success'] else 'failed'}", file=sys.stderr, flush=True)
+                if a.json:
+                    with open(a.json, "a") as f:
+                        f.write(json.dumps({"name": name, **r}) + "\n")
         done = [r for r in rows if r["planned"]]
         ok = sum(r["success"] for r in rows)
         err = np.median([r["place_error"] for r in done], axis=0) if done else [np.nan, np.nan]
