@@ -84,6 +84,59 @@ def test_once_non_converging_pushes_without_gravity_meet_every_constraint(k):
             assert np.allclose(sol["twist"], ref.twist, atol=1e-7), (support, sol["twist"], ref.twist)
 
 
+SLIDE_ALONG_THE_FACE = {
+    "name": "prop",
+    "object": {"outline": [[-0.0234375, -0.03125], [0.0234375, -0.03125], [0.0234375, 0.03125], [-0.0234375, 0.03125]],
+               "mass": 0.5, "com": [0.0, 0.0]},
+    "grasp": {"force": 5.0, "friction": 1.0, "pad_radius": 0.0078125},
+    "gravity": {"direction": [0.0, -1.0], "g": 0.0},
+    "pushers": [{"name": "p", "friction": 0.5, "points": [[-0.01875, -0.03125], [0.01875, -0.03125]], "normal": [0.0, 1.0]}],
+    "task": {"start": [0.0, 0.0, 0.0], "goal": [0.0, 0.0, 0.0], "tolerance": [0.001, 0.001, 0.01]}}
+
+
+@pytest.mark.parametrize("b", [1e-4, -1e-4, 1e-5, 1e-6])
+def test_sliding_along_the_face_with_a_tiny_rotation_is_linear_in_it(b):
+    """The pusher slides along the face it touches and turns by b of its speed, no gravity: one
+    end presses, the object turns in the grasp with a twist proportional to b (found by
+    hypothesis; Newton reached it only by continuation in the twist). Checked against the
+    solution at b = 1e-3 scaled by b / 1e-3 and by the recomputed residuals."""
+    sc = regrasp.Scene.from_dict(SLIDE_ALONG_THE_FACE)
+    p = quasistatic.problem(sc, [0.0, 0.0, 0.0], "p", support="limit_surface", rings=1)
+
+    def push(b):
+        return sc.metric_twist_inv(np.array([np.cos(b), 0.0, np.sin(b)])) * 0.01
+
+    ref = p.solve_forward(list(push(np.copysign(1e-3, b))))
+    sol = p.solve_forward(list(push(b)))
+    r = p.residuals(list(sol["twist"]), list(sol["pusher_twist"]), list(sol["normal_forces"]),
+                    [list(f) for f in sol["friction_forces"]])
+    assert max(r.values()) < 1e-6
+    assert np.allclose(sol["twist"], ref["twist"] * abs(b) / 1e-3, rtol=1e-2, atol=1e-12)
+    assert np.allclose(sol["normal_forces"], ref["normal_forces"], rtol=1e-3, atol=1e-6)
+
+
+@pytest.mark.xfail(strict=True, reason="known: a slide along the face turning by 1e-4 of its speed, the pusher "
+                                       "withdrawing by 4e-6 of it: every continuation ends 1e-3 from the constraints "
+                                       "(accepted: 1e-6); found by a 3,000-example hypothesis sweep")
+def test_known_non_convergence_sliding_along_the_face_while_withdrawing():
+    d = {"name": "prop",
+         "object": {"outline": [[-0.022221579425945354, -0.045454146519454966], [0.022221579425945354, -0.045454146519454966],
+                                [0.022221579425945354, 0.045454146519454966], [-0.022221579425945354, 0.045454146519454966]],
+                    "mass": 0.2766330394064216, "com": [0.0011110789712972678, 0.004540097808289834]},
+         "grasp": {"force": 30.176547364670537, "friction": 0.3, "pad_radius": 0.003},
+         "gravity": {"direction": [0.53322292676205, -0.8459747693491299], "g": 0.0},
+         "pushers": [{"name": "p", "friction": 0.3217840584255856,
+                      "points": [[-0.017777263540756285, -0.045454146519454966], [0.017777263540756285, -0.045454146519454966]],
+                      "normal": [0.0, 1.0]}],
+         "task": {"start": [-0.0009610789712972677, 0.010121803936429937, 0.0],
+                  "goal": [-0.0009610789712972677, 0.010121803936429937, 0.0], "tolerance": [0.001, 0.001, 0.01]}}
+    sc = regrasp.Scene.from_dict(d)
+    u = sc.metric_twist_inv(np.array([np.cos(1e-4), 0.0, np.sin(1e-4)])) * 0.01
+    p = quasistatic.problem(sc, d["task"]["start"], "p", support="limit_surface", rings=1)
+    sol = p.solve_forward(list(u))
+    assert sol["max_residual"] < 1e-6
+
+
 @pytest.mark.xfail(strict=True, reason="known: the limit-surface pad just past its limit (the load 0.2 % over it) "
                                        "with the pusher leaving: Newton stalls near rest (residual 2e-5); found by hypothesis")
 def test_known_non_convergence_just_past_the_pads_limit():
@@ -108,6 +161,7 @@ def test_known_non_convergence_just_past_the_pads_limit():
 @SETTINGS
 @given(block_scenes(line=True), st.floats(-np.pi, np.pi), st.floats(-1.5, 1.5))
 def test_limit_surface_support_agrees_with_the_motion_cone(d, a, b):
+    d["grasp"]["limit_surface"] = "ellipsoid"  # the support's patch is the ellipsoid (eq 3.7)
     sc = load(d)
     q = d["task"]["start"]
     u = sc.metric_twist_inv(np.array([np.cos(a) * np.cos(b), np.sin(a) * np.cos(b), np.sin(b)])) * 0.01

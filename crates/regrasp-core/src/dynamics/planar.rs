@@ -425,6 +425,27 @@ mod tests {
     }
 
     #[test]
+    fn sliding_along_a_face_with_a_tiny_rotation_converges() {
+        // the pusher slides along the face it touches and turns by 1e-5 of its speed: reached
+        // only by continuation in the twist (forward.rs step 6); the object turns in the grasp
+        let s = Scene::from_json_str(
+            r#"{"name": "prop", "object": {"outline": [[-0.0234375, -0.03125], [0.0234375, -0.03125], [0.0234375, 0.03125], [-0.0234375, 0.03125]], "mass": 0.5, "com": [0.0, 0.0]}, "grasp": {"force": 5.0, "friction": 1.0, "pad_radius": 0.0078125}, "gravity": {"direction": [0.0, -1.0], "g": 0.0}, "pushers": [{"name": "p", "friction": 0.5, "points": [[-0.01875, -0.03125], [0.01875, -0.03125]], "normal": [0.0, 1.0]}], "task": {"start": [0.0, 0.0, 0.0], "goal": [0.0, 0.0, 0.0], "tolerance": [0.001, 0.001, 0.01]}}"#,
+        )
+        .unwrap();
+        let opts = Options { support: SupportModel::LimitSurface, ..Options::default() };
+        let w = |b: f64| push_outcome(&s, &[0.0; 3], 0, &Vec3::new(0.01, 0.0, 0.01 * b), &opts).unwrap();
+        let (big, small) = (w(1e-3), w(1e-5));
+        assert!(small.solution.residuals.max() < 1e-6);
+        // linear in the rotation: the turn to 1 %, the drift (1e-10 m/s, below the accepted
+        // residual's resolution) to 5 % of the turn over the block's half-size
+        let turn = big.solution.twist[2].abs() * 1e-2;
+        for (k, tol) in [(0, 0.05 * 0.03), (1, 0.05 * 0.03), (2, 0.01)] {
+            let expect = big.solution.twist[k] * 1e-2;
+            assert!((small.solution.twist[k] - expect).abs() <= tol * turn, "{} vs {}", small.solution.twist, big.solution.twist);
+        }
+    }
+
+    #[test]
     fn horizontal_push_drifts_down_under_gravity() {
         let s = block();
         let i = s.pusher_index("left").unwrap();

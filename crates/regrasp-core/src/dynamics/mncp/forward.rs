@@ -1,8 +1,8 @@
 //! The forward problem (thesis §3.2): the pusher's twist given, the object's twist and every
 //! contact force. The object moving with the pusher is decided exactly by the inverse problem;
 //! otherwise the semismooth Newton solver ([`super::newton`]) is tried from a few starts, exact,
-//! smoothed, with other projection steps and by continuation in the pusher's friction, until one
-//! attempt meets every constraint.
+//! smoothed, with other projection steps and by continuation in the pusher's friction and
+//! twist, until one attempt meets every constraint.
 
 use super::newton::Newton;
 use super::{finish, solve_inverse, FrictionLaw, Problem, Settings, Side, Solution};
@@ -34,7 +34,7 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
     let starts = starts(p, u, &nw, settings);
     for x0 in &starts {
         crate::interrupt::check()?;
-        let (x, its) = smooth_then_exact(&nw, x0.clone(), 0.1, settings);
+        let (x, _, its) = smooth_then_exact(&nw, x0.clone(), 0.1, settings);
         if let Some(s) = tries.consider(&nw, &x, its) {
             return Ok(s);
         }
@@ -50,7 +50,7 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
         let best = tries.best().map(|b| nr.pack(b));
         for x0 in best.into_iter().chain(starts.iter().cloned()) {
             crate::interrupt::check()?;
-            let (x, its) = smooth_then_exact(&nr, x0, 0.3, settings);
+            let (x, _, its) = smooth_then_exact(&nr, x0, 0.3, settings);
             if let Some(s) = tries.consider(&nr, &x, its) {
                 return Ok(s);
             }
@@ -61,41 +61,103 @@ pub fn solve_forward(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Resu
     if let Some(s) = friction_continuation(p, u, settings, &mut tries)? {
         return Ok(s);
     }
+    // 6. Continuation in the pusher's twist: from the push with one component larger.
+    if let Some(s) = twist_continuation(p, u, settings, &mut tries)? {
+        return Ok(s);
+    }
     crate::interrupt::check()?; // an interrupt that cut the last attempt short is not a failure to converge
     Err(tries.failure())
 }
 
 /// Step 5: the pusher's friction coefficients scaled by `CONTINUATION` in turn, each problem
-/// solved (smoothing Newton, then exact) from the previous one's solution; the last is `p`.
+/// solved from the previous one's solution; the last is `p`.
 fn friction_continuation(p: &Problem, u: &DVector<f64>, settings: &Settings, tries: &mut Attempts<'_>) -> Result<Option<Solution>> {
-    let mut x: Option<DVector<f64>> = None;
-    for scale in CONTINUATION {
-        crate::interrupt::check()?;
+    let stages = CONTINUATION.iter().map(|&scale| {
         let mut q = p.clone();
         for c in q.contacts.iter_mut().filter(|c| c.side == Side::Pusher) {
             if let FrictionLaw::Coulomb(mu) = &mut c.friction {
                 *mu *= scale;
             }
         }
-        let nw = Newton::new(&q, u);
-        // from the last solution, exact Newton first (it is near); smoothing where that fails
-        let (xs, its) = match x.take() {
-            Some(x0) => match nw.solve(x0.clone(), 0.0, settings.tolerance, settings.max_iterations) {
-                (xs, r, its) if r <= settings.tolerance => (xs, its),
-                _ => smooth_then_exact(&nw, x0, 0.1, settings),
-            },
-            None => smooth_then_exact(&nw, nw.start(u), 0.1, settings),
-        };
-        if scale == 1.0 {
-            return Ok(tries.consider(&nw, &xs, its));
-        }
-        x = Some(xs);
-    }
-    Ok(None)
+        (scale, q, u.clone())
+    });
+    let x = follow(stages, settings)?;
+    Ok(x.and_then(|(x, its)| tries.consider(&Newton::new(p, u), &x, its)))
 }
 
 /// The pusher-friction scales of [`friction_continuation`] (the last is the problem's own).
 const CONTINUATION: [f64; 6] = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0];
+
+/// Step 6: continuation in the pusher's twist, along each component in each sign: from `u`
+/// plus `δ` times the component's scale, `δ` down `TWIST_DELTAS` to 0. A push whose twist is
+/// nearly degenerate (sliding along a face with a rotation of 1e-4 of its speed, no gravity)
+/// has a solution linear in that small component that Newton does not reach from any start,
+/// but reaches from the same push with the component larger. Scales: the velocity scale for a
+/// translation, over the radius of gyration `√(M_kk / max M_ii)` for a rotation.
+fn twist_continuation(p: &Problem, u: &DVector<f64>, settings: &Settings, tries: &mut Attempts<'_>) -> Result<Option<Solution>> {
+    let top = p.mass.diagonal().iter().fold(0.0f64, |m, x| m.max(*x));
+    for k in 0..p.dim {
+        let scale = p.velocity_scale * (top / p.mass[(k, k)].max(1e-300)).sqrt().min(1e6);
+        // the sign of the component first (the push made more of what it already is)
+        let first = if u[k] < 0.0 { -1.0 } else { 1.0 };
+        for sign in [first, -first] {
+            let stages = TWIST_DELTAS.iter().map(|&d| {
+                let mut w = u.clone();
+                w[k] += sign * d * scale;
+                (d, p.clone(), w)
+            });
+            if let Some((x, its)) = follow(stages, settings)? {
+                if let Some(s) = tries.consider(&Newton::new(p, u), &x, its) {
+                    return Ok(Some(s));
+                }
+            }
+        }
+    }
+    Ok(None)
+}
+
+/// The perturbations of [`twist_continuation`], in units of the component's scale.
+const TWIST_DELTAS: [f64; 10] = [0.3, 0.1, 0.03, 0.01, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 0.0];
+
+/// Solves each stage (its parameter `t`, a problem and a pusher twist) from the previous
+/// stages' solutions, linearly extrapolated in `t` (a branch of solutions is locally affine in
+/// it), exact Newton first, smoothing where that fails; returns the last stage's point and the
+/// iterations of all.
+fn follow(stages: impl Iterator<Item = (f64, Problem, DVector<f64>)>, settings: &Settings) -> Result<Option<(DVector<f64>, usize)>> {
+    let mut done: Vec<(f64, DVector<f64>)> = Vec::new();
+    let mut total = 0;
+    for (t, q, w) in stages {
+        crate::interrupt::check()?;
+        let nw = Newton::new(&q, &w);
+        let (xs, _, its) = match done.as_slice() {
+            [] => smooth_then_exact(&nw, nw.start(&w), 0.1, settings),
+            [.., (t0, x0), (t1, x1)] if t1 != t0 => {
+                let x = x1 + (x1 - x0) * ((t - t1) / (t1 - t0));
+                polish(&nw, x, settings)
+            }
+            [.., (_, x1)] => polish(&nw, x1.clone(), settings),
+        };
+        total += its;
+        done.push((t, xs));
+    }
+    Ok(done.pop().map(|(_, x)| (x, total)))
+}
+
+/// Exact Newton from `x0`, near a solution; where it does not converge, the better (by the
+/// exact equations' residual) of its end and smoothing Newton's from `x0`.
+fn polish(nw: &Newton<'_>, x0: DVector<f64>, settings: &Settings) -> (DVector<f64>, f64, usize) {
+    let exact = nw.solve(x0.clone(), 0.0, settings.tolerance, settings.max_iterations);
+    if exact.1 <= settings.tolerance {
+        return exact;
+    }
+    let smooth = smooth_then_exact(nw, x0, 0.1, settings);
+    if smooth.1 <= exact.1 {
+        smooth
+    } else {
+        exact
+    }
+}
+
 
 /// Step 1: the solution of the inverse problem at `V = U`, if it exists and is accepted (the
 /// object moving rigidly with the pusher).
@@ -152,8 +214,9 @@ impl Attempts<'_> {
 
 /// Smoothing Newton: the equations with max and the projections smoothed by ε, from ε = 1 (in
 /// units of the force scale) down to 1e-10 by `factor`, each solve warm-starting the next, then
-/// polished with the exact equations. Returns the point and the iterations of all the solves.
-fn smooth_then_exact(nw: &Newton<'_>, x0: DVector<f64>, factor: f64, settings: &Settings) -> (DVector<f64>, usize) {
+/// polished with the exact equations. Returns the point, its residual of the exact equations
+/// and the iterations of all the solves.
+fn smooth_then_exact(nw: &Newton<'_>, x0: DVector<f64>, factor: f64, settings: &Settings) -> (DVector<f64>, f64, usize) {
     let mut x = x0;
     let mut its = 0;
     let mut e = 1.0;
@@ -163,8 +226,8 @@ fn smooth_then_exact(nw: &Newton<'_>, x0: DVector<f64>, factor: f64, settings: &
         x = xe;
         e *= factor;
     }
-    let (x, _, it) = nw.solve(x, 0.0, settings.tolerance, settings.max_iterations);
-    (x, its + it)
+    let (x, r, it) = nw.solve(x, 0.0, settings.tolerance, settings.max_iterations);
+    (x, r, its + it)
 }
 
 /// The starts of step 3: the object moving with the pusher with the forces of a push by a very
