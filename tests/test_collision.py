@@ -86,8 +86,9 @@ def test_every_example_moves_clear_of_the_workcell_by_mujocos_distances(name):
     if name == "pivot-90-3d":
         # the quarter turn's last push is by the patch under the block, turned 77° with it in the
         # grasp: only a face tilted as much could serve it, and the default workcell has none
-        with pytest.raises(ExecutionError, match=r"no feature of workcell `default-pivot-90-3d` serves .*max_tilt"):
+        with pytest.raises(ExecutionError, match=r"no feature of workcell `default-pivot-90-3d` serves .*max_tilt") as e:
             world_motion(scene, plan)
+        assert e.value.pusher in scene.pusher_names and f"pusher `{e.value.pusher}`" in str(e.value)
         return
     m = world_motion(scene, plan)
     D = mujoco_depths(scene, m.workcell, m.object)

@@ -152,6 +152,34 @@ def test_a_pusher_the_arm_cannot_follow_is_left_out_and_named(monkeypatch):
         assert blocked in r.without and blocked not in {a.pusher for a in r.motion.assignments}
 
 
+def test_a_pusher_no_feature_serves_is_left_out_and_named(monkeypatch):
+    """When no pair gets as far as the arm because no feature serves a push of its plan (the
+    assignment's error names the pusher), the pairs are planned again without that pusher. The
+    real ``world_motion``, wrapped to refuse every plan that uses the pusher of the first
+    choice's first push as the assignment does, on block-xztheta: the choice found instead uses
+    none of it and names it left out, or the refusal names it."""
+    s = scene_of("block-xztheta")
+    first = pp.pick_place(s, seed=1)
+    blocked = first.motion.assignments[0].pusher
+    real = pp.world_motion
+
+    def motion(scene, plan, workcell, **kw):
+        if blocked in [p for p in plan.pushers if p]:
+            e = ExecutionError(f"push 0 (pusher `{blocked}`): no feature of workcell `{workcell.name}` serves it "
+                               "in this test", "plan.path[1].pusher")
+            e.pusher = blocked
+            raise e
+        return real(scene, plan, workcell, **kw)
+
+    monkeypatch.setattr(pp, "world_motion", motion)
+    try:
+        r = pp.pick_place(s, seed=1)
+    except ExecutionError as e:
+        assert f"without pushers {blocked}" in str(e) and e.field == "place"
+    else:
+        assert blocked in r.without and blocked not in {a.pusher for a in r.motion.assignments}
+
+
 def test_cli_json(chosen, monkeypatch):
     s, wc, r, _ = chosen["block-low-friction"]
     calls = []

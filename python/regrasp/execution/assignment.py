@@ -207,10 +207,12 @@ def candidates(scene, poses, pushers: list, workcell: Workcell, max_tilt: float 
                 each.append(mine)
         if best is None:
             why = "; ".join(f"{n}: {r}" for n, r in reasons.values()) or "the workcell offers no contact"
-            raise ExecutionError(
+            err = ExecutionError(
                 f"push {k} (pusher `{name}`, plan path[{first}] to path[{last}]): no feature of workcell "
                 f"`{workcell.name}` serves this {pc.kind} pusher, which needs "
                 f"{NEEDS[pc.kind]} with friction at least {pc.friction:g} ({why})", f"plan.path[{first + 1}].pusher")
+            err.pusher = name  # the pusher no feature serves (pick_place re-plans without it)
+            raise err
         rest = sorted((e for e in each if e[1] is not best[1]), key=lambda e: (e[0], e[3]))
         out.append([Assignment(k, name, first, last, e[1].name, e[2], e[0], pc) for e in [best] + rest])
     return out

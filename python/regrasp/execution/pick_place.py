@@ -84,7 +84,7 @@ class Candidate:
     """A (pick, place) pair: ``pick`` and ``place`` (:class:`Grasp`), the regrasp ``plan`` (None
     when the grasps are the same), ``switch_overs``, ``duration`` [s] of its world motion (0
     without a regrasp), ``motion`` (:class:`WorldMotion` or None), ``why`` (why it cannot be
-    used, or "")."""
+    used, or ""), ``unserved``: the pusher of its plan that no feature serves (or None)."""
     pick: Grasp
     place: Grasp
     plan: object = None
@@ -92,6 +92,7 @@ class Candidate:
     duration: float = 0.0
     motion: object = None
     why: str = ""
+    unserved: str | None = None
 
     @property
     def cost(self) -> tuple:
@@ -111,7 +112,8 @@ class PickPlace:
     whole choice (grasps, plans, reachability, world motions; not the robot model's build nor
     the chosen motion's joint trajectory); ``candidates``: every pair considered, ranked;
     ``without``: the pushers left out of the plans because the arm could not follow them (the
-    gripper's own body against the feature: see docs/robot.md)."""
+    gripper's own body against the feature: see docs/robot.md) or, where no pair got as far as
+    the arm, because no feature of the workcell serves them."""
     scene: str
     pick_pose: np.ndarray
     place_pose: np.ndarray
@@ -248,6 +250,7 @@ def render(scene, workcell: Workcell, c: Candidate) -> Candidate:
             c.duration = c.motion.duration
         except RegraspError as e:
             c.why = str(e)
+            c.unserved = getattr(e, "pusher", None)
     return c
 
 
@@ -419,7 +422,7 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
         return seen[key]
 
     planning, banned, cands, arm_why = time.perf_counter() - t0, set(), [], []
-    for _ in range(MAX_ROUNDS):  # without the pushers the arm could not follow, re-planned
+    for _ in range(MAX_ROUNDS):  # without the pushers the arm could not follow or no feature serves
         t1 = time.perf_counter()
         cands = planned(with_pushers(scene, [p for p in scene.pusher_names if p not in banned]), picks, places, seed)
         for c in cands:  # reachability first: it rules a grasp out for every pair
@@ -450,6 +453,8 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
                 ranked = sorted(cands, key=lambda c: (bool(c.why), c.cost))
                 return PickPlace(scene.name, pick_pose, place_pose, c.pick, c.place, c.plan, c.switch_overs, motion,
                                  phases, arm, planning, ranked, sorted(banned))
+        if not blocked:  # no pair reached the arm: the pushers no feature serves
+            blocked = {c.unserved for c in cands if c.unserved}
         if not blocked - banned or len(banned | blocked) >= len(scene.pusher_names):
             break
         banned |= blocked
