@@ -4,7 +4,7 @@
 the arm, open loop; a cell is the success against the task's tolerance with the goal error, or
 the refusal (or failure) and its reason. ``--workers`` processes.
 
-    python scripts/robot-table.py --workers 2 [--robots ur5e-2f85,ur5e-parallel,panda-parallel] [--json out.json] [NAME ...]
+    python scripts/robot-table.py --workers 2 [--robots ur5e-2f85,ur5e-parallel,panda-parallel,panda-hand] [--json out.json] [NAME ...]
     python scripts/robot-table.py --from out.json   # the table again, from the outcomes written
 """
 
@@ -16,7 +16,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
-ROBOTS = ("ur5e-2f85", "ur5e-parallel", "panda-parallel")
+ROBOTS = ("ur5e-2f85", "ur5e-parallel", "panda-parallel", "panda-hand")
 #: A cell's reason is cut to this many characters (the JSON keeps it whole).
 REASON = 200
 #: Where a refusal names the cause behind every contact's exclusion.

@@ -15,7 +15,7 @@ from regrasp import examples
 
 #: the bundled examples (README, "Example scenes"): planar, then 3-D
 PLANAR_NAMES = ["block-fixtureless", "block-high-friction", "block-low-friction", "block-on-incline",
-                "block-tilted-gripper", "block-xztheta", "t-shape"]
+                "block-tilted-gripper", "block-xztheta", "small-block-xztheta", "t-shape"]
 SPATIAL_NAMES = ["ball-roll-3d", "block-3d", "bracket-pivot-3d", "light-side-3d", "offset-3d", "offset-pivot-3d", "pivot-3d", "pivot-90-3d",
                  "pivot-single-3d", "prism-3d"]
 

@@ -12,7 +12,8 @@ from importlib.resources import files
 from ..errors import ArgumentError
 from ..extras import need
 from ..mujoco.model import Contact
-from .pads import add_pads, face as pad_face
+from .franka_hand import FrankaHand
+from .pads import Pads, add_pads, face as pad_face
 from .parallel_gripper import ParallelGripper
 
 ARM_PREFIX, GRIPPER_PREFIX = "arm/", "gripper/"
@@ -29,8 +30,8 @@ class RobotKind:
     of the clearance checks against the table it stands on, :attr:`Robot.clearance_geoms`); the
     joints' ``velocity_limit`` [rad/s] and ``acceleration_limit`` [rad/s²], one per arm joint,
     which the trajectory's time parametrisation keeps (:mod:`regrasp.execution.retime`). A
-    ``gripper`` (:class:`~regrasp.robot.parallel_gripper.ParallelGripper`) builds the gripper from
-    its parameters instead of ``gripper_file``; ``opening`` [m] is the widest grasp, and
+    ``gripper`` (:class:`~regrasp.robot.parallel_gripper.ParallelGripper` or
+    :class:`~regrasp.robot.franka_hand.FrankaHand`) builds the gripper instead of ``gripper_file``; ``opening`` [m] is the widest grasp, and
     ``calibration_height`` [m] where along the base's z the grip's calibration box stands (at the
     pads). A robot file's (:mod:`.robot_file`, its path in ``source``) also says the arm model's
     root body ``arm_root``, the ``flange_body`` and ``flange_pose`` where the gripper mounts, the
@@ -50,7 +51,7 @@ class RobotKind:
     mounted: tuple = ()
     velocity_limit: tuple = ()
     acceleration_limit: tuple = ()
-    gripper: ParallelGripper | None = None
+    gripper: ParallelGripper | FrankaHand | None = None
     opening: float = 0.085
     calibration_height: float = 0.16
     arm_root: str = "base"
@@ -136,9 +137,7 @@ def gripper_spec(kind: RobotKind, pads: Pads, pad_friction: float):
     under load and touch the object with their tips only)."""
     mujoco = need("mujoco", "robot")
     if kind.gripper is not None:
-        from .parallel_gripper import spec
-
-        g = spec(kind.gripper)
+        g = kind.gripper.spec()
     else:
         g = mujoco.MjSpec.from_file(asset_path(kind.gripper_file))
     for a in list(g.actuators):

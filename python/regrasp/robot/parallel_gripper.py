@@ -77,6 +77,10 @@ class ParallelGripper:
         """The pad's face: (half-width, half-length) [m] (:meth:`regrasp.robot.pads.Pads.points`)."""
         return (self.pad_width / 2, self.pad_length / 2)
 
+    def spec(self):
+        """The gripper's ``mujoco.MjSpec`` (:func:`spec`)."""
+        return spec(self)
+
 
 def spec(g: ParallelGripper):
     """The gripper's ``mujoco.MjSpec`` (no actuator: :func:`regrasp.robot.kinds.gripper_spec`

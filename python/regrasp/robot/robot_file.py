@@ -17,6 +17,7 @@ from ..errors import ArgumentError, SceneError
 from ..fields import FieldCheck
 from . import kinds
 from .kinds import ROBOTS, RobotKind
+from .franka_hand import FrankaHand
 from .parallel_gripper import ParallelGripper
 
 _CHECK = FieldCheck("robot file")
@@ -25,7 +26,7 @@ KEYS = ("name", "arm", "gripper")
 ARM_REQUIRED = ("model", "root", "flange", "joints", "home", "velocity_limit", "acceleration_limit", "shoulder", "reach")
 ARM_OPTIONAL = ("flange_pose", "remove", "mounted", "kp", "kv", "armature")
 #: The bundled grippers by ``gripper.kind`` (the parametric one takes its parameters beside it).
-GRIPPERS = ("robotiq-2f85", "parallel")
+GRIPPERS = ("robotiq-2f85", "parallel", "franka-hand")
 MAX_JOINTS = 16
 #: The prefix of a model path inside an installed Python distribution.
 DIST = "dist://"
@@ -99,13 +100,17 @@ def _with_gripper(kind: RobotKind, g) -> RobotKind:
     _keys_subset(g, ("kind", *params), ("kind",), "gripper")
     if g["kind"] not in GRIPPERS:
         raise _fail("gripper.kind", f"must be one of {', '.join(GRIPPERS)}", g["kind"])
+    if g["kind"] in ("robotiq-2f85", "franka-hand") and len(g) > 1:
+        raise _fail(f"gripper.{next(k for k in g if k != 'kind')}", f"the {g['kind']} gripper takes no parameters", g)
     if g["kind"] == "robotiq-2f85":
-        if len(g) > 1:
-            raise _fail(f"gripper.{next(k for k in g if k != 'kind')}", "the 2F-85 takes no parameters", g)
         base = ROBOTS["ur5e-2f85"]
         return RobotKind(**{**kind.__dict__, "gripper_file": base.gripper_file, "pad_bodies": base.pad_bodies,
                             "driver_joints": base.driver_joints, "opening": base.opening,
                             "calibration_height": base.calibration_height})
+    if g["kind"] == "franka-hand":
+        p = FrankaHand()
+        return RobotKind(**{**kind.__dict__, "gripper": p, "opening": p.stroke, "calibration_height": p.pad_height,
+                            "driver_joints": ("right_finger_joint", "left_finger_joint")})
     try:
         p = ParallelGripper(**{k: v for k, v in g.items() if k != "kind"})
     except ArgumentError as e:
