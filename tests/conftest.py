@@ -138,3 +138,18 @@ def plan_of(name: str) -> tuple:
         scene = regrasp.load_scene(regrasp.examples.path(name))
         _PLANS[name] = (scene, regrasp.plan(scene, seed=0))
     return _PLANS[name]
+
+
+def pad_faces(robot) -> tuple:
+    """(left, right): each pad's contact face along the TCP's grasp axis [m] from the TCP, one
+    value a contact sphere (its point nearest the other pad), asserted flat to 1e-9 m."""
+    m, d = robot.model, robot.data
+    tcp = robot.tcp_pose()
+    R = rotation_matrix(tcp[3:])
+    faces = []
+    for side in robot.pad_geoms:
+        c = np.array([d.geom_xpos[g] for g in side])
+        y = (c - tcp[:3]) @ R[:, 1]
+        faces.append(y - np.sign(y.mean()) * m.geom_size[side[0], 0])
+        assert np.ptp(faces[-1]) < 1e-9, "a flat face"
+    return tuple(faces)

@@ -14,7 +14,7 @@ import pytest
 import regrasp
 from regrasp.robot.parallel_gripper import GEAR
 
-from .conftest import rotation_matrix, run_cli
+from .conftest import pad_faces, rotation_matrix, run_cli
 
 pytest.importorskip("mink")
 try:
@@ -86,16 +86,7 @@ def test_the_tcp_is_midway_between_the_pads_faces(width):
 
     r = build(ROBOT, grasp_width=width)
     close_fingers(r)
-    m, d = r.model, r.data
-    tcp = r.tcp_pose()
-    R = rotation_matrix(tcp[3:])
-    faces = []
-    for side in r.pad_geoms:
-        c = np.array([d.geom_xpos[g] for g in side])
-        y = (c - tcp[:3]) @ R[:, 1]
-        faces.append(y - np.sign(y.mean()) * m.geom_size[side[0], 0])
-        assert np.ptp(faces[-1]) < 1e-9, "a flat face"
-    left, right = faces
+    left, right = pad_faces(r)
     assert left.mean() + right.mean() == pytest.approx(0.0, abs=1e-6)
     # the pads sink into a box as wide as the grasp at the calibration's 25 N a pad: 0.67 mm each
     # (MuJoCo's contact impedance scales with the 15 g finger's mass; the parametric's 50 g: < 0.5)

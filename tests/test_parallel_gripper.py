@@ -13,7 +13,7 @@ import regrasp
 from regrasp import ArgumentError, ExecutionError
 from regrasp.robot.parallel_gripper import GEAR, ParallelGripper
 
-from .conftest import rotation_matrix
+from .conftest import pad_faces, rotation_matrix
 
 pytest.importorskip("mink")
 ROBOT = "ur5e-parallel"
@@ -32,13 +32,7 @@ def test_the_tcp_is_midway_between_the_pads_faces(width):
     m, d = r.model, r.data
     tcp = r.tcp_pose()
     R = rotation_matrix(tcp[3:])
-    faces = []
-    for side in r.pad_geoms:  # the spheres' points nearest the other pad: the contact face
-        c = np.array([d.geom_xpos[g] for g in side])
-        y = (c - tcp[:3]) @ R[:, 1]
-        faces.append(y - np.sign(y.mean()) * m.geom_size[side[0], 0])
-        assert np.ptp(faces[-1]) < 1e-9, "a flat face"
-    left, right = faces
+    left, right = pad_faces(r)
     assert left.mean() + right.mean() == pytest.approx(0.0, abs=1e-6), "midway"
     # the fingers as they close on a box as wide as the grasp (the calibration's 25 N a pad): the
     # compliant pads' spheres sink a little into it

@@ -122,6 +122,17 @@ def test_an_object_the_hand_cannot_hold_is_refused_naming_the_part():
     assert e.value.field == "place"
 
 
+def assert_left_out(s, blocked: str) -> None:
+    """pick_place of ``s`` (seed 1) chooses a regrasp without pusher ``blocked`` and names it left
+    out, or its refusal names it."""
+    try:
+        r = pp.pick_place(s, seed=1)
+    except ExecutionError as e:
+        assert f"without pushers {blocked}" in str(e) and e.field == "place"
+    else:
+        assert blocked in r.without and blocked not in {a.pusher for a in r.motion.assignments}
+
+
 def test_a_pusher_the_arm_cannot_follow_is_left_out_and_named(monkeypatch):
     """When the arm cannot follow a push (``solve_arm`` raises naming it: its reach, a joint
     limit, the fingers against the feature), the grasp pairs are planned again without that
@@ -144,12 +155,7 @@ def test_a_pusher_the_arm_cannot_follow_is_left_out_and_named(monkeypatch):
         return real(robot, motion, tcp)
 
     monkeypatch.setattr(arm, "solve_arm", solve)
-    try:
-        r = pp.pick_place(s, seed=1)
-    except ExecutionError as e:
-        assert f"without pushers {blocked}" in str(e) and e.field == "place"
-    else:
-        assert blocked in r.without and blocked not in {a.pusher for a in r.motion.assignments}
+    assert_left_out(s, blocked)
 
 
 def test_a_pusher_no_feature_serves_is_left_out_and_named(monkeypatch):
@@ -172,12 +178,7 @@ def test_a_pusher_no_feature_serves_is_left_out_and_named(monkeypatch):
         return real(scene, plan, workcell, **kw)
 
     monkeypatch.setattr(pp, "world_motion", motion)
-    try:
-        r = pp.pick_place(s, seed=1)
-    except ExecutionError as e:
-        assert f"without pushers {blocked}" in str(e) and e.field == "place"
-    else:
-        assert blocked in r.without and blocked not in {a.pusher for a in r.motion.assignments}
+    assert_left_out(s, blocked)
 
 
 def test_cli_json(chosen, monkeypatch):

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 from ..errors import MissingExtraError
 from ..extras import need
-from .pads import FACE_Y, LENGTH
-from .parallel_gripper import GEAR
+from .pads import FACE_Y
+from .parallel_gripper import add_base, add_finger, add_pad_body, couple
 
 #: Where ``example-robot-data`` keeps the Panda's description (under its distribution's files).
 DESCRIPTION = "cmeel.prefix/share/example-robot-data/robots/panda_description"
@@ -93,33 +93,17 @@ class FrankaHand:
         mujoco = need("mujoco", "robot")
         s = mujoco.MjSpec()
         s.add_mesh(name="hand", file=mesh_path())
-        mount = s.worldbody.add_body(name="base_mount")
-        # base: the mount turned −90° about z (the grasp axis along the mount's x, as every
-        # gripper's); the hand is base turned 180° about z
-        base = mount.add_body(name="base", quat=[math.sqrt(0.5), 0, 0, -math.sqrt(0.5)])
+        base = add_base(s)  # the hand's frame: base turned 180° about z
         base.add_geom(name="hand", type=mujoco.mjtGeom.mjGEOM_MESH, meshname="hand", quat=[0, 0, 0, 1],
                       mass=HAND_MASS, rgba=[0.92, 0.92, 0.92, 1])
-        # the finger's frame: its tip's face at y = FACE_Y, RECESS behind the pads' face
-        shift = FACE_Y - TIP_FACE_Y + RECESS
-        for side, sign in (("right", 1.0), ("left", -1.0)):
-            quat = [1, 0, 0, 0] if sign > 0 else [0, 0, 0, 1]  # the left finger turned 180° about z
-            finger = base.add_body(name=f"{side}_finger", pos=[0, sign * (TRAVEL - FACE_Y), 0], quat=quat)
-            finger.add_joint(name=f"{side}_finger_joint", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, -1, 0],
-                             range=[0, TRAVEL - 0.001], limited=mujoco.mjtLimited.mjLIMITED_TRUE, damping=DAMPING,
-                             armature=0.01)
+        shift = FACE_Y - TIP_FACE_Y + RECESS  # the URDF's finger frame to ours: its tip RECESS behind the pads
+        for side in ("right", "left"):
+            finger = add_finger(base, side, TRAVEL, TRAVEL - 0.001, DAMPING)
             for name, (x, y, z), rx, size in BOXES:
                 finger.add_geom(name=f"{side}_{name}", type=mujoco.mjtGeom.mjGEOM_BOX, size=[v / 2 for v in size],
                                 pos=[x, y + shift, FINGER_Z + z], quat=[math.cos(rx / 2), math.sin(rx / 2), 0, 0],
                                 mass=FINGER_MASS / len(BOXES), rgba=[0.3, 0.3, 0.32, 1])
-            pad = finger.add_body(name=f"{side}_pad", pos=[0, 0, self.pad_height - LENGTH / 2])
-            pad.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[TIP_HALF_WIDTH, 0.0005, TIP_HALF_LENGTH],
-                         pos=[0, FACE_Y + 0.0005, LENGTH / 2], contype=0, conaffinity=0, mass=0,
-                         rgba=[0.1, 0.1, 0.1, 1], group=1)
-        for side in ("right", "left"):  # the fingers run in the hand's slots (its mesh's convex hull)
-            s.add_exclude(bodyname1="base", bodyname2=f"{side}_finger")
-        split = s.add_tendon(name="split")
-        for side in ("right", "left"):
-            split.wrap_joint(f"{side}_finger_joint", GEAR)
-        s.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1="right_finger_joint", name2="left_finger_joint",
-                       data=[0, 1, 0, 0, 0] + [0] * 7, solref=[0.005, 1], solimp=[0.95, 0.99, 0.001, 0.5, 2])
+            add_pad_body(finger, side, self.pad_height, self.face)
+            s.add_exclude(bodyname1="base", bodyname2=f"{side}_finger")  # it runs in the hand's slot (in the mesh's hull)
+        couple(s)
         return s

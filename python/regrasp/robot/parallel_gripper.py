@@ -88,27 +88,55 @@ def spec(g: ParallelGripper):
     mujoco = need("mujoco", "robot")
     s = mujoco.MjSpec()
     box = mujoco.mjtGeom.mjGEOM_BOX
-    mount = s.worldbody.add_body(name="base_mount")
-    base = mount.add_body(name="base", quat=[math.sqrt(0.5), 0, 0, -math.sqrt(0.5)])
+    base = add_base(s)
     half_palm_y = g.stroke / 2 + g.recess + g.finger_thickness + 0.01
     base.add_geom(name="palm", type=box, size=[0.03, half_palm_y, g.palm_height / 2], pos=[0, 0, g.palm_height / 2],
                   mass=g.palm_mass, rgba=[0.25, 0.25, 0.28, 1])
-    travel = max(g.stroke / 2 - 0.001, 0.0)
-    for side, sign in (("right", 1.0), ("left", -1.0)):
-        quat = [1, 0, 0, 0] if sign > 0 else [0, 0, 0, 1]  # the left finger turned 180° about z: its face looks at +y
-        finger = base.add_body(name=f"{side}_finger", pos=[0, sign * (g.stroke / 2 - FACE_Y), 0], quat=quat)
-        finger.add_joint(name=f"{side}_finger_joint", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, -1, 0],
-                         range=[0, travel], limited=mujoco.mjtLimited.mjLIMITED_TRUE, damping=g.damping, armature=0.01)
+    for side in ("right", "left"):
+        finger = add_finger(base, side, g.stroke / 2, max(g.stroke / 2 - 0.001, 0.0), g.damping)
         finger.add_geom(name=f"{side}_finger_geom", type=box,
                         size=[g.finger_width / 2, g.finger_thickness / 2, g.finger_length / 2],
                         pos=[0, FACE_Y + g.recess + g.finger_thickness / 2, g.palm_height + g.finger_length / 2],
                         mass=g.finger_mass, rgba=[0.55, 0.57, 0.6, 1])
-        pad = finger.add_body(name=f"{side}_pad", pos=[0, 0, g.pad_height - LENGTH / 2])
-        pad.add_geom(type=box, size=[g.pad_width / 2, 0.0005, g.pad_length / 2], pos=[0, FACE_Y + 0.0005, LENGTH / 2],
-                     contype=0, conaffinity=0, mass=0, rgba=[0.1, 0.1, 0.1, 1], group=1)
+        add_pad_body(finger, side, g.pad_height, g.face)
+    couple(s)
+    return s
+
+
+def add_base(s):
+    """The gripper's root ``base_mount`` and, turned −90° about z from it, ``base`` (returned)."""
+    mount = s.worldbody.add_body(name="base_mount")
+    return mount.add_body(name="base", quat=[math.sqrt(0.5), 0, 0, -math.sqrt(0.5)])
+
+
+def add_finger(base, side: str, half_open: float, travel: float, damping: float):
+    """Finger ``side`` ("right" at +y of ``base``, "left" turned 180° about z at −y) on a prismatic
+    joint ``{side}_finger_joint`` closing by up to ``travel`` [m], its frame putting the pad's
+    face at ``y = FACE_Y`` and ``half_open`` [m] from the grasp axis when open."""
+    mujoco = need("mujoco", "robot")
+    sign = 1.0 if side == "right" else -1.0
+    quat = [1, 0, 0, 0] if sign > 0 else [0, 0, 0, 1]  # the left finger turned 180° about z: its face looks at +y
+    finger = base.add_body(name=f"{side}_finger", pos=[0, sign * (half_open - FACE_Y), 0], quat=quat)
+    finger.add_joint(name=f"{side}_finger_joint", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, -1, 0],
+                     range=[0, travel], limited=mujoco.mjtLimited.mjLIMITED_TRUE, damping=damping, armature=0.01)
+    return finger
+
+
+def add_pad_body(finger, side: str, height: float, face: tuple) -> None:
+    """The pad body ``{side}_pad`` of ``finger``, its face's centre ``height`` [m] above the base
+    (:mod:`.pads`' frame), drawn as a thin plate of ``face`` (half-width, half-length) [m]."""
+    mujoco = need("mujoco", "robot")
+    pad = finger.add_body(name=f"{side}_pad", pos=[0, 0, height - LENGTH / 2])
+    pad.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[face[0], 0.0005, face[1]], pos=[0, FACE_Y + 0.0005, LENGTH / 2],
+                 contype=0, conaffinity=0, mass=0, rgba=[0.1, 0.1, 0.1, 1], group=1)
+
+
+def couple(s) -> None:
+    """The fingers' drive: the tendon ``split`` over both joints with gear :data:`GEAR` (the grip
+    actuator pulls it) and a joint equality that moves them together (a rack and pinion)."""
+    mujoco = need("mujoco", "robot")
     split = s.add_tendon(name="split")
     for side in ("right", "left"):
         split.wrap_joint(f"{side}_finger_joint", GEAR)
     s.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1="right_finger_joint", name2="left_finger_joint",
                    data=[0, 1, 0, 0, 0] + [0] * 7, solref=[0.005, 1], solimp=[0.95, 0.99, 0.001, 0.5, 2])
-    return s
