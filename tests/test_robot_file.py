@@ -91,6 +91,7 @@ BAD = [
     ("arm.joints", lambda t: t.replace('"elbow_joint",', '"shoulder_lift_joint",')),
     ("arm.speed", lambda t: t.replace("reach = 0.85", "reach = 0.85\nspeed = 1.0")),
     ("arm.flange", lambda t: t.replace('flange = "wrist_3_link"', 'flange = "no_link"')),
+    ("arm.root", lambda t: t.replace('root = "base"', 'root = "NaN"')),  # found by the fuzz suite
     ("arm.joints", lambda t: t.replace('"wrist_3_joint"]', '"no_joint"]')),
     ("arm.remove", lambda t: t.replace("armature = 0.0", 'armature = 0.0\nremove = ["no_body"]')),
     ("gripper.kind", lambda t: t.replace('kind = "robotiq-2f85"', 'kind = "magnet"')),

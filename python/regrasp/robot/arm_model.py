@@ -35,6 +35,7 @@ def arm_spec(kind, model_path: str):
         s = mujoco.MjSpec.from_string(urdf_text(path))
     else:
         s = mujoco.MjSpec.from_file(str(path))
+    _body(s, kind.arm_root, "arm.root")  # the body the robot model attaches
     for b in kind.remove:
         body = _body(s, b, "arm.remove")
         s.delete(body)
