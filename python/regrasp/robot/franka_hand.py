@@ -11,8 +11,9 @@ root ``base_mount``, and ``base`` turned −90° about z from it, its +y towards
 (Franka's ``panda_rightfinger``): the hand's own frame is ``base`` turned 180° about z, i.e. the
 mount turned +90°, so that on Franka's flange (the hand turned −45° about z, as the Panda's
 ``panda_hand_joint``) the mount stands at −135° (``arm.flange_pose`` of
-``examples/robots/panda-hand.toml``); pad bodies ``left_pad``, ``right_pad`` with the face at ``y = FACE_Y``,
-the tendon ``split`` and the force-driven grip of :func:`regrasp.robot.kinds.gripper_spec`. The
+``examples/robots/panda-hand.toml``); pad bodies ``left_pad``, ``right_pad`` with the face at
+``y = FACE_Y``, the tendon ``split`` and the force-driven grip of
+:func:`regrasp.robot.kinds.gripper_spec`. The
 rubber tip's box stands ``RECESS`` behind the pad's face: regrasp's distributed-contact pads are
 the tip's surface. The hand's own joint damping (0.3 N·s/m) is replaced by the parametric
 gripper's: the grip is force-controlled here, as the thesis assumes (Franka's hand holds a set
@@ -104,6 +105,7 @@ class FrankaHand:
                                 pos=[x, y + shift, FINGER_Z + z], quat=[math.cos(rx / 2), math.sin(rx / 2), 0, 0],
                                 mass=FINGER_MASS / len(BOXES), rgba=[0.3, 0.3, 0.32, 1])
             add_pad_body(finger, side, self.pad_height, self.face)
-            s.add_exclude(bodyname1="base", bodyname2=f"{side}_finger")  # it runs in the hand's slot (in the mesh's hull)
+            # the finger runs in the hand's slot, inside the mesh's convex hull
+            s.add_exclude(bodyname1="base", bodyname2=f"{side}_finger")
         couple(s)
         return s
