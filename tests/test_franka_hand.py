@@ -90,7 +90,26 @@ def test_the_tcp_is_midway_between_the_pads_faces(width):
     assert left.mean() + right.mean() == pytest.approx(0.0, abs=1e-6)
     # the pads sink into a box as wide as the grasp at the calibration's 25 N a pad: 0.67 mm each
     # (MuJoCo's contact impedance scales with the 15 g finger's mass; the parametric's 50 g: < 0.5)
-    assert 0.0 <= width - (left.mean() - right.mean()) < 1.5e-3
+    assert 0.6e-3 < (width - (left.mean() - right.mean())) / 2 < 0.75e-3
+
+
+def test_the_housing_is_37_6_mm_below_the_tips_centre():
+    """The figure docs/robot.md gives: the hand mesh's highest point along the fingers (its
+    convex hull, as MuJoCo collides it), measured in the compiled model, below the pads' centre."""
+    import mujoco
+
+    from regrasp.robot.franka_hand import FrankaHand
+    from regrasp.robot.model import build
+
+    r = build(ROBOT, grasp_width=0.03)
+    m, d = r.model, r.data
+    mujoco.mj_forward(m, d)
+    g = m.geom("gripper/hand").id
+    v = m.mesh_vert[m.mesh_vertadr[m.geom_dataid[g]]:][:m.mesh_vertnum[m.geom_dataid[g]]]
+    world = v @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g]
+    base = m.body("gripper/base").id
+    up = world @ d.xmat[base].reshape(3, 3)[:, 2] - d.xpos[base] @ d.xmat[base].reshape(3, 3)[:, 2]
+    assert FrankaHand().pad_height - up.max() == pytest.approx(0.0376, abs=1e-4)
 
 
 def test_the_grip_map_is_the_tendons_gear():

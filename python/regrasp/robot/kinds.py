@@ -31,8 +31,8 @@ class RobotKind:
     joints' ``velocity_limit`` [rad/s] and ``acceleration_limit`` [rad/s²], one per arm joint,
     which the trajectory's time parametrisation keeps (:mod:`regrasp.execution.retime`). A
     ``gripper`` (:class:`~regrasp.robot.parallel_gripper.ParallelGripper` or
-    :class:`~regrasp.robot.franka_hand.FrankaHand`) builds the gripper instead of ``gripper_file``; ``opening`` [m] is the widest grasp, and
-    ``calibration_height`` [m] where along the base's z the grip's calibration box stands (at the
+    :class:`~regrasp.robot.franka_hand.FrankaHand`) builds the gripper instead of
+    ``gripper_file``; ``opening`` [m] is the widest grasp, and ``calibration_height`` [m] where along the base's z the grip's calibration box stands (at the
     pads). A robot file's (:mod:`.robot_file`, its path in ``source``) also says the arm model's
     root body ``arm_root``, the ``flange_body`` and ``flange_pose`` where the gripper mounts, the
     bodies to ``remove``, the position gains ``kp``, ``kv`` and ``armature`` of the arm joints

@@ -107,12 +107,8 @@ def _with_gripper(kind: RobotKind, g) -> RobotKind:
         return RobotKind(**{**kind.__dict__, "gripper_file": base.gripper_file, "pad_bodies": base.pad_bodies,
                             "driver_joints": base.driver_joints, "opening": base.opening,
                             "calibration_height": base.calibration_height})
-    if g["kind"] == "franka-hand":
-        p = FrankaHand()
-        return RobotKind(**{**kind.__dict__, "gripper": p, "opening": p.stroke, "calibration_height": p.pad_height,
-                            "driver_joints": ("right_finger_joint", "left_finger_joint")})
     try:
-        p = ParallelGripper(**{k: v for k, v in g.items() if k != "kind"})
+        p = FrankaHand() if g["kind"] == "franka-hand" else ParallelGripper(**{k: v for k, v in g.items() if k != "kind"})
     except ArgumentError as e:
         raise SceneError(f"robot file field `{e.field}`: {str(e).split(': ', 1)[-1]}", e.field) from None
     return RobotKind(**{**kind.__dict__, "gripper": p, "opening": p.stroke, "calibration_height": p.pad_height,

@@ -158,7 +158,6 @@ fn polish(nw: &Newton<'_>, x0: DVector<f64>, settings: &Settings) -> (DVector<f6
     }
 }
 
-
 /// Step 1: the solution of the inverse problem at `V = U`, if it exists and is accepted (the
 /// object moving rigidly with the pusher).
 fn moves_with_pusher(p: &Problem, u: &DVector<f64>, settings: &Settings) -> Option<Solution> {
