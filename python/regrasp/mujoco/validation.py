@@ -210,11 +210,18 @@ def _each_chunk(scene: Scene, chunks: list, workers: int, ray_address, take) -> 
     process pool."""
     if ray_address is not None:
         ray = ray_init(ray_address, workers)
-        remote = ray.remote(_mujoco_chunk)
-        pending = [remote.remote(scene, c) for c in chunks]
-        while pending:
-            done, pending = ray.wait(pending, num_returns=1)
-            take(ray.get(done[0]))
+        try:
+            remote = ray.remote(_mujoco_chunk)
+            pending = [remote.remote(scene, c) for c in chunks]
+            while pending:
+                done, pending = ray.wait(pending, num_returns=1)
+                take(ray.get(done[0]))
+        except BaseException:
+            # stopped (Ctrl-C) or failed: the driver leaves the cluster now, so that Ray's own
+            # messages as its tasks are cancelled come before ours, not after
+            with deferred():
+                ray.shutdown()
+            raise
     elif workers <= 1:
         for c in chunks:
             take(_mujoco_chunk(scene, c))
