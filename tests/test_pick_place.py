@@ -146,13 +146,13 @@ def test_a_pusher_the_arm_cannot_follow_is_left_out_and_named(monkeypatch):
     blocked = first.motion.assignments[0].pusher
     real = arm.solve_arm
 
-    def solve(robot, motion, tcp):
+    def solve(robot, motion, tcp, load=None):
         for a in motion.assignments:
             if a.pusher == blocked:
                 e = ExecutionError(f"the arm cannot execute push {a.index}: blocked in this test", "robot")
                 e.push = a.index
                 raise e
-        return real(robot, motion, tcp)
+        return real(robot, motion, tcp, load)
 
     monkeypatch.setattr(arm, "solve_arm", solve)
     assert_left_out(s, blocked)

@@ -23,7 +23,8 @@ except MissingExtraError as e:
 from regrasp import Scene  # noqa: E402
 from regrasp.pose import quat_angle, quat_from_matrix  # noqa: E402
 from regrasp.robot.creep import OBJECT, hold_box  # noqa: E402
-from regrasp.robot.ik import MAX_JUMP, MIN_DISTANCE, IKError, IKSolver, ik_path, solve_ik, table_distance  # noqa: E402
+from regrasp.robot.ik import (MAX_JUMP, MIN_DISTANCE, IKError, IKSolver, ik_path, ik_solutions, solve_ik,  # noqa: E402
+                              table_distance)
 from regrasp.robot.model import ROBOTS, TCP, build  # noqa: E402
 from regrasp.robot.pads import Pads  # noqa: E402
 from regrasp.robot.tracking import track  # noqa: E402
@@ -437,3 +438,62 @@ def test_a_held_box_stays_while_the_arm_moves():
     assert t.max_error < 0.005
     assert np.linalg.norm(after[:3] - before[:3]) < 1e-3 and quat_angle(after[3:], before[3:]) < 0.02
     assert np.linalg.norm(r.data.xpos[body] - r.data.site_xpos[r.tcp]) < 0.005  # and it went along
+
+
+def test_ik_solutions_are_distinct_branches_that_reach_the_pose(robot):
+    """From random starts: each solution reaches the pose (forward kinematics, 2e-5), within the
+    limits and clear of the table; every two differ by more than MAX_JUMP in a joint modulo 2π
+    (the same arm shape 2π round is one branch); the same answers twice (a fixed stream)."""
+    home = np.array(ROBOTS["ur5e-2f85"].home)
+    target = fk(robot, home)
+    target[:3] = [0.45, 0.15, 0.25]
+    sols = list(ik_solutions(robot, target))
+    assert len(sols) >= 3  # a UR5e reaches a pose in front of it with the elbow and wrist either way
+    lo, hi = robot.joint_limits().T
+    for i, q in enumerate(sols):
+        got = fk(robot, q)
+        assert np.linalg.norm(got[:3] - target[:3]) <= 2e-5 and quat_angle(got[3:], target[3:]) <= 2e-5
+        assert np.all(q >= lo) and np.all(q <= hi) and table_distance(robot, q) >= MIN_DISTANCE
+        for p in sols[:i]:
+            d = np.abs(np.angle(np.exp(1j * (q - p))))
+            assert d.max() > MAX_JUMP
+    assert np.array_equal(np.array(sols), np.array(list(ik_solutions(robot, target))))
+
+
+def test_a_post_on_the_home_branch_is_passed_on_another():
+    """A post where the home branch's wrist_1 would be: the IK from home refuses the pose (a
+    collision), ``ik_solutions`` finds it on another branch clear of the post, and a descent to
+    line to it that the home branch's path cannot make is made from another branch
+    (``execution.arm._other_branch``, what ``solve_arm`` does when the home's path fails):
+    every pose reached, clear of the post, no joint jump."""
+    from regrasp.execution.arm import _other_branch
+
+    home = np.array(ROBOTS["ur5e-2f85"].home)
+    plain = build()
+    target = fk(plain, home)
+    target[:3] = [0.45, 0.15, 0.25]
+    qh = solve_ik(plain, target, home)
+    d = mujoco.MjData(plain.model)
+    d.qpos[plain.arm_qpos] = qh
+    mujoco.mj_kinematics(plain.model, d)
+    wrist = d.xpos[plain.model.body("arm/wrist_1_link").id].copy()
+
+    def add(spec):
+        spec.worldbody.add_geom(name="post", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.03] * 3, pos=wrist)
+
+    r = build(add=add)
+    with pytest.raises(IKError) as e:
+        solve_ik(r, target, home, avoid=["post"])
+    assert e.value.reason == "collision" and "post" in str(e.value)
+    q = next(ik_solutions(r, target, avoid=["post"], seeds=[home]))
+    assert table_distance(r, q, avoid=["post"]) >= MIN_DISTANCE
+    assert np.linalg.norm(fk(r, q)[:3] - target[:3]) <= 2e-5
+    line = [np.r_[target[0], target[1] + dy, target[2:]] for dy in np.linspace(0.15, 0.0, 16)]
+    q0 = solve_ik(r, line[0], home, avoid=["post"])
+    with pytest.raises(IKError) as e:
+        ik_path(r, line, q0, avoid=["post"])
+    assert e.value.reason == "collision"
+    path = _other_branch(r, np.array(line), ["post"], [MIN_DISTANCE] * len(line), q0, e.value)
+    assert path is not None and np.abs(np.diff(path, axis=0)).max() <= MAX_JUMP
+    for p, qq in zip(line, path):
+        assert np.linalg.norm(fk(r, qq)[:3] - p[:3]) <= 1e-3 and table_distance(r, qq, avoid=["post"]) >= MIN_DISTANCE

@@ -189,6 +189,30 @@ proptest! {
         }
     }
 
+    /// `load_ratio` of a wrench on the object is, on the ellipsoid, the share of the pads' friction
+    /// (`s = 2μN`, `k = 0.6 r`) its opposite takes at the pad's centre, recomputed by hand:
+    /// `√(|f|²/s² + τ_c²/(s k)²)`; gravity's is `hold_ratio`; on the exact surface too, and there
+    /// it grows linearly with the wrench.
+    #[test]
+    fn load_ratio_is_the_pads_share_of_the_wrench(b in block_case(), w in (-5.0f64..5.0, -5.0f64..5.0, -0.3f64..0.3), t in 0.1f64..3.0) {
+        let w = Vec3::new(w.0, w.1, w.2);
+        for (scene, exact) in [(scene_ellipsoid(&b), false), (scene(&b), true)] {
+            let Some(scene) = scene else { continue };
+            let q = b.pose;
+            let hold = scene.hold_ratio(&q);
+            prop_assert!((scene.load_ratio(&q, &scene.frame(&q).gravity) - hold).abs() <= 1e-12 * hold.max(1.0));
+            let r = scene.load_ratio(&q, &w);
+            prop_assert!((scene.load_ratio(&q, &(w * t)) - t * r).abs() <= 1e-9 * r.max(1e-9), "not linear: {r}");
+            if !exact {
+                let c = rot(q[2]).transpose() * -Vec2::new(q[0], q[1]); // pad centre, object frame
+                let tau_c = w.z - (c.x * w.y - c.y * w.x);
+                let (sf, k) = (2.0 * b.force * b.mu_s, 0.6 * b.pad);
+                let want = ((w.x * w.x + w.y * w.y) / (sf * sf) + tau_c * tau_c / (sf * sf * k * k)).sqrt();
+                prop_assert!((r - want).abs() <= 1e-9 * want.max(1e-9), "{r} vs {want}");
+            }
+        }
+    }
+
     /// Rays from random wrenches inside W_p are feasible, with the pusher wrench along them.
     #[test]
     fn interior_rays_are_feasible(b in block_case(), w in proptest::collection::vec(0.01f64..1.0, 4)) {

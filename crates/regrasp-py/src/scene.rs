@@ -11,6 +11,7 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use regrasp::cones::robust::ConeMode;
+use regrasp::mechanics::geometry::Vec3;
 use regrasp::mechanics::limit_surface::SurfaceModel;
 use regrasp::scene::perturb;
 use regrasp::scene::planar::{PadShape, Support};
@@ -161,6 +162,25 @@ impl Scene {
                 return Err(arg_err("pose", format!("has no finite hold ratio (got {r}): the support cannot hold the object there at all")));
             }
             Ok(r)
+        })
+    }
+
+    /// The share of the support's friction each object-frame wrench row of `wrenches` (n, 3) (N, N,
+    /// N·m about the object's origin) uses at the pose row of `poses` (n, 3) (m, m, rad): (n,).
+    fn load_ratios<'py>(&self, py: Python<'py>, poses: &Arg<'py>, wrenches: &Arg<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        guard(move || {
+            let q = rows::<3>("poses", poses)?;
+            let w = rows::<3>("wrenches", wrenches)?;
+            if q.len() != w.len() {
+                return Err(arg_err("wrenches", format!("one per pose: {} rows (got {})", q.len(), w.len())));
+            }
+            let out: Vec<f64> = py.allow_threads(|| {
+                q.iter().zip(&w).map(|(p, x)| self.inner.load_ratio(p, &Vec3::new(x[0], x[1], x[2]))).collect()
+            });
+            if let Some(i) = out.iter().position(|r| !r.is_finite()) {
+                return Err(arg_err(&format!("poses[{i}]"), "has no finite load ratio: the support cannot hold anything there"));
+            }
+            Ok(array1(py, out))
         })
     }
 

@@ -15,7 +15,10 @@ frame is the TCP shifted by the grasp's centre.
 
 The joint trajectory: the TCP's world poses along the motion (every sample) by
 :func:`~regrasp.robot.ik.ik_path` from the arm's solution for the first pose (from its home
-joints), clear of the table and the features; a pose the arm cannot reach (its reach, a joint
+joints), clear of the table and the features; when that path hits a collision, a joint limit or a
+branch flip, from up to :data:`MAX_BRANCHES` other branches of the arm at the first pose
+(:func:`~regrasp.robot.ik.ik_solutions`: a UR5e's wrist_1 clear of a feature with the elbow the
+other way). A pose the arm cannot reach on any of them (its reach, a joint
 limit, a collision, a branch flip) fails the execution with an :class:`~regrasp.errors.ExecutionError`
 naming the push (or the transfer before it) and why. The object starts in the hand: held at the
 motion's first in-hand pose while the fingers close, then let go."""
@@ -51,6 +54,9 @@ CONTACT_CLEARANCE = 0.001
 HAND_TOUCH = 1e-6
 #: How many choices of contacts :func:`arm_motion` tries before giving up.
 MAX_TRIES = 6
+#: How many other branches of the arm at the first pose :func:`solve_arm` tries when the path
+#: from the home's branch fails (each a whole :func:`~regrasp.robot.ik.ik_path`, ~2–6 s).
+MAX_BRANCHES = 2
 #: Time [s] the arm holds still after the motion before the object's pose is measured.
 SETTLE = 0.3
 
@@ -65,7 +71,8 @@ class ArmTrajectory:
     ``joint_names``, per motion sample ``times`` (n,) [s] (time-parametrised within the robot's
     joint limits, never faster than the motion: :func:`~regrasp.execution.retime.retime`),
     ``q`` (n, 6) [rad], ``qd`` (n, 6) [rad/s] and ``qdd`` (n, 6) [rad/s²]; ``tcp`` (7,) the TCP's
-    pose in regrasp's gripper frame (m, unit quaternion); ``grasp_width`` [m]."""
+    pose in regrasp's gripper frame (m, unit quaternion); ``grasp_width`` [m]; ``holding``: the
+    pads' :class:`~regrasp.execution.holding.Holding` along it (None: not tested, a 3-D scene)."""
     robot: str
     joint_names: list
     times: np.ndarray
@@ -74,6 +81,7 @@ class ArmTrajectory:
     grasp_width: float
     qd: np.ndarray | None = None
     qdd: np.ndarray | None = None
+    holding: object = None
 
 
 @dataclass
@@ -256,33 +264,106 @@ def check_hand(robot, motion: WorldMotion, tcp) -> None:
                          f"the pads)", field_)
 
 
-def solve_arm(robot, motion: WorldMotion, tcp) -> ArmTrajectory:
+def solve_arm(robot, motion: WorldMotion, tcp, load=None) -> ArmTrajectory:
     """The arm's :class:`ArmTrajectory` putting the TCP at ``motion.gripper ∘ tcp`` at every
     sample, clear of the table and the workcell's features (by :data:`CONTACT_CLEARANCE` in
     contact, else the IK's ``MIN_DISTANCE``); from the solution for the first pose
-    found from the arm's home. Raises ExecutionError naming the push (see the module's doc), or
+    found from the arm's home, else from another branch (see the module's doc); timed so that
+    the pads hold the object's ``load`` (an :class:`~regrasp.execution.holding.ObjectLoad`,
+    :func:`timed`). Raises ExecutionError naming the push (see the module's doc), or
     when the plan puts the object into the gripper's body (:func:`check_hand`)."""
     from ..robot.ik import MIN_DISTANCE, IKError, fixed_geoms, ik_path
 
     check_hand(robot, motion, tcp)
     avoid = fixed_geoms(robot)
     targets = P.compose_rows(motion.gripper, np.broadcast_to(tcp, motion.gripper.shape))
+    gaps = [CONTACT_CLEARANCE if lab in ("approach", "push", "retreat") else MIN_DISTANCE for lab in motion.labels]
+    q0 = None
     try:
         q0 = first_solution(robot, targets[0], avoid)
-        gaps = [CONTACT_CLEARANCE if lab in ("approach", "push", "retreat") else MIN_DISTANCE for lab in motion.labels]
         q = ik_path(robot, targets, q0, avoid=avoid, min_distance=gaps)
     except IKError as e:
-        i = int(e.field.split("[")[1].rstrip("]")) if "[" in (e.field or "") else 0
-        why = str(e).split(": ", 1)[1] if ": " in str(e) else str(e)
-        err = ExecutionError(f"the arm cannot execute {where(motion, i)}: {why}", "robot")
-        # the push it serves or leads to (the final transfer: the last push's)
-        err.push = next((int(p) for p in motion.push[i:] if p >= 0), int(motion.push.max()))
-        raise err from None
-    from .retime import retime
+        q = _other_branch(robot, targets, avoid, gaps, q0, e)
+        if q is None:
+            raise _arm_error(motion, e) from None
+    return timed(robot, motion, tcp, q, load)
 
-    timed = retime(motion.times, q, robot.kind.velocity_limit, robot.kind.acceleration_limit)
-    return ArmTrajectory(robot.name, list(robot.kind.arm_joints), motion.times[0] + timed.times, q,
-                         np.asarray(tcp, float), robot.grasp_width, timed.qd, timed.qdd)
+
+def timed(robot, motion: WorldMotion, tcp, q, load=None) -> ArmTrajectory:
+    """The :class:`ArmTrajectory` of joint path ``q`` (one row per sample of ``motion``), time-
+    parametrised within the robot's joint limits (:func:`~regrasp.execution.retime.retime`) and,
+    with ``load``, slowed where the pads could not hold the object's load with the scene's
+    required margin (:mod:`.holding`). ExecutionError naming where (and the push it serves or
+    leads to, ``push``) when gravity alone leaves less than that margin, or no timing holds."""
+    from .holding import required_margin
+    from .retime import HoldError, retime
+
+    hold = None
+    if load is not None:
+        allowed = 1.0 - required_margin(load.scene)
+        z = np.zeros_like(q)
+        still = load.ratios(np.arange(len(q)), q, z, z)
+        if np.nanmax(still, initial=0.0) > allowed:
+            i = int(np.nanargmax(still))
+            raise _hold_error(motion, i, f"gravity alone takes {still[i]:.1%} of the pads' friction there, where at "
+                                         f"most {allowed:.1%} may be (the required margin {1 - allowed:.1%}: "
+                                         "the scene's uncertainty and HOLD_MARGIN)")
+        hold = lambda idx, qq, qd, qdd: load.ratios(idx, qq, qd, qdd) / allowed  # noqa: E731
+    try:
+        t = retime(motion.times, q, robot.kind.velocity_limit, robot.kind.acceleration_limit, hold)
+    except HoldError as e:
+        raise _hold_error(motion, e.sample, f"its load takes {e.excess:.2f} of the allowed share of the pads' "
+                                            "friction however slowly the arm moves") from None
+    holding = None if load is None else load.holding(q, t.qd, t.qdd, lambda i: where(motion, i))
+    return ArmTrajectory(robot.name, list(robot.kind.arm_joints), motion.times[0] + t.times, q,
+                         np.asarray(tcp, float), robot.grasp_width, t.qd, t.qdd, holding)
+
+
+def _hold_error(motion: WorldMotion, i: int, why: str) -> ExecutionError:
+    """The ExecutionError of the pads unable to hold the object at sample ``i``: where, why, and
+    the push it serves or leads to (``push``: another contact may need less tilt)."""
+    err = ExecutionError(f"the pads cannot hold the object in {where(motion, i)}: {why}", "robot")
+    err.push = next((int(p) for p in motion.push[i:] if p >= 0), int(motion.push.max()))
+    return err
+
+
+def object_load(scene, robot, body: int, tcp, motion: WorldMotion):
+    """The :class:`~regrasp.execution.holding.ObjectLoad` of a planar ``scene``'s object held
+    through ``motion`` (None for a 3-D scene: not tested)."""
+    from .holding import ObjectLoad
+
+    return ObjectLoad(scene, robot, body, tcp, motion) if scene.dimension == 2 else None
+
+
+def _other_branch(robot, targets, avoid, gaps, home_q, err):
+    """The joint path [rad] through ``targets`` from another branch of the arm at the first pose
+    (:data:`MAX_BRANCHES` at most), after the home branch's path (from ``home_q``; None: the home
+    found none) failed with ``err``; None when none passes or ``err`` is not the branch's (the pose out of reach)."""
+    from ..robot.ik import MAX_JUMP, IKError, branch_distance, ik_path, ik_solutions
+
+    if err.reason not in ("collision", "joint limit", "jump"):
+        return None
+    tried = 0
+    for q0 in ik_solutions(robot, targets[0], avoid, min_distance=gaps[0]):
+        if home_q is not None and branch_distance(q0, home_q) <= MAX_JUMP:
+            continue
+        try:
+            return ik_path(robot, targets, q0, avoid=avoid, min_distance=gaps)
+        except IKError:
+            tried += 1
+            if tried >= MAX_BRANCHES:
+                return None
+    return None
+
+
+def _arm_error(motion: WorldMotion, e) -> ExecutionError:
+    """The ExecutionError of a path's IKError ``e``: where in ``motion`` and why, with the push it
+    serves or leads to (``push``; the final transfer: the last push's)."""
+    i = int(e.field.split("[")[1].rstrip("]")) if "[" in (e.field or "") else 0
+    why = str(e).split(": ", 1)[1] if ": " in str(e) else str(e)
+    err = ExecutionError(f"the arm cannot execute {where(motion, i)}: {why}", "robot")
+    err.push = next((int(p) for p in motion.push[i:] if p >= 0), int(motion.push.max()))
+    return err
 
 
 @dataclass
@@ -320,7 +401,8 @@ def arm_motion(scene, plan, workcell=None, robot: str | None = None, scales: Per
                                  + "; ".join(f"push {k} on {f}: {why}" for k, f, why in refused), "robot") from None
         r, body, geoms, tcp = build_robot(scene, motion, robot, scales)
         try:
-            return ArmMotion(motion, r, body, geoms, tcp, solve_arm(r, motion, tcp), refused)
+            load = object_load(scene, r, body, tcp, motion)
+            return ArmMotion(motion, r, body, geoms, tcp, solve_arm(r, motion, tcp, load), refused)
         except ExecutionError as e:
             k = getattr(e, "push", -1)
             if k < 0:
@@ -379,7 +461,7 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
     r, body, geoms, tcp = build_robot(scene, motion, robot if trajectory is None else trajectory.robot, scales, pads)
     if trajectory is not None:
         check_hand(r, motion, tcp)  # solve_arm checks it otherwise
-    traj = solve_arm(r, motion, tcp) if trajectory is None else trajectory
+    traj = solve_arm(r, motion, tcp, object_load(scene, r, body, tcp, motion)) if trajectory is None else trajectory
     m, d = r.model, r.data
     r.set_q(traj.q[0])
     jq = m.jnt_qposadr[m.body_jntadr[body]]

@@ -359,16 +359,18 @@ def _arm_robot(scene, workcell: Workcell, pick_pose, in_hand):
 
 
 def reachable(robot, avoid, tcp, G) -> np.ndarray | None:
-    """The arm's joints [rad] putting the TCP at gripper pose ``G`` ∘ ``tcp`` (from home, clear
-    of ``avoid``) when it and the pose :data:`LIFT` above are reachable; else None."""
-    from ..robot.ik import IKError, solve_ik
+    """The arm's joints [rad] putting the TCP at gripper pose ``G`` ∘ ``tcp`` (from home, else on
+    another branch of the arm: :func:`~regrasp.robot.ik.ik_solutions`), clear of ``avoid``, when it
+    and the pose :data:`LIFT` above are reachable on one branch; else None."""
+    from ..robot.ik import IKError, ik_solutions, solve_ik
 
-    try:
-        q = solve_ik(robot, P.compose(G, tcp), robot.kind.home, avoid=avoid)
-        solve_ik(robot, P.compose(lifted(G), tcp), q, avoid=avoid)
-        return q
-    except IKError:
-        return None
+    for q in ik_solutions(robot, P.compose(G, tcp), avoid, seeds=[robot.kind.home]):
+        try:
+            solve_ik(robot, P.compose(lifted(G), tcp), q, avoid=avoid)
+            return q
+        except IKError:
+            continue
+    return None
 
 
 def check_place(place, field_: str = "place", table=None) -> np.ndarray:
@@ -394,7 +396,7 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
     crowded shelf); ``seed`` of the planner. Returns the :class:`PickPlace` of the cheapest usable pair (see the module's
     doc); ExecutionError naming ``place`` when no pair is usable (no reachable pick or place
     grasp, or no regrasp between them the arm can follow)."""
-    from .arm import solve_arm
+    from .arm import object_load, solve_arm
 
     _check_planar(scene)
     workcell = default_workcell(scene) if workcell is None else workcell
@@ -406,7 +408,7 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
     if isinstance(depth, bool) or not isinstance(depth, (int, float)) or not (0 <= depth < 1):
         raise ArgumentError(f"invalid `depth`: a height in [0, 1) m (got {depth!r:.40})", "depth")
     start, goal = spots(scene)
-    r, _, _, tcp, avoid = _arm_robot(scene, workcell, pick_pose, (*start, 0.0))  # the model: not planning
+    r, body, _, tcp, avoid = _arm_robot(scene, workcell, pick_pose, (*start, 0.0))  # the model: not planning
     t0 = time.perf_counter()
     picks, places = grasps(scene, workcell, pick_pose, start), grasps(scene, workcell, place_pose, goal, depth)
     if not picks:
@@ -442,7 +444,7 @@ def pick_place(scene, workcell: Workcell | None = None, place=None, pick=None, d
                     continue
                 motion, phases = assemble(scene, workcell, pick_pose, place_pose, c, timing)
                 try:
-                    arm = solve_arm(r, motion, tcp)
+                    arm = solve_arm(r, motion, tcp, object_load(scene, r, body, tcp, motion))
                 except ExecutionError as e:
                     c.why = str(e)
                     arm_why.append(c.why)

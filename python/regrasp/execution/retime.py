@@ -15,7 +15,13 @@ TOPP-RA finds its fastest speed profile from rest to rest with
 
 The constraints hold at the waypoints and at each interval's midpoint (TOPP-RA's grid); the
 profile is then checked every :data:`CHECK_POINTS` per interval, and solved again with limits
-scaled down until that check passes too. Holds keep their planned duration at rest."""
+scaled down until that check passes too. Holds keep their planned duration at rest.
+
+With a ``hold`` test (the pads' share of friction the held object's load takes at each
+waypoint over the share allowed, :mod:`.holding`), a piece whose load exceeds it is solved
+again with its joint limits halved (:data:`HOLD_STEP`, at most :data:`MAX_HOLD_SOLVES` times):
+slower, so the arm's accelerations load the grasp less; :class:`HoldError` names the waypoint
+when even that does not hold."""
 
 from __future__ import annotations
 
@@ -36,6 +42,19 @@ CHECK_POINTS = 8
 SLACK = 1e-6
 #: Solves with scaled-down limits before giving up.
 MAX_SOLVES = 6
+#: The factor [−] a piece's joint limits are scaled by when the pads cannot hold its load, and
+#: how many times at most.
+HOLD_STEP = 0.5
+MAX_HOLD_SOLVES = 10
+
+
+class HoldError(ExecutionError):
+    """The pads cannot hold the object's load at waypoint ``sample`` however slowly the piece is
+    timed (within :data:`MAX_HOLD_SOLVES`): ``excess`` is its load over the allowed share."""
+
+    def __init__(self, message: str, sample: int, excess: float):
+        super().__init__(message, "robot")
+        self.sample, self.excess = sample, excess
 
 
 @dataclass(frozen=True)
@@ -52,11 +71,13 @@ class Retimed:
     stops: tuple
 
 
-def retime(times, q, velocity_limit, acceleration_limit) -> Retimed:
+def retime(times, q, velocity_limit, acceleration_limit, hold=None) -> Retimed:
     """The :class:`Retimed` trajectory through waypoints ``q`` (n, dof) [rad], planned at
     ``times`` (n,) [s] (the speed cap), within ``velocity_limit`` (dof,) [rad/s] and
-    ``acceleration_limit`` (dof,) [rad/s²] (see the module's doc). ArgumentError naming the field
-    for bad input; ExecutionError when TOPP-RA finds no profile."""
+    ``acceleration_limit`` (dof,) [rad/s²] (see the module's doc); ``hold(idx, q, qd, qdd)``:
+    the load over the allowed share at waypoints ``idx`` (NaN: not held), slowing a piece until it
+    is ≤ 1. ArgumentError naming the field for bad input; ExecutionError when TOPP-RA finds no
+    profile; :class:`HoldError` when no timing holds."""
     t, q = np.asarray(times, float), np.asarray(q, float)
     if t.ndim != 1 or len(t) < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise ArgumentError("invalid `times`: at least 2 finite, strictly increasing times [s]", "times")
@@ -72,7 +93,9 @@ def retime(times, q, velocity_limit, acceleration_limit) -> Retimed:
         if step[a] <= HOLD:  # a hold: at rest for its planned time
             out_t[a + 1:b + 1] = clock + (t[a + 1:b + 1] - t[a])
         else:
-            dt, qd[a:b + 1], qdd[a:b + 1] = _piece(t[a:b + 1], q[a:b + 1], vmax, amax)
+            test = None if hold is None else \
+                (lambda qd_, qdd_, a=a, b=b: hold(np.arange(a, b + 1), q[a:b + 1], qd_, qdd_))
+            dt, qd[a:b + 1], qdd[a:b + 1] = _piece(t[a:b + 1], q[a:b + 1], vmax, amax, test, a)
             out_t[a + 1:b + 1] = clock + dt[1:]
         clock = out_t[b]
     return Retimed(out_t, q.copy(), qd, qdd, tuple(int(i) for i in stops))
@@ -106,8 +129,9 @@ def _stops(q: np.ndarray, step: np.ndarray) -> list:
     return sorted(stops)
 
 
-def _piece(t: np.ndarray, q: np.ndarray, vmax: np.ndarray, amax: np.ndarray):
-    """One moving piece from rest to rest: (times from its start (m,), qd (m, dof), qdd (m, dof))."""
+def _piece(t: np.ndarray, q: np.ndarray, vmax: np.ndarray, amax: np.ndarray, hold=None, first: int = 0):
+    """One moving piece from rest to rest: (times from its start (m,), qd (m, dof), qdd (m, dof));
+    ``hold(qd, qdd)``: the load over the allowed share at its waypoints (``first`` its first)."""
     need("toppra", "robot")
     from scipy.interpolate import CubicSpline
 
@@ -115,17 +139,33 @@ def _piece(t: np.ndarray, q: np.ndarray, vmax: np.ndarray, amax: np.ndarray):
     cap = np.diff(s) / np.diff(t)  # rad/s of arc length: the planned speed per interval
     spline = CubicSpline(s, q) if len(s) > 2 else CubicSpline(s, q, bc_type="natural")
     grid = np.sort(np.concatenate([s, 0.5 * (s[1:] + s[:-1])]))
-    scale = 1.0
-    for _ in range(MAX_SOLVES):
+    scale, solves, holds = 1.0, 0, 0
+    while True:
         sd = _solve(spline, s, grid, cap, vmax * scale, amax * scale)
         times, ratio = _check(spline, grid, sd, vmax, amax)
-        if ratio <= 1.0 + SLACK:
-            break
-        scale *= 0.995 / ratio
-    else:
-        raise ExecutionError(f"the arm's trajectory exceeds its joint limits by {ratio - 1:.1%} after {MAX_SOLVES} "
-                             "time parametrisations", "robot")
-    at = np.searchsorted(grid, s)  # the waypoints among the grid points
+        if ratio > 1.0 + SLACK:
+            solves += 1
+            if solves >= MAX_SOLVES:
+                raise ExecutionError(f"the arm's trajectory exceeds its joint limits by {ratio - 1:.1%} after "
+                                     f"{MAX_SOLVES} time parametrisations", "robot")
+            scale *= 0.995 / ratio
+            continue
+        out = _at_waypoints(spline, s, grid, sd, times)
+        excess = None if hold is None else np.asarray(hold(out[1], out[2]), float)
+        if excess is None or not np.nanmax(excess, initial=0.0) > 1.0:
+            return out
+        holds += 1
+        if holds > MAX_HOLD_SOLVES:
+            i = int(np.nanargmax(excess))
+            raise HoldError(f"the pads cannot hold the object at waypoint {first + i} even with the arm's joint "
+                            f"limits scaled by {scale:.2g}: its load is {excess[i]:.2f} of what they may take",
+                            first + i, float(excess[i]))
+        scale *= HOLD_STEP
+
+
+def _at_waypoints(spline, s, grid, sd, times):
+    """(times, qd, qdd) at the waypoints ``s`` among the grid points of a solved profile ``sd``."""
+    at = np.searchsorted(grid, s)
     u = np.diff(sd ** 2) / (2 * np.diff(grid))  # s̈ per grid interval (constant)
     u_at = np.append(u, u[-1])[at]
     qs, qss = spline(s, 1), spline(s, 2)

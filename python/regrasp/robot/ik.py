@@ -30,6 +30,7 @@ IK_DT = 0.05  # s, the differential IK's integration step
 MAX_SPEED = np.pi  # rad/s, a joint's speed in the differential IK (a step turns it at most MAX_SPEED · IK_DT)
 LIMIT_MARGIN = 1e-3  # rad, a joint this close to its range's end is at its limit
 MAX_JUMP = 0.5  # rad, the largest joint change between consecutive poses of an ik_path (more: a branch flip)
+BRANCH_SEEDS = 24  # random starts :func:`ik_solutions` tries (uniform within the joint limits, at most ±π)
 
 
 class IKError(ArgumentError):
@@ -199,6 +200,35 @@ def solve_ik(robot, target_pose, q_init=None, field: str = "pose", avoid=()) -> 
     ``MIN_DISTANCE`` off the table and the geoms ``avoid`` (ids or names). Raises
     :class:`IKError` (its ``field`` is ``field``) saying why when none is found."""
     return IKSolver(robot, avoid).solve(target_pose, robot.q if q_init is None else q_init, field)
+
+
+def branch_distance(a, b) -> float:
+    """The largest turn [rad] of one joint between configurations ``a`` and ``b``, each joint's
+    difference wrapped to [−π, π] (a revolute joint 2π round is the same branch)."""
+    d = np.asarray(a, float) - np.asarray(b, float)
+    return float(np.abs((d + np.pi) % (2 * np.pi) - np.pi).max())
+
+
+def ik_solutions(robot, target_pose, avoid=(), seeds=(), tries: int = BRANCH_SEEDS, min_distance=MIN_DISTANCE):
+    """Distinct arm configurations [rad] (each more than ``MAX_JUMP`` in some joint from those
+    before, :func:`branch_distance`: other branches of the arm — elbow, wrist, base turned) putting the TCP at
+    ``target_pose``, clear of the table and ``avoid``, yielded lazily: from each of ``seeds``
+    first, then from ``tries`` random starts (uniform within the joint limits, at most ±π; a fixed
+    random stream, so the same arm and target give the same answers)."""
+    solver = IKSolver(robot, avoid, min_distance)
+    lo, hi = robot.joint_limits().T
+    rng = np.random.default_rng(0)
+    starts = [np.asarray(q, float) for q in seeds]
+    starts += [rng.uniform(np.maximum(lo, -np.pi), np.minimum(hi, np.pi)) for _ in range(tries)]
+    found: list = []
+    for q0 in starts:
+        try:
+            q = solver.solve(target_pose, q0)
+        except IKError:
+            continue
+        if all(branch_distance(q, f) > MAX_JUMP for f in found):
+            found.append(q)
+            yield q
 
 
 def ik_path(robot, poses, q_init=None, avoid=(), max_jump: float = MAX_JUMP, min_distance=MIN_DISTANCE) -> np.ndarray:

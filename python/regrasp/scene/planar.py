@@ -538,6 +538,17 @@ class Scene:
             return None
         return self.grip_force * self.hold_ratio(pose)
 
+    def load_ratio(self, pose, wrench) -> float | np.ndarray:
+        """Share of the support's friction that the object-frame wrench ``wrench`` ``[fx, fz, τ]``
+        (N, N, N·m about the object's origin, like gravity's) uses at ``pose`` ``[x, z, theta]``
+        (m, m, rad), on the limit surface the cones use; rows of (n, 3) arrays give an (n,) array.
+        Gravity's is :meth:`hold_ratio`; an arm's motion adds its inertial load. < 1: the pads
+        supply the wrench's opposite without slipping."""
+        q, w = _array(pose, "pose"), _array(wrench, "wrench")
+        if q.ndim == 2 or w.ndim == 2:
+            return self._core.load_ratios(_rows(q, "pose"), _rows(w, "wrench"))
+        return float(self._core.load_ratios([list(_vec(q, 3, "pose"))], [list(_vec(w, 3, "wrench"))])[0])
+
     def motion_cone(self, pose, pusher: str, check_hold: bool = True) -> MotionCone:
         """The motion cone of ``pusher`` at ``pose`` ``[x, z, theta]`` (m, m, rad). Raises GraspError
         when the grasp cannot hold the object there (pass ``check_hold=False`` for gravity-free and grip-force queries)."""

@@ -74,6 +74,17 @@ impl SupportFrame {
         Self { a, a_inv, js, js_inv, gravity, ug, hold_ratio, mode: ConeMode::Nominal, exact: None }
     }
 
+    /// Share of the support's friction that an object-frame wrench `w` (N, N, N·m about the
+    /// object's origin, like [`Self::gravity`]) uses: `√(uᵀAu)` with `u = J_s⁻ᵀ w` (exact surface:
+    /// `H(u/μN)`); `hold_ratio` is this of gravity. < 1: the support can supply `−w` without slip.
+    pub fn load_ratio(&self, w: &Vec3) -> f64 {
+        let u = self.js_inv.tr_mul(w);
+        match &self.exact {
+            Some((surface, scale)) => surface.gauge(&(u / *scale)),
+            None => u.dot(&(self.a * u)).sqrt(),
+        }
+    }
+
     /// The same frame on the exact limit surface `surface` (μN = 1) at `μN = scale` [N].
     pub fn with_exact(mut self, surface: &ExactSurface, scale: f64) -> Self {
         self.hold_ratio = surface.gauge(&(self.ug / scale));

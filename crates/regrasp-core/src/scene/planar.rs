@@ -326,6 +326,13 @@ impl Scene {
         self.frame(q).hold_ratio
     }
 
+    /// Share of the support's friction that the object-frame wrench `w` (N, N, N·m about the
+    /// object's origin) uses at pose `q` ([`SupportFrame::load_ratio`]): gravity's is
+    /// [`Self::hold_ratio`]; an arm's motion adds its inertial load (`−m a`, `−I α − ω × Iω`).
+    pub fn load_ratio(&self, q: &[f64; 3], w: &Vec3) -> f64 {
+        self.frame(q).load_ratio(w)
+    }
+
     pub fn check_pose(&self, q: &[f64; 3]) -> Result<()> {
         if !q.iter().all(|x| x.is_finite()) {
             return Err(Error::arg("pose", "has a non-finite component"));

@@ -1,0 +1,142 @@
+"""Whether the pads hold the object through an arm's motion: at every sample where only the pads
+hold it (the start, transfers, approaches, retreats with the fingers closed: not while a feature
+pushes it, nor on the table before a pick or after a place), the wrench
+the pads must supply — gravity, the held object's inertia ``m a`` and its rotational terms
+``I α + ω × I ω`` as the arm moves — tested against the pads' limit surface at the grip force
+(:meth:`regrasp.Scene.load_ratio`, the test of the motion cones' hold check).
+
+The object's motion comes from the arm's joints ``q``, velocities ``qd`` and accelerations
+``qdd`` through MuJoCo's Jacobians of its centre of mass, rigidly held in the gripper at the
+sample's in-hand pose: ``a = J q̈ + J̇ q̇``, ``ω = J_r q̇``, ``α = J_r q̈ + J̇_r q̇``. Its mass,
+centre of mass and inertia are those of the object body MuJoCo simulates.
+
+The margin is ``1 − ratio`` (the share of the pads' friction left unused); a world motion must
+keep :func:`required_margin`: :data:`HOLD_MARGIN` beyond the scene's ``[uncertainty]`` of finger
+friction, grip force and mass (the ratio's worst case under them). Planar scenes only (a 3-D
+scene's pads have no limit-surface test here yet: None)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import pose as P
+
+#: The least share of the pads' friction a world motion leaves unused beyond what the scene's
+#: uncertainty takes: the model's own error (the limit surface's shape, the pads' pressure).
+HOLD_MARGIN = 0.05
+#: The samples where only the pads hold the object (their labels).
+HELD = ("start", "transfer", "approach", "retreat")
+
+
+def required_margin(scene) -> float:
+    """The margin [−] a world motion of ``scene`` must keep: ``1 − (1 − HOLD_MARGIN)(1 − δμ)(1 − δN)
+    / (1 + δm)`` with the scene's ``[uncertainty]`` spreads of finger friction, grip force and mass
+    (0 without)."""
+    u = scene.uncertainty or {}
+    dmu, dn, dm = (float(u.get(k, 0.0)) for k in ("finger_friction", "grip_force", "mass"))
+    return 1.0 - (1.0 - HOLD_MARGIN) * (1.0 - dmu) * (1.0 - dn) / (1.0 + dm)
+
+
+@dataclass(frozen=True)
+class Holding:
+    """The pads' hold along a motion: ``ratio`` (n,) the share of their friction used at each
+    sample (NaN where a feature pushes), ``required`` the margin the scene needs, ``where`` the
+    least margin's place in the motion (e.g. "the transfer before push 1 (t = 3.20 s)");
+    ``smallest`` that margin ``1 − ratio`` and ``at`` its sample."""
+    ratio: np.ndarray
+    required: float
+    where: str = ""
+
+    def to_json(self) -> dict:
+        """``smallest_margin``, ``required_margin``, ``sample``, ``where``, ``holds``."""
+        return {"smallest_margin": self.smallest, "required_margin": self.required, "sample": self.at,
+                "where": self.where, "holds": self.holds}
+
+    @property
+    def at(self) -> int:
+        return int(np.nanargmax(self.ratio)) if np.any(np.isfinite(self.ratio)) else 0
+
+    @property
+    def smallest(self) -> float:
+        return float(1.0 - self.ratio[self.at]) if np.any(np.isfinite(self.ratio)) else 1.0
+
+    @property
+    def holds(self) -> bool:
+        """Whether every held sample keeps the required margin."""
+        return self.smallest >= self.required - 1e-12
+
+
+class ObjectLoad:
+    """The object's load on the pads at arm states, for one world motion (planar ``scene``) on
+    the arm ``robot`` (:func:`~regrasp.execution.arm.build_robot`'s, the object's ``body``)
+    with the TCP at ``tcp`` in the gripper frame."""
+
+    def __init__(self, scene, robot, body: int, tcp, motion):
+        import mujoco
+
+        self.scene, self.robot, self.mj = scene, robot, mujoco
+        m = robot.model
+        self.data = mujoco.MjData(m)
+        self.mass = float(scene.mass)  # the nominal object's (a perturbed model's scales its inertia)
+        self.com = np.array(m.body_ipos[body], float)  # object frame [m]
+        Ri = P.quat_matrix(m.body_iquat[body])
+        scale = self.mass / float(m.body_mass[body])
+        self.inertia = scale * Ri @ np.diag(m.body_inertia[body]) @ Ri.T  # about the com, object frame [kg m²]
+        self.gravity = np.array(m.opt.gravity, float)
+        self.site_body = int(m.site_bodyid[robot.tcp])
+        self.tcp_inv = P.inverse(np.asarray(tcp, float))
+        self.in_hand = np.asarray(motion.in_hand, float)
+        self.planar = np.array([P.spatial_to_planar(h) for h in self.in_hand])
+        self.held = np.array([lab in HELD for lab in motion.labels]) & (np.asarray(motion.grip_force, float) > 0)
+
+    def wrenches(self, idx, q, qd, qdd) -> np.ndarray:
+        """The object-frame wrench ``[fx, fz, τ]`` (N, N, N·m about the object's origin, gravity's
+        convention) the pads must resist at samples ``idx`` with the arm at ``q``, ``qd``, ``qdd``
+        (len(idx), dof): gravity and the inertial load, (len(idx), 3)."""
+        mj, m, d, r = self.mj, self.robot.model, self.data, self.robot
+        dof = r.arm_dof
+        out = np.zeros((len(idx), 3))
+        jp, jr, dp, dr = (np.zeros((3, m.nv)) for _ in range(4))
+        for k, i in enumerate(idx):
+            d.qpos[:] = r.data.qpos
+            d.qpos[r.arm_qpos] = q[k]
+            d.qvel[:] = 0.0
+            d.qvel[dof] = qd[k]
+            mj.mj_kinematics(m, d)
+            mj.mj_comPos(m, d)
+            mj.mj_comVel(m, d)
+            tcp = np.concatenate([d.site_xpos[r.tcp], P.quat_from_matrix(d.site_xmat[r.tcp].reshape(3, 3))])
+            W = P.compose(P.compose(tcp, self.tcp_inv), self.in_hand[i])  # the object's world pose
+            R = P.quat_matrix(W[3:])
+            c = W[:3] + R @ self.com
+            mj.mj_jac(m, d, jp, jr, c, self.site_body)
+            mj.mj_jacDot(m, d, dp, dr, c, self.site_body)
+            a = jp[:, dof] @ qdd[k] + dp[:, dof] @ qd[k]
+            w = jr[:, dof] @ qd[k]
+            alpha = jr[:, dof] @ qdd[k] + dr[:, dof] @ qd[k]
+            f = R.T @ (self.mass * (self.gravity - a))  # gravity and −m a, object frame
+            Iw = R @ self.inertia @ R.T
+            T = R.T @ (Iw @ alpha + np.cross(w, Iw @ w))  # the torque the pads supply about the com
+            # planar torque is about −y: the com's moment of f, and −T's component along −y
+            out[k] = [f[0], f[2], self.com[0] * f[2] - self.com[2] * f[0] + T[1]]
+        return out
+
+    def ratios(self, idx, q, qd, qdd) -> np.ndarray:
+        """The share of the pads' friction used at samples ``idx`` (NaN where a feature pushes)."""
+        idx = np.asarray(idx, int)
+        out = np.full(len(idx), np.nan)
+        keep = self.held[idx]
+        if keep.any():
+            k = np.flatnonzero(keep)
+            w = self.wrenches(idx[k], q[k], qd[k], qdd[k])
+            out[k] = self.scene.load_ratio(self.planar[idx[k]], w)
+        return out
+
+    def holding(self, q, qd, qdd, where=None) -> Holding:
+        """The :class:`Holding` of the whole motion at arm states ``q``, ``qd``, ``qdd`` (n, dof);
+        ``where(i)`` names sample ``i``'s place in the motion."""
+        ratio = self.ratios(np.arange(len(q)), q, qd, qdd)
+        h = Holding(ratio, required_margin(self.scene))
+        return Holding(ratio, h.required, where(h.at) if where is not None else "")
