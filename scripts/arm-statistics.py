@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Prints the README's table of the arm's success (regrasp.execution.campaign): every bundled
-example (or those named), ``--runs`` executions each with friction, grip force and mass drawn
-within ±``--spread``, ``--workers`` processes.
+example (or those named: bundled examples or scene files), ``--runs`` executions each with
+friction, grip force and mass drawn within ±``--spread``, ``--workers`` processes; with the
+smallest share of the pads' friction left unused through the arm's motion per run
+(regrasp.execution.holding), the least and the median over the runs.
 
     python scripts/arm-statistics.py --runs 20 --spread 0.1 --workers 2 [--robot NAME] [--json out.json] [NAME ...]
 """
@@ -17,15 +19,17 @@ import numpy as np
 def row(o) -> str:
     """The README's table row of an :class:`~regrasp.execution.campaign.Outcome`."""
     if o.refused:
-        return f"| {o.name} | refused: {o.refused} | | | {o.seconds:.0f} |"
+        return f"| {o.name} | refused: {o.refused} | | | | {o.seconds:.0f} |"
     if not o.errors:
-        return f"| {o.name} | 0/{o.runs} ({o.failures[0] if o.failures else ''}) | | | {o.seconds:.0f} |"
+        return f"| {o.name} | 0/{o.runs} ({o.failures[0] if o.failures else ''}) | | | | {o.seconds:.0f} |"
     e = np.median(np.abs(np.array(o.errors)), axis=0)
     err = (f"{e[0] * 1e3:.2f} mm, {e[1] * 1e3:.2f} mm, {np.degrees(e[2]):.2f}°" if len(e) == 3
            else f"{e[0] * 1e3:.2f} mm, {np.degrees(e[1]):.2f}°")
     creep = np.array(o.max_creep, float)
     creep = "-" if np.all(np.isnan(creep)) else f"{np.nanmax(creep) * 1e3:.2f}"
-    return f"| {o.name} | {o.successes}/{o.runs} | {err} | {creep} | {o.seconds:.0f} |"
+    m = [x for x in o.margins if x is not None]
+    margin = f"{min(m):.2f} ({np.median(m):.2f})" if m else "-"
+    return f"| {o.name} | {o.successes}/{o.runs} | {err} | {creep} | {margin} | {o.seconds:.0f} |"
 
 
 def main() -> int:
@@ -33,7 +37,7 @@ def main() -> int:
     from regrasp.execution.campaign import example
 
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("names", nargs="*", help="bundled examples (default: all with a task)")
+    ap.add_argument("names", nargs="*", help="bundled examples or scene files (.toml; default: every bundled example with a task)")
     ap.add_argument("--runs", type=int, default=20)
     ap.add_argument("--spread", type=float, default=0.1)
     ap.add_argument("--seed", type=int, default=0)
@@ -44,8 +48,8 @@ def main() -> int:
     a = ap.parse_args()
     names = a.names or regrasp.examples.names()
     loop = "closed loop" if a.closed_loop else "open loop"
-    print(f"| example | {loop}{', ' + a.robot if a.robot else ''}: success (±{a.spread:.0%}, {a.runs} runs) | median goal error | max creep [mm] | wall [s] |")
-    print("|---|---|---|---|---|", flush=True)
+    print(f"| example | {loop}{', ' + a.robot if a.robot else ''}: success (±{a.spread:.0%}, {a.runs} runs) | median goal error | max creep [mm] | holding margin: least (median) | wall [s] |")
+    print("|---|---|---|---|---|---|", flush=True)
     with ProcessPoolExecutor(a.workers) as pool:  # a row as each example completes
         jobs = [pool.submit(example, name, a.runs, a.spread, a.seed, a.closed_loop, a.robot) for name in names]
         for job in as_completed(jobs):

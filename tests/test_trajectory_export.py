@@ -74,7 +74,9 @@ def test_plan_only_writes_the_trajectory_without_simulating(exported):
     tr = Trajectory.load(d / "t.json")
     assert out["plan_only"] and out["samples"] == len(tr) and out["duration_s"] == pytest.approx(tr.duration)
     assert 0 < out["max_velocity_ratio"] <= 1 + 1e-6 and 0 < out["max_acceleration_ratio"] <= 1 + 1e-6
-    assert "not simulated" in runs["yaml"][1]
+    h = out["holding"]  # the pads' hold along it (execution.holding): the smallest margin and where
+    assert h["holds"] and 1 > h["smallest_margin"] >= h["required_margin"] > 0 and "t = " in h["where"]
+    assert "not simulated" in runs["yaml"][1] and "of their friction unused at least" in runs["yaml"][1]
 
 
 def test_every_sample_is_within_the_robot_limits(exported):

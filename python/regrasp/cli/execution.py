@@ -115,6 +115,8 @@ def _arm(scene, plan, a):
                              max_tcp_error=r.tracking.tcp_error),
                refused=[dict(push=k, feature=f_, why=why) for k, f_, why in run.refused],
                task_error=run.goal_error)
+    if r.trajectory.holding is not None:
+        out["holding"] = r.trajectory.holding.to_json()
     return out, run.motion, (r, holder.get("r"))
 
 
@@ -193,11 +195,16 @@ def _plan_only(scene, plan, a) -> int:
         kind = ROBOTS[arm.robot]
         out["max_velocity_ratio"] = float(np.max(np.abs(arm.qd) / np.asarray(kind.velocity_limit)))
         out["max_acceleration_ratio"] = float(np.max(np.abs(arm.qdd) / np.asarray(kind.acceleration_limit)))
+        if arm.holding is not None:
+            out["holding"] = arm.holding.to_json()
     if a.json:
         print(json.dumps(out, allow_nan=False))
     else:
         rates = (f"; joint speeds up to {out['max_velocity_ratio']:.0%} and accelerations up to "
                  f"{out['max_acceleration_ratio']:.0%} of the limits") if arm is not None else ""
+        if "holding" in out:
+            h = out["holding"]
+            rates += f"; the pads keep {h['smallest_margin']:.0%} of their friction unused at least ({h['where']})"
         print(f"{scene.name}: {out['robot']} in workcell {out['workcell']}, {len(motion.assignments)} pushes "
               f"({', '.join(f'{p.pusher} on {p.feature}' for p in motion.assignments)}): a trajectory of "
               f"{len(tr)} samples, {tr.duration:.1f} s{rates} (not simulated)")

@@ -25,7 +25,10 @@ class Outcome:
     the task (``errors``, planar ``[x, z, theta]`` or 3-D ``[position, angle]``), ``max_creep`` [m];
     ``refused``: why the example could not be executed (no plan, no feature, the arm), else
     None; ``seconds`` of wall time; ``failures``: why runs stopped early (the arm refused to go
-    on in a perturbed world; each counts as a failed run)."""
+    on in a perturbed world; each counts as a failed run); ``margins``: per run the smallest
+    share of the pads' friction left unused through the arm's motion in that run's world (the
+    nominal trajectory's :mod:`~regrasp.execution.holding` ratio × mass / (finger friction ×
+    grip); None: not tested, a 3-D scene or closed loop)."""
     name: str
     runs: int = 0
     successes: int = 0
@@ -34,6 +37,7 @@ class Outcome:
     refused: str | None = None
     seconds: float = 0.0
     failures: list = field(default_factory=list)
+    margins: list = field(default_factory=list)
 
     @property
     def rate(self) -> float:
@@ -53,7 +57,8 @@ def draws(runs: int, spread: float, seed: int):
 
 def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: bool = False,
             robot: str | None = None) -> Outcome:
-    """The :class:`Outcome` of bundled example ``name`` (see the module's doc); ``closed_loop``:
+    """The :class:`Outcome` of bundled example ``name`` (or a scene file's path, ``….toml``; see
+    the module's doc); ``closed_loop``:
     each run with the arm in the loop (:func:`~regrasp.execution.arm_loop.control_arm`) instead
     of the open-loop joint trajectory; ``robot``: the robot (default: the workcell's)."""
     import time
@@ -64,15 +69,16 @@ def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: boo
 
     t0 = time.perf_counter()
     out = Outcome(name)
-    scene = regrasp.load_scene(regrasp.examples.path(name))
+    scene = regrasp.load_scene(name if name.endswith(".toml") else regrasp.examples.path(name))
     if scene.task is None:
         out.refused = "no task (the object rests on a surface: nothing to regrasp)"
         return out
     try:
         plan = regrasp.plan(scene, seed=0)
         world = World(scene, rig="arm", robot=robot)
-        if not closed_loop:
-            arm_motion_of(world, plan)  # solved once, here: an arm that cannot do the plan refuses the example
+        holding = None
+        if not closed_loop:  # solved once, here: an arm that cannot do the plan refuses the example
+            holding = arm_motion_of(world, plan).trajectory.holding
     except RegraspError as e:
         out.refused = f"{type(e).__name__}: {e}"
         out.seconds = time.perf_counter() - t0
@@ -86,6 +92,8 @@ def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: boo
             continue
         out.runs += 1
         out.successes += int(r.success)
+        worst = None if holding is None else 1 - (1 - holding.smallest) * scales.mass / (scales.finger_friction * scales.grip)
+        out.margins.append(worst)
         e = r.goal_error  # against the task; 3-D as [position, angle]
         out.errors.append([float(x) for x in (e if scene.dimension == 2 else (np.linalg.norm(e[:3]), e[3]))])
         out.max_creep.append(float("nan") if r.max_creep is None else r.max_creep)

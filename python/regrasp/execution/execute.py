@@ -122,6 +122,9 @@ class Execution:
         for k in ("duration", "max_creep", "max_creep_angle"):
             if getattr(self, k) is not None:
                 out[k] = float(getattr(self, k))
+        holding = getattr(self.trajectory, "holding", None)  # the arm's (execution.holding)
+        if holding is not None:
+            out["holding"] = holding.to_json()
         return out
 
 
