@@ -120,10 +120,12 @@ def test_execute_cli(tmp_path):
     plan = tmp_path / "plan.json"
     scene = regrasp.examples.path("block-3d")
     assert run_cli("plan", scene, "--out", plan)[0] == 0
-    code, out, err = run_cli("execute", scene, "--plan", plan, "--trajectory", tmp_path / "traj.json", "--json")
+    code, out, err = run_cli("execute", scene, "--plan", plan, "--trajectory", tmp_path / "traj.json", "--json",
+                             "--grip-sensing", "open-loop")  # a 2F-85's own: its force setting, no measurement
     assert code == 0, err
     r = json.loads(out)
     assert {"success", "goal_error", "max_creep", "robot", "duration_s"} <= set(r) and r["success"] is True
+    assert r["grip_sensing"] == "open-loop" and "holding" not in r  # a 3-D scene's hold is not tested yet
     assert r["robot"] == "ur5e-2f85" and r["pushes"][0]["feature"]
     assert Trajectory.load(tmp_path / "traj.json").q.shape[1] == 6
     code, out, err = run_cli("execute", scene, "--plan", plan, "--robot", "free-gripper", "--json")
@@ -141,6 +143,10 @@ def test_execute_cli_refusals(tmp_path):
     assert code == 2 and "--trajectory" in err
     code, _, err = run_cli("execute", scene, "--plan", tmp_path / "p.json", "--trajectory", scene)
     assert code == 2
+    for extra in (["--grip-sensing", "psychic"], ["--grip-sensing", "sensor:0.1,nan,100"],
+                  ["--grip-sensing", "ideal", "--robot", "free-gripper"], ["--grip-sensing", "ideal", "--plan-only"]):
+        code, _, err = run_cli("execute", scene, "--plan", tmp_path / "p.json", *extra)
+        assert code == 2 and "--grip-sensing" in err and "Traceback" not in err, (extra, err)
     for name in ("block-3d", "block-xztheta"):
         regrasp.plan(regrasp.load_scene(regrasp.examples.path(name)), seed=0).save(tmp_path / f"{name}.json")
     bad = [("block-3d", ["--start-error", "0.001,0,0"]),  # planar only

@@ -38,8 +38,14 @@ def _check(a) -> None:
     if a.video and a.robot == FREE_GRIPPER:
         raise ArgumentError("invalid `--video`: the video shows the arm (not --robot free-gripper)", "--video")
     if a.plan_only:
-        refuse_flags(a, ("video", "closed_loop", "scale_friction", "scale_grip", "scale_mass", "start_error"),
-                     "with --plan-only", "nothing is simulated (leave out --plan-only to run it in MuJoCo)")
+        refuse_flags(a, ("video", "closed_loop", "scale_friction", "scale_grip", "scale_mass", "start_error",
+                         "grip_sensing"), "with --plan-only", "nothing is simulated (leave out --plan-only to run it in MuJoCo)")
+    if a.grip_sensing is not None:
+        from ..robot.sensing import GripSensing
+
+        if a.robot == FREE_GRIPPER:
+            raise ArgumentError("invalid `--grip-sensing`: the arm's grip loop (not --robot free-gripper)", "--grip-sensing")
+        a.grip_sensing = GripSensing.parse(a.grip_sensing)
     if a.format is not None and not a.trajectory:
         raise ArgumentError("invalid `--format`: the format of --trajectory, which is not given", "--format")
     if a.trajectory and a.robot == FREE_GRIPPER and format_of(a.trajectory, a.format) != "json":
@@ -106,7 +112,7 @@ def _arm(scene, plan, a):
             if "r" not in holder:
                 holder["r"] = Recorder(robot.model, robot.data)
             holder["r"].capture()
-    run = execute(World(scene, rig="arm", workcell=_workcell(a), robot=a.robot), plan,
+    run = execute(World(scene, rig="arm", workcell=_workcell(a), robot=a.robot, grip_sensing=a.grip_sensing), plan,
                   perturbation=_perturbation(scene, a), observe=observe)
     r = run.detail
     out = dict(success=run.success, goal_error=r.goal_error, max_creep=r.max_creep, max_creep_angle=r.max_creep_angle,
@@ -117,6 +123,7 @@ def _arm(scene, plan, a):
                task_error=run.goal_error)
     if r.trajectory.holding is not None:
         out["holding"] = r.trajectory.holding.to_json()
+    out["grip_sensing"] = "ideal" if a.grip_sensing is None else a.grip_sensing.kind
     return out, run.motion, (r, holder.get("r"))
 
 
@@ -142,8 +149,8 @@ def _closed_loop(scene, plan, a) -> int:
                                 f"--{opt}")
     if a.robot == FREE_GRIPPER:
         raise ArgumentError("invalid `--robot`: --closed-loop runs the arm (not the free gripper)", "--robot")
-    run = execute(World(scene, rig="arm", workcell=_workcell(a), robot=a.robot), plan, loop="closed",
-                  perturbation=_perturbation(scene, a))
+    world = World(scene, rig="arm", workcell=_workcell(a), robot=a.robot, grip_sensing=a.grip_sensing)
+    run = execute(world, plan, loop="closed", perturbation=_perturbation(scene, a))
     r = run.detail
     out = dict(success=run.success, goal_error=r.goal_error, task_error=run.goal_error, replans=r.replans, switch_overs=r.switch_overs,
                duration_s=r.duration, failure=r.failure, closed_loop=True)
@@ -271,5 +278,8 @@ def add_parsers(sub) -> None:
                    "re-planning (3-D) from the object's pose measured in MuJoCo")
     e.add_argument("--start-error", metavar="dx,dz,dtheta", help="planar: the object starts this far from the "
                    "plan's start in the grasp (m, m, rad)")
+    e.add_argument("--grip-sensing", metavar="KIND", help="what the arm's grip loop measures: ideal (default: "
+                   "MuJoCo's contact forces), open-loop (none: the calibrated feed-forward), sensor or "
+                   "sensor:NOISE,DELAY,BANDWIDTH (a force sensor per finger; N, s, Hz)")
     e.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(e)

@@ -414,11 +414,12 @@ def arm_motion(scene, plan, workcell=None, robot: str | None = None, scales: Per
                          + "; ".join(f"push {k} on {f}: {why}" for k, f, why in refused), "robot")
 
 
-def close_on(robot, body: int, geoms, grip_force: float):
+def close_on(robot, body: int, geoms, grip_force: float, sensing=None):
     """Closes the fingers on the object (held in place) until both pads press within
     :data:`SETTLED` of ``grip_force`` [N] (:data:`CLOSE_TIME`), the arm's servo holding the
     joints where they are (so the hand does not sag against the held object: 0.54 mm on
-    offset-3d with the joints left free); returns the grip controller."""
+    offset-3d with the joints left free); returns the grip controller, its loop measuring as
+    ``sensing`` says (:class:`~regrasp.robot.sensing.GripSensing`; None: ideal)."""
     mujoco = need("mujoco", "robot")
     from ..robot.grip import GripController, pad_forces
     from ..robot.tracking import Servo
@@ -426,7 +427,7 @@ def close_on(robot, body: int, geoms, grip_force: float):
     m, d = robot.model, robot.data
     jq, jv = m.jnt_qposadr[m.body_jntadr[body]], m.jnt_dofadr[m.body_jntadr[body]]
     hold, q = d.qpos[jq:jq + 7].copy(), robot.q.copy()
-    grip = GripController(robot, grip_force, geoms, period=GRIP_PERIOD)
+    grip = GripController(robot, grip_force, geoms, period=GRIP_PERIOD, sensing=sensing)
     servo = Servo(robot)
     t0 = d.time
     while d.time - t0 < CLOSE_TIME[1]:
@@ -441,7 +442,7 @@ def close_on(robot, body: int, geoms, grip_force: float):
 
 
 def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scales: Perturbation = Perturbation(),
-                observe=None, trajectory: ArmTrajectory | None = None, pads=None, start=None) -> ArmResult:
+                observe=None, trajectory: ArmTrajectory | None = None, pads=None, start=None, sensing=None) -> ArmResult:
     """Executes ``motion`` (the :class:`WorldMotion` of ``plan`` for ``scene``) with the arm
     ``robot`` (default: the workcell's) in MuJoCo, in a world perturbed by ``scales``, and
     measures it (:class:`ArmResult`). ``observe(robot)``: called after every control period
@@ -449,7 +450,8 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
     (:func:`solve_arm`, e.g. for repeated runs in perturbed worlds). Raises ExecutionError when
     the arm cannot follow the motion. ``pads``: as :func:`build_robot`'s. ``start``: where the
     object really starts in the hand (planar ``[x, z, theta]`` or ``[x, y, z, qw, qx, qy, qz]``;
-    default the motion's first in-hand pose), the motion left as planned."""
+    default the motion's first in-hand pose), the motion left as planned. ``sensing``: what the
+    grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: ideal)."""
     mujoco = need("mujoco", "robot")
     from ..robot.grip import body_pose
     from ..robot.tracking import track
@@ -467,7 +469,7 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
     jq = m.jnt_qposadr[m.body_jntadr[body]]
     d.qpos[jq:jq + 7] = P.compose(P.compose(r.tcp_pose(), P.inverse(tcp)), start)
     mujoco.mj_forward(m, d)
-    grip = close_on(r, body, geoms, float(motion.grip_force[0]) * scales.grip)
+    grip = close_on(r, body, geoms, float(motion.grip_force[0]) * scales.grip, sensing)
     untcp = P.inverse(tcp)
     samples, qs, k = [], [], [0]
 

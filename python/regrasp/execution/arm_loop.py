@@ -63,10 +63,11 @@ class ArmPlant:
     above the first push, the safe height and the pushers' features); ``start``: the object's
     in-hand start pose (planar ``[x, z, theta]`` or 3-D; default the plan's); ``workcell``,
     ``robot``, ``scales`` (:class:`~regrasp.execution.arm.Scales`), ``timing``
-    (:class:`~regrasp.execution.world_motion.Timing`) as for an open-loop execution."""
+    (:class:`~regrasp.execution.world_motion.Timing`), ``sensing`` (the grip loop's) as for an
+    open-loop execution."""
 
     def __init__(self, scene, plan, start=None, workcell=None, robot: str | None = None,
-                 scales: Perturbation = Perturbation(), timing: Timing = Timing()):
+                 scales: Perturbation = Perturbation(), timing: Timing = Timing(), sensing=None):
         mujoco = need("mujoco", "robot")
         from ..robot.ik import IKError, IKSolver, fixed_geoms
 
@@ -94,7 +95,7 @@ class ArmPlant:
         self._jq, self._jv = jq, m.jnt_dofadr[m.body_jntadr[body]]
         r.data.qpos[jq:jq + 7] = P.compose(r.tcp_pose(), self.untcp, O)  # at the arm's actual TCP
         mujoco.mj_forward(m, r.data)
-        self.grip = close_on(r, body, geoms, float(self.motion.grip_force[0]) * scales.grip)
+        self.grip = close_on(r, body, geoms, float(self.motion.grip_force[0]) * scales.grip, sensing)
         self.solver = IKSolver(r, avoid)
         self.contact_solver = IKSolver(r, avoid, CONTACT_CLEARANCE)  # fingers near the feature in contact
         self.q = r.q.copy()  # the arm's commanded joints
@@ -253,7 +254,7 @@ def goal_error(scene, plan, pose) -> tuple[np.ndarray, bool]:
 
 def control_arm(scene, plan, workcell=None, scales: Perturbation = Perturbation(), robot: str | None = None,
                 timing: Timing = Timing(), seed: int = 0, max_replans: int = 10, max_time: float | None = None,
-                start_error=(0.0, 0.0, 0.0), **mpc) -> ArmLoopResult:
+                start_error=(0.0, 0.0, 0.0), sensing=None, **mpc) -> ArmLoopResult:
     """Executes ``plan`` (a :class:`~regrasp.Plan` of ``scene``) closed loop with the arm in
     ``workcell`` (default: the scene's default workcell) in a world perturbed by ``scales``
     (see the module's doc): planar by the MPC (``mpc``: its settings, e.g. ``dt`` [s], ``speed``
@@ -275,8 +276,8 @@ def control_arm(scene, plan, workcell=None, scales: Perturbation = Perturbation(
                             "start_error")
     _check_features(scene, plan, workcell)
     if scene.dimension == 2:
-        return _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, start_error, mpc)
-    return _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_replans)
+        return _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, start_error, mpc, sensing)
+    return _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_replans, sensing)
 
 
 def _check_features(scene, plan, workcell) -> None:
@@ -332,7 +333,8 @@ def _served(scene, pusher: str, pose, workcell) -> bool:
     return True
 
 
-def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, start_error, mpc) -> ArmLoopResult:
+def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time, start_error, mpc,
+                    sensing=None) -> ArmLoopResult:
     from ..control.loop import ControlRun, _check_arguments
 
     d = mpc_defaults()
@@ -341,7 +343,7 @@ def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time
     made = []
 
     def plant(q0):
-        made.append(ArmPlant(scene, plan, q0, workcell, robot, scales, timing))
+        made.append(ArmPlant(scene, plan, q0, workcell, robot, scales, timing, sensing))
         return made[0]
 
     run = ControlRun(scene, plan, "arm", "mpc", (), se, Perturbation(), controller_scene(scene, plan, workcell),
@@ -365,10 +367,10 @@ def sticking(scene, a: dict, b: dict) -> bool:
     return u is None or bool(np.allclose(u, P.twist_between(a["pose"], b["pose"]), rtol=1e-6, atol=1e-9))
 
 
-def _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_replans) -> ArmLoopResult:
+def _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_replans, sensing=None) -> ArmLoopResult:
     from ..scene.spatial import check_plan3d, run_plan3d
 
-    arm = ArmPlant(scene, plan, None, workcell, robot, scales, timing)
+    arm = ArmPlant(scene, plan, None, workcell, robot, scales, timing, sensing)
     path = check_plan3d(scene, plan)
 
     def step(a: dict, b: dict) -> np.ndarray:

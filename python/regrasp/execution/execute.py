@@ -41,9 +41,11 @@ LOOPS = ("open", "closed")
 class World:
     """Where a plan runs: ``scene`` (planar or 3-D), ``rig`` (:data:`RIGS`), ``engine``
     (:data:`ENGINES`; the gripper rigs are MuJoCo's), ``workcell`` (the gripper rigs'; default:
-    the scene's default workcell), ``robot`` (the arm's registry name; default: the workcell's)
-    and ``options``: settings of the rig's function (e.g. ``speed`` [m/s], ``dt`` [s],
-    ``view``, ``timing``, ``seed``), each checked against it."""
+    the scene's default workcell), ``robot`` (the arm's registry name; default: the workcell's),
+    ``options``: settings of the rig's function (e.g. ``speed`` [m/s], ``dt`` [s],
+    ``view``, ``timing``, ``seed``), each checked against it, and ``grip_sensing``: what the
+    arm's grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the ideal
+    contact forces)."""
 
     scene: object
     rig: str = "planner"
@@ -51,6 +53,7 @@ class World:
     workcell: Workcell | None = None
     robot: str | None = None
     options: dict = field(default_factory=dict)
+    grip_sensing: object = None
     #: the arm's world motion and joint trajectory of each plan run here (:func:`arm_motion_of`)
     _motions: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -70,6 +73,11 @@ class World:
             raise ArgumentError("invalid `world.robot`: a robot's name, for the arm rig", "world.robot")
         if not isinstance(self.options, dict) or not all(isinstance(k, str) for k in self.options):
             raise ArgumentError("invalid `world.options`: a dict of settings by name", "world.options")
+        if self.grip_sensing is not None:
+            from ..robot.sensing import GripSensing
+
+            if self.rig != "arm" or not isinstance(self.grip_sensing, GripSensing):
+                raise ArgumentError("invalid `world.grip_sensing`: a GripSensing, for the arm rig", "world.grip_sensing")
 
 
 @dataclass
@@ -253,13 +261,14 @@ def _arm(world, scene, plan, loop, pert, observe) -> dict:
 
         r = control_arm(scene, plan, **_options(world, control_arm, {
             "workcell": world.workcell, "scales": pert, "robot": world.robot,
-            "start_error": np.zeros(3) if se is None else se}))
+            "start_error": np.zeros(3) if se is None else se, "sensing": world.grip_sensing}))
         return {"final": r.final, "detail": r, "duration": r.duration, "replans": r.replans}
     from .arm import execute_arm
 
     am = arm_motion_of(world, plan)
     start = None if se is None else np.asarray(plan.poses[0], float) + se
-    r = execute_arm(scene, plan, am.motion, world.robot, pert, observe=observe, trajectory=am.trajectory, start=start)
+    r = execute_arm(scene, plan, am.motion, world.robot, pert, observe=observe, trajectory=am.trajectory, start=start,
+                    sensing=world.grip_sensing)
     return {"final": r.in_hand[-1], "poses": r.in_hand, "detail": r, "duration": r.duration,
             "creep": (r.max_creep, r.max_creep_angle), "tracking": r.tracking, "motion": am.motion,
             "trajectory": r.trajectory, "refused": list(am.refused)}
@@ -302,7 +311,7 @@ def _pick_place(world, scene, r, loop, pert, observe) -> Execution:
     if pert.pose is not None or any(pert.shift) or pert.turn:
         raise ArgumentError("invalid `perturbation`: a pick-regrasp-place starts from its pick pose (no shift, "
                             "turn or pose)", "perturbation.shift")
-    x = execute_pick_place(scene, r, pert, observe=observe)
+    x = execute_pick_place(scene, r, pert, observe=observe, sensing=world.grip_sensing)
     err = np.asarray(x.place_error, float)
     return Execution(bool(x.success), err, err.copy(), bool(x.success), np.asarray(x.final_pose, float), world, loop,
                      pert, x.duration, tracking=x.tracking, motion=r.motion, trajectory=r.arm, detail=x)

@@ -520,14 +520,15 @@ class PickPlaceRun:
 OPEN_TIME = 0.5
 
 
-def execute_pick_place(scene, r: PickPlace, scales=None, observe=None) -> PickPlaceRun:
+def execute_pick_place(scene, r: PickPlace, scales=None, observe=None, sensing=None) -> PickPlaceRun:
     """Executes the planned pick-regrasp-place ``r`` of ``scene`` in MuJoCo with its arm
     (:func:`~regrasp.execution.arm.build_robot`: the UR5e + 2F-85 with the scene's pads), in a
     world perturbed by ``scales`` (:class:`~regrasp.Perturbation`): the object on the
     table at the pick pose, the fingers open; the approach; the fingers close
     (:func:`~regrasp.execution.arm.close_on`); lift, regrasp, carry and lower under the grip
     force loop; the fingers open (:func:`~regrasp.robot.grip.open_gripper`); the retreat.
-    ``observe(robot)`` is called after every control period (e.g. a video recorder)."""
+    ``observe(robot)`` is called after every control period (e.g. a video recorder);
+    ``sensing``: what the grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: ideal)."""
     mujoco = need("mujoco", "robot")
     from ..robot.grip import body_pose, open_gripper
     from ..robot.tracking import track
@@ -553,7 +554,7 @@ def execute_pick_place(scene, r: PickPlace, scales=None, observe=None) -> PickPl
 
     track(rob, [0.0, OPEN_TIME], [q[0], q[0]], settle=0.0, ease=False, observe=obs)
     run(0, ph["approach"][1])
-    grip = close_on(rob, body, geoms, float(grip_force(scene)) * scales.grip)
+    grip = close_on(rob, body, geoms, float(grip_force(scene)) * scales.grip, sensing)
     tracking = run(ph["close"][1], ph["lower"][0] - 1, grip)
     held_pose = P.compose(P.compose(rob.tcp_pose(), P.inverse(tcp)), P.planar_to_spatial(r.place.in_hand))
     held = place_error(body_pose(d, body), held_pose)[0] < 0.02

@@ -46,12 +46,13 @@ class Creep:
 
 
 def hold_box(grip_force: float, size=(0.04, 0.04, 0.04), mass: float = 0.1, friction: float = PAD_FRICTION,
-             duration: float = 2.0, q=None, robot_name: Optional[str] = None, offset=(0.0, 0.0)) -> Creep:
+             duration: float = 2.0, q=None, robot_name: Optional[str] = None, offset=(0.0, 0.0), sensing=None) -> Creep:
     """Holds a box of full ``size`` [m] (x, y along the grasp axis, z), ``mass`` [kg] and
     Coulomb friction ``friction`` between the pads (whose friction is the same) at per-finger
     ``grip_force`` [N] with the arm at joint positions ``q`` [rad] (home by default) for
     ``duration`` [s] under gravity, and returns its :class:`Creep`. ``offset`` [m]: the box's
-    centre from the TCP along the TCP's (x, z) (a torque on the pads)."""
+    centre from the TCP along the TCP's (x, z) (a torque on the pads); ``sensing``: the grip
+    loop's (:class:`~regrasp.robot.sensing.GripSensing`; None: ideal)."""
     mujoco = need("mujoco", "robot")
     from .grip import GripController, pad_forces
     from .model import DEFAULT_ROBOT, build, is_number
@@ -85,7 +86,7 @@ def hold_box(grip_force: float, size=(0.04, 0.04, 0.04), mass: float = 0.1, fric
     jq = m.jnt_qposadr[m.body_jntadr[body]]
     hold = d.qpos[jq:jq + 7].copy()
     box = [m.geom(OBJECT).id]
-    grip = GripController(robot, grip_force, box)
+    grip = GripController(robot, grip_force, box, sensing=sensing)
     t0 = d.time
     while d.time - t0 < CLOSE_TIME[1]:
         if d.time - t0 >= CLOSE_TIME[0] and np.all(np.abs(pad_forces(robot, box) - grip_force) <= SETTLED * grip_force):

@@ -7,7 +7,8 @@ settings (timestep included), and :func:`set_grip_force` commands a per-finger g
 it (feed-forward). The feed-forward map alone gives ≈ +0.5 N under a held 0.1 kg box (2.53 N for
 2 N, 5.53 N for 5 N, 20.49 N for 20 N: the load moves the pads through the linkage), so
 :class:`GripController` closes a loop on the pads' normal force **as MuJoCo reports it** — an
-ideal tactile sensor that a real 2F-85 lacks (it has none; its current is a coarse proxy).
+ideal tactile sensor that a real 2F-85 lacks (it has none; its current is a coarse proxy);
+:mod:`.sensing` gives the loop a force sensor's readings (delay, bandwidth, noise) or none.
 :func:`pad_forces` measures the pads' normal forces on the held object only.
 """
 
@@ -258,13 +259,24 @@ class GripController:
     not open the hand). Why a loop: a load along the pads moves them through the linkage — under
     a 0.1 kg box the normal force sags ≈ 20 % as the load comes on and settles ≈ 0.5 N high
     without it; with τ = 0.1 s the box slipped up to 1.35 times the holding limit, with the
-    default (a 2 kHz loop, τ = 5 ms) up to ≈ 1.05 times. Call :meth:`update` before each
+    default (a 2 kHz loop, τ = 5 ms) up to ≈ 1.05 times. ``sensing``
+    (:class:`~regrasp.robot.sensing.GripSensing`): what the loop measures — the ideal contact
+    forces (default), a force sensor's delayed, filtered, noisy readings (τ at least
+    ``SETTLE_DELAYS`` delays; a pad touches when its reading exceeds 3 noise deviations), or
+    nothing (``"open-loop"``: the feed-forward alone). Call :meth:`update` before each
     ``mj_step``."""
 
-    def __init__(self, robot, grip_force: float, objects, tau: float = 0.005, period: float = 0.0005, data=None):
+    def __init__(self, robot, grip_force: float, objects, tau: float = 0.005, period: float = 0.0005, data=None,
+                 sensing=None):
+        from .sensing import SETTLE_DELAYS, GripSensing, SensedForces
+
         self.robot, self.data = robot, data if data is not None else robot.data
         self.objects = geom_ids(robot.model, objects)
         self.forces = ContactForces(robot.model, robot.pad_geoms, self.objects)
+        self.sensing = GripSensing() if sensing is None else sensing
+        if self.sensing.kind == "sensor":
+            tau = max(float(tau), SETTLE_DELAYS * self.sensing.delay)
+        self.sensed = SensedForces(self.sensing, period) if self.sensing.kind == "sensor" else None
         self.grip_force, self.tau, self.period = float(grip_force), float(tau), float(period)
         self.u = self.feedforward = grip_command(robot, grip_force)
         self.gain = robot_pad_state(robot)[0]
@@ -274,10 +286,13 @@ class GripController:
     def update(self) -> None:
         """Updates the grip actuator's command from the pads' forces now (at most every ``period``)."""
         d = self.data
-        if d.time + 1e-12 < self.next:
+        if d.time + 1e-12 < self.next or self.sensing.kind == "open-loop":
             return
         self.next = d.time + self.period
         f = self.forces(d).tolist()
+        if self.sensed is not None:
+            f = self.sensed.read(f)
+            f = f.tolist() if min(f) > 3 * self.sensing.noise else [0.0]
         if min(f) > 0:
             self.u += self.period / self.tau * (self.grip_force - sum(f) / len(f)) / self.gain
             bound = max(CORRECTION * self.grip_force, MIN_CORRECTION) / self.gain

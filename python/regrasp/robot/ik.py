@@ -217,9 +217,13 @@ def ik_solutions(robot, target_pose, avoid=(), seeds=(), tries: int = BRANCH_SEE
     random stream, so the same arm and target give the same answers)."""
     solver = IKSolver(robot, avoid, min_distance)
     lo, hi = robot.joint_limits().T
+    unlimited = ~(hi > lo)  # MuJoCo's range of a joint without limits is [0, 0]
+    lo, hi = np.where(unlimited, -np.pi, lo), np.where(unlimited, np.pi, hi)
+    a, b = np.maximum(lo, -np.pi), np.minimum(hi, np.pi)
+    a, b = np.where(a < b, a, lo), np.where(a < b, b, hi)  # a range beyond ±π: all of it
     rng = np.random.default_rng(0)
     starts = [np.asarray(q, float) for q in seeds]
-    starts += [rng.uniform(np.maximum(lo, -np.pi), np.minimum(hi, np.pi)) for _ in range(tries)]
+    starts += [rng.uniform(a, b) for _ in range(tries)]
     found: list = []
     for q0 in starts:
         try:
