@@ -33,11 +33,11 @@ def scene_at(hold: float):
     return s0.scaled(mass=hold / s0.hold_ratio(s0.task.start))
 
 
-def lift(scene, n: int = 61, duration: float = 0.6):
+def lift(scene, n: int = 61, duration: float = 0.6, in_hand=None):
     """The arm, the object's load and a WorldMotion of a fast vertical lift holding ``scene``'s
-    object at its start in-hand pose: (robot, load, motion, tcp, joint path)."""
+    object at ``in_hand`` (default: its start) in-hand pose: (robot, load, motion, tcp, joint path)."""
     wc = default_workcell(scene)
-    start = np.asarray(scene.task.start, float)
+    start = np.asarray(scene.task.start if in_hand is None else in_hand, float)
     in_hand = np.array(P.planar_to_spatial(start))
     G = np.array([np.r_[LIFT_FROM + [0, 0, LIFT * pp.eased(s)], 1.0, 0, 0, 0] for s in np.linspace(0, 1, n)])
     W = P.compose_rows(G, np.broadcast_to(in_hand, G.shape))
@@ -60,35 +60,45 @@ def fk_object(r, load, q, i):
 
 
 def test_the_load_is_gravity_and_inertia_by_finite_differences():
-    """A smooth joint motion q(t) = q0 + A sin(w t): the wrench from the Jacobians (a = J q̈ + J̇ q̇,
-    α = J_r q̈ + J̇_r q̇) against the object's centre of mass and rotation differentiated
-    numerically (central differences, h = 1e-4 s) through forward kinematics."""
-    s = scene_at(0.5)
-    r, load, _, _, q = lift(s, n=5)
+    """A smooth joint motion q(t) = q0 + A sin(w t) holding the T (its centre of mass 12.9 mm off
+    its origin) 10 mm, 5 mm and 0.3 rad off the pad: the wrench from the Jacobians against
+    Newton–Euler done numerically and in 3-D — the pads' force m(a − g) and their moment about the
+    object's origin dL/dt + (c − o) × F, with the centre of mass, the rotation and the angular
+    momentum I_w ω differentiated by central differences (h = 1e-4 s) through forward
+    kinematics — turned into the object frame, the moment's planar part about −y."""
+    s = regrasp.load_scene(regrasp.examples.path("t-shape"))
+    r, load, _, _, q = lift(s, n=5, in_hand=[0.01, 0.005, 0.3])
     q0, amp, w = q[2], np.array([0.3, -0.2, 0.25, 0.4, -0.3, 0.5]), np.array([2.0, 3.0, 2.5, 4.0, 3.5, 5.0])
     h = 1e-4
+    qt = lambda t: q0 + amp * np.sin(w * t)  # noqa: E731
+
+    def state(t):
+        """(origin, centre of mass, rotation) of the object at time t."""
+        W = fk_object(r, load, qt(t), 0)
+        R = P.quat_matrix(W[3:])
+        return W[:3], W[:3] + R @ load.com, R
+
+    def momentum(t):
+        """The angular momentum I_w ω about the centre of mass, ω from Ṙ Rᵀ."""
+        (_, _, Ra), (_, _, R), (_, _, Rb) = state(t - h), state(t), state(t + h)
+        S = (Rb - Ra) / (2 * h) @ R.T
+        om = np.array([S[2, 1], S[0, 2], S[1, 0]])
+        return R @ load.inertia @ R.T @ om, om
+
     for t in (0.1, 0.4, 0.9):
-        qt = lambda t: q0 + amp * np.sin(w * t)  # noqa: E731
         qd, qdd = amp * w * np.cos(w * t), -amp * w ** 2 * np.sin(w * t)
         got = load.wrenches([0], qt(t)[None], qd[None], qdd[None])[0]
-        poses = [fk_object(r, load, qt(t + k * h), 0) for k in (-1, 0, 1)]
-        Rs = [P.quat_matrix(p[3:]) for p in poses]
-        com = [p[:3] + R @ load.com for p, R in zip(poses, Rs)]
-        a = (com[2] - 2 * com[1] + com[0]) / h ** 2
-        # ω from Ṙ Rᵀ, α from ω's central difference over neighbouring steps
-        def omega(t_):
-            Ra, Rb = (P.quat_matrix(fk_object(r, load, qt(t_ + k * h), 0)[3:]) for k in (-1, 1))
-            S = (Rb - Ra) / (2 * h) @ P.quat_matrix(fk_object(r, load, qt(t_), 0)[3:]).T
-            return np.array([S[2, 1], S[0, 2], S[1, 0]])
-        om, alpha = omega(t), (omega(t + h) - omega(t - h)) / (2 * h)
-        R = Rs[1]
-        f = R.T @ (load.mass * (load.gravity - a))
-        Iw = R @ load.inertia @ R.T
-        T = R.T @ (Iw @ alpha + np.cross(om, Iw @ om))
-        want = np.array([f[0], f[2], load.com[0] * f[2] - load.com[2] * f[0] + T[1]])
+        (_, ca, _), (o, c, R), (_, cb, _) = state(t - h), state(t), state(t + h)
+        a = (cb - 2 * c + ca) / h ** 2
+        F = load.mass * (a - load.gravity)  # what the pads supply, world
+        dL = (momentum(t + h)[0] - momentum(t - h)[0]) / (2 * h)
+        M = dL + np.cross(c - o, F)  # the pads' moment about the object's origin, world
+        fo, Mo = R.T @ F, R.T @ M
+        want = -np.array([fo[0], fo[2], -Mo[1]])  # the load is what the pads resist; planar θ is about −y
         assert np.allclose(got, want, rtol=2e-3, atol=2e-3 * load.mass * 9.81), (got, want)
-        # the motion's inertia is a sizeable part of the load tested, turning too
-        assert np.linalg.norm(a) > 0.5 and np.linalg.norm(alpha) > 1.0
+        # the motion's inertia and turning are a sizeable part of the load tested
+        assert np.linalg.norm(a) > 0.5 and np.linalg.norm(momentum(t)[1]) > 0.5
+        assert abs(load.com[2]) > 0.01 and abs(got[2]) > 1e-3
 
 
 def test_at_rest_in_the_planned_orientation_the_ratio_is_the_cones_hold_ratio():

@@ -343,6 +343,16 @@ def _other_branch(robot, targets, avoid, gaps, home_q, err):
 
     if err.reason not in ("collision", "joint limit", "jump"):
         return None
+    if home_q is not None and err.reason == "joint limit":  # the same arm shape, a joint wound 2π the other way
+        lo, hi = robot.joint_limits().T
+        for j in range(len(home_q)):
+            q0 = home_q.copy()
+            q0[j] -= 2 * np.pi * np.sign(q0[j])
+            if hi[j] > lo[j] and lo[j] <= q0[j] <= hi[j] and q0[j] != home_q[j]:
+                try:
+                    return ik_path(robot, targets, q0, avoid=avoid, min_distance=gaps)
+                except IKError:
+                    pass
     tried = 0
     for q0 in ik_solutions(robot, targets[0], avoid, min_distance=gaps[0]):
         if home_q is not None and branch_distance(q0, home_q) <= MAX_JUMP:

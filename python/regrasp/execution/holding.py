@@ -1,9 +1,12 @@
 """Whether the pads hold the object through an arm's motion: at every sample where only the pads
 hold it (the start, transfers, approaches, retreats with the fingers closed: not while a feature
-pushes it, nor on the table before a pick or after a place), the wrench
+pushes it, nor on the table before the fingers close or after they open), the wrench
 the pads must supply — gravity, the held object's inertia ``m a`` and its rotational terms
 ``I α + ω × I ω`` as the arm moves — tested against the pads' limit surface at the grip force
-(:meth:`regrasp.Scene.load_ratio`, the test of the motion cones' hold check).
+(:meth:`regrasp.Scene.load_ratio`, the test of the motion cones' hold check). The planar limit
+surface takes the load in the pads' plane (two forces, the torque about the grasp axis); the
+force along the grasp axis and the torques about the plane's axes, which the pads' normal
+forces and pressure carry, are not tested.
 
 The object's motion comes from the arm's joints ``q``, velocities ``qd`` and accelerations
 ``qdd`` through MuJoCo's Jacobians of its centre of mass, rigidly held in the gripper at the
@@ -131,7 +134,10 @@ class ObjectLoad:
         if keep.any():
             k = np.flatnonzero(keep)
             w = self.wrenches(idx[k], q[k], qd[k], qdd[k])
-            out[k] = self.scene.load_ratio(self.planar[idx[k]], w)
+            ok = np.all(np.isfinite(w), axis=1)  # a non-finite state cannot be held: inf, not NaN
+            out[k[~ok]] = np.inf
+            if ok.any():
+                out[k[ok]] = self.scene.load_ratio(self.planar[idx[k[ok]]], w[ok])
         return out
 
     def holding(self, q, qd, qdd, where=None) -> Holding:

@@ -364,7 +364,14 @@ def reachable(robot, avoid, tcp, G) -> np.ndarray | None:
     and the pose :data:`LIFT` above are reachable on one branch; else None."""
     from ..robot.ik import IKError, ik_solutions, solve_ik
 
-    for q in ik_solutions(robot, P.compose(G, tcp), avoid, seeds=[robot.kind.home]):
+    try:
+        q = solve_ik(robot, P.compose(G, tcp), robot.kind.home, avoid=avoid)
+        solve_ik(robot, P.compose(lifted(G), tcp), q, avoid=avoid)
+        return q
+    except IKError as e:
+        if e.reason == "unreachable":  # beyond the arm's reach: on every branch
+            return None
+    for q in ik_solutions(robot, P.compose(G, tcp), avoid):
         try:
             solve_ik(robot, P.compose(lifted(G), tcp), q, avoid=avoid)
             return q

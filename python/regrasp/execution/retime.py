@@ -150,11 +150,13 @@ def _piece(t: np.ndarray, q: np.ndarray, vmax: np.ndarray, amax: np.ndarray, hol
                                      f"{MAX_SOLVES} time parametrisations", "robot")
             scale *= 0.995 / ratio
             continue
-        out = _at_waypoints(spline, s, grid, sd, times)
-        excess = None if hold is None else np.asarray(hold(out[1], out[2]), float)
+        out, before = _at_waypoints(spline, s, grid, sd, times)
+        # the hold at each waypoint with the acceleration of the half-interval after it and before it
+        excess = None if hold is None else np.fmax(np.asarray(hold(out[1], out[2]), float),
+                                                   np.asarray(hold(out[1], before), float))
         if excess is None or not np.nanmax(excess, initial=0.0) > 1.0:
             return out
-        holds += 1
+        holds, solves = holds + 1, 0
         if holds > MAX_HOLD_SOLVES:
             i = int(np.nanargmax(excess))
             raise HoldError(f"the pads cannot hold the object at waypoint {first + i} even with the arm's joint "
@@ -164,12 +166,15 @@ def _piece(t: np.ndarray, q: np.ndarray, vmax: np.ndarray, amax: np.ndarray, hol
 
 
 def _at_waypoints(spline, s, grid, sd, times):
-    """(times, qd, qdd) at the waypoints ``s`` among the grid points of a solved profile ``sd``."""
+    """((times, qd, qdd) at the waypoints ``s`` among the grid points of a solved profile ``sd``,
+    qdd with the half-interval before each instead of after): s̈ is constant per grid interval,
+    so a waypoint's acceleration jumps there (TOPP-RA's switches)."""
     at = np.searchsorted(grid, s)
     u = np.diff(sd ** 2) / (2 * np.diff(grid))  # s̈ per grid interval (constant)
-    u_at = np.append(u, u[-1])[at]
+    u_at, u_before = np.append(u, u[-1])[at], np.insert(u, 0, u[0])[at]
     qs, qss = spline(s, 1), spline(s, 2)
-    return times[at], qs * sd[at, None], qss * sd[at, None] ** 2 + qs * u_at[:, None]
+    qd, base = qs * sd[at, None], qss * sd[at, None] ** 2
+    return (times[at], qd, base + qs * u_at[:, None]), base + qs * u_before[:, None]
 
 
 def _solve(spline, s, grid, cap, vmax, amax) -> np.ndarray:

@@ -173,11 +173,13 @@ class IKSolver:
         q = self.config.q[robot.arm_qpos].copy()
         reached = pose_error(self.tcp_pose(), target)
         rng = robot.joint_limits()
-        inside = np.all((q >= rng[:, 0] - 1e-9) & (q <= rng[:, 1] + 1e-9))
+        free = ~(rng[:, 1] > rng[:, 0])  # a joint without limits (MuJoCo's range [0, 0])
+        inside = np.all(free | ((q >= rng[:, 0] - 1e-9) & (q <= rng[:, 1] + 1e-9)))
         gap, part, obstacle = closest(robot, q, self.avoid)
         if reached[0] <= POSITION_TOLERANCE and reached[1] <= ANGLE_TOLERANCE and inside and gap >= self.min_distance:
             return q
-        at_limit = [robot.arm_joints[i] for i in range(len(q)) if min(q[i] - rng[i, 0], rng[i, 1] - q[i]) < LIMIT_MARGIN]
+        at_limit = [robot.arm_joints[i] for i in range(len(q))
+                    if not free[i] and min(q[i] - rng[i, 0], rng[i, 1] - q[i]) < LIMIT_MARGIN]
         beyond = robot.reach(target)
         if beyond > 0:
             reason, why = "unreachable", f"{beyond * 1e3:.0f} mm beyond the arm's reach"
