@@ -338,11 +338,14 @@ def object_load(scene, robot, body: int, tcp, motion: WorldMotion):
 def _other_branch(robot, targets, avoid, gaps, home_q, err):
     """The joint path [rad] through ``targets`` from another branch of the arm at the first pose
     (:data:`MAX_BRANCHES` at most), after the home branch's path (from ``home_q``; None: the home
-    found none) failed with ``err``; None when none passes or ``err`` is not the branch's (the pose out of reach)."""
+    found none) failed with ``err``; None when none passes or ``err`` is not the branch's (the
+    pose out of reach, the gripper's own body against an obstacle: its pose is the TCP's)."""
     from ..robot.ik import MAX_JUMP, IKError, branch_distance, ik_path, ik_solutions
 
-    if err.reason not in ("collision", "joint limit", "jump"):
-        return None
+    from ..robot.kinds import GRIPPER_PREFIX
+
+    if err.reason not in ("collision", "joint limit", "jump") or err.part.startswith(GRIPPER_PREFIX):
+        return None  # out of reach, or the gripper itself against an obstacle: the same on every branch
     if home_q is not None and err.reason == "joint limit":  # the same arm shape, a joint wound 2π the other way
         lo, hi = robot.joint_limits().T
         for j in range(len(home_q)):

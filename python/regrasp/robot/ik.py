@@ -35,11 +35,12 @@ BRANCH_SEEDS = 24  # random starts :func:`ik_solutions` tries (uniform within th
 
 class IKError(ArgumentError):
     """No arm configuration reaches a TCP pose: ``field`` names it (``pose``, or ``poses[i]``
-    in a path), ``reason`` says why: ``"unreachable"``, ``"joint limit"`` or ``"collision"``."""
+    in a path), ``reason`` says why: ``"unreachable"``, ``"joint limit"`` or ``"collision"``;
+    ``part``: for a collision, the robot's body nearest the obstacle (``arm/…`` or ``gripper/…``)."""
 
-    def __init__(self, message: str, field: str, reason: str):
+    def __init__(self, message: str, field: str, reason: str, part: str = ""):
         super().__init__(message, field)
-        self.reason = reason
+        self.reason, self.part = reason, part
 
 
 def pose_error(a, b) -> tuple:
@@ -191,7 +192,8 @@ class IKSolver:
         else:
             reason, why = "unreachable", "no arm configuration found"
         raise IKError(f"invalid `{field}`: the TCP cannot reach {np.round(target, 4).tolist()} ({reason}: {why}; "
-                      f"closest {reached[0] * 1e3:.1f} mm, {reached[1]:.3f} rad away)", field, reason)
+                      f"closest {reached[0] * 1e3:.1f} mm, {reached[1]:.3f} rad away)", field, reason,
+                      part if reason == "collision" else "")
 
 
 def solve_ik(robot, target_pose, q_init=None, field: str = "pose", avoid=()) -> np.ndarray:
