@@ -147,3 +147,24 @@ def test_a_load_gravity_alone_takes_beyond_the_margin_is_refused_naming_where():
     msg = str(e.value)
     assert "the pads cannot hold the object in the final transfer" in msg and "gravity alone takes 97.0%" in msg
     assert e.value.field == "robot"
+
+
+def test_the_grip_is_raised_between_pushes_and_the_push_keeps_the_plans():
+    """Gravity takes 0.8 of the pads' friction: held samples (start, transfer, retreat, the approach
+    but its last SETTLE_SAMPLES) get the grip that makes it TRANSFER_SHARE, at rest; the push and
+    the approach's tail keep the plan's grip; a cap bounds it."""
+    from regrasp.execution.holding import HELD, SETTLE_SAMPLES, TRANSFER_SHARE
+
+    s = scene_at(0.8)
+    r, load, motion, _, q = lift(s, n=61)
+    labels = ["start"] + ["transfer"] * 19 + ["approach"] * 20 + ["push"] * 5 + ["retreat"] * 16
+    load.labels, load.held = labels, np.array([lab in HELD for lab in labels])
+    scale = load.boost(q, max_scale=10.0)
+    z = np.zeros_like(q)
+    ratio = load.ratios(np.arange(len(q)), q, z, z)
+    tail = np.arange(40 - SETTLE_SAMPLES, 40)
+    raised = np.array([i for i in range(len(q)) if labels[i] != "push" and i not in tail])
+    assert np.allclose(scale[raised], 0.8 / TRANSFER_SHARE, rtol=1e-3)
+    assert np.all(scale[tail] == 1.0) and np.all(scale[40:45] == 1.0)
+    assert np.allclose(ratio[raised], TRANSFER_SHARE, rtol=1e-3) and np.allclose(ratio[tail], 0.8, rtol=1e-3)
+    assert np.all(load.boost(q, max_scale=1.2) <= 1.2)

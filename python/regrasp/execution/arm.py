@@ -264,13 +264,15 @@ def check_hand(robot, motion: WorldMotion, tcp) -> None:
                          f"the pads)", field_)
 
 
-def solve_arm(robot, motion: WorldMotion, tcp, load=None) -> ArmTrajectory:
+def solve_arm(robot, motion: WorldMotion, tcp, load=None, boost: bool = False) -> ArmTrajectory:
     """The arm's :class:`ArmTrajectory` putting the TCP at ``motion.gripper ∘ tcp`` at every
     sample, clear of the table and the workcell's features (by :data:`CONTACT_CLEARANCE` in
     contact, else the IK's ``MIN_DISTANCE``); from the solution for the first pose
     found from the arm's home, else from another branch (see the module's doc); timed so that
     the pads hold the object's ``load`` (an :class:`~regrasp.execution.holding.ObjectLoad`,
-    :func:`timed`). Raises ExecutionError naming the push (see the module's doc), or
+    :func:`timed`; with ``boost``, the grip raised between pushes where gravity takes more than
+    :data:`~regrasp.execution.holding.TRANSFER_SHARE` of the pads' friction, written into
+    ``motion.grip_force``). Raises ExecutionError naming the push (see the module's doc), or
     when the plan puts the object into the gripper's body (:func:`check_hand`)."""
     from ..robot.ik import MIN_DISTANCE, IKError, fixed_geoms, ik_path
 
@@ -286,7 +288,26 @@ def solve_arm(robot, motion: WorldMotion, tcp, load=None) -> ArmTrajectory:
         q = _other_branch(robot, targets, avoid, gaps, q0, e)
         if q is None:
             raise _arm_error(motion, e) from None
+    if load is not None and boost:
+        _boost(robot, motion, load, q)
     return timed(robot, motion, tcp, q, load)
+
+
+def _boost(robot, motion: WorldMotion, load, q) -> None:
+    """The grip raised between pushes (:meth:`~regrasp.execution.holding.ObjectLoad.boost`),
+    within :data:`~regrasp.execution.holding.MAX_GRIP_SHARE` of the gripper's force range:
+    ``motion.grip_force`` per sample."""
+    from ..robot.grip import robot_pad_state
+    from ..robot.kinds import GRIP_RANGE
+    from .holding import MAX_GRIP_SHARE
+
+    gain, bias, _ = robot_pad_state(robot)
+    f = np.asarray(motion.grip_force, float)
+    base = float(np.max(f)) if np.any(f > 0) else 0.0
+    if base <= 0:
+        return
+    scale = load.boost(q, MAX_GRIP_SHARE * (GRIP_RANGE * gain + bias) / base)
+    motion.grip_force = np.where(f > 0, f * scale, f)
 
 
 def timed(robot, motion: WorldMotion, tcp, q, load=None) -> ArmTrajectory:
@@ -415,7 +436,7 @@ def arm_motion(scene, plan, workcell=None, robot: str | None = None, scales: Per
         r, body, geoms, tcp = build_robot(scene, motion, robot, scales)
         try:
             load = object_load(scene, r, body, tcp, motion)
-            return ArmMotion(motion, r, body, geoms, tcp, solve_arm(r, motion, tcp, load), refused)
+            return ArmMotion(motion, r, body, geoms, tcp, solve_arm(r, motion, tcp, load, boost=True), refused)
         except ExecutionError as e:
             k = getattr(e, "push", -1)
             if k < 0:
@@ -476,7 +497,8 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
     r, body, geoms, tcp = build_robot(scene, motion, robot if trajectory is None else trajectory.robot, scales, pads)
     if trajectory is not None:
         check_hand(r, motion, tcp)  # solve_arm checks it otherwise
-    traj = solve_arm(r, motion, tcp, object_load(scene, r, body, tcp, motion)) if trajectory is None else trajectory
+    traj = solve_arm(r, motion, tcp, object_load(scene, r, body, tcp, motion), boost=True) if trajectory is None \
+        else trajectory
     m, d = r.model, r.data
     r.set_q(traj.q[0])
     jq = m.jnt_qposadr[m.body_jntadr[body]]
@@ -494,6 +516,8 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
             samples.append(in_hand())
             qs.append(r.q)
             k[0] += 1
+            if k[0] < len(traj.times) and motion.grip_force[k[0]] != motion.grip_force[k[0] - 1]:
+                grip.set_force(float(motion.grip_force[k[0]]) * scales.grip)  # raised between pushes
         if observe is not None:
             observe(r)
 

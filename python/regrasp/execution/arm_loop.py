@@ -35,7 +35,7 @@ from ..scene.perturbation import Perturbation
 from ..scene.settings import mpc_defaults
 from .arm import CONTACT_CLEARANCE, arm_motion, build_robot, close_on, first_solution
 from .assignment import assign, pusher_contact
-from .world_motion import Segments, Timing
+from .world_motion import Segments, Timing, grip_force
 
 
 @dataclass
@@ -95,7 +95,8 @@ class ArmPlant:
         self._jq, self._jv = jq, m.jnt_dofadr[m.body_jntadr[body]]
         r.data.qpos[jq:jq + 7] = P.compose(r.tcp_pose(), self.untcp, O)  # at the arm's actual TCP
         mujoco.mj_forward(m, r.data)
-        self.grip = close_on(r, body, geoms, float(self.motion.grip_force[0]) * scales.grip, sensing)
+        # the plan's grip (the open loop's motion raises it between pushes; this loop does not)
+        self.grip = close_on(r, body, geoms, float(grip_force(scene)) * scales.grip, sensing)
         self.solver = IKSolver(r, avoid)
         self.contact_solver = IKSolver(r, avoid, CONTACT_CLEARANCE)  # fingers near the feature in contact
         self.q = r.q.copy()  # the arm's commanded joints

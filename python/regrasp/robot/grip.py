@@ -283,6 +283,14 @@ class GripController:
         self.next = self.data.time
         self.data.ctrl[robot.grip_actuator] = self.u
 
+    def set_force(self, grip_force: float) -> None:
+        """A new per-finger grip force [N] to hold: the feed-forward moves to it, the loop's
+        correction stays."""
+        feedforward = grip_command(self.robot, grip_force)
+        self.u += feedforward - self.feedforward
+        self.grip_force, self.feedforward = float(grip_force), feedforward
+        self.data.ctrl[self.robot.grip_actuator] = self.u
+
     def update(self) -> None:
         """Updates the grip actuator's command from the pads' forces now (at most every ``period``)."""
         d = self.data
