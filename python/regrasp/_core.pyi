@@ -112,6 +112,9 @@ class Scene:
     def hold_ratio(self, pose: ArrayLike) -> float:
         """Share of the support's friction that gravity alone uses at `pose` `[x, z, theta]` (m, m, rad)
         (< 1 holds)."""
+    def load_ratios(self, poses: ArrayLike, wrenches: ArrayLike) -> _Floats:
+        """The share of the support's friction each object-frame wrench row of `wrenches` (n, 3) (N, N,
+        N·m about the object's origin) uses at the pose row of `poses` (n, 3) (m, m, rad): (n,)."""
     def with_grip_force(self, force: float) -> Scene:
         """The same scene with grip force `force` [N] per finger (grasp scenes)."""
     def with_limit_surface(self, model: str) -> Scene:

@@ -69,10 +69,12 @@ class Holding:
 
     @property
     def at(self) -> int:
+        """The sample of the least margin (0 when no sample is held)."""
         return int(np.nanargmax(self.ratio)) if np.any(np.isfinite(self.ratio)) else 0
 
     @property
     def smallest(self) -> float:
+        """The least margin ``1 − ratio`` over the held samples (1 when none is held)."""
         return float(1.0 - self.ratio[self.at]) if np.any(np.isfinite(self.ratio)) else 1.0
 
     @property
