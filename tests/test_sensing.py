@@ -42,7 +42,8 @@ def test_bad_sensing_is_refused_naming_the_option(text, field):
 
 
 @pytest.mark.parametrize("kw, field", [({"kind": "x"}, "grip_sensing.kind"), ({"noise": float("nan")}, "grip_sensing.noise"),
-                                       ({"delay": -1.0}, "grip_sensing.delay"), ({"bandwidth": 0.0}, "grip_sensing.bandwidth")])
+                                       ({"delay": -1.0}, "grip_sensing.delay"), ({"bandwidth": 0.0}, "grip_sensing.bandwidth"),
+                                       ({"seed": -1}, "grip_sensing.seed"), ({"seed": 1.5}, "grip_sensing.seed")])
 def test_bad_settings_are_refused_naming_the_field(kw, field):
     with pytest.raises(ArgumentError) as e:
         GripSensing(**kw)
@@ -67,3 +68,30 @@ def test_a_held_box_under_each_sensing():
     assert abs(got["ideal"] - 5.0) < 0.05
     assert 0.3 < got["open-loop"] - 5.0 < 0.8
     assert abs(got["sensor"] - 5.0) < 0.15
+
+
+@pytest.mark.parametrize("kind", ["ideal", "open-loop"])
+def test_a_new_grip_force_is_held(kind):
+    """``GripController.set_force`` (the grip raised between pushes): a held box's pads go from
+    5 N to 10 N and back within 0.3 s each, measured by the pads' own contacts (the open loop: to
+    the feed-forward's, its bias under the load as at 5 N)."""
+    mujoco = pytest.importorskip("mujoco")
+    pytest.importorskip("mink")
+    from regrasp.robot.creep import OBJECT, hold_box
+    from regrasp.robot.grip import GripController, pad_forces
+
+    c = hold_box(5.0, duration=0.2, sensing=GripSensing(kind))
+    r = c.robot
+    box = [r.model.geom(OBJECT).id]
+    grip = GripController(r, 5.0, box, sensing=GripSensing(kind))
+    bias = 0.0 if kind == "ideal" else np.mean(c.grip_forces) - 5.0
+
+    def run(seconds):
+        for _ in range(int(seconds / r.model.opt.timestep)):
+            grip.update()
+            mujoco.mj_step(r.model, r.data)
+        return np.mean(pad_forces(r, box))
+
+    for target in (10.0, 5.0):
+        grip.set_force(target)
+        assert abs(run(0.3) - target - bias) < 0.15, (kind, target)

@@ -322,8 +322,7 @@ def timed(robot, motion: WorldMotion, tcp, q, load=None) -> ArmTrajectory:
     hold = None
     if load is not None:
         allowed = 1.0 - required_margin(load.scene)
-        z = np.zeros_like(q)
-        still = load.ratios(np.arange(len(q)), q, z, z)
+        still = load.at_rest(q)
         if np.nanmax(still, initial=0.0) > allowed:
             i = int(np.nanargmax(still))
             raise _hold_error(motion, i, f"gravity alone takes {still[i]:.1%} of the pads' friction there, where at "
@@ -344,8 +343,13 @@ def _hold_error(motion: WorldMotion, i: int, why: str) -> ExecutionError:
     """The ExecutionError of the pads unable to hold the object at sample ``i``: where, why, and
     the push it serves or leads to (``push``: another contact may need less tilt)."""
     err = ExecutionError(f"the pads cannot hold the object in {where(motion, i)}: {why}", "robot")
-    err.push = next((int(p) for p in motion.push[i:] if p >= 0), int(motion.push.max()))
+    err.push = _push_of(motion, i)
     return err
+
+
+def _push_of(motion: WorldMotion, i: int) -> int:
+    """The push sample ``i`` serves or leads to (the final transfer: the last push's)."""
+    return next((int(p) for p in motion.push[i:] if p >= 0), int(motion.push.max()))
 
 
 def object_load(scene, robot, body: int, tcp, motion: WorldMotion):
@@ -362,7 +366,6 @@ def _other_branch(robot, targets, avoid, gaps, home_q, err):
     found none) failed with ``err``; None when none passes or ``err`` is not the branch's (the
     pose out of reach, the gripper's own body against an obstacle: its pose is the TCP's)."""
     from ..robot.ik import MAX_JUMP, IKError, branch_distance, ik_path, ik_solutions
-
     from ..robot.kinds import GRIPPER_PREFIX
 
     if err.reason not in ("collision", "joint limit", "jump") or err.part.startswith(GRIPPER_PREFIX):
@@ -396,7 +399,7 @@ def _arm_error(motion: WorldMotion, e) -> ExecutionError:
     i = int(e.field.split("[")[1].rstrip("]")) if "[" in (e.field or "") else 0
     why = str(e).split(": ", 1)[1] if ": " in str(e) else str(e)
     err = ExecutionError(f"the arm cannot execute {where(motion, i)}: {why}", "robot")
-    err.push = next((int(p) for p in motion.push[i:] if p >= 0), int(motion.push.max()))
+    err.push = _push_of(motion, i)
     return err
 
 

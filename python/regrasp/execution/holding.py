@@ -107,14 +107,19 @@ class ObjectLoad:
         self.held = np.array([lab in HELD for lab in motion.labels]) & (np.asarray(motion.grip_force, float) > 0)
         self.labels = list(motion.labels)
         self.grip_scale = np.ones(len(self.labels))  # the grip per sample over the motion's (boost)
+        self._rest = (None, None)  # (joint path, its ratios at rest at the motion's grip)
 
     def wrenches(self, idx, q, qd, qdd) -> np.ndarray:
         """The object-frame wrench ``[fx, fz, τ]`` (N, N, N·m about the object's origin, gravity's
-        convention) the pads must resist at samples ``idx`` with the arm at ``q``, ``qd``, ``qdd``
-        (len(idx), dof): gravity and the inertial load, (len(idx), 3)."""
+        convention) the pads must resist at samples ``idx`` with the arm at ``q``, ``qd`` (len(idx),
+        dof) and accelerations ``qdd`` (len(idx), dof), or several of them (k, len(idx), dof: the
+        kinematics computed once): gravity and the inertial load, (len(idx), 3) or (k, len(idx), 3)."""
         mj, m, d, r = self.mj, self.robot.model, self.data, self.robot
         dof = r.arm_dof
-        out = np.zeros((len(idx), 3))
+        qdd = np.asarray(qdd, float)
+        many = qdd.ndim == 3
+        qdd = qdd if many else qdd[None]
+        out = np.zeros((len(qdd), len(idx), 3))
         jp, jr, dp, dr = (np.zeros((3, m.nv)) for _ in range(4))
         for k, i in enumerate(idx):
             d.qpos[:] = r.data.qpos
@@ -130,30 +135,45 @@ class ObjectLoad:
             c = W[:3] + R @ self.com
             mj.mj_jac(m, d, jp, jr, c, self.site_body)
             mj.mj_jacDot(m, d, dp, dr, c, self.site_body)
-            a = jp[:, dof] @ qdd[k] + dp[:, dof] @ qd[k]
             w = jr[:, dof] @ qd[k]
-            alpha = jr[:, dof] @ qdd[k] + dr[:, dof] @ qd[k]
-            f = R.T @ (self.mass * (self.gravity - a))  # gravity and −m a, object frame
             Iw = R @ self.inertia @ R.T
-            T = R.T @ (Iw @ alpha + np.cross(w, Iw @ w))  # the torque the pads supply about the com
-            # planar torque is about −y: the com's moment of f, and −T's component along −y
-            out[k] = [f[0], f[2], self.com[0] * f[2] - self.com[2] * f[0] + T[1]]
-        return out
+            for v, acc in enumerate(qdd[:, k]):
+                a = jp[:, dof] @ acc + dp[:, dof] @ qd[k]
+                alpha = jr[:, dof] @ acc + dr[:, dof] @ qd[k]
+                f = R.T @ (self.mass * (self.gravity - a))  # gravity and −m a, object frame
+                T = R.T @ (Iw @ alpha + np.cross(w, Iw @ w))  # the torque the pads supply about the com
+                # planar torque is about −y: the com's moment of f, and −T's component along −y
+                out[v, k] = [f[0], f[2], self.com[0] * f[2] - self.com[2] * f[0] + T[1]]
+        return out if many else out[0]
 
     def ratios(self, idx, q, qd, qdd) -> np.ndarray:
-        """The share of the pads' friction used at samples ``idx`` (NaN where a feature pushes)."""
+        """The share of the pads' friction used at samples ``idx`` (NaN where a feature pushes) at
+        the motion's grip; with several accelerations ``qdd`` (k, len(idx), dof), the most."""
         idx = np.asarray(idx, int)
+        qdd = np.asarray(qdd, float)
         out = np.full(len(idx), np.nan)
         keep = self.held[idx]
         if keep.any():
             k = np.flatnonzero(keep)
-            w = self.wrenches(idx[k], q[k], qd[k], qdd[k])
-            ok = np.all(np.isfinite(w), axis=1)  # a non-finite state cannot be held: inf, not NaN
+            w = self.wrenches(idx[k], q[k], qd[k], qdd[..., k, :])
+            w = w if w.ndim == 3 else w[None]
+            ok = np.all(np.isfinite(w), axis=(0, 2))  # a non-finite state cannot be held: inf, not NaN
             out[k[~ok]] = np.inf
             if ok.any():
                 j = idx[k[ok]]
-                out[k[ok]] = self.scene.load_ratio(self.planar[j], w[ok]) / self.grip_scale[j]
+                r = [self.scene.load_ratio(self.planar[j], x[ok]) for x in w]
+                out[k[ok]] = np.max(r, axis=0) / self.grip_scale[j]
         return out
+
+    def at_rest(self, q) -> np.ndarray:
+        """:meth:`ratios` of every sample with the arm at rest at joint path ``q`` (n, dof): gravity
+        alone (computed once per path)."""
+        if self._rest[0] is not q:
+            z = np.zeros_like(q)
+            scale, self.grip_scale = self.grip_scale, np.ones(len(self.labels))
+            self._rest = (q, self.ratios(np.arange(len(q)), q, z, z))
+            self.grip_scale = scale
+        return self._rest[1] / self.grip_scale
 
     def boost(self, q, max_scale: float) -> np.ndarray:
         """Raises the grip between pushes (each run of held samples — retreat, transfers, approach —
@@ -162,8 +182,7 @@ class ObjectLoad:
         ``max_scale`` times the plan's: sets and returns :attr:`grip_scale` (n,) from the arm at
         rest at ``q`` (n, dof)."""
         self.grip_scale = np.ones(len(self.labels))
-        z = np.zeros_like(q)
-        still = self.ratios(np.arange(len(q)), q, z, z)
+        still = self.at_rest(q)
         free = self.held.copy()
         for i, lab in enumerate(self.labels):  # an approach's tail: the next SETTLE_SAMPLES are not all approach
             if lab == "approach" and "approach" not in self.labels[i + SETTLE_SAMPLES:i + SETTLE_SAMPLES + 1]:

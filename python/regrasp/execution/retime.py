@@ -75,8 +75,9 @@ def retime(times, q, velocity_limit, acceleration_limit, hold=None) -> Retimed:
     """The :class:`Retimed` trajectory through waypoints ``q`` (n, dof) [rad], planned at
     ``times`` (n,) [s] (the speed cap), within ``velocity_limit`` (dof,) [rad/s] and
     ``acceleration_limit`` (dof,) [rad/s²] (see the module's doc); ``hold(idx, q, qd, qdd)``:
-    the load over the allowed share at waypoints ``idx`` (NaN: not held), slowing a piece until it
-    is ≤ 1. ArgumentError naming the field for bad input; ExecutionError when TOPP-RA finds no
+    the load over the allowed share at waypoints ``idx`` (NaN: not held; ``qdd`` (2, len(idx),
+    dof): the accelerations after and before each waypoint, the larger load counts), slowing a
+    piece until it is ≤ 1. ArgumentError naming the field for bad input; ExecutionError when TOPP-RA finds no
     profile; :class:`HoldError` when no timing holds."""
     t, q = np.asarray(times, float), np.asarray(q, float)
     if t.ndim != 1 or len(t) < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
@@ -152,8 +153,7 @@ def _piece(t: np.ndarray, q: np.ndarray, vmax: np.ndarray, amax: np.ndarray, hol
             continue
         out, before = _at_waypoints(spline, s, grid, sd, times)
         # the hold at each waypoint with the acceleration of the half-interval after it and before it
-        excess = None if hold is None else np.fmax(np.asarray(hold(out[1], out[2]), float),
-                                                   np.asarray(hold(out[1], before), float))
+        excess = None if hold is None else np.asarray(hold(out[1], np.stack([out[2], before])), float)
         if excess is None or not np.nanmax(excess, initial=0.0) > 1.0:
             return out
         holds, solves = holds + 1, 0

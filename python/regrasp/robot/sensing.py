@@ -49,6 +49,9 @@ class GripSensing:
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and lo <= v <= 1e3):
                 raise ArgumentError(f"invalid `grip_sensing.{k}`: a number in [{lo:g}, 1000] (got {v!r:.40})",
                                     f"grip_sensing.{k}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise ArgumentError(f"invalid `grip_sensing.seed`: an integer >= 0 (got {self.seed!r:.40})",
+                                "grip_sensing.seed")
 
     @classmethod
     def parse(cls, text: str, field: str = "--grip-sensing") -> "GripSensing":
