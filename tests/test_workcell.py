@@ -190,7 +190,11 @@ def test_default_workcell_serves_every_pusher(name):
                 assert c.length >= np.linalg.norm(pts[1] - pts[0]) - 1e-12
             else:
                 assert c.name == "table"        # a line pusher from below rests on the table
-        assert c.friction >= pc.friction
+        # features at the pushers' own friction (the plan's); where the scene's pushers differ,
+        # a shared feature has the largest
+        mus = {scene.pusher(q).friction if scene.dimension == 2 else scene._core.pusher_spec(q, list(start))[2]
+               for q in scene.pusher_names}
+        assert c.friction == pc.friction if len(mus) == 1 else c.friction >= pc.friction
         assert np.isclose(np.linalg.norm(a.frame[3:]), 1) and np.allclose(a.frame[:3], c.frame[:3])
 
 
@@ -341,3 +345,24 @@ def test_a_deeply_nested_workcell_is_refused_naming_the_file():
     with pytest.raises(SceneError) as e:
         Workcell.from_toml(deep)
     assert e.value.field == "(toml)" and "nested" in str(e.value)
+
+
+def test_default_features_have_the_friction_of_the_pushers_they_serve():
+    """Each generated feature has its pushers' friction (not a floor of 0.5): the thesis'
+    low-friction pushers meet low-friction features; a feature at the pusher's own friction is
+    preferred to one with more."""
+    low = regrasp.load_scene(regrasp.examples.path("block-low-friction"))
+    w = default_workcell(low)
+    assert w.table.friction == 0.25 and {f.friction for f in w.features} == {0.25}
+    # block-3d: a line pusher at 0.25 and a patch at 0.5. Lines meet the ledge and rod at 0.25, the
+    # block (serving both) has the larger, and the line pusher is assigned a 0.25 contact
+    b3 = regrasp.load_scene(regrasp.examples.path("block-3d"))
+    w = default_workcell(b3)
+    mu = {f.name: f.friction for f in w.features}
+    assert mu["ledge"] == mu["rod"] == 0.25 and mu["fixture"] == 0.5 and w.table.friction == 0.5
+    start = b3.task[0]
+    (a,) = assign(b3, [start, start], [None, "left"], w, max_tilt=np.pi)
+    assert {c.name: c for c in w.contacts()}[a.feature].friction == 0.25
+    # a scene with only point pushers: the table serves none and keeps TABLE_FRICTION
+    from regrasp.execution.layout import TABLE_FRICTION, feature_friction
+    assert feature_friction(low, ("point",), TABLE_FRICTION) == TABLE_FRICTION

@@ -34,7 +34,7 @@ macro_rules! fields {
 fields!(search_dict, set_search, SearchSettings;
     seed, time_limit, max_nodes, max_iterations, goal_bias, step, checks, k, t0, alpha, n_fail, c_max,
     neighbour_steps, same_pusher_cost, switch_cost, length_weight, cost_threshold, refine, random_tries,
-    theta_margin, connect);
+    theta_margin, connect, goal_share);
 
 fields!(mpc_dict, set_mpc, MpcSettings;
     dt, horizon, speed, stage_weight, terminal_weight, effort_weight, margin, stall_steps, progress,

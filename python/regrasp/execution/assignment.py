@@ -14,7 +14,8 @@ direction it pushes the object) and +x along a line pusher's segment. A feature'
 
 A contact serves only when it keeps the scene's gravity (fixed in the gripper frame, as the
 plan's mechanics assumed it) within ``max_tilt`` (default :data:`MAX_TILT`) of the world's −z at
-the push's start. Among the contacts that serve it, the one that keeps gravity closest wins
+the push's start. Among the contacts that serve it, one at the pusher's own friction (what the
+plan assumed) beats one with more; then the one that keeps gravity closest wins
 (ties: for a patch the smaller face, then the first in :meth:`Workcell.contacts` order); the contact frame's free turn about its +z (a corner's or a
 face's any angle, an edge's half turn) is chosen for the same reason. When none serves a push,
 an ExecutionError names the push (its index, pusher and the plan's path entries) and why.
@@ -198,10 +199,10 @@ def candidates(scene, poses, pushers: list, workcell: Workcell, max_tilt: float 
                                                         f"world's, more than max_tilt {np.degrees(max_tilt):.1f}°"))
                     continue
                 area = float(np.prod(c.extent)) if pc.kind == "patch" else 0.0
-                cand = (tilt, c, F, area)
-                if best is None or tilt < best[0] - 1e-9 or (tilt < best[0] + 1e-9 and area < best[3]):
+                cand = (tilt, c, F, area, c.friction > pc.friction + 1e-9)
+                if best is None or _better(cand, best):
                     best = cand
-                if mine is None or tilt < mine[0] - 1e-9 or (tilt < mine[0] + 1e-9 and area < mine[3]):
+                if mine is None or _better(cand, mine):
                     mine = cand
             if mine is not None:
                 each.append(mine)
@@ -213,9 +214,18 @@ def candidates(scene, poses, pushers: list, workcell: Workcell, max_tilt: float 
                 f"{NEEDS[pc.kind]} with friction at least {pc.friction:g} ({why})", f"plan.path[{first + 1}].pusher")
             err.pusher = name  # the pusher no feature serves (pick_place re-plans without it)
             raise err
-        rest = sorted((e for e in each if e[1] is not best[1]), key=lambda e: (e[0], e[3]))
+        rest = sorted((e for e in each if e[1] is not best[1]), key=lambda e: (e[4], e[0], e[3]))
         out.append([Assignment(k, name, first, last, e[1].name, e[2], e[0], pc) for e in [best] + rest])
     return out
+
+
+def _better(a, b) -> bool:
+    """Whether candidate ``a`` (tilt, contact, frame, area, friction above the pusher's) beats
+    ``b``: a contact at the pusher's own friction first, then the smaller tilt, then the smaller
+    face."""
+    if a[4] != b[4]:
+        return not a[4]
+    return a[0] < b[0] - 1e-9 or (a[0] < b[0] + 1e-9 and a[3] < b[3])
 
 
 def assign(scene, poses, pushers: list, workcell: Workcell, max_tilt: float = MAX_TILT) -> list[Assignment]:

@@ -5,7 +5,8 @@ table top for planes and pushers from below), a ledge (a horizontal edge high ab
 that pushes downward, so a pusher that pushes the object along the scene's gravity needs no
 tilt), a rod (a short vertical bar pushing towards the robot: side pushers need no tilt on it,
 and it passes between the fingers) and a plate (a small face, just large enough for the scene's largest patch pusher, so an
-object pivoting on a patch does not swing into a larger face).
+object pivoting on a patch does not swing into a larger face). Each feature has the friction of
+the pushers it serves, as the plan assumed it (:func:`feature_friction`).
 
 The layout is made for the assignment of features to pushers (:mod:`.assignment`), so it lives
 beside it; a :class:`~regrasp.workcell.Workcell` itself is a description (before 0.2:
@@ -20,8 +21,8 @@ from ..workcell.description import Feature, ObjectStart, Robot, Table, Workcell
 
 #: The default layout, stated once: table top height [m], table size [m] and centre [m] (world
 #: x-y), the robot (a UR5e at the world origin on the table top), the block's centre [m] (world
-#: x-y), its smallest side [m] and how much longer [×] its sides are than the largest pusher, and
-#: the least friction of table and block.
+#: x-y), its smallest side [m] and how much longer [×] its sides are than the largest pusher.
+#: Every feature has the friction of the pushers it serves (:func:`feature_friction`).
 TABLE_HEIGHT = 0.75
 TABLE_SIZE = (1.2, 0.8)
 TABLE_CENTER = (0.5, 0.0)
@@ -32,7 +33,8 @@ BLOCK_CENTER = (0.5, 0.25)
 BLOCK_LIFT = 0.1
 BLOCK_SIDE = 0.1
 BLOCK_MARGIN = 1.5
-FRICTION = 0.5
+#: The table's friction when it serves no pusher of the scene (no line, patch or plane pusher).
+TABLE_FRICTION = 0.5
 #: The ledge: its edge's centre [m] (world x-y), its height above the table top [m]; it runs
 #: along world x and pushes along world −z, its length as the block's side.
 LEDGE_CENTER = (0.5, -0.25)
@@ -92,6 +94,29 @@ def patch_extent(scene) -> float:
     return out
 
 
+def pusher_kinds(scene) -> list[tuple[str, str, float]]:
+    """``(name, kind, friction)`` of each pusher of ``scene``: kind ``point`` (one contact
+    point), ``line`` (two), ``patch`` (three or more) or ``plane`` (a 3-D ``plane = true``)."""
+    if scene.dimension == 2:
+        return [(p.name, "point" if len(p.points) == 1 else "line", float(p.friction)) for p in scene.pushers]
+    out = []
+    for name in scene.pusher_names:
+        pts, _, mu = scene.pusher_spec(name)
+        n = len(np.asarray(pts).reshape(-1, 3))
+        kind = "plane" if scene.is_plane(name) else "point" if n == 1 else "line" if n == 2 else "patch"
+        out.append((name, kind, float(mu)))
+    return out
+
+
+def feature_friction(scene, kinds, default: float | None = None) -> float | None:
+    """The friction of a feature that serves the pushers of ``scene`` of the given ``kinds``: the
+    pushers' own coefficient (the plan assumed it: a feature with more friction would make a
+    planned slip at the pusher stick), the largest where they differ; ``default`` when the scene
+    has no pusher of those kinds."""
+    mus = [mu for _, k, mu in pusher_kinds(scene) if k in kinds]
+    return max(mus) if mus else default
+
+
 def default_workcell(scene) -> Workcell:
     """The default workcell for ``scene`` (planar or 3-D; see the module's doc): named
     ``default-SCENE``, the object starting in the hand."""
@@ -102,24 +127,26 @@ def default_workcell(scene) -> Workcell:
         raise ArgumentError(f"invalid `scene`: a regrasp Scene or Scene3D (got {type(scene).__name__})", "scene")
     size, mu = pusher_extent(scene)
     side = max(BLOCK_SIDE, BLOCK_MARGIN * size)
-    friction = max(FRICTION, mu)
-    table = Table(TABLE_HEIGHT, list(TABLE_SIZE), friction, list(TABLE_CENTER))
-    block = Feature("fixture", "block", [*BLOCK_CENTER, TABLE_HEIGHT + BLOCK_LIFT + side / 2, 1.0, 0.0, 0.0, 0.0], friction,
+    lines = feature_friction(scene, ("line",), mu)
+    table = Table(TABLE_HEIGHT, list(TABLE_SIZE), feature_friction(scene, ("line", "patch", "plane"), TABLE_FRICTION),
+                  list(TABLE_CENTER))
+    block = Feature("fixture", "block", [*BLOCK_CENTER, TABLE_HEIGHT + BLOCK_LIFT + side / 2, 1.0, 0.0, 0.0, 0.0], mu,
                     [side] * 3)
-    ledge = Feature("ledge", "edge", [*LEDGE_CENTER, TABLE_HEIGHT + LEDGE_HEIGHT, 0.0, 1.0, 0.0, 0.0], friction,
+    ledge = Feature("ledge", "edge", [*LEDGE_CENTER, TABLE_HEIGHT + LEDGE_HEIGHT, 0.0, 1.0, 0.0, 0.0], lines,
                     length=side, index=1)
     r = np.sqrt(0.5)
     features = [block, ledge]
     if size > 0:  # its x along world z, its z (the push) along world −x: −90° about y
-        features.append(Feature("rod", "edge", [*ROD_CENTER, TABLE_HEIGHT + ROD_HEIGHT, r, 0.0, -r, 0.0], friction,
+        features.append(Feature("rod", "edge", [*ROD_CENTER, TABLE_HEIGHT + ROD_HEIGHT, r, 0.0, -r, 0.0], lines,
                                 length=ROD_MARGIN * size, index=len(features)))
     patch = patch_extent(scene)
     if patch > 0:  # the face's +z along world −x: −90° about y
-        features.append(Feature("plate", "face", [*PLATE_CENTER, TABLE_HEIGHT + PLATE_HEIGHT, r, 0.0, -r, 0.0], friction,
+        features.append(Feature("plate", "face", [*PLATE_CENTER, TABLE_HEIGHT + PLATE_HEIGHT, r, 0.0, -r, 0.0],
+                                feature_friction(scene, ("patch",), mu),
                                 [max(PLATE_MIN, PLATE_MARGIN * patch)] * 2, index=len(features)))
     robot = Robot(ROBOT, [0.0, 0.0, TABLE_HEIGHT, 1.0, 0.0, 0.0, 0.0])
     name, start = f"default-{scene.name}", ObjectStart("hand")
-    inclines = _inclines(scene, Workcell(name, table, tuple(features), robot, start), friction)
+    inclines = _inclines(scene, Workcell(name, table, tuple(features), robot, start))
     return Workcell(name, table, tuple(features) + inclines, robot, start,
                     f"generated for scene {scene.name}: a table, a fixture block, a ledge"
                     + (", a rod" if size > 0 else "")
@@ -135,7 +162,7 @@ def _start_pose(scene) -> np.ndarray:
     return np.zeros(3) if scene.dimension == 2 else np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
 
 
-def _inclines(scene, cell: Workcell, friction: float) -> tuple:
+def _inclines(scene, cell: Workcell) -> tuple:
     """The inclines (see :data:`INCLINE_CENTER`) for the line pushers of ``scene`` that no
     contact of ``cell`` serves within ``MAX_TILT`` at the task's start."""
     from .. import pose as P
@@ -164,7 +191,7 @@ def _inclines(scene, cell: Workcell, friction: float) -> tuple:
         origin = [INCLINE_CENTER[0], INCLINE_CENTER[1] + k * INCLINE_STEP, TABLE_HEIGHT + INCLINE_HEIGHT]
         pose = P.from_frame(np.column_stack([e, np.cross(d, e), d]), origin)
         length = ROD_MARGIN * float(np.ptp(pc.footprint[:, 0]))
-        out.append(Feature(f"incline-{name}", "edge", pose, friction, length=length,
+        out.append(Feature(f"incline-{name}", "edge", pose, pc.friction, length=length,
                            index=len(cell.features) + k))
     return tuple(out)
 

@@ -101,7 +101,9 @@ pub struct PlanarSpace<'a> {
     core: SpaceCore<[f64; 3]>,
     scene: &'a Scene,
     s: &'a PlanarSettings,
+    /// The goal's inner tolerance ([`SearchSettings::goal_share`] of `task_tol`) and the task's.
     tol: [f64; 3],
+    task_tol: [f64; 3],
     bounds: ([f64; 2], [f64; 2], [f64; 2]),
     qs_opts: QsOptions,
     /// The pad's path around walls, when the straight one leaves the object.
@@ -134,7 +136,8 @@ impl<'a> PlanarSpace<'a> {
             core: SpaceCore { search: s.search.clone(), length: scene.length, step, pushers: scene.pushers.len(), goal },
             scene,
             s,
-            tol,
+            tol: tol.map(|t| t * s.search.goal_share),
+            task_tol: tol,
             bounds: ([-reach, reach], [-reach, reach], [tlo, thi]),
             qs_opts: QsOptions { support: SupportModel::Points { rings: 2, points: 0, merge_fingers: true }, ..QsOptions::default() },
             guide: None, // built once the certificates have let the search go ([`plan_tree`])
@@ -398,6 +401,9 @@ impl Space<3> for PlanarSpace<'_> {
     }
     fn at_goal(&self, q: &[f64; 3]) -> bool {
         (0..3).all(|k| (q[k] - self.core.goal[k]).abs() <= self.tol[k])
+    }
+    fn within_task(&self, q: &[f64; 3]) -> bool {
+        (0..3).all(|k| (q[k] - self.core.goal[k]).abs() <= self.task_tol[k])
     }
     /// Around walls, the pad's distance left along its guide path combined with the turn left.
     fn cost_to_go(&self, q: &[f64; 3]) -> f64 {

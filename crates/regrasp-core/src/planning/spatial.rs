@@ -233,23 +233,24 @@ impl<'a> SpatialSpace<'a> {
 
     /// Rolling to the goal from `q0` with a plane pusher (whose pushes are forward-dynamics
     /// steps, never exact): unit steps re-aimed at the goal after each, at most `n + 4`, kept if
-    /// the goal is reached (within its tolerance) while each step closes in on it. A position
-    /// already within the tolerance is not chased (the aim is then the goal's orientation only:
-    /// rolling moves the object's centre as a side effect).
+    /// the goal is reached (within its inner tolerance) while each step closes in on it, or, when
+    /// they stop short of it, if they end within the task's tolerance (the search then decides,
+    /// [`trrt::plan_tree`]). A position already within the task's tolerance is not chased (the aim
+    /// is then the goal's orientation only: rolling moves the object's centre as a side effect).
     fn connect_rolling(&self, q0: &Isometry3<f64>, pusher: Option<usize>, n: usize) -> Option<(usize, Vec<(Isometry3<f64>, Twist6, f64)>)> {
         let planes: Vec<usize> = pusher_order(self.scene.pushers.len(), pusher).into_iter().filter(|&p| self.scene.pushers[p].plane).collect();
         self.first_pusher(&planes, |p, solves| {
             let (mut q, mut steps) = (*q0, Vec::new());
             for _ in 0..n + 4 {
-                let aim = if self.within_position(&q) { Isometry3::from_parts(q.translation, self.core.goal.rotation) } else { self.core.goal };
+                let aim = if self.within_position(&q, 1.0) { Isometry3::from_parts(q.translation, self.core.goal.rotation) } else { self.core.goal };
                 let xi = se3_log(&q, &aim);
                 let len = twist_length(self.l(), &xi);
                 let u: Twist6 = xi.map(|x| x * self.core.step.min(len) / len.max(1e-300));
                 let up = pusher_motion(self.scene, &q, p, &u);
                 solves.fetch_add(FORWARD_STEPS + 1, Ordering::Relaxed);
-                let end = simulate_step(self.scene, &q, &up, p, FORWARD_STEPS)?;
+                let Some(end) = simulate_step(self.scene, &q, &up, p, FORWARD_STEPS) else { break };
                 if self.dist(&end, &self.core.goal) >= self.dist(&q, &self.core.goal) {
-                    return None;
+                    break;
                 }
                 steps.push((end, up, self.dist(&q, &end)));
                 q = end;
@@ -257,15 +258,20 @@ impl<'a> SpatialSpace<'a> {
                     return Some((p, steps));
                 }
             }
-            None
+            (!steps.is_empty() && self.within_task(&q)).then_some((p, steps))
         })
     }
 
-    /// Whether the position of `q` is within the goal's tolerance.
-    fn within_position(&self, q: &Isometry3<f64>) -> bool {
+    /// Whether the position of `q` is within `share` of the goal's tolerance.
+    fn within_position(&self, q: &Isometry3<f64>, share: f64) -> bool {
         let d = q.translation.vector - self.core.goal.translation.vector;
-        let t = self.scene.tolerance;
+        let t = self.scene.tolerance.map(|t| t * share);
         d.x.abs() <= t[0] && d.y.abs() <= t[1] && d.z.abs() <= t[2]
+    }
+
+    /// Whether `q` is within `share` of the goal's tolerance (position and angle).
+    fn in_goal_region(&self, q: &Isometry3<f64>, share: f64) -> bool {
+        self.within_position(q, share) && (self.core.goal.inverse() * q).rotation.angle() <= self.scene.tolerance[3] * share
     }
 }
 
@@ -287,7 +293,10 @@ impl Space<7> for SpatialSpace<'_> {
         distance(self.l(), a, b)
     }
     fn at_goal(&self, q: &Isometry3<f64>) -> bool {
-        self.within_position(q) && (self.core.goal.inverse() * q).rotation.angle() <= self.scene.tolerance[3]
+        self.in_goal_region(q, self.s.search.goal_share)
+    }
+    fn within_task(&self, q: &Isometry3<f64>) -> bool {
+        self.in_goal_region(q, 1.0)
     }
     /// A random pose near the start–goal region: translation within the object's reach, rotation
     /// a random interpolation between start and goal perturbed by up to `theta_margin`.

@@ -62,6 +62,10 @@ pub struct SearchSettings {
     pub theta_margin: f64,
     /// Try to reach the goal from each new node directly (straight push, rolling).
     pub connect: bool,
+    /// The share (0, 1] of the task's tolerance within which a plan ends, so that execution has
+    /// room ([`Space::at_goal`]); a search that reaches only the whole tolerance returns its
+    /// cheapest node there ([`Space::within_task`], [`plan_tree`]).
+    pub goal_share: f64,
 }
 
 impl Default for SearchSettings {
@@ -88,6 +92,7 @@ impl Default for SearchSettings {
             random_tries: 8,
             theta_margin: 0.5,
             connect: true,
+            goal_share: 0.5,
         }
     }
 }
@@ -123,6 +128,9 @@ impl SearchSettings {
         }
         if !(self.refine >= 0.0) {
             return Err(Error::arg("refine", format!("must be a non-negative fraction of the iterations, or inf (got {})", self.refine)));
+        }
+        if !(self.goal_share > 0.0 && self.goal_share <= 1.0) {
+            return Err(Error::arg("goal_share", format!("must be a share of the tolerance in (0, 1] (got {})", self.goal_share)));
         }
         if self.cost_threshold.is_nan() {
             return Err(Error::arg("cost_threshold", "is NaN"));
@@ -222,7 +230,13 @@ pub trait Space<const K: usize>: Sync {
     fn key(&self, q: &Self::Q) -> [f64; K];
     /// The metric distance [m].
     fn dist(&self, a: &Self::Q, b: &Self::Q) -> f64;
+    /// Whether `q` is within the goal's inner tolerance ([`SearchSettings::goal_share`] of the
+    /// task's).
     fn at_goal(&self, q: &Self::Q) -> bool;
+    /// Whether `q` is within the task's whole tolerance (default: [`Space::at_goal`]).
+    fn within_task(&self, q: &Self::Q) -> bool {
+        self.at_goal(q)
+    }
     /// T-RRT's cost map: how far `q` is from the goal, in units of L (default: the metric's
     /// distance; a space may know a better one, e.g. around walls).
     fn cost_to_go(&self, q: &Self::Q) -> f64 {
@@ -551,17 +565,30 @@ pub fn plan<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<Plan<
 /// The search tree of a plan.
 pub type Nodes<S, const K: usize> = Vec<TreeNode<<S as Space<K>>::Q, <S as Space<K>>::Edge>>;
 
-/// [`plan`], also returning the search tree; [`crate::interrupt::check`]ed every iteration.
+/// How long a search goes on for the inner goal region after its first node within the task's
+/// tolerance, at least: iterations and seconds (see [`plan_tree`]).
+const MIN_INNER_ITERATIONS: usize = 200;
+const MIN_INNER_TIME_S: f64 = 0.1;
+
+/// [`plan`], also returning the search tree; [`crate::interrupt::check`]ed every iteration. The
+/// goal is the inner region ([`Space::at_goal`]); once a node lies within the task's whole
+/// tolerance ([`Space::within_task`]) at iteration `k`, time `t` [s], the search goes on for the
+/// inner region at most `(1 + refine) · max(k, MIN_INNER_ITERATIONS)` more iterations or
+/// `(1 + refine) · max(t, MIN_INNER_TIME_S)` more seconds, whichever ends first, then ends at the
+/// cheapest node within the task's tolerance (found, the plan ending outside the inner region).
 pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<(Plan<S::Q, S::Edge>, Nodes<S, K>)> {
     let s = space.search();
     let mut search = Search::new(space, start);
     let t0 = Instant::now();
     let mut best: Option<usize> = if space.at_goal(&search.nodes[0].q) { Some(0) } else { None };
     if best.is_none() {
-        best = search.connect_goal(0);
+        best = search.connect_goal(0).filter(|&g| space.at_goal(&search.nodes[g].q));
     }
     let mut iterations = 0;
     let mut first: Option<FirstPlan> = None;
+    // the iteration and time of the first node within the task's tolerance
+    let last = search.nodes.len() - 1;
+    let mut outer: Option<(usize, f64)> = space.within_task(&search.nodes[last].q).then_some((0, 0.0));
     let stop = loop {
         if let Some(g) = best {
             let f = *first.get_or_insert_with(|| FirstPlan {
@@ -577,18 +604,40 @@ pub fn plan_tree<S: Space<K>, const K: usize>(space: &S, start: S::Q) -> Result<
         if let Some(r) = stop_reason(s, best.map(|g| search.nodes[g].cost), &t0, search.nodes.len(), iterations) {
             break r;
         }
+        if let (None, Some((k, t))) = (best, outer) {
+            let more = 1.0 + s.refine;
+            if (iterations - k) as f64 >= more * k.max(MIN_INNER_ITERATIONS) as f64
+                || t0.elapsed().as_secs_f64() - t >= more * t.max(MIN_INNER_TIME_S)
+            {
+                break StopReason::GoalReached;
+            }
+        }
         crate::interrupt::check()?;
         iterations += 1;
         let Some(i) = search.grow() else { continue };
-        if space.at_goal(&search.nodes[i].q) {
-            search.nodes.keep_cheaper(&mut best, i);
-        } else if let Some(g) = search.connect_goal(i) {
-            search.nodes.keep_cheaper(&mut best, g);
+        // the new node, or the end of a chain from it towards the goal (which may stop short)
+        let end = if space.at_goal(&search.nodes[i].q) { Some(i) } else { search.connect_goal(i) };
+        match end {
+            Some(g) if space.at_goal(&search.nodes[g].q) => search.nodes.keep_cheaper(&mut best, g),
+            _ if outer.is_none() && space.within_task(&search.nodes[search.nodes.len() - 1].q) => {
+                outer = Some((iterations, t0.elapsed().as_secs_f64()));
+            }
+            _ => {}
         }
     };
     // rewiring may have made another goal node the cheapest
     if best.is_some() {
         best = search.nodes.cheapest(|q| space.at_goal(q));
+    } else if outer.is_some() {
+        best = search.nodes.cheapest(|q| space.within_task(q));
+        if let Some(g) = best {
+            first = Some(FirstPlan {
+                planning_time_s: t0.elapsed().as_secs_f64(),
+                iterations,
+                switch_overs: switch_overs(&search.nodes.path_to(g)),
+                cost: search.nodes[g].cost,
+            });
+        }
     }
     let end = best.unwrap_or(search.closest.0);
     let path = search.nodes.path_to(end);
