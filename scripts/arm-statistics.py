@@ -44,7 +44,7 @@ def main() -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--closed-loop", action="store_true", help="the arm in the loop (MPC / re-planning)")
     ap.add_argument("--robot", help="the robot (regrasp.robot.kinds.ROBOTS; default: the workcell's)")
-    ap.add_argument("--grip-sensing", help="what the grip loop measures: ideal (default), open-loop, sensor or "
+    ap.add_argument("--grip-sensing", help="what the grip loop measures (default: the gripper's, regrasp.robot.kinds.GRIPPER_SENSING): ideal, open-loop, sensor or "
                     "sensor:NOISE,DELAY,BANDWIDTH (regrasp.robot.sensing)")
     ap.add_argument("--json", help="also write the outcomes here")
     a = ap.parse_args()
@@ -53,7 +53,7 @@ def main() -> int:
     sensing = GripSensing.parse(a.grip_sensing) if a.grip_sensing else None
     names = a.names or regrasp.examples.names()
     loop = "closed loop" if a.closed_loop else "open loop"
-    loop += f", grip sensing {a.grip_sensing}" if a.grip_sensing else ""
+    loop += f", grip sensing {a.grip_sensing or 'the gripper’s default'}"
     print(f"| example | {loop}{', ' + a.robot if a.robot else ''}: success (±{a.spread:.0%}, {a.runs} runs) | median goal error | max creep [mm] | holding margin: least (median) | wall [s] |")
     print("|---|---|---|---|---|---|", flush=True)
     with ProcessPoolExecutor(a.workers) as pool:  # a row as each example completes

@@ -120,11 +120,11 @@ def test_execute_cli(tmp_path):
     plan = tmp_path / "plan.json"
     scene = regrasp.examples.path("block-3d")
     assert run_cli("plan", scene, "--out", plan)[0] == 0
-    code, out, err = run_cli("execute", scene, "--plan", plan, "--trajectory", tmp_path / "traj.json", "--json",
-                             "--grip-sensing", "open-loop")  # a 2F-85's own: its force setting, no measurement
+    code, out, err = run_cli("execute", scene, "--plan", plan, "--trajectory", tmp_path / "traj.json", "--json")
     assert code == 0, err
     r = json.loads(out)
     assert {"success", "goal_error", "max_creep", "robot", "duration_s"} <= set(r) and r["success"] is True
+    # the 2F-85's own sensing by default: its force setting, no measurement
     assert r["grip_sensing"] == "open-loop" and "holding" not in r  # a 3-D scene's hold is not tested yet
     assert r["robot"] == "ur5e-2f85" and r["pushes"][0]["feature"]
     assert Trajectory.load(tmp_path / "traj.json").q.shape[1] == 6

@@ -97,6 +97,9 @@ BAD = [
     ("gripper.kind", lambda t: t.replace('kind = "robotiq-2f85"', 'kind = "magnet"')),
     ("gripper.finger_length", lambda t: t.replace('kind = "robotiq-2f85"', 'kind = "parallel"\nfinger_length = -1.0')),
     ("gripper.stroke", lambda t: t.replace('kind = "robotiq-2f85"', 'kind = "robotiq-2f85"\nstroke = 0.1')),
+    ("gripper.sensing", lambda t: t.replace('kind = "robotiq-2f85"', 'kind = "robotiq-2f85"\nsensing = "psychic"')),
+    ("gripper.sensing", lambda t: t.replace('kind = "robotiq-2f85"', 'kind = "parallel"\nsensing = "sensor:0.1,-2,100"')),
+    ("gripper.sensing", lambda t: t.replace('kind = "robotiq-2f85"', 'kind = "parallel"\nsensing = 3')),
 ]
 
 
@@ -159,7 +162,7 @@ def test_the_documented_keys_are_the_readers():
     doc = (Path(__file__).resolve().parents[1] / "docs" / "robot-file.md").read_text()
     documented = set(re.findall(r"^\| `([a-z_.]+)` \|", doc, flags=re.M))
     keys = {*robot_file.KEYS, *(f"arm.{k}" for k in robot_file.ARM_REQUIRED + robot_file.ARM_OPTIONAL),
-            "gripper.kind", *(f"gripper.{f.name}" for f in fields(ParallelGripper))}
+            "gripper.kind", "gripper.sensing", *(f"gripper.{f.name}" for f in fields(ParallelGripper))}
     assert documented == keys
 
 
@@ -173,3 +176,28 @@ def test_a_bundled_robot_file_is_named_by_its_name():
     with pytest.raises(ArgumentError) as e:
         robot_name("no-such-robot")
     assert e.value.field == "robot" and "panda-parallel" in str(e.value)
+
+
+def test_each_gripper_has_its_own_grip_sensing_and_a_file_may_state_another(tmp_path):
+    """The 2F-85 and the Franka Hand measure no force (open loop), the parametric gripper has a
+    force sensor per finger; ``gripper.sensing`` states another; the grip loop takes the robot's
+    unless the run says otherwise."""
+    from regrasp.execution.arm import grip_sensing
+    from regrasp.robot.kinds import GRIPPER_SENSING, ROBOTS
+    from regrasp.robot.sensing import GripSensing
+
+    assert GRIPPER_SENSING == {"robotiq-2f85": "open-loop", "franka-hand": "open-loop", "parallel": "sensor"}
+    assert ROBOTS["ur5e-2f85"].sensing == "open-loop" and ROBOTS["ur5e-parallel"].sensing == "sensor"
+    assert ROBOTS[robot_name("panda-hand")].sensing == "open-loop"
+    assert ROBOTS[robot_name("panda-parallel")].sensing == "sensor"
+    p = write(tmp_path, UR5E.replace('kind = "robotiq-2f85"', 'kind = "parallel"\nsensing = "sensor:0.2,0.004,50"'))
+    kind = load(p)
+    assert kind.sensing == "sensor:0.2,0.004,50" and kind.gripper.finger_length == pytest.approx(0.10)
+
+    class Robot:  # what grip_sensing reads of a built robot
+        pass
+    r = Robot()
+    r.kind = kind
+    assert grip_sensing(r) == GripSensing("sensor", 0.2, 0.004, 50.0)
+    assert grip_sensing(r, GripSensing("ideal")) == GripSensing("ideal")
+    assert load(write(tmp_path, UR5E, "plain.toml")).sensing == "open-loop"

@@ -1,6 +1,5 @@
 """The workcell file, its contacts and the default workcell (regrasp.workcell)."""
 
-import copy
 import itertools
 import tomllib
 

@@ -123,7 +123,10 @@ def _arm(scene, plan, a):
                task_error=run.goal_error)
     if r.trajectory.holding is not None:
         out["holding"] = r.trajectory.holding.to_json()
-    out["grip_sensing"] = "ideal" if a.grip_sensing is None else a.grip_sensing.kind
+    from ..robot.kinds import ROBOTS
+    from ..robot.sensing import GripSensing
+
+    out["grip_sensing"] = (a.grip_sensing or GripSensing.parse(ROBOTS[r.trajectory.robot].sensing)).kind
     return out, run.motion, (r, holder.get("r"))
 
 
@@ -278,8 +281,9 @@ def add_parsers(sub) -> None:
                    "re-planning (3-D) from the object's pose measured in MuJoCo")
     e.add_argument("--start-error", metavar="dx,dz,dtheta", help="planar: the object starts this far from the "
                    "plan's start in the grasp (m, m, rad)")
-    e.add_argument("--grip-sensing", metavar="KIND", help="what the arm's grip loop measures: ideal (default: "
-                   "MuJoCo's contact forces), open-loop (none: the calibrated feed-forward), sensor or "
-                   "sensor:NOISE,DELAY,BANDWIDTH (a force sensor per finger; N, s, Hz)")
+    e.add_argument("--grip-sensing", metavar="KIND", help="what the arm's grip loop measures: ideal "
+                   "(MuJoCo's contact forces), open-loop (none: the calibrated feed-forward), sensor or "
+                   "sensor:NOISE,DELAY,BANDWIDTH (a force sensor per finger; N, s, Hz) (default: the gripper's: "
+                   "open-loop for the 2F-85 and the Franka Hand, sensor for the parametric parallel gripper)")
     e.add_argument("--json", action="store_true", help="print the result as JSON")
     add_verbose(e)

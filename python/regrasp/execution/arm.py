@@ -451,16 +451,27 @@ def arm_motion(scene, plan, workcell=None, robot: str | None = None, scales: Per
                          + "; ".join(f"push {k} on {f}: {why}" for k, f, why in refused), "robot")
 
 
+def grip_sensing(robot, sensing=None):
+    """What ``robot``'s grip loop measures: ``sensing`` (a
+    :class:`~regrasp.robot.sensing.GripSensing`) when given, else its gripper's default
+    (``robot.kind.sensing``, :data:`~regrasp.robot.kinds.GRIPPER_SENSING`)."""
+    from ..robot.sensing import GripSensing
+
+    return GripSensing.parse(robot.kind.sensing, "robot.sensing") if sensing is None else sensing
+
+
 def close_on(robot, body: int, geoms, grip_force: float, sensing=None):
     """Closes the fingers on the object (held in place) until both pads press within
     :data:`SETTLED` of ``grip_force`` [N] (:data:`CLOSE_TIME`), the arm's servo holding the
     joints where they are (so the hand does not sag against the held object: 0.54 mm on
     offset-3d with the joints left free); returns the grip controller, its loop measuring as
-    ``sensing`` says (:class:`~regrasp.robot.sensing.GripSensing`; None: ideal)."""
+    ``sensing`` says (:class:`~regrasp.robot.sensing.GripSensing`; None: the robot's gripper's
+    default, :func:`grip_sensing`)."""
     mujoco = need("mujoco", "robot")
     from ..robot.grip import GripController, pad_forces
     from ..robot.tracking import Servo
 
+    sensing = grip_sensing(robot, sensing)
     m, d = robot.model, robot.data
     jq, jv = m.jnt_qposadr[m.body_jntadr[body]], m.jnt_dofadr[m.body_jntadr[body]]
     hold, q = d.qpos[jq:jq + 7].copy(), robot.q.copy()
@@ -488,7 +499,7 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
     the arm cannot follow the motion. ``pads``: as :func:`build_robot`'s. ``start``: where the
     object really starts in the hand (planar ``[x, z, theta]`` or ``[x, y, z, qw, qx, qy, qz]``;
     default the motion's first in-hand pose), the motion left as planned. ``sensing``: what the
-    grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: ideal)."""
+    grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the gripper's default, :func:`~regrasp.execution.arm.grip_sensing`)."""
     mujoco = need("mujoco", "robot")
     from ..robot.grip import body_pose
     from ..robot.tracking import track

@@ -61,7 +61,7 @@ def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: boo
     the module's doc); ``closed_loop``:
     each run with the arm in the loop (:func:`~regrasp.execution.arm_loop.control_arm`) instead
     of the open-loop joint trajectory; ``robot``: the robot (default: the workcell's); ``sensing``:
-    what the grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: ideal)."""
+    what the grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the gripper's default, :func:`~regrasp.execution.arm.grip_sensing`)."""
     import time
 
     import regrasp

@@ -44,8 +44,8 @@ class World:
     the scene's default workcell), ``robot`` (the arm's registry name; default: the workcell's),
     ``options``: settings of the rig's function (e.g. ``speed`` [m/s], ``dt`` [s],
     ``view``, ``timing``, ``seed``), each checked against it, and ``grip_sensing``: what the
-    arm's grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the ideal
-    contact forces)."""
+    arm's grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the robot's
+    gripper's default, :data:`~regrasp.robot.kinds.GRIPPER_SENSING`)."""
 
     scene: object
     rig: str = "planner"

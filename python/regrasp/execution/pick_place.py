@@ -535,7 +535,7 @@ def execute_pick_place(scene, r: PickPlace, scales=None, observe=None, sensing=N
     (:func:`~regrasp.execution.arm.close_on`); lift, regrasp, carry and lower under the grip
     force loop; the fingers open (:func:`~regrasp.robot.grip.open_gripper`); the retreat.
     ``observe(robot)`` is called after every control period (e.g. a video recorder);
-    ``sensing``: what the grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: ideal)."""
+    ``sensing``: what the grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the gripper's default, :func:`~regrasp.execution.arm.grip_sensing`)."""
     mujoco = need("mujoco", "robot")
     from ..robot.grip import body_pose, open_gripper
     from ..robot.tracking import track

@@ -36,7 +36,9 @@ class RobotKind:
     pads). A robot file's (:mod:`.robot_file`, its path in ``source``) also says the arm model's
     root body ``arm_root``, the ``flange_body`` and ``flange_pose`` where the gripper mounts, the
     bodies to ``remove``, the position gains ``kp``, ``kv`` and ``armature`` of the arm joints
-    (:mod:`.arm_model`); ``arm_file``/``gripper_file`` are then absolute paths, ``name`` the file's."""
+    (:mod:`.arm_model`); ``arm_file``/``gripper_file`` are then absolute paths, ``name`` the file's.
+    ``sensing``: what the gripper's grip loop measures by default, as
+    :meth:`~regrasp.robot.sensing.GripSensing.parse` reads it (:data:`GRIPPER_SENSING`)."""
 
     arm_file: str
     gripper_file: str
@@ -63,6 +65,15 @@ class RobotKind:
     armature: float = 0.0
     source: str = ""
     name: str = ""
+    sensing: str = "open-loop"
+
+
+#: What each bundled gripper's grip loop measures by default (``gripper.kind`` of a robot file):
+#: the Robotiq 2F-85 and the Franka Hand set their grip force through the motor current and
+#: measure no force (``open-loop``: the calibrated feed-forward); the parametric parallel gripper
+#: stands for a gripper with a force sensor in each finger (``sensor``: the illustrative defaults
+#: of :class:`~regrasp.robot.sensing.GripSensing`, noise 0.05 N, delay 2 ms, 100 Hz).
+GRIPPER_SENSING = {"robotiq-2f85": "open-loop", "franka-hand": "open-loop", "parallel": "sensor"}
 
 
 #: The robots by name (``--robot NAME``).
@@ -90,7 +101,7 @@ _LONG_FINGERS = ParallelGripper()
 ROBOTS["ur5e-parallel"] = RobotKind(  # the UR5e with the parametric parallel gripper (the thesis' long fingers)
     **{**ROBOTS["ur5e-2f85"].__dict__, "gripper_file": "", "gripper": _LONG_FINGERS, "opening": _LONG_FINGERS.stroke,
        "calibration_height": _LONG_FINGERS.pad_height, "pad_bodies": ("left_pad", "right_pad"),
-       "driver_joints": ("right_finger_joint", "left_finger_joint")})
+       "driver_joints": ("right_finger_joint", "left_finger_joint"), "sensing": GRIPPER_SENSING["parallel"]})
 #: The default robot.
 DEFAULT_ROBOT = "ur5e-2f85"
 #: Other names of the robots (a workcell file's ``robot.name``, e.g. ``"ur5e"``).

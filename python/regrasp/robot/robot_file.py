@@ -16,7 +16,7 @@ from pathlib import Path
 from ..errors import ArgumentError, SceneError
 from ..fields import FieldCheck
 from . import kinds
-from .kinds import ROBOTS, RobotKind
+from .kinds import GRIPPER_SENSING, ROBOTS, RobotKind
 from .franka_hand import FrankaHand
 from .parallel_gripper import ParallelGripper
 
@@ -97,9 +97,12 @@ def _with_gripper(kind: RobotKind, g) -> RobotKind:
     if not isinstance(g, dict):
         raise _fail("gripper", "must be a table", g)
     params = [f.name for f in fields(ParallelGripper)]
-    _keys_subset(g, ("kind", *params), ("kind",), "gripper")
+    _keys_subset(g, ("kind", "sensing", *params), ("kind",), "gripper")
     if g["kind"] not in GRIPPERS:
         raise _fail("gripper.kind", f"must be one of {', '.join(GRIPPERS)}", g["kind"])
+    sensing = _sensing(g.get("sensing", GRIPPER_SENSING[g["kind"]]))
+    g = {k: v for k, v in g.items() if k != "sensing"}
+    kind = RobotKind(**{**kind.__dict__, "sensing": sensing})
     if g["kind"] in ("robotiq-2f85", "franka-hand") and len(g) > 1:
         raise _fail(f"gripper.{next(k for k in g if k != 'kind')}", f"the {g['kind']} gripper takes no parameters", g)
     if g["kind"] == "robotiq-2f85":
@@ -113,6 +116,19 @@ def _with_gripper(kind: RobotKind, g) -> RobotKind:
         raise SceneError(f"robot file field `{e.field}`: {str(e).split(': ', 1)[-1]}", e.field) from None
     return RobotKind(**{**kind.__dict__, "gripper": p, "opening": p.stroke, "calibration_height": p.pad_height,
                         "driver_joints": ("right_finger_joint", "left_finger_joint")})
+
+
+def _sensing(text) -> str:
+    """``gripper.sensing`` checked (:meth:`~regrasp.robot.sensing.GripSensing.parse`)."""
+    from .sensing import GripSensing
+
+    if not isinstance(text, str):
+        raise _fail("gripper.sensing", "must be a string: ideal, open-loop, sensor or sensor:NOISE,DELAY,BANDWIDTH", text)
+    try:
+        GripSensing.parse(text, "gripper.sensing")
+    except ArgumentError as e:
+        raise SceneError(f"robot file field `gripper.sensing`: {str(e).split(': ', 1)[-1]}", "gripper.sensing") from None
+    return text
 
 
 def _keys_subset(d, allowed, required, where: str) -> None:
