@@ -46,6 +46,7 @@ def main() -> int:
     ap.add_argument("--robot", help="the robot (regrasp.robot.kinds.ROBOTS; default: the workcell's)")
     ap.add_argument("--grip-sensing", help="what the grip loop measures (default: the gripper's, regrasp.robot.kinds.GRIPPER_SENSING): ideal, open-loop, sensor or "
                     "sensor:NOISE,DELAY,BANDWIDTH (regrasp.robot.sensing)")
+    ap.add_argument("--no-noslip", action="store_true", help="without MuJoCo's no-slip post-processing (open loop)")
     ap.add_argument("--json", help="also write the outcomes here")
     a = ap.parse_args()
     from regrasp.robot.sensing import GripSensing
@@ -53,11 +54,12 @@ def main() -> int:
     sensing = GripSensing.parse(a.grip_sensing) if a.grip_sensing else None
     names = a.names or regrasp.examples.names()
     loop = "closed loop" if a.closed_loop else "open loop"
-    loop += f", grip sensing {a.grip_sensing or 'the gripper’s default'}"
+    loop += f", grip sensing {a.grip_sensing or 'the gripper’s default'}" + (", no no-slip" if a.no_noslip else "")
     print(f"| example | {loop}{', ' + a.robot if a.robot else ''}: success (±{a.spread:.0%}, {a.runs} runs) | median goal error | max creep [mm] | holding margin: least (median) | wall [s] |")
     print("|---|---|---|---|---|---|", flush=True)
     with ProcessPoolExecutor(a.workers) as pool:  # a row as each example completes
-        jobs = [pool.submit(example, name, a.runs, a.spread, a.seed, a.closed_loop, a.robot, sensing) for name in names]
+        jobs = [pool.submit(example, name, a.runs, a.spread, a.seed, a.closed_loop, a.robot, sensing, not a.no_noslip)
+                for name in names]
         for job in as_completed(jobs):
             print(row(job.result()), flush=True)
     outs = [job.result() for job in jobs]

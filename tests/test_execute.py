@@ -104,6 +104,9 @@ def test_free_gripper(planar):
     ({}, dict(perturbation=Perturbation(turn=0.1)), "perturbation.shift"),
     (dict(rig="free-gripper"), dict(perturbation=Perturbation(grip=0.9)), "perturbation"),
     (dict(rig="free-gripper"), dict(loop="closed"), "loop"),
+    (dict(noslip=False), {}, "world.noslip"),
+    (dict(rig="arm", noslip=0), {}, "world.noslip"),
+    (dict(rig="arm", noslip=False), dict(loop="closed"), "world.noslip"),
 ])
 def test_what_a_rig_cannot_do_is_named(planar, world, kw, field):
     scene, plan = planar
@@ -131,3 +134,22 @@ def test_the_arm_open_and_closed_loop(planar):
     c = execute(World(scene, rig="arm"), plan, loop="closed", perturbation=Perturbation(shift=(0.0005, 0.0, 0.0)))
     assert isinstance(c.detail, ArmLoopResult) and np.allclose(c.final_pose, c.detail.final)
     assert c.success == scene.goal_error(c.final_pose)[1] and c.loop == "closed"
+
+
+def test_the_arm_without_no_slip(planar):
+    """``World(noslip=False)``: the arm's world without MuJoCo's no-slip post-processing (the
+    model's option, nothing else changed); the run differs from the one with it."""
+    pytest.importorskip("mink")
+    from regrasp.execution.arm import build_robot
+    from regrasp.execution.execute import arm_motion_of
+
+    scene, plan = planar
+    world = World(scene, rig="arm")
+    motion = arm_motion_of(world, plan).motion
+    on, off = build_robot(scene, motion)[0], build_robot(scene, motion, noslip=False)[0]
+    assert on.model.opt.noslip_iterations == 20 and off.model.opt.noslip_iterations == 0
+    assert off.contact.noslip_iterations == 0 and off.model.nbody == on.model.nbody
+    soft = execute(World(scene, rig="arm", noslip=False), plan)
+    hard = execute(world, plan)
+    assert not np.allclose(soft.detail.in_hand, hard.detail.in_hand, atol=1e-9)
+    assert soft.success == scene.goal_error(soft.final_pose)[1] and soft.max_creep is not None

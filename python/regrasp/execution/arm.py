@@ -127,13 +127,19 @@ def _pad_friction(scene) -> float:
     return scene.pad_friction
 
 
-def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Perturbation = Perturbation(), pads=None):
+def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Perturbation = Perturbation(), pads=None,
+                noslip: bool = True):
     """The robot (:func:`regrasp.robot.model.build`) in ``motion``'s workcell with the object on
     a free joint at the motion's first world pose, the fingers closed at its width
     (:func:`~regrasp.robot.grip.close_fingers`), the pads of the scene's pad shape and finger
     friction (``pads``: another :class:`~regrasp.robot.pads.Pads`, e.g. the old single-contact
-    model :func:`~regrasp.robot.pads.single_contact`); returns (robot, the object's body id, its
+    model :func:`~regrasp.robot.pads.single_contact`); ``noslip``: MuJoCo's no-slip
+    post-processing as :class:`~regrasp.mujoco.model.Contact` sets it (False: none, MuJoCo's soft
+    contacts alone, which let a held object creep); returns (robot, the object's body id, its
     geom ids, the TCP in the gripper frame)."""
+    from dataclasses import replace
+
+    from ..mujoco.model import Contact
     from ..mujoco.world import Layout, build as build_world
     from ..robot.grip import close_fingers
     from ..robot.model import build
@@ -151,7 +157,8 @@ def build_robot(scene, motion: WorldMotion, robot: str | None = None, scales: Pe
 
     try:
         r = build(name, base_pose=wc.robot.base, table=None, pads=Pads.of_scene(scene) if pads is None else pads,
-                  pad_friction=_pad_friction(scene) * scales.finger_friction, grasp_width=width, add=add)
+                  pad_friction=_pad_friction(scene) * scales.finger_friction, grasp_width=width, add=add,
+                  contact=Contact() if noslip else replace(Contact(), noslip_iterations=0))
     except ArgumentError as e:
         if e.field == "grasp_width":
             raise ExecutionError(f"the object is {width * 1e3:.1f} mm wide across the grasp: the 2F-85 opens "
@@ -490,7 +497,8 @@ def close_on(robot, body: int, geoms, grip_force: float, sensing=None):
 
 
 def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scales: Perturbation = Perturbation(),
-                observe=None, trajectory: ArmTrajectory | None = None, pads=None, start=None, sensing=None) -> ArmResult:
+                observe=None, trajectory: ArmTrajectory | None = None, pads=None, start=None, sensing=None,
+                noslip: bool = True) -> ArmResult:
     """Executes ``motion`` (the :class:`WorldMotion` of ``plan`` for ``scene``) with the arm
     ``robot`` (default: the workcell's) in MuJoCo, in a world perturbed by ``scales``, and
     measures it (:class:`ArmResult`). ``observe(robot)``: called after every control period
@@ -499,7 +507,8 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
     the arm cannot follow the motion. ``pads``: as :func:`build_robot`'s. ``start``: where the
     object really starts in the hand (planar ``[x, z, theta]`` or ``[x, y, z, qw, qx, qy, qz]``;
     default the motion's first in-hand pose), the motion left as planned. ``sensing``: what the
-    grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the gripper's default, :func:`~regrasp.execution.arm.grip_sensing`)."""
+    grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the gripper's default,
+    :func:`~regrasp.execution.arm.grip_sensing`); ``noslip``: as :func:`build_robot`'s."""
     mujoco = need("mujoco", "robot")
     from ..robot.grip import body_pose
     from ..robot.tracking import track
@@ -508,7 +517,8 @@ def execute_arm(scene, plan, motion: WorldMotion, robot: str | None = None, scal
     if not isinstance(motion, WorldMotion):
         raise ArgumentError(f"invalid `motion`: a WorldMotion (got {type(motion).__name__})", "motion")
     start = np.asarray(_start(scene, motion, start), float)
-    r, body, geoms, tcp = build_robot(scene, motion, robot if trajectory is None else trajectory.robot, scales, pads)
+    r, body, geoms, tcp = build_robot(scene, motion, robot if trajectory is None else trajectory.robot, scales, pads,
+                                      noslip)
     if trajectory is not None:
         check_hand(r, motion, tcp)  # solve_arm checks it otherwise
     traj = solve_arm(r, motion, tcp, object_load(scene, r, body, tcp, motion), boost=True) if trajectory is None \

@@ -56,12 +56,14 @@ def draws(runs: int, spread: float, seed: int):
 
 
 def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: bool = False,
-            robot: str | None = None, sensing=None) -> Outcome:
+            robot: str | None = None, sensing=None, noslip: bool = True) -> Outcome:
     """The :class:`Outcome` of bundled example ``name`` (or a scene file's path, ``….toml``; see
     the module's doc); ``closed_loop``:
     each run with the arm in the loop (:func:`~regrasp.execution.arm_loop.control_arm`) instead
     of the open-loop joint trajectory; ``robot``: the robot (default: the workcell's); ``sensing``:
-    what the grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the gripper's default, :func:`~regrasp.execution.arm.grip_sensing`)."""
+    what the grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the gripper's
+    default, :func:`~regrasp.execution.arm.grip_sensing`); ``noslip``: MuJoCo's no-slip
+    post-processing (``World.noslip``)."""
     import time
 
     import regrasp
@@ -76,7 +78,7 @@ def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: boo
         return out
     try:
         plan = regrasp.plan(scene, seed=0)
-        world = World(scene, rig="arm", robot=robot, grip_sensing=sensing)
+        world = World(scene, rig="arm", robot=robot, grip_sensing=sensing, noslip=noslip)
         holding = None
         if not closed_loop:  # solved once, here: an arm that cannot do the plan refuses the example
             holding = arm_motion_of(world, plan).trajectory.holding

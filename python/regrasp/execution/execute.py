@@ -45,7 +45,8 @@ class World:
     ``options``: settings of the rig's function (e.g. ``speed`` [m/s], ``dt`` [s],
     ``view``, ``timing``, ``seed``), each checked against it, and ``grip_sensing``: what the
     arm's grip loop measures (:class:`~regrasp.robot.sensing.GripSensing`; None: the robot's
-    gripper's default, :data:`~regrasp.robot.kinds.GRIPPER_SENSING`)."""
+    gripper's default, :data:`~regrasp.robot.kinds.GRIPPER_SENSING`); ``noslip``: MuJoCo's
+    no-slip post-processing in the arm's world (False: none; open loop only)."""
 
     scene: object
     rig: str = "planner"
@@ -54,6 +55,7 @@ class World:
     robot: str | None = None
     options: dict = field(default_factory=dict)
     grip_sensing: object = None
+    noslip: bool = True
     #: the arm's world motion and joint trajectory of each plan run here (:func:`arm_motion_of`)
     _motions: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -78,6 +80,8 @@ class World:
 
             if self.rig != "arm" or not isinstance(self.grip_sensing, GripSensing):
                 raise ArgumentError("invalid `world.grip_sensing`: a GripSensing, for the arm rig", "world.grip_sensing")
+        if not isinstance(self.noslip, bool) or (not self.noslip and self.rig != "arm"):
+            raise ArgumentError("invalid `world.noslip`: True or False (False: the arm rig only)", "world.noslip")
 
 
 @dataclass
@@ -259,6 +263,8 @@ def _arm(world, scene, plan, loop, pert, observe) -> dict:
     if loop == "closed":
         from .arm_loop import control_arm
 
+        if not world.noslip:
+            raise ArgumentError("invalid `world.noslip`: False is for the open loop only", "world.noslip")
         r = control_arm(scene, plan, **_options(world, control_arm, {
             "workcell": world.workcell, "scales": pert, "robot": world.robot,
             "start_error": np.zeros(3) if se is None else se, "sensing": world.grip_sensing}))
@@ -268,7 +274,7 @@ def _arm(world, scene, plan, loop, pert, observe) -> dict:
     am = arm_motion_of(world, plan)
     start = None if se is None else np.asarray(plan.poses[0], float) + se
     r = execute_arm(scene, plan, am.motion, world.robot, pert, observe=observe, trajectory=am.trajectory, start=start,
-                    sensing=world.grip_sensing)
+                    sensing=world.grip_sensing, noslip=world.noslip)
     return {"final": r.in_hand[-1], "poses": r.in_hand, "detail": r, "duration": r.duration,
             "creep": (r.max_creep, r.max_creep_angle), "tracking": r.tracking, "motion": am.motion,
             "trajectory": r.trajectory, "refused": list(am.refused)}
