@@ -110,6 +110,10 @@ CASES = [  # (id, command line after `regrasp`, the extra it needs, the modules 
      "ray", ("ray",)),
     ("control --engine mujoco", ["control", "{ex}/block-high-friction.toml", "--plan", "{plan}", "--engine", "mujoco"],
      "mujoco", OPTIONAL),
+    ("validate --engines drake", ["validate", "{ex}/block-low-friction.toml", "--engines", "drake", "--pushes", "2"],
+     "drake", ("pydrake",)),
+    ("simulate --engine drake", ["simulate", "{ex}/block-high-friction.toml", "--plan", "{plan}", "--engine", "drake"],
+     "drake", ("pydrake",)),
 ]
 
 

@@ -125,7 +125,7 @@ STAGES = (
     ("reference",),
     ("sim",),
     ("workcell",),
-    ("mujoco",),
+    ("mujoco", "drake"),
     ("control",),
     ("robot",),
     ("execution",),

@@ -22,9 +22,9 @@ def cmd_validate(a) -> int:
     check_count(a, "pushes", 1, MAX_PUSHES)
     check_count(a, "workers", 1, MAX_WORKERS)
     engines = tuple(e.strip() for e in a.engines.split(",") if e.strip())
-    if "mujoco" not in engines:
-        refuse_flags(a, ("workers", "ray"), "without the MuJoCo engine", "only MuJoCo pushes run in processes "
-                     "(add --engines mujoco)")
+    if not {"mujoco", "drake"} & set(engines):
+        refuse_flags(a, ("workers", "ray"), "without the MuJoCo or Drake engine", "only their pushes run in "
+                     "processes (add --engines mujoco or drake)")
     if "quasistatic" not in engines:
         refuse_flags(a, ("support", "rings"), "without the quasi-static engine", "it is the quasi-static simulator's pad model")
     if a.rings is not None and a.support == "limit_surface":
@@ -42,9 +42,11 @@ def _check_engine_flags(a) -> None:
     """The flags of `regrasp simulate` that only one engine uses."""
     if a.engine == "quasistatic":
         refuse_flags(a, ("scale_friction", "scale_grip", "scale_mass", "perturb", "video"), "with --engine quasistatic",
-                     "they change or show the MuJoCo world (add --engine mujoco)")
+                     "they change or show the MuJoCo or Drake world (add --engine mujoco or drake)")
     else:
-        refuse_flags(a, ("dt",), "with --engine mujoco", "it is the quasi-static simulator's time step")
+        refuse_flags(a, ("dt",), f"with --engine {a.engine}", "it is the quasi-static simulator's time step")
+    if a.engine == "drake":
+        refuse_flags(a, ("video",), "with --engine drake", "the video is MuJoCo's renderer (use --plot)")
     if not a.perturb:
         refuse_flags(a, ("seed",), "without --perturb", "it seeds the factors --perturb draws")
 
@@ -196,10 +198,11 @@ def add_parsers(sub) -> None:
                     cmd_validate)
     v.add_argument("scene", help="a planar scene file")
     v.add_argument("--pushes", type=int, default=api_default(validate, "pushes"), help=f"random pushes, 1 to {MAX_PUSHES}")
-    v.add_argument("--engines", default="quasistatic", help="comma-separated: quasistatic,mujoco")
+    v.add_argument("--engines", default="quasistatic", help="comma-separated: quasistatic,mujoco,drake (drake: "
+                   "pip install 'regrasp[drake]')")
     v.add_argument("--seed", type=seed_arg, default=api_default(validate, "seed"), help="random seed, a whole number >= 0")
-    v.add_argument("--workers", type=int, help=f"local processes for MuJoCo, 1 to {MAX_WORKERS} (default: all cores)")
-    v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo pushes over a Ray cluster ('local' starts one)")
+    v.add_argument("--workers", type=int, help=f"local processes for MuJoCo and Drake, 1 to {MAX_WORKERS} (default: all cores)")
+    v.add_argument("--ray", metavar="ADDRESS", help="spread MuJoCo and Drake pushes over a Ray cluster ('local' starts one)")
     v.add_argument("--support", choices=["points", "limit_surface"],
                    help="quasi-static pads as point sets or as one patch on the ellipsoidal limit surface (eq 3.7) "
                    f"(default: {quasistatic_defaults()['support']})")
@@ -214,13 +217,13 @@ def add_parsers(sub) -> None:
                     cmd_simulate)
     s.add_argument("scene", help="the scene file the plan is for")
     s.add_argument("--plan", required=True, metavar="PLAN.json", help="the plan file")
-    s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco"],
-                   help="our quasi-static simulator or MuJoCo")
+    s.add_argument("--engine", default="quasistatic", choices=["quasistatic", "mujoco", "drake"],
+                   help="our quasi-static simulator, MuJoCo or Drake (planar; pip install 'regrasp[drake]')")
     s.add_argument("--dt", type=float, help=f"quasi-static time step [s] (default: {api_default(quasistatic.replay_plan, 'dt')} "
                    f"planar, {api_default(Scene3D.replay, 'dt')} 3-D)")
-    add_scale_options(s, "MuJoCo: ")
+    add_scale_options(s, "MuJoCo and Drake: ")
     s.add_argument("--perturb", type=float,
-                   help="MuJoCo, planar: also draw each factor uniformly in [1-P, 1+P] from --seed (default: 0, none)")
+                   help="MuJoCo and Drake, planar: also draw each factor uniformly in [1-P, 1+P] from --seed (default: 0, none)")
     s.add_argument("--seed", type=seed_arg, help=f"random seed of --perturb (default: {PERTURB_SEED})")
     s.add_argument("--video", metavar="GIF|MP4", help="MuJoCo, planar: an animation of the execution")
     s.add_argument("--plot", metavar="PNG", help="planar: planned against simulated poses")

@@ -33,7 +33,7 @@ from ..workcell.description import Workcell
 #: moved as planned), a free-flying gripper in a workcell, or the arm holding the gripper.
 RIGS = ("planner", "free-gripper", "arm")
 #: The physics: the quasi-static model the plans are made with, or MuJoCo (shares none of it).
-ENGINES = ("quasistatic", "mujoco")
+ENGINES = ("quasistatic", "mujoco", "drake")
 LOOPS = ("open", "closed")
 
 
@@ -204,7 +204,11 @@ def _refuse_start(scene, plan, pert, what: str) -> None:
 
 
 def _planner(world, scene, plan, loop, pert, observe) -> dict:
-    """The planner's view: quasi-static replay, MuJoCo, or (closed) the MPC / re-planning."""
+    """The planner's view: quasi-static replay, MuJoCo, Drake (planar, open loop), or (closed)
+    the MPC / re-planning."""
+    if world.engine == "drake" and (scene.dimension == 3 or loop == "closed"):
+        raise ArgumentError("invalid `world.engine`: Drake replays planar plans open loop (3-D and closed loop: "
+                            "quasistatic or mujoco)", "world.engine")
     if scene.dimension == 3:
         _refuse_start(scene, plan, pert, "a 3-D run")
         if world.engine == "quasistatic":
@@ -233,6 +237,10 @@ def _planner(world, scene, plan, loop, pert, observe) -> dict:
         from ..sim.quasistatic import replay_plan
 
         r = replay_plan(pert.scene(scene), plan, **_options(world, replay_plan, {}))
+    elif world.engine == "drake":
+        from ..drake.replay import replay_plan
+
+        r = replay_plan(scene, plan, **_options(world, replay_plan, {"perturb": pert}))
     else:
         from ..mujoco.planar import execute_plan
 

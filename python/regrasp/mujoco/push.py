@@ -73,62 +73,75 @@ class PushRig(Rig):
         return {"t": np.array(t), "pose": np.array(poses), "pusher_pose": np.array(pushers)}
 
     def slip_fraction(self, pose, twist, distance: float = 0.003, speed: float = 0.01) -> float:
-        """How far the pusher and the object move apart at the contact over a short push of
-        ``twist`` (m/s, m/s, rad/s) from ``pose`` (m, m, rad), as a
-        share of the push: for a line pusher, the largest motion of the object relative to the
-        pusher at either end of the line — its slide along the contact and its lift-off (a roll
-        about the other end), pressing in by the soft contact's compliance left out; for a point
-        pusher, the slide of its contact on the object (the object may turn about it)."""
-        tw = np.asarray(twist, float)
-        norm = float(np.linalg.norm(self.scene.metric_twist(tw)))
-        tw = tw / norm * speed
-        pts = self.scene.pusher(self.pusher).points
-        if len(pts) == 1:
-            return self._point_slip(pose, tw, distance, speed, pts[0])
-        r = self.push(pose, tw, distance / speed, record_dt=distance / speed)
-        rel0 = planar_compose(planar_inverse(r["pusher_pose"][0]), r["pose"][0])
-        rel1 = planar_compose(planar_inverse(r["pusher_pose"][-1]), r["pose"][-1])
-        n = self.scene.pusher(self.pusher).normal
-        n = n / np.linalg.norm(n)
-        t = np.array([-n[1], n[0]])
-        worst = 0.0
-        for c in pts:
-            # the object's material point at contact point c, seen from the pusher, before and
-            # after: its slide along the contact, and how far it lifted off the pusher (pressing
-            # further in is the soft contact's compliance, not a slip)
-            d = planar_compose(rel1, np.r_[c, 0.0])[:2] - planar_compose(rel0, np.r_[c, 0.0])[:2]
-            worst = max(worst, float(np.hypot(d @ t, max(0.0, d @ n))))
-        return worst / distance
-
-    def _point_slip(self, pose, twist, distance, speed, c) -> float:
-        """A point pusher sticks when its contact does not slide on the object (the object may
-        turn about it, rolling on the feature's small cylinder): the tangential slide at the
-        contact, integrated over the push (every 2.5 ms)."""
-        n = self.scene.pusher(self.pusher).normal
-        n = n / np.linalg.norm(n)
-        r = self.push(pose, twist, distance / speed, record_dt=0.0025)
-        centre = np.r_[c - FEATURE_RADIUS * n, 0.0]
-        slide = 0.0
-        for k in range(len(r["t"]) - 1):
-            q0, q1 = r["pose"][k], r["pose"][k + 1]
-            p0, p1 = r["pusher_pose"][k], r["pusher_pose"][k + 1]
-            nw = planar_rotate(q0[2], n)
-            x = planar_compose(p0, centre)[:2] + FEATURE_RADIUS * nw  # the contact point (world)
-            mo = planar_compose(planar_inverse(q0), np.r_[x, 0.0])  # material points there
-            mp = planar_compose(planar_inverse(p0), np.r_[x, 0.0])
-            d = (planar_compose(q1, mo)[:2] - x) - (planar_compose(p1, mp)[:2] - x)
-            slide += abs(d[0] * nw[1] - d[1] * nw[0])
-        return float(slide / distance)
+        """:func:`slip_fraction` of a push in this rig."""
+        return slip_fraction(self.scene, self.pusher, self.push, pose, twist, distance, speed)
 
     def sticks(self, pose, twist, distance: float = 0.003, speed: float = 0.01, ratio: float = 0.02) -> bool:
         """Whether the pusher and the object move together over a short push of ``twist``
         (m/s, m/s, rad/s) from ``pose`` (m, m, rad): they move apart at
         the contact by less than ``ratio`` of the push (:meth:`slip_fraction`; soft contacts creep
         by about 1% of a push when the pusher sticks)."""
-        f = self.slip_fraction(pose, twist, distance, speed)
-        if not np.isfinite(f):
-            raise FloatingPointError("the MuJoCo push diverged (non-finite poses)")
-        return f < ratio
+        return sticks(self.slip_fraction(pose, twist, distance, speed), ratio)
+
+
+def sticks(slip: float, ratio: float = 0.02) -> bool:
+    """Whether a push whose :func:`slip_fraction` is ``slip`` sticks: below ``ratio``; a
+    FloatingPointError when the engine diverged (a non-finite slip)."""
+    if not np.isfinite(slip):
+        raise FloatingPointError("the push diverged (non-finite poses)")
+    return slip < ratio
+
+
+def slip_fraction(scene: Scene, pusher: str, push, pose, twist, distance: float = 0.003, speed: float = 0.01) -> float:
+    """How far the pusher and the object move apart at the contact over a short push of
+    ``twist`` (m/s, m/s, rad/s) from ``pose`` (m, m, rad) at ``speed`` [m/s] over ``distance``
+    [m], as a share of the push, in an engine's ``push(pose, twist, duration, record_dt=...)``
+    (times, object and pusher poses: :meth:`PushRig.push`, the Drake rig's): for a line pusher,
+    the largest motion of the object relative to the pusher at either end of the line — its
+    slide along the contact and its lift-off (a roll about the other end), pressing in by the
+    soft contact's compliance left out; for a point pusher, the slide of its contact on the
+    object (the object may turn about it)."""
+    tw = np.asarray(twist, float)
+    norm = float(np.linalg.norm(scene.metric_twist(tw)))
+    tw = tw / norm * speed
+    pts = scene.pusher(pusher).points
+    if len(pts) == 1:
+        return _point_slip(scene, pusher, push, pose, tw, distance, speed, pts[0])
+    r = push(pose, tw, distance / speed, record_dt=distance / speed)
+    rel0 = planar_compose(planar_inverse(r["pusher_pose"][0]), r["pose"][0])
+    rel1 = planar_compose(planar_inverse(r["pusher_pose"][-1]), r["pose"][-1])
+    n = scene.pusher(pusher).normal
+    n = n / np.linalg.norm(n)
+    t = np.array([-n[1], n[0]])
+    worst = 0.0
+    for c in pts:
+        # the object's material point at contact point c, seen from the pusher, before and
+        # after: its slide along the contact, and how far it lifted off the pusher (pressing
+        # further in is the soft contact's compliance, not a slip)
+        d = planar_compose(rel1, np.r_[c, 0.0])[:2] - planar_compose(rel0, np.r_[c, 0.0])[:2]
+        worst = max(worst, float(np.hypot(d @ t, max(0.0, d @ n))))
+    return worst / distance
+
+
+def _point_slip(scene: Scene, pusher: str, push, pose, twist, distance, speed, c) -> float:
+    """A point pusher sticks when its contact does not slide on the object (the object may
+    turn about it, rolling on the feature's small cylinder): the tangential slide at the
+    contact, integrated over the push (every 2.5 ms)."""
+    n = scene.pusher(pusher).normal
+    n = n / np.linalg.norm(n)
+    r = push(pose, twist, distance / speed, record_dt=0.0025)
+    centre = np.r_[c - FEATURE_RADIUS * n, 0.0]
+    slide = 0.0
+    for k in range(len(r["t"]) - 1):
+        q0, q1 = r["pose"][k], r["pose"][k + 1]
+        p0, p1 = r["pusher_pose"][k], r["pusher_pose"][k + 1]
+        nw = planar_rotate(q0[2], n)
+        x = planar_compose(p0, centre)[:2] + FEATURE_RADIUS * nw  # the contact point (world)
+        mo = planar_compose(planar_inverse(q0), np.r_[x, 0.0])  # material points there
+        mp = planar_compose(planar_inverse(p0), np.r_[x, 0.0])
+        d = (planar_compose(q1, mo)[:2] - x) - (planar_compose(p1, mp)[:2] - x)
+        slide += abs(d[0] * nw[1] - d[1] * nw[0])
+    return float(slide / distance)
 
 
 def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, record_dt: float = 0.02,

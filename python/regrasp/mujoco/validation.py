@@ -119,7 +119,11 @@ def sample_push(scene: Scene, pose, pusher: str, kind: str, rng):
     return np.array([v[0], v[1], 0.0]), stick
 
 
-ENGINES = ("quasistatic", "mujoco")
+ENGINES = ("quasistatic", "mujoco", "drake")
+#: The simulators measured by the slip at the pusher (:func:`~regrasp.mujoco.push.slip_fraction`),
+#: by their names in print, and the share of the push below which a push sticks.
+SIMULATORS = {"mujoco": "MuJoCo", "drake": "Drake"}
+STICK_RATIO = 0.02
 #: fewest quasi-static pushes solved in one call of the core (it solves a call's pushes in parallel)
 QS_BATCH = 64
 KINDS = ("inside", "near", "random")
@@ -154,23 +158,34 @@ def samples(scene: Scene, pushes: int, seed: int, progress: bool = False) -> lis
     return out
 
 
-def _mujoco_chunk(scene: Scene, chunk: list) -> list:
-    """MuJoCo outcomes of a chunk of (index, pusher, pose, twist); None where the run failed."""
+def _rig(engine: str, scene: Scene, pusher: str):
+    """The push rig of a simulator engine (``mujoco`` or ``drake``) for one pusher."""
+    if engine == "drake":
+        from ..drake.push import DrakePushRig
+
+        return DrakePushRig(scene, pusher)
     from .push import PushRig
 
+    return PushRig(scene, pusher)
+
+
+def _engine_chunk(scene: Scene, chunk: list, engine: str = "mujoco") -> list:
+    """A simulator's slip fractions (:func:`~regrasp.mujoco.push.slip_fraction`) of a chunk of
+    (index, pusher, pose, twist); None where the run failed or diverged."""
     rigs, out = {}, []
     for i, pusher, pose, u in chunk:
         if pusher not in rigs:  # building the model: an error here is the caller's, never swallowed
-            rigs[pusher] = PushRig(scene, pusher)
+            rigs[pusher] = _rig(engine, scene, pusher)
         try:
-            out.append((i, rigs[pusher].sticks(pose, u)))
-        except (RegraspError, FloatingPointError, ValueError):  # an unstable run counts as unsolved, never as an answer
+            f = rigs[pusher].slip_fraction(pose, u)
+            out.append((i, f if np.isfinite(f) else None))
+        except (RegraspError, FloatingPointError, ValueError, RuntimeError):  # unsolved, never an answer
             out.append((i, None))
     return out
 
 
-def _mujoco_job(job: tuple) -> list:
-    return _mujoco_chunk(*job)
+def _engine_job(job: tuple) -> list:
+    return _engine_chunk(*job)
 
 
 def _ignore_sigint() -> None:
@@ -205,14 +220,14 @@ def ray_init(address: str, workers: int):
     return ray
 
 
-def _each_chunk(scene: Scene, chunks: list, workers: int, ray_address, take) -> None:
-    """``take(outcomes)`` of every chunk, run on Ray (``ray_address``), here (one worker) or in a
-    process pool."""
+def _each_chunk(scene: Scene, chunks: list, workers: int, ray_address, take, engine: str = "mujoco") -> None:
+    """``take(outcomes)`` of every chunk in ``engine``, run on Ray (``ray_address``), here (one
+    worker) or in a process pool."""
     if ray_address is not None:
         ray = ray_init(ray_address, workers)
         try:
-            remote = ray.remote(_mujoco_chunk)
-            pending = [remote.remote(scene, c) for c in chunks]
+            remote = ray.remote(_engine_chunk)
+            pending = [remote.remote(scene, c, engine) for c in chunks]
             while pending:
                 done, pending = ray.wait(pending, num_returns=1)
                 take(ray.get(done[0]))
@@ -224,28 +239,29 @@ def _each_chunk(scene: Scene, chunks: list, workers: int, ray_address, take) -> 
             raise
     elif workers <= 1:
         for c in chunks:
-            take(_mujoco_chunk(scene, c))
+            take(_engine_chunk(scene, c, engine))
     else:
         # a Pool's exit terminates its workers at once (Ctrl-C does not wait for running chunks);
         # the workers ignore SIGINT, the parent ends them
         with multiprocessing.Pool(workers, initializer=_ignore_sigint) as pool:
-            for part in pool.imap_unordered(_mujoco_job, [(scene, c) for c in chunks]):
+            for part in pool.imap_unordered(_engine_job, [(scene, c, engine) for c in chunks]):
                 take(part)
 
 
-def _run_mujoco(scene: Scene, rows: list, workers: int, ray_address, progress: bool) -> np.ndarray:
+def _run_engine(scene: Scene, rows: list, workers: int, ray_address, progress: bool, engine: str = "mujoco") -> np.ndarray:
+    """Each push's slip fraction in a simulator ``engine`` (NaN: unsolved)."""
     jobs = [(i, r[0], r[2], r[3]) for i, r in enumerate(rows)]
     size = max(1, min(50, len(jobs) // max(4 * workers, 1) or 1))
     chunks = [jobs[k:k + size] for k in range(0, len(jobs), size)]
     result = np.full(len(rows), np.nan)
     # the bar ends before any message (Ctrl-C included)
-    with bars.bar(len(jobs), f"MuJoCo pushes ({scene.name})", unit="push", show=progress) as bar:
+    with bars.bar(len(jobs), f"{SIMULATORS[engine]} pushes ({scene.name})", unit="push", show=progress) as bar:
         def take(part):
-            for i, st in part:
-                result[i] = np.nan if st is None else float(st)
+            for i, f in part:
+                result[i] = np.nan if f is None else float(f)
             bar.update(len(part))
 
-        _each_chunk(scene, chunks, workers, ray_address, take)
+        _each_chunk(scene, chunks, workers, ray_address, take, engine)
     return result
 
 
@@ -296,19 +312,23 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
     for e in engines:
         if e not in ENGINES:
             raise ArgumentError(f"invalid `engines`: unknown engine {e!r} (available: {', '.join(ENGINES)})", "engines")
-    if "mujoco" in engines and scene.kind != "grasp":
-        raise ArgumentError(f"invalid `engines`: the MuJoCo model is a parallel-jaw grasp; scene {scene.name!r} "
-                            f"is a {scene.kind!r} scene (use quasistatic)", "engines")
+    for e in SIMULATORS:
+        if e in engines and scene.kind != "grasp":
+            raise ArgumentError(f"invalid `engines`: the {SIMULATORS[e]} model is a parallel-jaw grasp; scene "
+                                f"{scene.name!r} is a {scene.kind!r} scene (use quasistatic)", "engines")
     if "mujoco" in engines:  # before any work
         need("mujoco", "mujoco")
-        if ray_address is not None:
-            need("ray", "ray")
+    if "drake" in engines:
+        need("pydrake", "drake")
+    if ray_address is not None and set(engines) & set(SIMULATORS):
+        need("ray", "ray")
     workers = workers or os.cpu_count() or 1
     rows = samples(scene, pushes, seed, progress)
     pred = np.array([r[4] for r in rows])
     amb = np.array([r[5] for r in rows], bool)
     kind = np.array([r[1] for r in rows])
     out = {"scene": scene.name, "pushes": pushes, "seed": seed, "limit_surface": scene.limit_surface}
+    slips: dict = {}
     for engine in engines:
         if engine == "quasistatic":
             sim, ok = _run_quasistatic(scene, rows, support, progress)
@@ -316,9 +336,10 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
             if support["support"] == "points":
                 out["rings"] = support["rings"]
         else:
-            res = _run_mujoco(scene, rows, workers, ray_address, progress)
-            ok = ~np.isnan(res)
-            sim = np.nan_to_num(res) > 0.5
+            slips[engine] = _run_engine(scene, rows, workers, ray_address, progress, engine)
+            ok = ~np.isnan(slips[engine])
+            sim = np.nan_to_num(slips[engine], nan=1.0) < STICK_RATIO
+            out[f"slip_{engine}"] = [None if np.isnan(f) else round(float(f), 6) for f in slips[engine]]
         n = int(ok.sum())
         out[f"solved_{engine}"] = n
         out[f"agreement_{engine}"] = float(((pred == sim) & ok).sum() / max(n, 1))
@@ -329,10 +350,38 @@ def validate(scene: Scene, pushes: int = 2000, seed: int = 0, engines=("quasista
             k: {"pushes": int((kind == k).sum()),
                 "agreement": float(((pred == sim) & ok & (kind == k)).sum() / max(((kind == k) & ok).sum(), 1))}
             for k in KINDS}
+    if len(slips) == 2:
+        out["slip_comparison"] = compare_slips(*slips.values(), kind)
     # the names of the first version, for the quasi-static engine
     if "quasistatic" in engines:
         out["solved"] = out["solved_quasistatic"]
         out["by_sample_kind"] = out["by_sample_kind_quasistatic"]
+    return out
+
+
+def compare_slips(a: np.ndarray, b: np.ndarray, kind=None) -> dict:
+    """Two simulators' slip fractions of the same pushes (NaN: unsolved) compared: the pushes
+    both solved, how often their verdicts agree (:data:`STICK_RATIO`), the median and 90th
+    percentile of the difference of their slips (in shares of the push), the rank correlation
+    of the slips (Spearman's ρ), and, where one calls the push a stick and the other a slip, the
+    median of the larger slip (a small one is a threshold case: both engines barely slip)."""
+    ok = ~(np.isnan(a) | np.isnan(b))
+    a, b = a[ok], b[ok]
+    if len(a) == 0:
+        return {"pushes": 0}
+    diff = np.abs(a - b)
+    va, vb = a < STICK_RATIO, b < STICK_RATIO
+    split = va != vb
+    rank = lambda x: np.argsort(np.argsort(x, kind="stable"), kind="stable").astype(float)  # noqa: E731
+    ra, rb = rank(a), rank(b)
+    rho = float(np.corrcoef(ra, rb)[0, 1]) if len(a) > 2 and ra.std() > 0 and rb.std() > 0 else float("nan")
+    out = {"pushes": int(len(a)), "verdict_agreement": float((va == vb).mean()),
+           "median_abs_difference": float(np.median(diff)), "p90_abs_difference": float(np.percentile(diff, 90)),
+           "spearman": rho, "disagreements": int(split.sum()),
+           "disagreement_median_larger_slip": float(np.median(np.maximum(a, b)[split])) if split.any() else 0.0}
+    if kind is not None:
+        k = np.asarray(kind)[ok]
+        out["verdict_agreement_by_kind"] = {x: float((va == vb)[k == x].mean()) for x in KINDS if (k == x).any()}
     return out
 
 
@@ -355,4 +404,12 @@ def format_validation(res: dict) -> str:
             "  by kind of push: " + ", ".join(f"{k} {100 * v['agreement']:.1f}% of {v['pushes']}"
                                              for k, v in res[f"by_sample_kind_{engine}"].items()),
         ]
+    c = res.get("slip_comparison")
+    if c and c["pushes"]:
+        a, b = [SIMULATORS[e] for e in ENGINES if f"slip_{e}" in res]
+        lines += [f"  {a} against {b}, {c['pushes']} pushes both solved: verdicts agree on "
+                  f"{100 * c['verdict_agreement']:.1f}%; slip difference median {100 * c['median_abs_difference']:.2f}% "
+                  f"(90th percentile {100 * c['p90_abs_difference']:.2f}%) of the push, rank correlation "
+                  f"{c['spearman']:.3f}; where they disagree the larger slip is {100 * c['disagreement_median_larger_slip']:.1f}% "
+                  f"of the push (median)"]
     return "\n".join(lines)
