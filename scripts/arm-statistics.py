@@ -29,7 +29,8 @@ def row(o) -> str:
     creep = "-" if np.all(np.isnan(creep)) else f"{np.nanmax(creep) * 1e3:.2f}"
     m = [x for x in o.margins if x is not None]
     margin = f"{min(m):.2f} ({np.median(m):.2f})" if m else "-"
-    return f"| {o.name} | {o.successes}/{o.runs} | {err} | {creep} | {margin} | {o.seconds:.0f} |"
+    nominal = "" if not o.succeeded else " (nominal ✓)" if o.succeeded[0] else " (nominal ✗)"
+    return f"| {o.name} | {o.successes}/{o.runs}{nominal} | {err} | {creep} | {margin} | {o.seconds:.0f} |"
 
 
 def main() -> int:

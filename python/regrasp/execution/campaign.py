@@ -28,7 +28,8 @@ class Outcome:
     on in a perturbed world; each counts as a failed run); ``margins``: per run the smallest
     share of the pads' friction left unused through the arm's motion in that run's world (the
     nominal trajectory's :mod:`~regrasp.execution.holding` ratio × mass / (finger friction ×
-    grip); None: not tested, a 3-D scene or closed loop)."""
+    grip); None: not tested, a 3-D scene or closed loop); ``succeeded``: per run whether it
+    succeeded (the first run is the nominal world, :func:`draws`)."""
     name: str
     runs: int = 0
     successes: int = 0
@@ -38,6 +39,7 @@ class Outcome:
     seconds: float = 0.0
     failures: list = field(default_factory=list)
     margins: list = field(default_factory=list)
+    succeeded: list = field(default_factory=list)
 
     @property
     def rate(self) -> float:
@@ -92,9 +94,11 @@ def example(name: str, runs: int, spread: float, seed: int = 0, closed_loop: boo
         except RegraspError as e:  # the arm could not go on in this world: a failed run
             out.failures.append(f"{type(e).__name__}: {e}")
             out.runs += 1
+            out.succeeded.append(False)
             continue
         out.runs += 1
         out.successes += int(r.success)
+        out.succeeded.append(bool(r.success))
         worst = None if holding is None else 1 - (1 - holding.smallest) * scales.mass / (scales.finger_friction * scales.grip)
         out.margins.append(worst)
         e = r.goal_error  # against the task; 3-D as [position, angle]
