@@ -28,7 +28,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..extras import need
-from ..fields import check_name, check_number, check_vector
 from ..pose import integrate_pose
 from ..scene.planar import Scene
 
@@ -43,8 +42,8 @@ PAD_DEPTH = 0.01
 PAD_RESOLUTION = 0.001
 #: The pusher's feature: compliant hydroelastic too, its modulus [Pa] (a hard rubber).
 FEATURE_MODULUS = 5e7
-#: The pads' and the pusher's Hunt–Crossley dissipation [s/m]; point-contact stiffness [N/m]
-#: of the pusher's feature against the object (both rigid: Drake's point contact).
+#: The pads' and the pusher's Hunt–Crossley dissipation [s/m]; the point-contact stiffness
+#: [N/m] where Drake falls back to point contact (none here: every contact has a compliant side).
 DISSIPATION = 5.0
 POINT_STIFFNESS = 1e6
 #: The pads' mass [kg] and their joints' damping [N·s/m]; the driven pusher's mass [kg] and PD
@@ -85,9 +84,9 @@ class DrakeRig:
         self._build()
 
     def _build(self) -> None:
-        from pydrake.all import (AddMultibodyPlant, DiagramBuilder, FixedOffsetFrame, MultibodyPlantConfig,
-                                 PlanarJoint, PrismaticJoint, RigidTransform, RotationalInertia, RotationMatrix,
-                                 Simulator, SpatialInertia)
+        from pydrake.all import (AddMultibodyPlant, CollisionFilterDeclaration, DiagramBuilder, FixedOffsetFrame,
+                                 GeometrySet, MultibodyPlantConfig, PlanarJoint, PrismaticJoint, RigidTransform,
+                                 RotationalInertia, RotationMatrix, Simulator, SpatialInertia)
         from ..mujoco.model import THICKNESS
 
         s = self.scene
@@ -95,7 +94,7 @@ class DrakeRig:
         cfg = MultibodyPlantConfig(time_step=SETTINGS["time_step"], contact_model=SETTINGS["contact_model"],
                                    discrete_contact_approximation=SETTINGS["discrete_contact_approximation"],
                                    sap_near_rigid_threshold=SETTINGS["near_rigid_threshold"])
-        plant, _ = AddMultibodyPlant(cfg, builder)
+        plant, scene_graph = AddMultibodyPlant(cfg, builder)
         gdir, g = s.gravity
         plant.mutable_gravity_field().set_gravity_vector([gdir[0] * g, 0.0, gdir[1] * g])
         # the plane: F's x along X, y along Z, z along −Y (a planar angle about −Y is θ)
@@ -127,6 +126,12 @@ class DrakeRig:
         self._features = {p: self._driven(plant, drv, p) for p in self.pushers}
         plant.set_gravity_enabled(drv, False)
         plant.Finalize()
+        # a feature touches only the object (as in MuJoCo): never the pads
+        ids = lambda bodies: GeometrySet([g for b in bodies for g in plant.GetCollisionGeometriesForBody(b)])  # noqa: E731
+        features = [plant.GetBodyByName(f"feature_{p}") for p in self.pushers]
+        pad_bodies = [plant.GetBodyByName(n) for n in ("pad_left", "pad_right")]
+        scene_graph.collision_filter_manager().Apply(
+            CollisionFilterDeclaration().ExcludeBetween(ids(pad_bodies), ids(features)))
         builder.ExportInput(plant.get_desired_state_input_port(drv), "features_state")
         builder.ExportInput(plant.get_actuation_input_port(pads), "grip")
         builder.ExportInput(plant.get_actuation_input_port(drv), "features_ff")
@@ -333,14 +338,3 @@ def _convex(verts: np.ndarray, label: str):
     from pydrake.all import Convex
 
     return Convex(np.asarray(verts, float).T, label)
-
-
-def simulate_push(scene: Scene, pose, pusher: str, twist, duration: float, record_dt: float = 0.02) -> dict:
-    """A push in Drake (as :func:`regrasp.mujoco.push.simulate_push`): the pads squeeze for 0.3
-    s, then the pusher moves with constant body ``twist`` (m/s, m/s, rad/s) from ``pose`` (m, m,
-    rad) for ``duration`` [s], recorded every ``record_dt`` [s]."""
-    pose, twist, pusher = check_vector(pose, 3, "pose"), check_vector(twist, 3, "twist"), check_name(pusher, "pusher")
-    duration = check_number(duration, "duration", high=MAX_DURATION)
-    record_dt = check_number(record_dt, "record_dt", high=MAX_DURATION)
-    r = DrakePushRig(scene, pusher).push(pose, twist, duration, settle=0.3, record_dt=record_dt)
-    return {"t": r["t"], "pose": r["pose"], "settled_pose": r["pose"][0]}
