@@ -300,20 +300,25 @@ def solve_arm(robot, motion: WorldMotion, tcp, load=None, boost: bool = False) -
     return timed(robot, motion, tcp, q, load)
 
 
-def _boost(robot, motion: WorldMotion, load, q) -> None:
-    """The grip raised between pushes (:meth:`~regrasp.execution.holding.ObjectLoad.boost`),
-    within :data:`~regrasp.execution.holding.MAX_GRIP_SHARE` of the gripper's force range:
-    ``motion.grip_force`` per sample."""
+def grip_ceiling(robot) -> float:
+    """The most per-finger grip force [N] the grip is raised to between pushes:
+    :data:`~regrasp.execution.holding.MAX_GRIP_SHARE` of the gripper's force range."""
     from ..robot.grip import robot_pad_state
     from ..robot.kinds import GRIP_RANGE
     from .holding import MAX_GRIP_SHARE
 
     gain, bias, _ = robot_pad_state(robot)
+    return MAX_GRIP_SHARE * (GRIP_RANGE * gain + bias)
+
+
+def _boost(robot, motion: WorldMotion, load, q) -> None:
+    """The grip raised between pushes (:meth:`~regrasp.execution.holding.ObjectLoad.boost`),
+    within :func:`grip_ceiling`: ``motion.grip_force`` per sample."""
     f = np.asarray(motion.grip_force, float)
     base = float(np.max(f)) if np.any(f > 0) else 0.0
     if base <= 0:
         return
-    scale = load.boost(q, MAX_GRIP_SHARE * (GRIP_RANGE * gain + bias) / base)
+    scale = load.boost(q, grip_ceiling(robot) / base)
     motion.grip_force = np.where(f > 0, f * scale, f)
 
 

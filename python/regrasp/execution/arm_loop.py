@@ -33,7 +33,7 @@ from ..errors import ArgumentError, ExecutionError, RegraspError
 from ..extras import need
 from ..scene.perturbation import Perturbation
 from ..scene.settings import mpc_defaults
-from .arm import CONTACT_CLEARANCE, arm_motion, build_robot, close_on, first_solution
+from .arm import CONTACT_CLEARANCE, arm_motion, build_robot, close_on, first_solution, grip_ceiling
 from .assignment import assign, pusher_contact
 from .world_motion import Segments, Timing, grip_force
 
@@ -95,8 +95,10 @@ class ArmPlant:
         self._jq, self._jv = jq, m.jnt_dofadr[m.body_jntadr[body]]
         r.data.qpos[jq:jq + 7] = P.compose(r.tcp_pose(), self.untcp, O)  # at the arm's actual TCP
         mujoco.mj_forward(m, r.data)
-        # the plan's grip (the open loop's motion raises it between pushes; this loop does not)
-        self.grip = close_on(r, body, geoms, float(grip_force(scene)) * scales.grip, sensing)
+        # the plan's grip, raised between pushes as the open loop's (:meth:`switch`)
+        self.grip_force, self.world_grip = float(grip_force(scene)), scales.grip
+        self.grip = close_on(r, body, geoms, self.grip_force * scales.grip, sensing)
+        self.grip_ceiling = grip_ceiling(r)
         self.solver = IKSolver(r, avoid)
         self.contact_solver = IKSolver(r, avoid, CONTACT_CLEARANCE)  # fingers near the feature in contact
         self.q = r.q.copy()  # the arm's commanded joints
@@ -162,7 +164,11 @@ class ArmPlant:
     def switch(self, pusher: str, O) -> None:
         """Switch-over to ``pusher`` with the object at in-hand pose ``O`` (m, unit quaternion):
         retreat from the feature in contact, transfer at the safe height, approach the new
-        pusher's feature until it meets the object."""
+        pusher's feature until it meets the object; the grip raised meanwhile as the open loop
+        raises it (:meth:`transfer_grip`), back at the plan's for the approach's last
+        :data:`~regrasp.execution.holding.SETTLE_SAMPLES` samples."""
+        from .holding import SETTLE_SAMPLES
+
         pose = P.spatial_to_planar(O) if self.scene.dimension == 2 else O
         a = self.feature(pusher, pose)
         Pk = P.compose(O, pusher_contact(self.scene, pusher, pose).frame)
@@ -173,11 +179,30 @@ class ArmPlant:
             seg.retreat(self.features[self.current], O)
         seg.transfer(pre, a, O)
         seg.approach(G0, a, O)
+        what = f"the switch-over to pusher `{pusher}` ({a.feature})"
         if len(seg.poses) > 1:
-            self._follow(seg.times[1:], seg.poses[1:], f"the switch-over to pusher `{pusher}` ({a.feature})",
-                         [lab in ("approach", "retreat") for lab in seg.samples.label[1:]])
+            times, poses = np.asarray(seg.times[1:], float), seg.poses[1:]
+            near = [lab in ("approach", "retreat") for lab in seg.samples.label[1:]]
+            k = max(0, len(poses) - SETTLE_SAMPLES)
+            if k > 0:
+                self.grip.set_force(self.transfer_grip(pose) * self.world_grip)
+                self._follow(times[:k], poses[:k], what, near[:k])
+            self.grip.set_force(self.grip_force * self.world_grip)
+            self._follow(times[k:] - (times[k - 1] if k > 0 else 0.0), poses[k:], what, near[k:])
         self.current = pusher
         self.switch_overs += 1
+
+    def transfer_grip(self, pose) -> float:
+        """The grip [N] between pushes with the object at in-hand ``pose``: raised until gravity
+        takes at most :data:`~regrasp.execution.holding.TRANSFER_SHARE` of the pads' friction
+        (planar scenes; the scene's gravity, which a transfer keeps in the gripper frame), within
+        :func:`~regrasp.execution.arm.grip_ceiling`; the plan's grip otherwise."""
+        from .holding import TRANSFER_SHARE
+
+        if self.scene.dimension != 2:
+            return self.grip_force
+        share = float(self.scene.hold_ratio(pose))
+        return self.grip_force * min(max(1.0, share / TRANSFER_SHARE), max(1.0, self.grip_ceiling / self.grip_force))
 
     def push(self, pusher: str, twist, duration: float, belief=None, absolute: bool = False):
         """Pushes with ``pusher``'s feature at body ``twist`` (planar ``[vx, vz, omega]`` (m/s,
