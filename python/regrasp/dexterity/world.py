@@ -190,6 +190,7 @@ class HandWorld:
         mujoco = need("mujoco", "robot")
         from ..execution.arm import close_on
         from ..robot.grip import close_fingers
+        from ..robot.sensing import GripSensing
 
         r = self.robot
         m, d = r.model, r.data
@@ -207,7 +208,8 @@ class HandWorld:
         start = P.compose(np.array([*perturbation.shift, np.cos(half), 0.0, np.sin(half), 0.0]), base)
         d.qpos[self.jq:self.jq + 7] = P.compose(self.hand_frame(), start)
         mujoco.mj_forward(m, d)
-        close_on(r, self.body, self.geoms, self.grip_force)
+        # the actions' own force loop measures the pads' forces (GripSchedule): the closing too
+        close_on(r, self.body, self.geoms, self.grip_force, GripSensing("ideal"))
         return self
 
     # --- reading the world ----------------------------------------------------------------------

@@ -243,8 +243,8 @@ class DrakeRig:
         self.simulator.Initialize()
 
     def place(self, pusher: str, pose) -> None:
-        """Puts ``pusher``'s feature frame at planar ``pose`` at once, at rest (to bring it or
-        park it where it touches nothing)."""
+        """Puts ``pusher``'s feature frame at planar ``pose`` ``[x, z, theta]`` (m, m, rad) at
+        once, at rest (to bring it or park it where it touches nothing)."""
         jx, jz, jt = self._features[pusher]
         pc = self.plant_context
         jx.set_translation(pc, pose[0])
@@ -322,8 +322,9 @@ class DrakePushRig(DrakeRig):
         return {"t": np.array(t), "pose": np.array(poses), "pusher_pose": np.array(pushers)}
 
     def slip_fraction(self, pose, twist, distance: float = 0.003, speed: float = 0.01) -> float:
-        """How far the pusher and the object move apart at the contact over a short push, as a
-        share of it (measured as in MuJoCo: :func:`regrasp.mujoco.push.slip_fraction`)."""
+        """How far the pusher and the object move apart at the contact over a short push of
+        ``twist`` (m/s, m/s, rad/s) from ``pose`` (m, m, rad), as a share of it (measured as in
+        MuJoCo: :func:`regrasp.mujoco.push.slip_fraction`)."""
         from ..mujoco.push import slip_fraction
 
         return slip_fraction(self.scene, self.pusher, self.push, pose, twist, distance, speed)

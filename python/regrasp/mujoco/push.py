@@ -73,7 +73,8 @@ class PushRig(Rig):
         return {"t": np.array(t), "pose": np.array(poses), "pusher_pose": np.array(pushers)}
 
     def slip_fraction(self, pose, twist, distance: float = 0.003, speed: float = 0.01) -> float:
-        """:func:`slip_fraction` of a push in this rig."""
+        """:func:`slip_fraction` of a push of ``twist`` (m/s, m/s, rad/s) from ``pose`` (m, m, rad)
+        in this rig."""
         return slip_fraction(self.scene, self.pusher, self.push, pose, twist, distance, speed)
 
     def sticks(self, pose, twist, distance: float = 0.003, speed: float = 0.01, ratio: float = 0.02) -> bool:
