@@ -114,3 +114,15 @@ def test_execute_in_drake_is_the_replay(block):
     with pytest.raises(ArgumentError) as e:
         execute(World(block, engine="drake"), plan, loop="closed")
     assert e.value.field == "world.engine"
+
+
+def test_what_drake_cannot_take_is_refused_naming_it(block):
+    from regrasp.drake.push import DrakeRig
+    from regrasp.drake.replay import replay_plan
+
+    with pytest.raises(ArgumentError) as e:
+        DrakeRig(regrasp.load_scene(example("offset-3d")), ("left",))
+    assert e.value.field == "scene"
+    with pytest.raises(ArgumentError) as e:
+        replay_plan(block, regrasp.plan(block, seed=0), perturb=(1.0, 1.0))
+    assert e.value.field == "perturb"

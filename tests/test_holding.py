@@ -168,3 +168,30 @@ def test_the_grip_is_raised_between_pushes_and_the_push_keeps_the_plans():
     assert np.all(scale[tail] == 1.0) and np.all(scale[40:45] == 1.0)
     assert np.allclose(ratio[raised], TRANSFER_SHARE, rtol=1e-3) and np.allclose(ratio[tail], 0.8, rtol=1e-3)
     assert np.all(load.boost(q, max_scale=1.2) <= 1.2)
+
+
+def test_the_closed_loop_raises_the_grip_between_pushes_as_the_open_loop():
+    """``ArmPlant.transfer_grip``: the plan's grip where gravity takes at most TRANSFER_SHARE,
+    raised in proportion beyond it, capped by the gripper's ceiling; the ceiling when the
+    measured pose has the pads (partly) off the object (no error mid-run)."""
+    from types import SimpleNamespace
+
+    import regrasp
+    from regrasp.execution.arm_loop import ArmPlant
+    from regrasp.execution.holding import TRANSFER_SHARE
+
+    scene = regrasp.load_scene(regrasp.examples.path("block-low-friction"))
+    me = SimpleNamespace(scene=scene, grip_force=10.0, grip_ceiling=40.0)
+    q = [0.0, 0.0, 0.0]
+    share = scene.hold_ratio(q)
+    want = 10.0 * max(1.0, share / TRANSFER_SHARE)
+    assert ArmPlant.transfer_grip(me, q) == pytest.approx(min(want, 40.0))
+    from pathlib import Path
+
+    heavy = regrasp.load_scene(Path(regrasp.examples.__file__).parent / "hard" / "heavy-low-friction.toml")
+    goal = heavy.task.goal  # gravity takes 82 % of the pads' friction there
+    h = SimpleNamespace(scene=heavy, grip_force=25.0, grip_ceiling=100.0)
+    ratio = heavy.hold_ratio(goal)
+    assert ratio > TRANSFER_SHARE and ArmPlant.transfer_grip(h, goal) == pytest.approx(25.0 * ratio / TRANSFER_SHARE)
+    assert ArmPlant.transfer_grip(SimpleNamespace(scene=heavy, grip_force=25.0, grip_ceiling=30.0), goal) == 30.0
+    assert ArmPlant.transfer_grip(me, [0.5, 0.5, 0.0]) == 40.0

@@ -74,6 +74,10 @@ class DrakeRig:
         from ..scene.perturbation import Perturbation
 
         need("pydrake", "drake")
+        if not isinstance(scene, Scene):
+            raise ArgumentError(f"invalid `scene`: Drake runs planar scenes (got {type(scene).__name__})", "scene")
+        if perturb is not None and not isinstance(perturb, Perturbation):
+            raise ArgumentError(f"invalid `perturb`: a regrasp.Perturbation (got {type(perturb).__name__})", "perturb")
         if scene.kind != "grasp":
             raise ArgumentError("invalid `scene`: the Drake model needs a grasp (not an object on a surface)", "scene")
         self.perturb = Perturbation() if perturb is None else perturb

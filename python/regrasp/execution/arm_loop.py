@@ -201,6 +201,8 @@ class ArmPlant:
 
         if self.scene.dimension != 2:
             return self.grip_force
+        if not self.scene.admissible(pose):  # the object has slid (partly) off the pads: hold what is left
+            return max(self.grip_force, self.grip_ceiling)
         share = float(self.scene.hold_ratio(pose))
         return self.grip_force * min(max(1.0, share / TRANSFER_SHARE), max(1.0, self.grip_ceiling / self.grip_force))
 
