@@ -27,7 +27,7 @@ use crate::mechanics::geometry::{perp, Mat3, Vec2, Vec3};
 use crate::mechanics::limit_surface::LimitSurface;
 use crate::mechanics::metric::Metric;
 pub use crate::cones::frame::{Classification, ConeMode, PusherModel, SupportFrame, MEMBERSHIP_TOL};
-pub use crate::cones::projection::{project_exact, project_onto_generators, project_with_margin, project_with_margin_on};
+pub use crate::cones::projection::{project_exact, project_exact_with_margin, project_onto_generators, project_with_margin, project_with_margin_on};
 
 /// Everything that defines one push at one pose.
 #[derive(Clone, Debug)]

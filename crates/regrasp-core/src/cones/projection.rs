@@ -51,6 +51,30 @@ pub fn project_with_margin_on(frame: &SupportFrame, model: &PusherModel, gens: &
             return None;
         }
     }
+    with_margin(frame, model, gens, v, margin_min)
+}
+
+/// The exact projection of `want` ([`project_exact`]: `want` itself when feasible, else the
+/// closest boundary ray in angle), then moved into the margin as [`project_with_margin_on`]
+/// does. Where gravity bends the cone so that the generators' span misses a direction of the
+/// exact cone (a heavy object slid along the pads by a line pusher: the edges' rays all turn
+/// it), the polyhedral projection is feasible yet far from `want`; this one is not.
+pub fn project_exact_with_margin(frame: &SupportFrame, model: &PusherModel, gens: &[Vec3], want: &Vec3, margin_min: f64) -> Option<Vec3> {
+    if gens.is_empty() || (frame.mode == ConeMode::Nominal && gens.len() < model.edges.len()) {
+        return None;
+    }
+    let v = project_exact(frame, model, want);
+    if v.amax() == 0.0 {
+        return None;
+    }
+    with_margin(frame, model, gens, v, margin_min)
+}
+
+/// Feasible `v` moved towards the generators' centre until its margin is at least `margin_min`
+/// (at `v`'s speed); `v` itself when it has the margin; `None` when neither reaches it and `v`
+/// is outside the cone.
+fn with_margin(frame: &SupportFrame, model: &PusherModel, gens: &[Vec3], v: Vec3, margin_min: f64) -> Option<Vec3> {
+    let m = &model.metric;
     let margin = |x: &Vec3| frame.classify(model, x).margin;
     if margin(&v) >= margin_min {
         return Some(v);

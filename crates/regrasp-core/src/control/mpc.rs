@@ -26,7 +26,7 @@
 
 use crate::error::{Error, Result};
 use crate::mechanics::geometry::Vec3;
-use crate::cones::motion_cone::project_with_margin_on;
+use crate::cones::motion_cone::{project_exact_with_margin, project_with_margin_on};
 use crate::dynamics::planar::integrate;
 use crate::cones::robust::generators;
 use crate::scene::planar::Scene;
@@ -308,7 +308,8 @@ impl Mpc {
         let mut g = generators(&f, model);
         let d = body_twist(at, target);
         if metric.twist_norm(&d) > 1e-12 && !g.is_empty() {
-            if let Some(u) = project_with_margin_on(&f, model, &g, &d, self.settings.margin) {
+            // the exact projection: the generators' span can miss the reference's direction
+            if let Some(u) = project_exact_with_margin(&f, model, &g, &d, self.settings.margin) {
                 let n = metric.twist_norm(&u);
                 if n > 1e-12 {
                     g.push(u / n);
