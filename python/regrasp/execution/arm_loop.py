@@ -38,6 +38,11 @@ from .assignment import assign, pusher_contact
 from .world_motion import Segments, Timing, grip_force
 
 
+#: how long [s] the arm holds still after its retreat from the last feature before the
+#: regrasp's end pose is measured (:meth:`ArmPlant.release`)
+RELEASE_DWELL = 0.3
+
+
 @dataclass
 class ArmLoopResult:
     """A closed-loop run with the arm: ``success`` (the object's final in-hand pose within the
@@ -233,6 +238,22 @@ class ArmPlant:
             G = P.compose(self.features[pusher].frame, P.inverse(P.compose(O, pusher_contact(self.scene, pusher, q).frame)))
         self._follow(s, [P.compose(G, O, P.inverse(o)) for o in Os], f"the push with pusher `{pusher}`")
 
+    def release(self) -> None:
+        """Ends a regrasp as the open loop's world motion does: retreats from the feature in
+        contact (if any) by the clearance, with the grip raised as between pushes
+        (:meth:`transfer_grip`), then holds still :data:`RELEASE_DWELL`: the object's pose in the
+        hand is the regrasp's once no feature touches it."""
+        if self.current is not None:
+            O = self.in_hand()
+            seg = Segments(self.timing, self.safe, _reach(self.scene, O), self.G, self.motion.envelope,
+                           self.motion.workcell.robot.base[:3], self.motion.workcell.contacts())
+            seg.retreat(self.features[self.current], O)
+            self.grip.set_force(self.transfer_grip(self.pose()) * self.world_grip)
+            self._follow(seg.times[1:], seg.poses[1:], "the retreat after the last push",
+                         [lab == "retreat" for lab in seg.samples.label[1:]])
+            self.current = None
+        self.idle(RELEASE_DWELL)
+
     def idle(self, duration: float):
         """Holds the arm still for ``duration`` [s] (the grip loop running)."""
         from ..robot.tracking import track
@@ -380,9 +401,33 @@ def _control_planar(scene, plan, workcell, scales, robot, timing, seed, max_time
         run.t += dt
     c = run.result()
     arm = made[0]
-    err, ok = goal_error(scene, plan, c.final_pose)
-    return ArmLoopResult(ok and c.success, err, c.replans, arm.time, arm.switch_overs, c.final_pose,
-                         c.failure, c)
+    if run.world_failed:
+        err, _ = goal_error(scene, plan, c.final_pose)
+        return ArmLoopResult(False, err, c.replans, arm.time, arm.switch_overs, c.final_pose, c.failure, c)
+    final, err, ok, failure = _released(arm, scene, plan, c.failure)  # the regrasp ends with the hand off the features
+    return ArmLoopResult(ok, err, c.replans, arm.time, arm.switch_overs, final, failure if not ok else "", c)
+
+
+def _released(arm: ArmPlant, scene, plan, failure: str) -> tuple[np.ndarray, np.ndarray, bool, str]:
+    """After :meth:`ArmPlant.release`: the in-hand pose, its error to the goal, whether within the
+    tolerance, and the run's failure — ``failure`` (the control's), the arm's when it cannot
+    retreat, or, when the release moved the object out of the tolerance, how far it moved."""
+    before = arm.pose()
+    _, held = goal_error(scene, plan, before)
+    try:
+        arm.release()
+    except RegraspError as e:  # the arm cannot retreat: the regrasp is not done, saying why
+        q = arm.pose()
+        return q, goal_error(scene, plan, q)[0], False, failure or str(e)
+    q = arm.pose()
+    err, ok = goal_error(scene, plan, q)
+    if held and not ok and not failure:
+        if scene.dimension == 2:
+            moved = f"{np.linalg.norm((q - before)[:2]) * 1e3:.2f} mm, {np.degrees(abs(q[2] - before[2])):.2f}°"
+        else:
+            moved = f"{np.linalg.norm((q - before)[:3]) * 1e3:.2f} mm, {np.degrees(P.quat_angle(before[3:], q[3:])):.2f}°"
+        failure = f"the object moved {moved} in the hand in the retreat from the last feature"
+    return q, err, ok, failure
 
 
 def sticking(scene, a: dict, b: dict) -> bool:
@@ -421,9 +466,7 @@ def _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_rep
         q, _, replans = run_plan3d(scene, path, step, arm.pose(), True, max_replans, seed)
     except RegraspError as e:  # the arm cannot go on, or no re-plan: the run ends, saying why
         q, failure = arm.pose(), str(e)
-    arm.idle(0.3)
-    q = arm.pose()
-    err, ok = goal_error(scene, plan, q)
+    q, err, ok, failure = _released(arm, scene, plan, failure)
     if not ok and not failure:
         failure = "ended outside the tolerance"
     return ArmLoopResult(ok, err, replans, arm.time, arm.switch_overs, q, failure)
