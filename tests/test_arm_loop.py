@@ -200,3 +200,39 @@ def test_bad_control_settings_are_refused_before_any_work(bad):
     with pytest.raises(regrasp.ArgumentError) as e:
         control_arm(scene, plan, **bad)
     assert e.value.field == next(iter(bad))
+
+
+class _StubArm:
+    """An ArmPlant's pose and release, scripted: the pose before and after the release, or a
+    release that raises."""
+
+    def __init__(self, scene, before, after=None, error=None):
+        self.scene, self.poses, self.error = scene, [np.asarray(before, float)], error
+        self.after = None if after is None else np.asarray(after, float)
+
+    def pose(self):
+        return self.poses[-1].copy()
+
+    def release(self):
+        if self.error is not None:
+            raise self.error
+        self.poses.append(self.after)
+
+
+def test_the_release_judges_the_regrasp_with_the_hand_off_the_features():
+    """The run's end (arm_loop._released): within the tolerance after the retreat, a success
+    whatever the control said; moved out of it by the retreat, a failure saying how far (the
+    turn wrapped: 2π + 0.1 rad is 5.73°); the arm unable to retreat, a failure saying why."""
+    from regrasp.execution.arm_loop import _released
+
+    scene, plan = example("block-low-friction")
+    goal = np.asarray(scene.task.goal, float)
+    q, err, ok, failure = _released(_StubArm(scene, goal, goal + [2e-4, 0, 0]), scene, plan, "")
+    assert ok and failure == "" and np.allclose(err, [2e-4, 0, 0])
+    q, err, ok, failure = _released(_StubArm(scene, goal, goal + [0.003, 0.004, 2 * np.pi + 0.1]), scene, plan, "")
+    assert not ok and "moved 5.00 mm, 5.73° in the hand in the retreat" in failure, failure
+    q, err, ok, failure = _released(_StubArm(scene, goal + [0.01, 0, 0], goal + [0.01, 0, 0]), scene, plan, "stuck")
+    assert not ok and failure == "stuck"  # the control's reason stands
+    stop = ExecutionError("the arm cannot execute the retreat after the last push: joint limit", "robot")
+    q, err, ok, failure = _released(_StubArm(scene, goal, error=stop), scene, plan, "")
+    assert not ok and "cannot execute the retreat" in failure and np.allclose(q, goal)

@@ -45,8 +45,9 @@ RELEASE_DWELL = 0.3
 
 @dataclass
 class ArmLoopResult:
-    """A closed-loop run with the arm: ``success`` (the object's final in-hand pose within the
-    scene's goal tolerance); ``goal_error`` planar ``[x, z, theta]`` (m, m, rad) or 3-D
+    """A closed-loop run with the arm: ``success`` (the object's in-hand pose after the retreat
+    from the last feature within the scene's goal tolerance, the world not having refused a
+    push); ``goal_error`` planar ``[x, z, theta]`` (m, m, rad) or 3-D
     ``[position, angle]`` (m, rad) to the task's goal; ``replans`` (the MPC's or the
     T-RRT*'s); ``duration`` [s] simulated; ``switch_overs`` made; ``final`` the measured in-hand
     pose (planar ``[x, z, theta]`` or ``[x, y, z, qw, qx, qy, qz]``); ``failure`` why not (""
@@ -423,7 +424,8 @@ def _released(arm: ArmPlant, scene, plan, failure: str) -> tuple[np.ndarray, np.
     err, ok = goal_error(scene, plan, q)
     if held and not ok and not failure:
         if scene.dimension == 2:
-            moved = f"{np.linalg.norm((q - before)[:2]) * 1e3:.2f} mm, {np.degrees(abs(q[2] - before[2])):.2f}°"
+            turn = abs(math.remainder(float(q[2] - before[2]), 2 * math.pi))
+            moved = f"{np.linalg.norm((q - before)[:2]) * 1e3:.2f} mm, {np.degrees(turn):.2f}°"
         else:
             moved = f"{np.linalg.norm((q - before)[:3]) * 1e3:.2f} mm, {np.degrees(P.quat_angle(before[3:], q[3:])):.2f}°"
         failure = f"the object moved {moved} in the hand in the retreat from the last feature"
@@ -469,4 +471,4 @@ def _control_spatial(scene, plan, workcell, scales, robot, timing, seed, max_rep
     q, err, ok, failure = _released(arm, scene, plan, failure)
     if not ok and not failure:
         failure = "ended outside the tolerance"
-    return ArmLoopResult(ok, err, replans, arm.time, arm.switch_overs, q, failure)
+    return ArmLoopResult(ok, err, replans, arm.time, arm.switch_overs, q, failure if not ok else "")

@@ -29,6 +29,7 @@ use crate::mechanics::geometry::Vec3;
 use crate::cones::motion_cone::{project_exact_with_margin, project_with_margin_on};
 use crate::dynamics::planar::integrate;
 use crate::cones::robust::generators;
+use crate::cones::frame::{ConeMode, PusherModel, SupportFrame};
 use crate::scene::planar::Scene;
 use crate::planning::planar::{self as trrt, PlanarSettings};
 use crate::planning::trrt::SearchSettings;
@@ -94,6 +95,10 @@ impl MpcSettings {
         self.planner.check()
     }
 }
+
+/// Cosine to the reference above which its projection on the generators' span is used as it is
+/// ([`Mpc::reference_twist`]).
+pub const CLOSE_REFERENCE: f64 = 0.9;
 
 /// Longest horizon (steps) of the QP.
 pub const MAX_HORIZON: usize = 200;
@@ -308,8 +313,7 @@ impl Mpc {
         let mut g = generators(&f, model);
         let d = body_twist(at, target);
         if metric.twist_norm(&d) > 1e-12 && !g.is_empty() {
-            // the exact projection: the generators' span can miss the reference's direction
-            if let Some(u) = project_exact_with_margin(&f, model, &g, &d, self.settings.margin) {
+            if let Some(u) = self.reference_twist(&f, model, &g, &d) {
                 let n = metric.twist_norm(&u);
                 if n > 1e-12 {
                     g.push(u / n);
@@ -317,6 +321,26 @@ impl Mpc {
             }
         }
         g
+    }
+
+    /// The reference twist `d` in the cone with the margin: its projection on the generators'
+    /// span `g`, or, in a nominal cone where that is not close to `d` (cosine below
+    /// [`CLOSE_REFERENCE`]), the exact projection when closer: where gravity bends the cone, the
+    /// span can miss the reference's direction altogether (a heavy block slid up the pads: the
+    /// edges' rays all turn it). (The exact search walks the nominal cone's boundary.)
+    fn reference_twist(&self, f: &SupportFrame, model: &PusherModel, g: &[Vec3], d: &Vec3) -> Option<Vec3> {
+        let metric = self.scene.metric();
+        let margin = self.settings.margin;
+        let cos = |u: &Vec3| metric.twist(u).dot(&metric.twist(d)) / (metric.twist_norm(u) * metric.twist_norm(d)).max(1e-300);
+        let span = project_with_margin_on(f, model, g, d, margin);
+        if f.mode != ConeMode::Nominal || span.as_ref().is_some_and(|u| cos(u) >= CLOSE_REFERENCE) {
+            return span;
+        }
+        let exact = project_exact_with_margin(f, model, g, d, margin);
+        match (span, exact) {
+            (Some(a), Some(b)) => Some(if cos(&b) > cos(&a) { b } else { a }),
+            (a, b) => a.or(b),
+        }
     }
 
     /// The horizon's steps from pose `q` with reference knots after `j`: (pusher, generators,
