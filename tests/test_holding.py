@@ -4,6 +4,8 @@ of its forward kinematics; at rest in the scene's own gripper orientation the ho
 cones; a lift too fast for a heavy object slowed until the pads hold it with the required
 margin; one that gravity alone loads beyond it refused naming where."""
 
+import tomllib
+
 import numpy as np
 import pytest
 
@@ -195,3 +197,10 @@ def test_the_closed_loop_raises_the_grip_between_pushes_as_the_open_loop():
     assert ratio > TRANSFER_SHARE and ArmPlant.transfer_grip(h, goal) == pytest.approx(25.0 * ratio / TRANSFER_SHARE)
     assert ArmPlant.transfer_grip(SimpleNamespace(scene=heavy, grip_force=25.0, grip_ceiling=30.0), goal) == 30.0
     assert ArmPlant.transfer_grip(me, [0.5, 0.5, 0.0]) == 40.0
+    # a scene that declares ±20 % in finger friction, grip and mass: TRANSFER_SHARE in its worst
+    # world, 0.5·0.8·0.8/1.2 of the nominal pads' friction (computed here from the definition)
+    d = tomllib.loads(heavy.source[1])
+    d["uncertainty"] = {"finger_friction": 0.2, "grip_force": 0.2, "mass": 0.2}
+    unsure = regrasp.Scene.from_dict(d)
+    u = SimpleNamespace(scene=unsure, grip_force=25.0, grip_ceiling=1000.0)
+    assert ArmPlant.transfer_grip(u, goal) == pytest.approx(25.0 * ratio / (TRANSFER_SHARE * 0.8 * 0.8 / 1.2))

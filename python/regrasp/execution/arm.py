@@ -278,7 +278,7 @@ def solve_arm(robot, motion: WorldMotion, tcp, load=None, boost: bool = False) -
     found from the arm's home, else from another branch (see the module's doc); timed so that
     the pads hold the object's ``load`` (an :class:`~regrasp.execution.holding.ObjectLoad`,
     :func:`timed`; with ``boost``, the grip raised between pushes where gravity takes more than
-    :data:`~regrasp.execution.holding.TRANSFER_SHARE` of the pads' friction, written into
+    :func:`~regrasp.execution.holding.transfer_share` of the pads' friction, written into
     ``motion.grip_force``). Raises ExecutionError naming the push (see the module's doc), or
     when the plan puts the object into the gripper's body (:func:`check_hand`)."""
     from ..robot.ik import MIN_DISTANCE, IKError, fixed_geoms, ik_path

@@ -200,17 +200,18 @@ class ArmPlant:
 
     def transfer_grip(self, pose) -> float:
         """The grip [N] between pushes with the object at in-hand ``pose``: raised until gravity
-        takes at most :data:`~regrasp.execution.holding.TRANSFER_SHARE` of the pads' friction
+        takes at most :func:`~regrasp.execution.holding.transfer_share` of the pads' friction
         (planar scenes; the scene's gravity, which a transfer keeps in the gripper frame), within
         :func:`~regrasp.execution.arm.grip_ceiling`; the plan's grip otherwise."""
-        from .holding import TRANSFER_SHARE
+        from .holding import transfer_share
 
         if self.scene.dimension != 2:
             return self.grip_force
         if not self.scene.admissible(pose):  # the object has slid (partly) off the pads: hold what is left
             return max(self.grip_force, self.grip_ceiling)
         share = float(self.scene.hold_ratio(pose))
-        return self.grip_force * min(max(1.0, share / TRANSFER_SHARE), max(1.0, self.grip_ceiling / self.grip_force))
+        return self.grip_force * min(max(1.0, share / transfer_share(self.scene)),
+                                     max(1.0, self.grip_ceiling / self.grip_force))
 
     def push(self, pusher: str, twist, duration: float, belief=None, absolute: bool = False):
         """Pushes with ``pusher``'s feature at body ``twist`` (planar ``[vx, vz, omega]`` (m/s,

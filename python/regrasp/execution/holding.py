@@ -43,13 +43,26 @@ SETTLE_SAMPLES = 10
 MAX_GRIP_SHARE = 0.8
 
 
-def required_margin(scene) -> float:
-    """The margin [−] a world motion of ``scene`` must keep: ``1 − (1 − HOLD_MARGIN)(1 − δμ)(1 − δN)
-    / (1 + δm)`` with the scene's ``[uncertainty]`` spreads of finger friction, grip force and mass
-    (0 without)."""
+def worst_hold_factor(scene) -> float:
+    """``(1 − δμ)(1 − δN) / (1 + δm)`` [−]: the worst world's pads' friction over its weight, as a
+    share of the nominal's, with the scene's ``[uncertainty]`` spreads of finger friction, grip
+    force and mass (1 without)."""
     u = scene.uncertainty or {}
     dmu, dn, dm = (float(u.get(k, 0.0)) for k in ("finger_friction", "grip_force", "mass"))
-    return 1.0 - (1.0 - HOLD_MARGIN) * (1.0 - dmu) * (1.0 - dn) / (1.0 + dm)
+    return (1.0 - dmu) * (1.0 - dn) / (1.0 + dm)
+
+
+def required_margin(scene) -> float:
+    """The margin [−] a world motion of ``scene`` must keep: ``1 − (1 − HOLD_MARGIN)·f`` with
+    :func:`worst_hold_factor` ``f``."""
+    return 1.0 - (1.0 - HOLD_MARGIN) * worst_hold_factor(scene)
+
+
+def transfer_share(scene) -> float:
+    """The share [−] of the nominal pads' friction gravity may take between pushes once the grip
+    is raised: :data:`TRANSFER_SHARE` in the worst world the scene's ``[uncertainty]`` declares
+    (``TRANSFER_SHARE · f``, :func:`worst_hold_factor` ``f``)."""
+    return TRANSFER_SHARE * worst_hold_factor(scene)
 
 
 @dataclass(frozen=True)
@@ -178,7 +191,7 @@ class ObjectLoad:
     def boost(self, q, max_scale: float) -> np.ndarray:
         """Raises the grip between pushes (each run of held samples — retreat, transfers, approach —
         but the last :data:`SETTLE_SAMPLES` of an approach: the push starts at the plan's grip) so
-        that gravity takes at most :data:`TRANSFER_SHARE` of the pads' friction there, at most
+        that gravity takes at most :func:`transfer_share` of the pads' friction there, at most
         ``max_scale`` times the plan's: sets and returns :attr:`grip_scale` (n,) from the arm at
         rest at ``q`` (n, dof)."""
         self.grip_scale = np.ones(len(self.labels))
@@ -187,7 +200,7 @@ class ObjectLoad:
         for i, lab in enumerate(self.labels):  # an approach's tail: the next SETTLE_SAMPLES are not all approach
             if lab == "approach" and "approach" not in self.labels[i + SETTLE_SAMPLES:i + SETTLE_SAMPLES + 1]:
                 free[i] = False
-        scale = np.ones(len(q))
+        scale, share = np.ones(len(q)), transfer_share(self.scene)
         i = 0
         while i < len(q):
             if not free[i]:
@@ -197,7 +210,7 @@ class ObjectLoad:
             while j < len(q) and free[j]:
                 j += 1
             worst = np.nanmax(still[i:j], initial=0.0)
-            scale[i:j] = min(max(1.0, worst / TRANSFER_SHARE), max(1.0, max_scale))
+            scale[i:j] = min(max(1.0, worst / share), max(1.0, max_scale))
             i = j
         self.grip_scale = scale
         return scale
