@@ -56,7 +56,7 @@ build: $(EXT)
 test: build $(ALL_DEPS)
 	@mkdir -p $(LOGS); STAGE_PLAIN=1 nice -n 10 $(STAGE) "cargo test ($(PROFILE))" $(LOGS)/cargo-test.log $(CARGO_TEST) \
 		2>$(LOGS)/cargo-test.stage & rust=$$!; \
-	start=$$(date +%s); $(BIN)/pytest -q; py=$$?; echo "pytest: exit $$py in $$(( $$(date +%s) - start )) s" >&2; \
+	start=$$(date +%s); $(BIN)/pytest -q --durations=10; py=$$?; echo "pytest: exit $$py in $$(( $$(date +%s) - start )) s" >&2; \
 	wait $$rust; rs=$$?; cat $(LOGS)/cargo-test.stage >&2; [ $$py -eq 0 ] && [ $$rs -eq 0 ]
 
 test-rust:
