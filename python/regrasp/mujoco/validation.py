@@ -242,8 +242,9 @@ def _each_chunk(scene: Scene, chunks: list, workers: int, ray_address, take, eng
             take(_engine_chunk(scene, c, engine))
     else:
         # a Pool's exit terminates its workers at once (Ctrl-C does not wait for running chunks);
-        # the workers ignore SIGINT, the parent ends them
-        with multiprocessing.Pool(workers, initializer=_ignore_sigint) as pool:
+        # the workers ignore SIGINT, the parent ends them. Spawned, not forked: a fork copies the
+        # caller's whole address space (a large one fails with ENOMEM) and its threads' locks
+        with multiprocessing.get_context("spawn").Pool(workers, initializer=_ignore_sigint) as pool:
             for part in pool.imap_unordered(_engine_job, [(scene, c, engine) for c in chunks]):
                 take(part)
 
