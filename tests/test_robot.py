@@ -497,3 +497,40 @@ def test_a_post_on_the_home_branch_is_passed_on_another():
     assert path is not None and np.abs(np.diff(path, axis=0)).max() <= MAX_JUMP
     for p, qq in zip(line, path):
         assert np.linalg.norm(fk(r, qq)[:3] - p[:3]) <= 1e-3 and table_distance(r, qq, avoid=["post"]) >= MIN_DISTANCE
+
+
+def test_a_wrist_wound_to_its_limit_is_wound_back_2pi_and_the_path_goes_on():
+    """A tool turn that winds wrist_3 past its range's end: the home branch's path stops there (a
+    joint limit naming wrist_3, its solutions so far on the error), and ``_other_branch`` winds
+    wrist_3 2π back (the same arm shape) keeping those solutions shifted and solving only the rest:
+    the same path as a whole ``ik_path`` from the wound start (the reference), every pose reached
+    within the joint limits and without a jump."""
+    from regrasp.execution.arm import _other_branch
+
+    r = build()
+    lo, hi = r.joint_limits().T
+    q0 = np.array(ROBOTS["ur5e-2f85"].home, float)
+    w = r.arm_joints.index("wrist_3_joint") if "wrist_3_joint" in r.arm_joints else len(q0) - 1
+    q0[w] = hi[w] - 0.3
+    line = []
+    for a in np.linspace(0.0, 1.0, 21):  # the tool turned 1 rad about wrist_3's axis: 0.7 rad past the limit
+        q = q0.copy()
+        q[w] += a
+        line.append(fk(r, q))
+    line = np.array(line)
+    with pytest.raises(IKError) as e:
+        ik_path(r, line, q0)
+    err = e.value
+    i = int(err.field.split("[")[1].rstrip("]"))
+    assert err.reason == "joint limit" and w in err.joints and 0 < i < len(line) and len(err.path) == i
+    path = _other_branch(r, line, (), [MIN_DISTANCE] * len(line), q0, err)
+    assert path is not None and path.shape == (len(line), len(q0))
+    wound = q0.copy()
+    wound[w] -= 2 * np.pi
+    reference = ik_path(r, line, wound)
+    # near the limit the home path's steps were slowed by it (µrad apart; both solve each pose)
+    assert np.allclose(path, reference, atol=1e-4)
+    assert np.all(path >= lo - 1e-9) and np.all(path <= hi + 1e-9) and np.abs(np.diff(path, axis=0)).max() <= MAX_JUMP
+    for p, qq in zip(line, path):
+        got = fk(r, qq)
+        assert np.linalg.norm(got[:3] - p[:3]) <= 1e-3 and quat_angle(got[3:], p[3:]) <= 0.01

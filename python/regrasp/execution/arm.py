@@ -383,15 +383,9 @@ def _other_branch(robot, targets, avoid, gaps, home_q, err):
     if err.reason not in ("collision", "joint limit", "jump") or err.part.startswith(GRIPPER_PREFIX):
         return None  # out of reach, or the gripper itself against an obstacle: the same on every branch
     if home_q is not None and err.reason == "joint limit":  # the same arm shape, a joint wound 2π the other way
-        lo, hi = robot.joint_limits().T
-        for j in range(len(home_q)):
-            q0 = home_q.copy()
-            q0[j] -= 2 * np.pi * np.sign(q0[j])
-            if hi[j] > lo[j] and lo[j] <= q0[j] <= hi[j] and q0[j] != home_q[j]:
-                try:
-                    return ik_path(robot, targets, q0, avoid=avoid, min_distance=gaps)
-                except IKError:
-                    pass
+        q = _rewound(robot, targets, avoid, gaps, home_q, err)
+        if q is not None:
+            return q
     tried = 0
     for q0 in ik_solutions(robot, targets[0], avoid, min_distance=gaps[0]):
         if home_q is not None and branch_distance(q0, home_q) <= MAX_JUMP:
@@ -402,6 +396,35 @@ def _other_branch(robot, targets, avoid, gaps, home_q, err):
             tried += 1
             if tried >= MAX_BRANCHES:
                 return None
+    return None
+
+
+def _rewound(robot, targets, avoid, gaps, home_q, err):
+    """The home branch's path (from ``home_q``) that failed with ``err`` at a joint limit, with a
+    joint at its limit (``err.joints``) wound 2π the other way: the same arm shape, so the
+    solutions before the failing pose (``err.path``) shifted stay valid where they stay within the
+    joint's range, and only the rest is solved again. None when no such joint's shifted path
+    stays within its range or the rest fails too."""
+    from ..robot.ik import IKError, ik_path
+
+    lo, hi = robot.joint_limits().T
+    i = int(err.field.split("[")[1].rstrip("]")) if "[" in (err.field or "") and err.path is not None else 0
+    done = np.asarray(err.path, float)[:i] if i else np.empty((0, len(home_q)))
+    for j in err.joints:
+        before = done[-1] if len(done) else home_q
+        shift = -2 * np.pi if hi[j] - before[j] < before[j] - lo[j] else 2 * np.pi  # away from the limit met
+        wound = np.r_[done[:, j], before[j]] + shift
+        if not hi[j] > lo[j] or np.any(wound < lo[j]) or np.any(wound > hi[j]):
+            continue
+        start = before.copy()
+        start[j] += shift
+        try:
+            rest = ik_path(robot, targets[i:], start, avoid=avoid, min_distance=gaps[i:])
+        except IKError:
+            continue
+        head = done.copy()
+        head[:, j] += shift
+        return np.vstack([head, rest])
     return None
 
 

@@ -36,11 +36,14 @@ BRANCH_SEEDS = 24  # random starts :func:`ik_solutions` tries (uniform within th
 class IKError(ArgumentError):
     """No arm configuration reaches a TCP pose: ``field`` names it (``pose``, or ``poses[i]``
     in a path), ``reason`` says why: ``"unreachable"``, ``"joint limit"`` or ``"collision"``;
-    ``part``: for a collision, the robot's body nearest the obstacle (``arm/…`` or ``gripper/…``)."""
+    ``part``: for a collision, the robot's body nearest the obstacle (``arm/…`` or ``gripper/…``);
+    ``joints``: for a joint limit, the indices of the arm joints at theirs; ``path``: in a path
+    (:func:`ik_path`), the solutions [rad] of the poses before the failing one, shape (i, n)."""
 
-    def __init__(self, message: str, field: str, reason: str, part: str = ""):
+    def __init__(self, message: str, field: str, reason: str, part: str = "", joints: tuple = ()):
         super().__init__(message, field)
-        self.reason, self.part = reason, part
+        self.reason, self.part, self.joints = reason, part, tuple(joints)
+        self.path = None
 
 
 def pose_error(a, b) -> tuple:
@@ -179,8 +182,8 @@ class IKSolver:
         gap, part, obstacle = closest(robot, q, self.avoid)
         if reached[0] <= POSITION_TOLERANCE and reached[1] <= ANGLE_TOLERANCE and inside and gap >= self.min_distance:
             return q
-        at_limit = [robot.arm_joints[i] for i in range(len(q))
-                    if not free[i] and min(q[i] - rng[i, 0], rng[i, 1] - q[i]) < LIMIT_MARGIN]
+        limited = [i for i in range(len(q)) if not free[i] and min(q[i] - rng[i, 0], rng[i, 1] - q[i]) < LIMIT_MARGIN]
+        at_limit = [robot.arm_joints[i] for i in limited]
         beyond = robot.reach(target)
         if beyond > 0:
             reason, why = "unreachable", f"{beyond * 1e3:.0f} mm beyond the arm's reach"
@@ -193,7 +196,7 @@ class IKSolver:
             reason, why = "unreachable", "no arm configuration found"
         raise IKError(f"invalid `{field}`: the TCP cannot reach {np.round(target, 4).tolist()} ({reason}: {why}; "
                       f"closest {reached[0] * 1e3:.1f} mm, {reached[1]:.3f} rad away)", field, reason,
-                      part if reason == "collision" else "")
+                      part if reason == "collision" else "", limited if reason == "joint limit" else ())
 
 
 def solve_ik(robot, target_pose, q_init=None, field: str = "pose", avoid=()) -> np.ndarray:
@@ -255,13 +258,17 @@ def ik_path(robot, poses, q_init=None, avoid=(), max_jump: float = MAX_JUMP, min
     q = robot.q if q_init is None else np.asarray(q_init, float)
     out = []
     for i, p in enumerate(P):
-        nxt = solvers[gaps[i]].solve(p, q, field=f"poses[{i}]")
-        jump = np.abs(nxt - q)
-        if jump.max() > max_jump:
-            j = int(np.argmax(jump))
-            raise IKError(f"invalid `poses[{i}]`: joint {robot.arm_joints[j]} jumps {jump[j]:.3f} rad from the "
-                          f"previous pose's solution (more than {max_jump} rad: a branch flip, or poses too far "
-                          f"apart)", f"poses[{i}]", "jump")
+        try:
+            nxt = solvers[gaps[i]].solve(p, q, field=f"poses[{i}]")
+            jump = np.abs(nxt - q)
+            if jump.max() > max_jump:
+                j = int(np.argmax(jump))
+                raise IKError(f"invalid `poses[{i}]`: joint {robot.arm_joints[j]} jumps {jump[j]:.3f} rad from the "
+                              f"previous pose's solution (more than {max_jump} rad: a branch flip, or poses too far "
+                              f"apart)", f"poses[{i}]", "jump")
+        except IKError as e:
+            e.path = np.array(out).reshape(len(out), len(q))
+            raise
         q = nxt
         out.append(q)
     return np.array(out)
