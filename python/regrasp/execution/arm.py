@@ -15,8 +15,9 @@ frame is the TCP shifted by the grasp's centre.
 
 The joint trajectory: the TCP's world poses along the motion (every sample) by
 :func:`~regrasp.robot.ik.ik_path` from the arm's solution for the first pose (from its home
-joints), clear of the table and the features; when that path hits a collision, a joint limit or a
-branch flip, from up to :data:`MAX_BRANCHES` other branches of the arm at the first pose
+joints), clear of the table and the features; when that path hits a joint limit, the same path
+with that joint wound 2π the other way from where it stopped (the same arm shape); when it hits a
+collision, a joint limit or a branch flip, from up to :data:`MAX_BRANCHES` other branches of the arm at the first pose
 (:func:`~regrasp.robot.ik.ik_solutions`: a UR5e's wrist_1 clear of a feature with the elbow the
 other way). A pose the arm cannot reach on any of them (its reach, a joint
 limit, a collision, a branch flip) fails the execution with an :class:`~regrasp.errors.ExecutionError`
