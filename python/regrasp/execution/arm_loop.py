@@ -38,6 +38,17 @@ from .assignment import assign, pusher_contact
 from .world_motion import Segments, Timing, grip_force
 
 
+#: The grip calibration (:meth:`ArmPlant.calibrate`): each step lowers the grip by this share,
+CALIBRATION_STEP = 0.04
+#: held this long [s],
+CALIBRATION_DWELL = 0.05
+#: until the object has moved this far [m] in the hand
+CALIBRATION_SLIP = 3e-4
+#: or turned this far [rad],
+CALIBRATION_TURN = 5e-3
+#: or down to this share of the grip at which the nominal pads would let it slip.
+CALIBRATION_FLOOR = 0.6
+
 #: how long [s] the arm holds still after its retreat from the last feature before the
 #: regrasp's end pose is measured (:meth:`ArmPlant.release`)
 RELEASE_DWELL = 0.3
@@ -101,16 +112,50 @@ class ArmPlant:
         self._jq, self._jv = jq, m.jnt_dofadr[m.body_jntadr[body]]
         r.data.qpos[jq:jq + 7] = P.compose(r.tcp_pose(), self.untcp, O)  # at the arm's actual TCP
         mujoco.mj_forward(m, r.data)
-        # the plan's grip, raised between pushes as the open loop's (:meth:`switch`)
+        # the plan's grip, raised between pushes as the open loop's (:meth:`switch`), and from
+        # the start: the object is held before the first feature is met
         self.grip_force, self.world_grip = float(grip_force(scene)), scales.grip
-        self.grip = close_on(r, body, geoms, self.grip_force * scales.grip, sensing)
         self.grip_ceiling = grip_ceiling(r)
+        start_grip = self.transfer_grip(P.spatial_to_planar(O) if scene.dimension == 2 else O)
+        self.grip = close_on(r, body, geoms, start_grip * scales.grip, sensing)
+        self.grip_gain = 1.0
         self.solver = IKSolver(r, avoid)
         self.contact_solver = IKSolver(r, avoid, CONTACT_CLEARANCE)  # fingers near the feature in contact
         self.q = r.q.copy()  # the arm's commanded joints
         self.current: str | None = None
         self.switch_overs = 0
         self._world = wc
+        if start_grip > self.grip_force:  # gravity needs a raised grip: the world's pads measured first
+            self.calibrate(start_grip)
+
+    def calibrate(self, raised: float) -> float:
+        """Measures how much grip the world's pads need to hold the object (planar scenes): the
+        arm holding still, the grip lowered from ``raised`` [N] by :data:`CALIBRATION_STEP` every
+        :data:`CALIBRATION_DWELL` until the measured in-hand pose moves by
+        :data:`CALIBRATION_SLIP` or turns by :data:`CALIBRATION_TURN` (or down to :data:`CALIBRATION_FLOOR` of where the nominal pads
+        would slip), then raised again. The plan's grip is scaled by the ratio of the grip it
+        slipped at to where the nominal pads slip (``grip_gain`` >= 1, within the ceiling), so the
+        world's pads hold the object as the plan's cones assume: a world whose friction, grip or
+        mass is off nominal by more than the scene declares would otherwise drop it at the first
+        push. Returns the gain."""
+        pose = self.pose()
+        share = float(self.scene.hold_ratio(pose))  # gravity's share of the nominal pads' friction at the plan's grip
+        nominal = self.grip_force * share  # [N] where the nominal pads would slip
+        g, slipped = raised, None
+        while g * (1 - CALIBRATION_STEP) >= CALIBRATION_FLOOR * nominal:
+            g *= 1 - CALIBRATION_STEP
+            self.grip.set_force(g * self.world_grip)
+            self.idle(CALIBRATION_DWELL)
+            d = self.pose() - pose
+            if np.hypot(d[0], d[1]) > CALIBRATION_SLIP or abs(d[2]) > CALIBRATION_TURN:
+                slipped = g
+                break
+        self.grip.set_force(raised * self.world_grip)
+        self.idle(CALIBRATION_DWELL)
+        if slipped is not None and nominal > 0:
+            self.grip_gain = min(max(1.0, slipped / nominal), max(1.0, self.grip_ceiling / self.grip_force))
+            self.grip_force *= self.grip_gain
+        return self.grip_gain
 
     # -- measurement ----------------------------------------------------------------------------
 
@@ -171,8 +216,11 @@ class ArmPlant:
         """Switch-over to ``pusher`` with the object at in-hand pose ``O`` (m, unit quaternion):
         retreat from the feature in contact, transfer at the safe height, approach the new
         pusher's feature until it meets the object; the grip raised meanwhile as the open loop
-        raises it (:meth:`transfer_grip`), back at the plan's for the approach's last
-        :data:`~regrasp.execution.holding.SETTLE_SAMPLES` samples."""
+        raises it (:meth:`transfer_grip`). Where it is raised, it is lowered back to the plan's
+        only once the feature touches the object, the arm holding still for
+        :data:`~regrasp.execution.holding.SETTLE_SAMPLES` samples (the open loop lowers it over
+        the approach's last samples: a world whose pads hold less than nominal drops the object
+        there, before the feature can support it)."""
         from .holding import SETTLE_SAMPLES
 
         pose = P.spatial_to_planar(O) if self.scene.dimension == 2 else O
@@ -189,12 +237,12 @@ class ArmPlant:
         if len(seg.poses) > 1:
             times, poses = np.asarray(seg.times[1:], float), seg.poses[1:]
             near = [lab in ("approach", "retreat") for lab in seg.samples.label[1:]]
-            k = max(0, len(poses) - SETTLE_SAMPLES)
-            if k > 0:
-                self.grip.set_force(self.transfer_grip(pose) * self.world_grip)
-                self._follow(times[:k], poses[:k], what, near[:k])
-            self.grip.set_force(self.grip_force * self.world_grip)
-            self._follow(times[k:] - (times[k - 1] if k > 0 else 0.0), poses[k:], what, near[k:])
+            raised = self.transfer_grip(pose)
+            self.grip.set_force(raised * self.world_grip)
+            self._follow(times, poses, what, near)
+            if raised > self.grip_force:  # at contact: the feature supports the object as the grip settles
+                self.grip.set_force(self.grip_force * self.world_grip)
+                self.idle(SETTLE_SAMPLES * self.timing.sample_period)
         self.current = pusher
         self.switch_overs += 1
 
@@ -242,15 +290,19 @@ class ArmPlant:
 
     def release(self) -> None:
         """Ends a regrasp as the open loop's world motion does: retreats from the feature in
-        contact (if any) by the clearance, with the grip raised as between pushes
-        (:meth:`transfer_grip`), then holds still :data:`RELEASE_DWELL`: the object's pose in the
-        hand is the regrasp's once no feature touches it."""
+        contact (if any) by the clearance, then holds still :data:`RELEASE_DWELL`: the object's
+        pose in the hand is the regrasp's once no feature touches it. The grip meanwhile: the
+        plan's where gravity leaves the pads enough (:meth:`transfer_grip`); where it needs a
+        raised grip, the ceiling (:func:`~regrasp.execution.arm.grip_ceiling`): after the last
+        push nothing is to slide any more, and the world's friction, grip and mass may be further
+        from nominal than the scene declares."""
         if self.current is not None:
             O = self.in_hand()
             seg = Segments(self.timing, self.safe, _reach(self.scene, O), self.G, self.motion.envelope,
                            self.motion.workcell.robot.base[:3], self.motion.workcell.contacts())
             seg.retreat(self.features[self.current], O)
-            self.grip.set_force(self.transfer_grip(self.pose()) * self.world_grip)
+            grip = self.transfer_grip(self.pose())
+            self.grip.set_force((grip if grip <= self.grip_force else max(grip, self.grip_ceiling)) * self.world_grip)
             self._follow(seg.times[1:], seg.poses[1:], "the retreat after the last push",
                          [lab == "retreat" for lab in seg.samples.label[1:]])
             self.current = None
