@@ -17,7 +17,7 @@ The joint trajectory: the TCP's world poses along the motion (every sample) by
 :func:`~regrasp.robot.ik.ik_path` from the arm's solution for the first pose (from its home
 joints), clear of the table and the features; when that path hits a joint limit, the same path
 with that joint wound 2π the other way from where it stopped (the same arm shape); when it hits a
-collision, a joint limit or a branch flip, from up to :data:`MAX_BRANCHES` other branches of the arm at the first pose
+collision, a joint limit or a branch flip, from up to :data:`~regrasp.robot.branches.MAX_BRANCHES` other branches of the arm at the first pose
 (:func:`~regrasp.robot.ik.ik_solutions`: a UR5e's wrist_1 clear of a feature with the elbow the
 other way). A pose the arm cannot reach on any of them (its reach, a joint
 limit, a collision, a branch flip) fails the execution with an :class:`~regrasp.errors.ExecutionError`
@@ -55,9 +55,6 @@ CONTACT_CLEARANCE = 0.001
 HAND_TOUCH = 1e-6
 #: How many choices of contacts :func:`arm_motion` tries before giving up.
 MAX_TRIES = 6
-#: How many other branches of the arm at the first pose :func:`solve_arm` tries when the path
-#: from the home's branch fails (each a whole :func:`~regrasp.robot.ik.ik_path`, ~2–6 s).
-MAX_BRANCHES = 2
 #: Time [s] the arm holds still after the motion before the object's pose is measured.
 SETTLE = 0.3
 
@@ -282,6 +279,7 @@ def solve_arm(robot, motion: WorldMotion, tcp, load=None, boost: bool = False) -
     :func:`~regrasp.execution.holding.transfer_share` of the pads' friction, written into
     ``motion.grip_force``). Raises ExecutionError naming the push (see the module's doc), or
     when the plan puts the object into the gripper's body (:func:`check_hand`)."""
+    from ..robot.branches import other_branch
     from ..robot.ik import MIN_DISTANCE, IKError, fixed_geoms, ik_path
 
     check_hand(robot, motion, tcp)
@@ -293,7 +291,7 @@ def solve_arm(robot, motion: WorldMotion, tcp, load=None, boost: bool = False) -
         q0 = first_solution(robot, targets[0], avoid)
         q = ik_path(robot, targets, q0, avoid=avoid, min_distance=gaps)
     except IKError as e:
-        q = _other_branch(robot, targets, avoid, gaps, q0, e)
+        q = other_branch(robot, targets, avoid, gaps, q0, e)
         if q is None:
             raise _arm_error(motion, e) from None
     if load is not None and boost:
@@ -371,62 +369,6 @@ def object_load(scene, robot, body: int, tcp, motion: WorldMotion):
     from .holding import ObjectLoad
 
     return ObjectLoad(scene, robot, body, tcp, motion) if scene.dimension == 2 else None
-
-
-def _other_branch(robot, targets, avoid, gaps, home_q, err):
-    """The joint path [rad] through ``targets`` from another branch of the arm at the first pose
-    (:data:`MAX_BRANCHES` at most), after the home branch's path (from ``home_q``; None: the home
-    found none) failed with ``err``; None when none passes or ``err`` is not the branch's (the
-    pose out of reach, the gripper's own body against an obstacle: its pose is the TCP's)."""
-    from ..robot.ik import MAX_JUMP, IKError, branch_distance, ik_path, ik_solutions
-    from ..robot.kinds import GRIPPER_PREFIX
-
-    if err.reason not in ("collision", "joint limit", "jump") or err.part.startswith(GRIPPER_PREFIX):
-        return None  # out of reach, or the gripper itself against an obstacle: the same on every branch
-    if home_q is not None and err.reason == "joint limit":  # the same arm shape, a joint wound 2π the other way
-        q = _rewound(robot, targets, avoid, gaps, home_q, err)
-        if q is not None:
-            return q
-    tried = 0
-    for q0 in ik_solutions(robot, targets[0], avoid, min_distance=gaps[0]):
-        if home_q is not None and branch_distance(q0, home_q) <= MAX_JUMP:
-            continue
-        try:
-            return ik_path(robot, targets, q0, avoid=avoid, min_distance=gaps)
-        except IKError:
-            tried += 1
-            if tried >= MAX_BRANCHES:
-                return None
-    return None
-
-
-def _rewound(robot, targets, avoid, gaps, home_q, err):
-    """The home branch's path (from ``home_q``) that failed with ``err`` at a joint limit, with a
-    joint at its limit (``err.joints``) wound 2π the other way: the same arm shape, so the
-    solutions before the failing pose (``err.path``) shifted stay valid where they stay within the
-    joint's range, and only the rest is solved again. None when no such joint's shifted path
-    stays within its range or the rest fails too."""
-    from ..robot.ik import IKError, ik_path
-
-    lo, hi = robot.joint_limits().T
-    i = int(err.field.split("[")[1].rstrip("]")) if "[" in (err.field or "") and err.path is not None else 0
-    done = np.asarray(err.path, float)[:i] if i else np.empty((0, len(home_q)))
-    for j in err.joints:
-        before = done[-1] if len(done) else home_q
-        shift = -2 * np.pi if hi[j] - before[j] < before[j] - lo[j] else 2 * np.pi  # away from the limit met
-        wound = np.r_[done[:, j], before[j]] + shift
-        if not hi[j] > lo[j] or np.any(wound < lo[j]) or np.any(wound > hi[j]):
-            continue
-        start = before.copy()
-        start[j] += shift
-        try:
-            rest = ik_path(robot, targets[i:], start, avoid=avoid, min_distance=gaps[i:])
-        except IKError:
-            continue
-        head = done.copy()
-        head[:, j] += shift
-        return np.vstack([head, rest])
-    return None
 
 
 def _arm_error(motion: WorldMotion, e) -> ExecutionError:
