@@ -139,8 +139,12 @@ class ArmPlant:
         mass is off nominal by more than the scene declares would otherwise drop it at the first
         push. Returns the gain."""
         pose = self.pose()
+        if self.scene.dimension != 2 or not self.scene.admissible(pose):
+            return self.grip_gain  # 3-D, or partly off the pads: no nominal slip grip to compare with
         share = float(self.scene.hold_ratio(pose))  # gravity's share of the nominal pads' friction at the plan's grip
         nominal = self.grip_force * share  # [N] where the nominal pads would slip
+        if not (math.isfinite(nominal) and nominal > 0):  # nothing to hold up: nothing to measure
+            return self.grip_gain
         g, slipped = raised, None
         while g * (1 - CALIBRATION_STEP) >= CALIBRATION_FLOOR * nominal:
             g *= 1 - CALIBRATION_STEP
