@@ -85,7 +85,7 @@ def quat_angle(a, b) -> float:
     normalized first); accurate for small angles too (an arctangent, not an arccosine)."""
     a, b = np.asarray(a, float), np.asarray(b, float)
     (aw, ax, ay, az), (bw, bx, by, bz) = (a / np.linalg.norm(a)).tolist(), (b / np.linalg.norm(b)).tolist()
-    # the vector part of a⁻¹ b, written out (np.cross costs ~20× this on one pair; it is called per IK step)
+    # the vector part of a⁻¹ b, written out: np.cross on one pair costs more than the rest (called per IK step)
     vx = aw * bx - bw * ax - (ay * bz - az * by)
     vy = aw * by - bw * ay - (az * bx - ax * bz)
     vz = aw * bz - bw * az - (ax * by - ay * bx)

@@ -78,7 +78,7 @@ def closest(robot, q, avoid=(), scratch=None) -> tuple:
     """(distance [m], the robot's body, the obstacle's geom name) of the closest pair between the
     arm's and gripper's collision geoms and the table and ``avoid`` at arm joints ``q`` [rad]
     (inf, "", "" when there are no obstacles; a distance beyond 0.1 m reads 0.1 m). ``scratch``:
-    an ``MjData`` of the robot's model to compute in (a new one costs ~0.5 ms, most of a call)."""
+    an ``MjData`` of the robot's model to compute in (making a new one is most of a call's cost)."""
     mujoco = need("mujoco", "robot")
     obstacles = obstacle_geoms(robot, avoid)
     if not obstacles:
