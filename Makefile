@@ -51,19 +51,24 @@ $(EXT): $(RUST_SRC) | $(DEMO_DEPS)
 
 build: $(EXT)
 
-# The Rust tests in the background (niced: pytest keeps its core), pytest in front; the Rust
-# tests' summary and, on failure, their log's end after pytest's.
+# pytest's workers (pytest-xdist): one per core, at most 4 (each holds MuJoCo models and an arm)
+PYTEST_WORKERS ?= $(shell n=$$(nproc 2>/dev/null || echo 2); [ $$n -gt 4 ] && n=4; echo $$n)
+# a test file's tests stay on one worker (its module fixtures are computed once)
+PYTEST := $(BIN)/pytest -q -n $(PYTEST_WORKERS) --dist loadfile
+
+# The Rust tests in the background (niced: pytest's workers keep the cores), pytest in front; the
+# Rust tests' summary and, on failure, their log's end after pytest's.
 test: build $(ALL_DEPS)
 	@mkdir -p $(LOGS); STAGE_PLAIN=1 nice -n 10 $(STAGE) "cargo test ($(PROFILE))" $(LOGS)/cargo-test.log $(CARGO_TEST) \
 		2>$(LOGS)/cargo-test.stage & rust=$$!; \
-	start=$$(date +%s); $(BIN)/pytest -q --durations=10; py=$$?; echo "pytest: exit $$py in $$(( $$(date +%s) - start )) s" >&2; \
+	start=$$(date +%s); $(PYTEST) --durations=10; py=$$?; echo "pytest: exit $$py in $$(( $$(date +%s) - start )) s" >&2; \
 	wait $$rust; rs=$$?; cat $(LOGS)/cargo-test.stage >&2; [ $$py -eq 0 ] && [ $$rs -eq 0 ]
 
 test-rust:
 	$(CARGO_TEST)
 
 test-python: build $(ALL_DEPS)
-	$(BIN)/pytest -q
+	$(PYTEST)
 
 demo: build
 	@$(BIN)/regrasp demo --out $(OUT)/demo

@@ -133,16 +133,16 @@ def assert_left_out(s, blocked: str) -> None:
         assert blocked in r.without and blocked not in {a.pusher for a in r.motion.assignments}
 
 
-def test_a_pusher_the_arm_cannot_follow_is_left_out_and_named(monkeypatch):
+def test_a_pusher_the_arm_cannot_follow_is_left_out_and_named(chosen, monkeypatch):
     """When the arm cannot follow a push (``solve_arm`` raises naming it: its reach, a joint
     limit, the fingers against the feature), the grasp pairs are planned again without that
     pusher. The real ``solve_arm``, wrapped to refuse every push of the pusher that the first
-    choice uses (as an arm blocked there would), on block-xztheta: the choice found instead uses
-    none of it and names it left out, or the refusal names it."""
+    choice uses (as an arm blocked there would), on block-low-friction: the choice found instead
+    uses none of it and names it left out, or the refusal names it (block-low-friction has no
+    regrasp without its `bottom` pusher; the choice found instead: the next test's)."""
     from regrasp.execution import arm
 
-    s = scene_of("block-xztheta")
-    first = pp.pick_place(s, seed=1)
+    s, _, first, _ = chosen["block-low-friction"]
     blocked = first.motion.assignments[0].pusher
     real = arm.solve_arm
 
@@ -158,14 +158,13 @@ def test_a_pusher_the_arm_cannot_follow_is_left_out_and_named(monkeypatch):
     assert_left_out(s, blocked)
 
 
-def test_a_pusher_no_feature_serves_is_left_out_and_named(monkeypatch):
+def test_a_pusher_no_feature_serves_is_left_out_and_named(chosen, monkeypatch):
     """When no pair gets as far as the arm because no feature serves a push of its plan (the
     assignment's error names the pusher), the pairs are planned again without that pusher. The
     real ``world_motion``, wrapped to refuse every plan that uses the pusher of the first
     choice's first push as the assignment does, on block-xztheta: the choice found instead uses
     none of it and names it left out, or the refusal names it."""
-    s = scene_of("block-xztheta")
-    first = pp.pick_place(s, seed=1)
+    s, _, first, _ = chosen["block-xztheta"]
     blocked = first.motion.assignments[0].pusher
     real = pp.world_motion
 

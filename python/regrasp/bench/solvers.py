@@ -124,10 +124,26 @@ def _mpc_qp_scipy(scene: Scene, q, steps, targets, settings: dict):
     minimize = need("scipy.optimize", "reference").minimize
     P, c, T, offs, sizes = mpc_qp_condensed(scene, q, steps, targets, settings)
     n = len(c)
-    cons = [{"type": "ineq", "fun": (lambda a, i=i: 1.0 - np.sum((a[offs[i]:offs[i] + sizes[i]] @ T[i]) ** 2))}
-            for i in range(len(sizes)) if sizes[i]]
-    cons += [{"type": "ineq", "fun": (lambda a, i=i: 10.0 - np.sum(a[offs[i]:offs[i] + sizes[i]]))}
-             for i in range(len(sizes)) if sizes[i]]  # the weights of a step sum to at most 10
+    cons = []
+    for i in range(len(sizes)):
+        if not sizes[i]:
+            continue
+        blk = slice(offs[i], offs[i] + sizes[i])
+
+        def norm_jac(a, blk=blk, Ti=T[i]):  # d/da (1 - |a_i T_i|^2) = -2 T_i (a_i T_i)
+            g = np.zeros(n)
+            g[blk] = -2.0 * (Ti @ (a[blk] @ Ti))
+            return g
+
+        def sum_jac(a, blk=blk):
+            g = np.zeros(n)
+            g[blk] = -1.0
+            return g
+
+        cons.append({"type": "ineq", "fun": (lambda a, blk=blk, Ti=T[i]: 1.0 - np.sum((a[blk] @ Ti) ** 2)),
+                     "jac": norm_jac})
+        # the weights of a step sum to at most 10
+        cons.append({"type": "ineq", "fun": (lambda a, blk=blk: 10.0 - np.sum(a[blk])), "jac": sum_jac})
     r = minimize(lambda a: 0.5 * a @ P @ a + c @ a, np.zeros(n), jac=lambda a: P @ a + c, bounds=[(0, 10)] * n,
                  constraints=cons, method="SLSQP", options={"ftol": 1e-10, "maxiter": 200})
     return r.x * settings["speed"]
