@@ -24,8 +24,8 @@ MIN_DISTANCE = 0.005  # m, the closest the arm and gripper may come to the table
 LIMIT_MARGIN_DISTANCE = 0.002  # m, mink's collision limit is this much more (it is linearised and can tunnel)
 LIMIT_DISTANCE = MIN_DISTANCE + LIMIT_MARGIN_DISTANCE  # m, mink's collision limit at MIN_DISTANCE
 MAX_ITERATIONS = 300  # of the differential IK
-STALL_ITERATIONS = 10  # ... which stops early when this many iterations in a row ...
-STALL_PROGRESS = 1e-7  # m or rad, ... brought the TCP no closer than this (a limit holds it back)
+STALL_ITERATIONS = 3  # ... which stops early when this many steps in a row ...
+STALL_STEP = 1e-9  # rad, ... turned no joint more than this (the limits hold it where it is)
 POLISH_ITERATIONS = 50  # without the collision limit, when it held the TCP back from the target
 POLISH_REACH = 0.005  # m, ... by at most this much (the margin's worth; a larger miss is not the margin's)
 IK_DT = 0.05  # s, the differential IK's integration step
@@ -145,23 +145,21 @@ class IKSolver:
     def _iterate(self, target, limits, iterations: int) -> None:
         """Differential IK steps towards ``target`` under ``limits`` until converged
         (``CONVERGED_POSITION``/``CONVERGED_ANGLE``), stalled (no feasible step, or
-        ``STALL_ITERATIONS`` steps in a row each ``STALL_PROGRESS`` or less closer in both position
-        and angle: a limit holds the TCP back) or ``iterations``."""
+        ``STALL_ITERATIONS`` steps in a row that turn no joint more than ``STALL_STEP``: the limits
+        hold the arm where it is, and the same state gives the same step) or ``iterations``."""
         mink = self.mink
-        best, stalled = (np.inf, np.inf), 0
+        still = 0
         for _ in range(iterations):
             reached = pose_error(self.tcp_pose(), target)
             if reached[0] <= CONVERGED_POSITION and reached[1] <= CONVERGED_ANGLE:
-                return
-            closer = reached[0] < best[0] - STALL_PROGRESS or reached[1] < best[1] - STALL_PROGRESS
-            best = (min(best[0], reached[0]), min(best[1], reached[1]))
-            stalled = 0 if closer else stalled + 1
-            if stalled >= STALL_ITERATIONS:
                 return
             try:
                 v = mink.solve_ik(self.config, [self.task], IK_DT, "daqp", damping=1e-3, limits=limits,
                                   constraints=self.constraints)
             except mink.NoSolutionFound:  # the limits admit no step from here: classified by solve
+                return
+            still = still + 1 if np.abs(v).max() * IK_DT <= STALL_STEP else 0
+            if still >= STALL_ITERATIONS:
                 return
             self.config.integrate_inplace(v, IK_DT)
 
