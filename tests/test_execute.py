@@ -25,6 +25,13 @@ def spatial():
     return scene, regrasp.plan(scene, seed=0)
 
 
+@pytest.fixture(scope="module")
+def arm_world(planar):
+    """The arm's world of ``planar``: its arm motion solved once for the tests that share it."""
+    pytest.importorskip("mink")
+    return World(planar[0], rig="arm")
+
+
 def cut(plan, n: int):
     """The plan's first ``n`` poses: a plan that ends off the task's goal."""
     return regrasp.Plan.from_json({"path": plan.to_json()["path"][:n]})
@@ -115,7 +122,7 @@ def test_what_a_rig_cannot_do_is_named(planar, world, kw, field):
     assert e.value.field == field
 
 
-def test_the_arm_open_and_closed_loop(planar):
+def test_the_arm_open_and_closed_loop(planar, arm_world):
     pytest.importorskip("mink")
     from regrasp.execution.arm import arm_motion, execute_arm
     from regrasp.execution.arm_loop import ArmLoopResult
@@ -123,20 +130,21 @@ def test_the_arm_open_and_closed_loop(planar):
 
     scene, plan = planar
     pert = Perturbation(0.95, 1.05, 1.0, 1.0)
-    world = World(scene, rig="arm")
+    world = arm_world
     run = execute(world, plan, perturbation=pert)
-    am = arm_motion(scene, plan)  # the robot is sent the nominal world's trajectory: the perturbation is unknown to it
+    am = arm_motion_of(world, plan)  # the robot is sent the nominal world's trajectory: the perturbation is unknown to it
+    assert am is arm_motion_of(world, plan) and len(world._motions) == 1  # solved once
+    assert np.array_equal(am.trajectory.q, arm_motion(scene, plan).trajectory.q)  # the arm's own motion
     ref = execute_arm(scene, plan, am.motion, scales=pert, trajectory=am.trajectory)
     assert np.allclose(run.detail.in_hand, ref.in_hand, atol=1e-9) and run.tracking is not None
     assert run.trajectory.robot == ref.trajectory.robot and run.max_creep == ref.max_creep
     assert run.success == scene.goal_error(run.final_pose)[1]
-    assert arm_motion_of(world, plan) is arm_motion_of(world, plan) and len(world._motions) == 1  # solved once
-    c = execute(World(scene, rig="arm"), plan, loop="closed", perturbation=Perturbation(shift=(0.0005, 0.0, 0.0)))
+    c = execute(world, plan, loop="closed", perturbation=Perturbation(shift=(0.0005, 0.0, 0.0)))
     assert isinstance(c.detail, ArmLoopResult) and np.allclose(c.final_pose, c.detail.final)
     assert c.success == scene.goal_error(c.final_pose)[1] and c.loop == "closed"
 
 
-def test_the_arm_without_no_slip(planar):
+def test_the_arm_without_no_slip(planar, arm_world):
     """``World(noslip=False)``: the arm's world without MuJoCo's no-slip post-processing (the
     model's option, nothing else changed); the run differs from the one with it."""
     pytest.importorskip("mink")
@@ -144,7 +152,7 @@ def test_the_arm_without_no_slip(planar):
     from regrasp.execution.execute import arm_motion_of
 
     scene, plan = planar
-    world = World(scene, rig="arm")
+    world = arm_world
     motion = arm_motion_of(world, plan).motion
     on, off = build_robot(scene, motion)[0], build_robot(scene, motion, noslip=False)[0]
     assert on.model.opt.noslip_iterations == 20 and off.model.opt.noslip_iterations == 0
