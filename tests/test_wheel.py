@@ -48,7 +48,16 @@ def wheel(tmp_path_factory) -> Path:
     # this interpreter and make's profile (release-fast), as `maturin develop` (make build) uses:
     # the same build configuration, so the target folder's artifacts are reused (a wheel in
     # seconds after make build; the published wheel's `--release` adds link-time optimisation only)
-    r = sh([MATURIN, "build", "--profile", "release-fast", "-q", "-i", sys.executable, "-o", out], cwd=ROOT, timeout=900)
+    # and make's environment (its virtual environment named, its bin first on PATH, its `python`
+    # named as `maturin develop` finds it, not pytest's `python3`): pyo3's build configuration is
+    # rerun, and pyo3 and the extension recompiled, when these differ
+    env, python = dict(os.environ), sys.executable
+    if sys.prefix != sys.base_prefix and (Path(sys.prefix) / "bin" / "python").exists():
+        python = str(Path(sys.prefix) / "bin" / "python")
+        env["VIRTUAL_ENV"] = sys.prefix
+        env["PATH"] = os.pathsep.join([str(Path(sys.prefix) / "bin"), env.get("PATH", "")])
+    r = sh([MATURIN, "build", "--profile", "release-fast", "-q", "-i", python, "-o", out], cwd=ROOT, timeout=900,
+           env=env)
     assert r.returncode == 0, r.stderr[-3000:]
     wheels = list(out.glob("regrasp-*.whl"))
     assert len(wheels) == 1, wheels
