@@ -37,12 +37,9 @@ $(DEMO_DEPS): pyproject.toml
 	@$(STAGE) "Rust extension ($(PROFILE), installed editable)" $(LOGS)/build.log $(DEVELOP)
 	@touch $@
 
-# (a recipe line of its own: `make test` runs it beside the Rust tests' compile)
-ALL_DEPS_STAGE = [ $(ALL_DEPS) -nt $(DEMO_DEPS) ] || { $(STAGE) "dependencies (every extra, dev)" $(LOGS)/pip-all.log \
-	$(PIP) $(call deps,all dev) && touch $(ALL_DEPS); }
-
 $(ALL_DEPS): $(DEMO_DEPS)
-	@$(ALL_DEPS_STAGE)
+	@$(STAGE) "dependencies (every extra, dev)" $(LOGS)/pip-all.log $(PIP) $(call deps,all dev)
+	@touch $@
 
 setup: $(ALL_DEPS)
 
@@ -59,13 +56,11 @@ PYTEST_WORKERS ?= $(shell n=$$(nproc 2>/dev/null || echo 2); [ $$n -gt 4 ] && n=
 # a test file's tests stay on one worker (its module fixtures are computed once)
 PYTEST := $(BIN)/pytest -q -n $(PYTEST_WORKERS) --dist loadfile
 
-# The Rust tests in the background (niced: pytest's workers keep the cores), compiling while the
-# test dependencies install (a first setup: pip is mostly one core's work), then pytest in front;
-# the Rust tests' summary and, on failure, their log's end after pytest's.
-test: build
+# The Rust tests in the background (niced: pytest's workers keep the cores), pytest in front; the
+# Rust tests' summary and, on failure, their log's end after pytest's.
+test: build $(ALL_DEPS)
 	@mkdir -p $(LOGS); STAGE_PLAIN=1 nice -n 10 $(STAGE) "cargo test ($(PROFILE))" $(LOGS)/cargo-test.log $(CARGO_TEST) \
 		2>$(LOGS)/cargo-test.stage & rust=$$!; \
-	$(ALL_DEPS_STAGE) || { wait $$rust; exit 1; }; \
 	start=$$(date +%s); $(PYTEST) --durations=10; py=$$?; echo "pytest: exit $$py in $$(( $$(date +%s) - start )) s" >&2; \
 	wait $$rust; rs=$$?; cat $(LOGS)/cargo-test.stage >&2; [ $$py -eq 0 ] && [ $$rs -eq 0 ]
 
