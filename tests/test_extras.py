@@ -216,13 +216,13 @@ def test_bench_json_without_reference_is_valid_json(blocker):
         bench.run_limit_surface = lambda: ls(seeds=2, time_limit=5.0, examples=("block-high-friction",))
         sys.exit(regrasp.cli.main(["bench", "--quick", "--json"]))
     ''')
-    r = run(blocker, ["-c", code], ("casadi", "scipy", "mujoco"))
+    r = run(blocker, ["-c", code], ("casadi", "scipy", "mujoco", "ompl"))
     assert r.returncode == 0, r.stderr
     res = json.loads(r.stdout, parse_constant=_no_nan)
     skipped = res["plan3d_offset-3d"]
     assert skipped["baseline_median_s"] is None and skipped["ratio"] is None, skipped
     assert "regrasp[reference]" in skipped["baseline"]
-    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_step_", "mujoco_", "ik_", "arm_", "plan_only_")) for k in res), sorted(res)
+    assert "cone_batch_300" in res and not any(k.startswith(("mncp_", "mpc_step_", "mujoco_", "ik_", "arm_", "plan_only_", "plan_node_")) for k in res), sorted(res)
     assert res["world_motion_block-low-friction"]["median_s"] > 0 and res["mpc_horizon_20"]["median_s"] > 0  # need no extra
     assert res["cli_start_version"]["ratio"] > 0 and res["cli_start_plan_t_shape"]["baseline_median_s"] > 0
     assert res["hard_neck-unreachable"]["unreachable"] == 1 and res["hard_neck-unreachable"]["median_s"] < 1.0

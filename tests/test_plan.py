@@ -159,3 +159,17 @@ def test_a_point_pushers_step_that_does_not_land_is_invalid():
     bad.check(sc)
     assert not bad.valid and bad.step_margins[k - 1] < 0
     assert all(m >= 0 for i, m in enumerate(bad.step_margins) if i not in (k - 1, k))
+
+
+def test_the_cost_per_node_is_timed_against_ompls_rrtstar_grown_to_the_same_size():
+    """`regrasp bench`'s planner-per-node row: OMPL's RRT* (the real library) grows the tree size
+    asked, and the row's ratio is OMPL's time per node over ours."""
+    pytest.importorskip("ompl")
+    from regrasp.bench.planners import ompl_rrtstar_cpu, run_node_cost
+
+    for n in (2, 40, 300):
+        seconds, grown = ompl_rrtstar_cpu(n)
+        assert grown == n and seconds > 0
+    r = run_node_cost(seeds=2, examples=("t-shape",))["plan_node_t-shape"]
+    assert r["median_s"] > 0 and r["baseline_median_s"] > 0 and r["median_nodes"] >= 2
+    assert r["ratio"] == pytest.approx(r["baseline_median_s"] / r["median_s"])

