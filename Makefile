@@ -79,7 +79,7 @@ docs: build $(ALL_DEPS)
 
 # The benchmarks run on the release profile (link-time optimisation), as the wheel is built.
 bench: $(ALL_DEPS)
-	cargo bench -p regrasp-core --bench cones --bench mncp --bench mpc
+	cargo bench -p regrasp-bench --bench cones --bench mncp --bench mpc
 	@$(STAGE) "Rust extension (release)" $(LOGS)/build.log $(MATURIN) --release --skip-install
 	$(BIN)/regrasp bench --json
 

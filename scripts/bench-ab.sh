@@ -9,11 +9,13 @@ top=$(git rev-parse --show-toplevel)
 work=$(mktemp -d)
 trap 'git -C "$top" worktree remove --force "$work/base" >/dev/null 2>&1 || true' EXIT
 git -C "$top" worktree add --detach "$work/base" "$base_rev" >/dev/null
-(cd "$work/base" && CARGO_TARGET_DIR="$work/base-target" cargo bench -p regrasp-core --no-run -q)
-(cd "$top" && cargo bench -p regrasp-core --no-run -q)
+# the benches' crate: regrasp-bench, or regrasp-core in a revision before they had their own
+crate() { if [ -d "$1/crates/regrasp-bench" ]; then echo regrasp-bench; else echo regrasp-core; fi; }
+(cd "$work/base" && CARGO_TARGET_DIR="$work/base-target" cargo bench -p "$(crate "$work/base")" --no-run -q)
+(cd "$top" && cargo bench -p "$(crate "$top")" --no-run -q)
 bin() { ls "$1"/release/deps/"$2"-* | grep -v '\.d$' | head -1; }
 run() {  # run NAME TARGET_DIR SRC_DIR ROUND LABEL
-  (cd "$3/crates/regrasp-core" && CRITERION_HOME="$work/criterion-$5" "$(bin "$2" "$1")" --bench --warm-up-time 1 \
+  (cd "$3/crates/$(crate "$3")" && CRITERION_HOME="$work/criterion-$5" "$(bin "$2" "$1")" --bench --warm-up-time 1 \
     --measurement-time 2 --noplot > "$work/$1-$5-$4.txt" 2>&1)
 }
 for b in cones mncp mpc; do
