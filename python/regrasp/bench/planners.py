@@ -203,10 +203,10 @@ def ompl_rrtstar_cpu(nodes: int) -> tuple[float, int]:
 
 def run_node_cost(seeds: int = 10, examples=NODE_COST_PLANS) -> dict:
     """CPU time per tree node of the planar planner (T-RRT* with motion-cone steps, each checked
-    exactly; the whole call from Python; ``search_per_node_s``: the core's search alone) per example, the median over ``seeds`` seeds, against
-    OMPL's RRT* (:func:`ompl_rrtstar_cpu`, a trivial checker) grown to the same number of nodes
-    in the same run; the ratio is OMPL's time per node over ours (issue 45's target: ≥ 0.5).
-    Needs OMPL (``regrasp[bench]``)."""
+    exactly; the whole call from Python; ``search_per_node_s``: the core's search alone) per
+    example, the median over ``seeds`` seeds, against OMPL's RRT* (:func:`ompl_rrtstar_cpu`, a
+    trivial checker) grown to the same number of nodes in the same run; the ratio is OMPL's time
+    per node over ours (issue 45's target: ≥ 0.5). Needs OMPL (``regrasp[bench]``)."""
     from ..planning.plan import plan
 
     ou = need("ompl.util", "bench")
