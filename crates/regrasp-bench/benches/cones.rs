@@ -90,30 +90,20 @@ fn bench_cone(c: &mut Criterion) {
 
     let model = &scene.pushers[i].model;
     let ellipsoid = scene.with_surface_model(SurfaceModel::Ellipsoid);
-    g.bench_function("frame+rays_ellipsoid", |b| {
-        b.iter(|| {
-            let frame = ellipsoid.frame(black_box(&POSE));
-            let mut acc = Vec3::zeros();
-            for e in &model.edges {
-                if let Some(v) = frame.ray(&e.wrench, &ellipsoid.metric()) {
-                    acc += v;
+    for (name, sc) in [("frame+rays_ellipsoid", &ellipsoid), ("frame+rays", &scene)] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let frame = sc.frame(black_box(&POSE));
+                let mut acc = Vec3::zeros();
+                for e in &model.edges {
+                    if let Some(v) = frame.ray(&e.wrench, &sc.metric()) {
+                        acc += v;
+                    }
                 }
-            }
-            black_box(acc)
-        })
-    });
-    g.bench_function("frame+rays", |b| {
-        b.iter(|| {
-            let frame = scene.frame(black_box(&POSE));
-            let mut acc = Vec3::zeros();
-            for e in &model.edges {
-                if let Some(v) = frame.ray(&e.wrench, &scene.metric()) {
-                    acc += v;
-                }
-            }
-            black_box(acc)
-        })
-    });
+                black_box(acc)
+            })
+        });
+    }
     g.finish();
 }
 
