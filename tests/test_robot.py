@@ -534,3 +534,38 @@ def test_a_wrist_wound_to_its_limit_is_wound_back_2pi_and_the_path_goes_on():
     for p, qq in zip(line, path):
         got = fk(r, qq)
         assert np.linalg.norm(got[:3] - p[:3]) <= 1e-3 and quat_angle(got[3:], p[3:]) <= 0.01
+
+
+def test_a_pose_the_collision_limit_holds_back_stops_early_with_the_same_solution(robot, monkeypatch):
+    """The fingers asked 6.5 mm above the table (the collision limit keeps 7 mm, the exact check
+    5 mm): the differential IK stalls a fraction of a mm short, no joint moving. It stops after
+    ``STALL_ITERATIONS`` still steps instead of running all ``MAX_ITERATIONS``, with the same
+    solution (the reference: the rule switched off); a pose in free space is solved as before."""
+    import mink
+
+    from regrasp.robot import ik
+
+    steps = [0]
+    real = mink.solve_ik
+
+    def counted(*a, **k):
+        steps[0] += 1
+        return real(*a, **k)
+
+    monkeypatch.setattr(mink, "solve_ik", counted)
+    home = robot.tcp_pose(robot.q)
+    for z, held in ((0.0135, True), (0.03, False)):  # the TCP's height [m]; the fingers ~7 mm lower
+        target = np.r_[0.45, 0.0, z, home[3:]]
+        runs = []
+        for stall in (ik.STALL_ITERATIONS, ik.MAX_ITERATIONS + 1):
+            monkeypatch.setattr(ik, "STALL_ITERATIONS", stall)
+            steps[0] = 0
+            q = IKSolver(robot).solve(target, robot.q)
+            runs.append((q, steps[0]))
+        (q, n), (q_ref, n_ref) = runs
+        assert np.allclose(q, q_ref, atol=1e-9) and table_distance(robot, q) >= MIN_DISTANCE
+        if held:
+            assert n_ref == ik.MAX_ITERATIONS and n < 50, (n, n_ref)
+            assert np.linalg.norm(robot.tcp_pose(q)[:3] - target[:3]) > ik.CONVERGED_POSITION
+        else:
+            assert n == n_ref < 50

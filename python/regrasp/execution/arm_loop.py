@@ -156,7 +156,7 @@ class ArmPlant:
                 break
         self.grip.set_force(raised * self.world_grip)
         self.idle(CALIBRATION_DWELL)
-        if slipped is not None and nominal > 0:
+        if slipped is not None:
             self.grip_gain = min(max(1.0, slipped / nominal), max(1.0, self.grip_ceiling / self.grip_force))
             self.grip_force *= self.grip_gain
         return self.grip_gain
